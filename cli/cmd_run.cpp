@@ -1,0 +1,50 @@
+// `impactdeck run SCENE [--json] [--out DIR]`: compute what the scene asks for, nothing more.
+#include <filesystem>
+#include <iostream>
+#include <memory>
+
+#include "commands.hpp"
+#include "impactdeck/common/error.hpp"
+#include "impactdeck/scene/pipeline.hpp"
+#include "impactdeck/scene/report.hpp"
+#include "impactdeck/scene/scene.hpp"
+
+namespace impactdeck::cli {
+namespace fs = std::filesystem;
+
+void register_run(CLI::App& app, Context& ctx) {
+  struct Args {
+    std::string scene;
+    bool json = false;
+    std::string out = ".";
+  };
+  auto args = std::make_shared<Args>();
+  CLI::App* cmd = app.add_subcommand("run", "Run a scene: impacts, force tables and decks it asks for");
+  cmd->add_option("scene", args->scene, "Scene file (TOML, docs/scene-format.md)")->required();
+  cmd->add_flag("--json", args->json, "Print one JSON document on stdout (keys: docs/cli.md)");
+  cmd->add_option("--out", args->out, "Output folder (created if missing; default: current folder)");
+  cmd->callback([args, &ctx] {
+    const scene::Scene sc = scene::load_scene(args->scene);
+    std::error_code ec;
+    fs::create_directories(args->out, ec);
+    if (!fs::is_directory(args->out)) {
+      throw InputError(args->out, "--out", "cannot create the output folder");
+    }
+    scene::RunOptions opt;
+    opt.out_dir = args->out;
+    const scene::RunReport rep = scene::run_scene(sc, opt);
+    if (args->json) {
+      std::cout << scene::to_json(sc, rep).dump(2) << "\n";
+    } else {
+      std::cout << scene::format_summary(sc, rep);
+    }
+    if (args->json)
+      for (const auto& w : rep.warnings) std::cerr << "impactdeck: warning: " << w << "\n";
+    if (!rep.all_checks_passed()) {
+      std::cerr << "impactdeck: error: a physics self-check failed (see checks above)\n";
+      ctx.exit_code = static_cast<int>(ExitCode::check_failed);
+    }
+  });
+}
+
+}  // namespace impactdeck::cli

@@ -1,0 +1,35 @@
+// impactdeck — eccentric Hertz impacts to FEM decks. Exit codes: docs/cli.md.
+#include <exception>
+#include <iostream>
+
+#include "commands.hpp"
+#include "impactdeck/common/error.hpp"
+#include "impactdeck/common/version.hpp"
+
+int main(int argc, char** argv) {
+  using impactdeck::ExitCode;
+  CLI::App app{"impactdeck: collision force histories for eccentric impacts, and FEM decks that use them"};
+  app.set_version_flag("--version", std::string(impactdeck::kVersion));
+  app.require_subcommand(1);
+  impactdeck::cli::Context ctx;
+  impactdeck::cli::register_run(app, ctx);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::cerr << "impactdeck: usage error: " << e.what() << "\n(run 'impactdeck --help')\n";
+    return static_cast<int>(ExitCode::usage);
+  } catch (const impactdeck::Error& e) {
+    std::cerr << "impactdeck: error: " << e.what() << "\n";
+    return static_cast<int>(e.code());
+  } catch (const std::exception& e) {
+    std::cerr << "impactdeck: internal error: " << e.what() << "\n";
+    return static_cast<int>(ExitCode::internal_error);
+  }
+  return ctx.exit_code;
+}

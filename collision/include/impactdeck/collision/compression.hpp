@@ -1,0 +1,55 @@
+#pragma once
+// Compression phase of a Hertz impact, in closed form (paper Eq. 2-12, MODEL.md).
+//
+//   m_w x'' + k_H x^n = 0,  x(0) = 0, x'(0) = v,  n = 3/2, p = n + 1
+//   x_max = [p m_w v^2 / (2 k_H)]^(1/p),  F_max = k_H x_max^n            (Eq. 8)
+//   t_m   = C_n x_max / v,  C_n = sqrt(pi) Gamma(1+1/p) / Gamma(1/2+1/p)   (Eq. 10 at z = 1)
+//   t/t_m = I_{z^p}(1/p, 1/2),  z = x/x_max  (regularized incomplete beta; Eq. 10)
+//
+// The shape is universal: x(t) = x_max Z(t/t_m), F(t) = F_max Z^n, with one function Z on [0, 1].
+// Z is evaluated by a Chebyshev expansion of g(s) = Z(tau)/(C_n tau) in s = tau^(5/2), a variable
+// in which g is analytic (Z - C_n tau ~ tau^(7/2) is not analytic in tau at 0). The expansion is
+// built once from the exact inverse of the incomplete beta function.
+
+namespace impactdeck::collision {
+
+/// Hertz force exponent n.
+inline constexpr double kHertzExponent = 1.5;
+
+/// C_n for n = 3/2: t_m = C_n x_max / v (= 1.4716375921623523...).
+double compression_time_factor();
+
+/// Universal compression shape Z(tau) = x/x_max at tau = t/t_m, tau clamped to [0, 1].
+/// Fast (a few ns); absolute error below 1e-14 (tests/test_compression.cpp).
+double compression_shape(double tau);
+
+/// Same, by direct inversion of the regularized incomplete beta function (GSL beta_inc plus a
+/// safeguarded Newton iteration, about a microsecond). Reference for tests and for building the
+/// fast expansion.
+double compression_shape_exact(double tau);
+
+/// The paper's Eq. 10: tau = t/t_m for a given z = x/x_max in [0, 1), through the Gauss
+/// hypergeometric function 2F1(1/2, 1/p; 1+1/p; z^p). Used only as a cross-check.
+double compression_time_fraction_hypergeometric(double z);
+
+/// The compression phase of one impact; all SI.
+struct CompressionPhase {
+  double reduced_mass_kg = 0;          ///< m_w
+  double approach_velocity_m_s = 0;    ///< v_w > 0
+  double hertz_constant = 0;           ///< k_H, N/m^1.5
+  double max_indentation_m = 0;        ///< x_max
+  double max_force_N = 0;              ///< F_max
+  double compression_time_s = 0;       ///< t_m
+  double impulse_Ns = 0;               ///< Pi_1 = m_w v_w exactly (Eq. 31)
+
+  /// x(t) for 0 <= t <= t_m (clamped outside).
+  double indentation_m(double t_s) const;
+  /// F(t) = k_H x(t)^n for 0 <= t <= t_m (0 before, F_max after).
+  double force_N(double t_s) const;
+};
+
+/// Closed-form compression phase. Throws InputError unless m_w > 0, v_w > 0, k_H > 0 (finite).
+CompressionPhase solve_compression(double reduced_mass_kg, double approach_velocity_m_s,
+                                   double hertz_constant);
+
+}  // namespace impactdeck::collision

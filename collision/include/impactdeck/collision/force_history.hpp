@@ -1,0 +1,54 @@
+#pragma once
+// Force history of one impact: the closed-form compression phase followed by the restitution
+// phase, and its sampling into a piecewise-linear table for FEM (MODEL.md "Restitution").
+//
+//   compression   F(t) = F_max Z(t/t_m)^n                              0 <= t <= t_m
+//   restitution   F(t) = F_comp(t_m - (t - t_m)/R)                     t_m <= t <= (1+R) t_m
+// The restitution curve is the compression curve mirrored and stretched by R in time: continuous
+// at F_max, impulse exactly R Pi_1 (the paper iterates a curve of the same family to 1 %).
+#include <cstddef>
+#include <vector>
+
+#include "impactdeck/collision/compression.hpp"
+
+namespace impactdeck::collision {
+
+struct ForceHistory {
+  CompressionPhase compression;
+  double restitution = 0;  ///< Poisson's coefficient R in [0, 1]
+
+  double contact_time_s() const { return (1.0 + restitution) * compression.compression_time_s; }
+  double impulse_compression_Ns() const { return compression.impulse_Ns; }
+  double impulse_restitution_Ns() const { return restitution * compression.impulse_Ns; }
+  double impulse_total_Ns() const { return (1.0 + restitution) * compression.impulse_Ns; }
+  /// F(t) in N; 0 outside the contact.
+  double force_N(double t_s) const;
+};
+
+/// Integral of F over [t0, t1] by adaptive Gauss-Kronrod quadrature (GSL qag, 61 points) on the
+/// curve itself, relative accuracy 1e-12: the paper's "numerically integrated" impulse.
+double integrate_force_Ns(const ForceHistory& h, double t0_s, double t1_s);
+
+struct ForceTableOptions {
+  /// Relative tolerance on the table's impulse against Pi; the sample count doubles until met.
+  double impulse_tolerance = 1e-4;
+  /// If > 0, use this spacing instead (the impulse error is then only reported).
+  double time_step_s = 0;
+  /// Upper bound on samples per phase.
+  std::size_t max_intervals_per_phase = std::size_t{1} << 22;
+};
+
+/// Piecewise-linear force table: uniform spacing in each phase, t_m always a node, first and last
+/// force exactly 0.
+struct ForceTable {
+  std::vector<double> time_s;
+  std::vector<double> force_N;
+  double impulse_Ns = 0;                 ///< trapezoidal impulse of the table
+  double impulse_relative_error = 0;     ///< |impulse_Ns - Pi| / Pi
+  double impulse_tolerance = 0;          ///< what was asked
+  bool tolerance_met = false;
+};
+
+ForceTable sample_force_table(const ForceHistory& h, const ForceTableOptions& options = {});
+
+}  // namespace impactdeck::collision

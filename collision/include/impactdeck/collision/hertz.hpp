@@ -1,0 +1,32 @@
+#pragma once
+// Hertz contact stiffness (paper Eq. 1, 27, 28, 29; MODEL.md "Hertz contact").
+//   P = k_H x^n, n = 3/2,   k_H = 4/3 E* sqrt(R*)                       (Eq. 27)
+//   1/R* = 1/R1 + 1/R2 (a plane has curvature 0)                          (Eq. 29, Eq. 15)
+//   1/E* = (1-nu1^2)/E1 + (1-nu2^2)/E2   ("hertz" convention, default)
+//   1/E* = 1/E1 + 1/E2                   ("paper" convention, Eq. 28)
+
+namespace impactdeck::collision {
+
+/// Isotropic linear-elastic material (SI).
+struct ElasticMaterial {
+  double youngs_modulus_Pa = 0.0;  ///< E > 0
+  double poisson_ratio = 0.0;      ///< -1 < nu < 0.5
+};
+
+enum class ModulusConvention {
+  hertz,  ///< standard Hertz: (1 - nu^2)/E per body
+  paper,  ///< the paper's Eq. 28: 1/E per body, no Poisson term
+};
+
+/// Effective (reduced) modulus E* in Pa. Throws InputError for E <= 0 or nu outside (-1, 0.5).
+double effective_modulus_Pa(const ElasticMaterial& a, const ElasticMaterial& b,
+                            ModulusConvention convention);
+
+/// Effective radius R* in m from the two bodies' curvatures at the contact point (1/m; 0 for a
+/// plane; each must be >= 0, their sum > 0). Throws InputError otherwise.
+double effective_radius_m(double curvature_target_per_m, double curvature_impactor_per_m);
+
+/// Hertz constant k_H = 4/3 E* sqrt(R*) in N/m^1.5.
+double hertz_constant(double effective_modulus_Pa, double effective_radius_m);
+
+}  // namespace impactdeck::collision

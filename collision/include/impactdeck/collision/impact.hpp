@@ -1,0 +1,69 @@
+#pragma once
+// One eccentric Hertz impact, end to end: reduced mass and approach velocity at the contact point,
+// Hertz constant, restitution, force history, velocity jumps and the paper's two self-checks.
+#include <string>
+#include <vector>
+
+#include "impactdeck/collision/eccentric.hpp"
+#include "impactdeck/collision/force_history.hpp"
+#include "impactdeck/collision/restitution.hpp"
+
+namespace impactdeck::collision {
+
+/// How R is obtained.
+struct RestitutionModel {
+  bool from_energy_flux = true;  ///< Eq. 14 + 30; otherwise `constant`
+  double constant = 1.0;         ///< R in [0, 1] when !from_energy_flux
+  EnergyFluxUnit flux_unit = EnergyFluxUnit::J_per_cm3;
+  RangePolicy range_policy = RangePolicy::warn;
+};
+
+/// The paper's thresholds (Sect. 2.3): 3 % on the compression impulse, 1 % on the energy loss.
+struct CheckThresholds {
+  double impulse_relative = 0.03;
+  double energy_relative = 0.01;
+};
+
+struct ImpactInput {
+  RigidBody target;
+  RigidBody impactor;
+  Contact contact;                  ///< point and the target's outward normal
+  double effective_radius_m = 0;    ///< R* (Eq. 29)
+  double effective_modulus_Pa = 0;  ///< E* (Eq. 28 or Hertz)
+  RestitutionModel restitution;
+  CheckThresholds thresholds;
+};
+
+/// The paper's self-checks, run on every impact.
+struct ImpactChecks {
+  double impulse_compression_numerical_Ns = 0;  ///< quadrature of F over [0, t_m]
+  double impulse_total_numerical_Ns = 0;        ///< quadrature of F over the whole contact
+  double impulse_relative_error = 0;    ///< |numerical Pi_1 - m_w v_w| / (m_w v_w)   (Eq. 31)
+  double carnot_loss_J = 0;             ///< (1 - R^2)/2 m_w v_w^2                    (Eq. 32)
+  double kinetic_energy_loss_J = 0;     ///< from the velocities before/after, numerical Pi
+  /// |kinetic loss - Carnot loss| / Carnot loss; for R = 1 (no loss) relative to m_w v_w^2 / 2.
+  double energy_relative_error = 0;
+  CheckThresholds thresholds;
+  bool passed = false;
+};
+
+struct ImpactResult {
+  double reduced_mass_kg = 0;
+  double effective_radius_m = 0;
+  double effective_modulus_Pa = 0;
+  double hertz_constant = 0;
+  double approach_velocity_m_s = 0;
+  bool restitution_from_energy_flux = false;
+  RestitutionResult restitution;  ///< coefficient always set; flux fields when from the flux
+  ForceHistory history;
+  VelocityJump target_jump;
+  VelocityJump impactor_jump;
+  ImpactChecks checks;
+  std::vector<std::string> warnings;
+};
+
+/// Solves the impact. Throws InputError for invalid input or when the bodies do not approach at
+/// the contact point (no impact). Check failures do not throw: see `checks.passed`.
+ImpactResult solve_impact(const ImpactInput& input);
+
+}  // namespace impactdeck::collision

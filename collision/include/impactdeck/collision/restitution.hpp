@@ -1,0 +1,45 @@
+#pragma once
+// Coefficient of restitution (Poisson's, Eq. 13) from the energy flux density (Eq. 14, 30).
+//   Phi = m_w v_w^2 / (2 r_w^3)                              (Eq. 14; r_w from Eq. 15 = R*)
+//   R   = 0.55 - 0.047 ln Phi   valid for -5 < ln Phi < 6    (Eq. 30; steel of 1400 HB only)
+// The paper gives no unit for Phi. Here the unit is an explicit setting (default J/cm^3, where
+// ordinary steel impacts fall inside the validity range; in J/m^3 they fall far outside).
+#include <string>
+
+namespace impactdeck::collision {
+
+enum class EnergyFluxUnit { J_per_m3, J_per_cm3, J_per_mm3 };
+
+/// What to do when ln Phi lies outside (-5, 6).
+enum class RangePolicy {
+  warn,         ///< clamp ln Phi to the range edge and report a warning (default)
+  error,        ///< throw InputError
+  extrapolate,  ///< use Eq. 30 as is; an R outside [0, 1] is still an error
+};
+
+/// Cubic metres per one volume unit of the flux (J/m^3 -> 1, J/cm^3 -> 1e-6, J/mm^3 -> 1e-9).
+double cubic_metres_per(EnergyFluxUnit u);
+const char* to_string(EnergyFluxUnit u);
+
+/// Eq. 14 in J/m^3.
+double energy_flux_density_J_m3(double reduced_mass_kg, double approach_velocity_m_s,
+                                double reduced_radius_m);
+
+struct RestitutionResult {
+  double coefficient = 0;              ///< R in [0, 1]
+  double energy_flux_density = 0;      ///< Phi in `unit`
+  double energy_flux_density_J_m3 = 0; ///< Phi in J/m^3
+  double ln_energy_flux = 0;           ///< ln Phi in `unit` (before any clamping)
+  bool clamped = false;                ///< true when ln Phi was clamped to the validity range
+  std::string warning;                 ///< non-empty when clamped or extrapolated
+};
+
+/// Eq. 30 with the given unit convention and range policy.
+RestitutionResult restitution_from_energy_flux(double reduced_mass_kg, double approach_velocity_m_s,
+                                               double reduced_radius_m, EnergyFluxUnit unit,
+                                               RangePolicy policy);
+
+inline constexpr double kEnergyFluxLnMin = -5.0;  ///< Eq. 30 validity, lower edge of ln Phi
+inline constexpr double kEnergyFluxLnMax = 6.0;   ///< Eq. 30 validity, upper edge of ln Phi
+
+}  // namespace impactdeck::collision

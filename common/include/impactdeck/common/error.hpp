@@ -1,0 +1,64 @@
+#pragma once
+// Error types shared by every module. Each maps to one documented exit code of the CLI
+// (docs/cli.md): the message is a single line "FILE: PLACE: REASON".
+#include <stdexcept>
+#include <string>
+
+namespace impactdeck {
+
+/// Exit codes of the `impactdeck` command (stable contract).
+enum class ExitCode : int {
+  ok = 0,
+  internal_error = 1,
+  usage = 2,
+  invalid_input = 3,
+  check_failed = 4,
+};
+
+/// Base class: carries the exit code the CLI returns for it.
+class Error : public std::runtime_error {
+ public:
+  Error(ExitCode code, const std::string& message) : std::runtime_error(message), code_(code) {}
+  ExitCode code() const noexcept { return code_; }
+
+ private:
+  ExitCode code_;
+};
+
+/// Bad input (file, scene key, parameter value). `where` names the file (may be empty for
+/// programmatic input), `place` the line / face / key, `reason` what is wrong.
+class InputError : public Error {
+ public:
+  InputError(const std::string& where, const std::string& place, const std::string& reason)
+      : Error(ExitCode::invalid_input, compose(where, place, reason)),
+        where_(where), place_(place), reason_(reason) {}
+  const std::string& where() const noexcept { return where_; }
+  const std::string& place() const noexcept { return place_; }
+  const std::string& reason() const noexcept { return reason_; }
+
+  static std::string compose(const std::string& where, const std::string& place,
+                             const std::string& reason) {
+    std::string s;
+    if (!where.empty()) s += where + ": ";
+    if (!place.empty()) s += place + ": ";
+    s += reason;
+    return s;
+  }
+
+ private:
+  std::string where_, place_, reason_;
+};
+
+/// A physics self-check (impulse, Carnot energy, FEM momentum) exceeded its threshold.
+class CheckFailed : public Error {
+ public:
+  explicit CheckFailed(const std::string& message) : Error(ExitCode::check_failed, message) {}
+};
+
+/// Wrong command-line usage.
+class UsageError : public Error {
+ public:
+  explicit UsageError(const std::string& message) : Error(ExitCode::usage, message) {}
+};
+
+}  // namespace impactdeck

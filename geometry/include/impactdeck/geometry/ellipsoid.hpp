@@ -1,0 +1,40 @@
+#pragma once
+// Analytic ellipsoid x^2/a^2 + y^2/b^2 + z^2/c^2 = 1 centred at the origin of its frame (a sphere
+// when a = b = c). Exact volume, inertia, normal (Eq. 25), principal curvatures and the paper's
+// Eq. 26 averaged radius; closest point by a robust bisection on the Lagrange parameter.
+#include "impactdeck/geometry/shape.hpp"
+
+namespace impactdeck::geometry {
+
+class Ellipsoid final : public Shape {
+ public:
+  /// Semi-axes along x, y, z in metres; each positive and finite (InputError otherwise).
+  Ellipsoid(double a_m, double b_m, double c_m);
+  static Ellipsoid sphere(double radius_m) { return Ellipsoid(radius_m, radius_m, radius_m); }
+
+  const Eigen::Vector3d& semi_axes_m() const { return e_; }
+  bool is_sphere() const { return e_.x() == e_.y() && e_.y() == e_.z(); }
+
+  std::string kind() const override { return is_sphere() ? "sphere" : "ellipsoid"; }
+  VolumeProperties volume_properties() const override;
+  SurfacePoint closest_point(const Eigen::Vector3d& query_m) const override;
+  Curvature curvature(const SurfacePoint& at) const override;
+  double paper_radius_m(const SurfacePoint& at) const override;
+  std::optional<SurfacePoint> ray_exit(const Eigen::Vector3d& origin_m,
+                                       const Eigen::Vector3d& direction) const override;
+  double size_m() const override { return 2.0 * e_.maxCoeff(); }
+
+  /// Outward unit normal at a surface point (Eq. 25).
+  Eigen::Vector3d normal_at(const Eigen::Vector3d& p_m) const;
+  /// Surface area (Legendre's form with incomplete elliptic integrals; exact for spheroids too).
+  double area_m2() const;
+
+ private:
+  Eigen::Vector3d e_;
+};
+
+/// Mean and Gaussian curvature of the ellipsoid at a surface point, closed forms (tests).
+double ellipsoid_mean_curvature(const Eigen::Vector3d& semi_axes, const Eigen::Vector3d& p);
+double ellipsoid_gaussian_curvature(const Eigen::Vector3d& semi_axes, const Eigen::Vector3d& p);
+
+}  // namespace impactdeck::geometry

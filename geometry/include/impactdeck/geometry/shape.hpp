@@ -1,0 +1,56 @@
+#pragma once
+// What the collision pipeline asks of a body's shape, whatever it is (analytic or a mesh):
+// mass properties, closest surface point, outward normal, local curvature and the paper's
+// Eq. 26 radius. All in the shape's own frame, SI units.
+#include <optional>
+#include <string>
+
+#include <Eigen/Dense>
+
+namespace impactdeck::geometry {
+
+/// Geometric mass properties of a solid of unit density.
+struct VolumeProperties {
+  double volume_m3 = 0;
+  double area_m2 = 0;
+  Eigen::Vector3d centroid_m = Eigen::Vector3d::Zero();
+  /// Inertia tensor about the centroid for density 1 kg/m^3 (kg m^2 per kg/m^3 = m^5).
+  Eigen::Matrix3d inertia_per_density_m5 = Eigen::Matrix3d::Zero();
+};
+
+/// Closest point on the surface and the outward unit normal there.
+struct SurfacePoint {
+  Eigen::Vector3d point_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+  double distance_m = 0;  ///< distance from the query point
+};
+
+/// Principal curvatures (1/m, positive where the surface is convex, k1 >= k2) and directions.
+struct Curvature {
+  double k1_per_m = 0;
+  double k2_per_m = 0;
+  Eigen::Vector3d d1 = Eigen::Vector3d::UnitX();
+  Eigen::Vector3d d2 = Eigen::Vector3d::UnitY();
+  double error_estimate_per_m = 0;  ///< 0 for exact (analytic) values
+  bool sharp_feature = false;        ///< on a sharp edge or corner: curvature is not defined
+  double mean_per_m() const { return 0.5 * (k1_per_m + k2_per_m); }
+};
+
+class Shape {
+ public:
+  virtual ~Shape() = default;
+  virtual std::string kind() const = 0;
+  virtual VolumeProperties volume_properties() const = 0;
+  virtual SurfacePoint closest_point(const Eigen::Vector3d& query_m) const = 0;
+  virtual Curvature curvature(const SurfacePoint& at) const = 0;
+  /// The paper's local radius (Eq. 26): mean radius of the sections by the three axis-normal
+  /// planes through the point, degenerate (tangent) sections left out.
+  virtual double paper_radius_m(const SurfacePoint& at) const = 0;
+  /// Where the ray from `origin_m` (inside the solid) along `direction` leaves the surface.
+  virtual std::optional<SurfacePoint> ray_exit(const Eigen::Vector3d& origin_m,
+                                               const Eigen::Vector3d& direction) const = 0;
+  /// Largest extent, m (for relative tolerances).
+  virtual double size_m() const = 0;
+};
+
+}  // namespace impactdeck::geometry

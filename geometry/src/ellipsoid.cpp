@@ -1,0 +1,247 @@
+#include "impactdeck/geometry/ellipsoid.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numeric>
+#include <sstream>
+
+#include <gsl/gsl_mode.h>
+#include <gsl/gsl_sf_ellint.h>
+
+#include "impactdeck/common/error.hpp"
+
+namespace impactdeck::geometry {
+
+Ellipsoid::Ellipsoid(double a, double b, double c) : e_(a, b, c) {
+  for (int i = 0; i < 3; ++i) {
+    if (!(e_[i] > 0.0) || !std::isfinite(e_[i])) {
+      std::ostringstream s;
+      s << "semi-axes must be positive and finite, got (" << a << ", " << b << ", " << c << ") m";
+      throw InputError("", "semi_axes", s.str());
+    }
+  }
+}
+
+double Ellipsoid::area_m2() const {
+  std::array<double, 3> s{e_.x(), e_.y(), e_.z()};
+  std::sort(s.begin(), s.end(), std::greater<>());
+  const double a = s[0], b = s[1], c = s[2];
+  if (a - c <= 1e-14 * a) return 4.0 * M_PI * a * a;
+  const double phi = std::acos(c / a);
+  const double sphi = std::sin(phi);
+  const double k = std::sqrt(std::clamp(a * a * (b * b - c * c) / (b * b * (a * a - c * c)), 0.0, 1.0));
+  const double E = gsl_sf_ellint_E(phi, k, GSL_PREC_DOUBLE);
+  const double F = gsl_sf_ellint_F(phi, k, GSL_PREC_DOUBLE);
+  return 2.0 * M_PI * c * c + 2.0 * M_PI * a * b / sphi * (E * sphi * sphi + F * (1.0 - sphi * sphi));
+}
+
+VolumeProperties Ellipsoid::volume_properties() const {
+  VolumeProperties v;
+  const double a = e_.x(), b = e_.y(), c = e_.z();
+  v.volume_m3 = 4.0 / 3.0 * M_PI * a * b * c;
+  v.area_m2 = area_m2();
+  v.centroid_m.setZero();
+  // I = m/5 diag(b^2+c^2, a^2+c^2, a^2+b^2) with m = rho V.
+  v.inertia_per_density_m5 = (v.volume_m3 / 5.0) *
+                             Eigen::Vector3d(b * b + c * c, a * a + c * c, a * a + b * b).asDiagonal();
+  return v;
+}
+
+Eigen::Vector3d Ellipsoid::normal_at(const Eigen::Vector3d& p) const {
+  const Eigen::Vector3d g = p.cwiseQuotient(e_.cwiseProduct(e_));
+  return g.normalized();
+}
+
+namespace {
+
+// Closest point on an ellipse with semi-axes e0 >= e1 > 0 to a point (y0, y1) with y0, y1 >= 0.
+// Bisection on the Lagrange parameter (after D. Eberly, "Distance from a point to an ellipse, an
+// ellipsoid, or a hyperellipsoid"); exact to round-off, no iteration limit issues.
+void closest_on_ellipse(double e0, double e1, double y0, double y1, double& x0, double& x1) {
+  if (y1 > 0.0) {
+    if (y0 > 0.0) {
+      const double z0 = y0 / e0, z1 = y1 / e1;
+      const double g = z0 * z0 + z1 * z1 - 1.0;
+      if (g != 0.0) {
+        const double r0 = (e0 / e1) * (e0 / e1);
+        const double n0 = r0 * z0;
+        double s0 = z1 - 1.0, s1 = g < 0.0 ? 0.0 : std::hypot(n0, z1) - 1.0, s = 0.0;
+        for (int i = 0; i < 1100; ++i) {
+          s = 0.5 * (s0 + s1);
+          if (s == s0 || s == s1) break;
+          const double a0 = n0 / (s + r0), a1 = z1 / (s + 1.0);
+          const double gs = a0 * a0 + a1 * a1 - 1.0;
+          if (gs > 0.0) s0 = s; else if (gs < 0.0) s1 = s; else break;
+        }
+        x0 = r0 * y0 / (s + r0);
+        x1 = y1 / (s + 1.0);
+      } else {
+        x0 = y0;
+        x1 = y1;
+      }
+    } else {
+      x0 = 0.0;
+      x1 = e1;
+    }
+  } else {
+    const double numer0 = e0 * y0, denom0 = e0 * e0 - e1 * e1;
+    if (numer0 < denom0) {
+      const double xde0 = numer0 / denom0;
+      x0 = e0 * xde0;
+      x1 = e1 * std::sqrt(std::max(0.0, 1.0 - xde0 * xde0));
+    } else {
+      x0 = e0;
+      x1 = 0.0;
+    }
+  }
+}
+
+// Same for an ellipsoid with e0 >= e1 >= e2 > 0 and y >= 0 componentwise.
+void closest_on_ellipsoid(const double e[3], const double y[3], double x[3]) {
+  if (y[2] > 0.0) {
+    if (y[1] > 0.0) {
+      if (y[0] > 0.0) {
+        const double z0 = y[0] / e[0], z1 = y[1] / e[1], z2 = y[2] / e[2];
+        const double g = z0 * z0 + z1 * z1 + z2 * z2 - 1.0;
+        if (g != 0.0) {
+          const double r0 = (e[0] / e[2]) * (e[0] / e[2]), r1 = (e[1] / e[2]) * (e[1] / e[2]);
+          const double n0 = r0 * z0, n1 = r1 * z1;
+          double s0 = z2 - 1.0;
+          double s1 = g < 0.0 ? 0.0 : std::sqrt(n0 * n0 + n1 * n1 + z2 * z2) - 1.0, s = 0.0;
+          for (int i = 0; i < 1100; ++i) {
+            s = 0.5 * (s0 + s1);
+            if (s == s0 || s == s1) break;
+            const double a0 = n0 / (s + r0), a1 = n1 / (s + r1), a2 = z2 / (s + 1.0);
+            const double gs = a0 * a0 + a1 * a1 + a2 * a2 - 1.0;
+            if (gs > 0.0) s0 = s; else if (gs < 0.0) s1 = s; else break;
+          }
+          x[0] = r0 * y[0] / (s + r0);
+          x[1] = r1 * y[1] / (s + r1);
+          x[2] = y[2] / (s + 1.0);
+        } else {
+          x[0] = y[0]; x[1] = y[1]; x[2] = y[2];
+        }
+      } else {
+        x[0] = 0.0;
+        closest_on_ellipse(e[1], e[2], y[1], y[2], x[1], x[2]);
+      }
+    } else {
+      x[1] = 0.0;
+      if (y[0] > 0.0) {
+        closest_on_ellipse(e[0], e[2], y[0], y[2], x[0], x[2]);
+      } else {
+        x[0] = 0.0;
+        x[2] = e[2];
+      }
+    }
+  } else {
+    const double d0 = e[0] * e[0] - e[2] * e[2], d1 = e[1] * e[1] - e[2] * e[2];
+    const double n0 = e[0] * y[0], n1 = e[1] * y[1];
+    bool done = false;
+    if (n0 < d0 && n1 < d1) {
+      const double q0 = n0 / d0, q1 = n1 / d1, disc = 1.0 - q0 * q0 - q1 * q1;
+      if (disc > 0.0) {
+        x[0] = e[0] * q0;
+        x[1] = e[1] * q1;
+        x[2] = e[2] * std::sqrt(disc);
+        done = true;
+      }
+    }
+    if (!done) {
+      x[2] = 0.0;
+      closest_on_ellipse(e[0], e[1], y[0], y[1], x[0], x[1]);
+    }
+  }
+}
+
+}  // namespace
+
+SurfacePoint Ellipsoid::closest_point(const Eigen::Vector3d& q) const {
+  if (!q.allFinite()) throw InputError("", "point", "must be finite");
+  // Sort the axes in decreasing order, fold the query into the first octant.
+  std::array<int, 3> order{0, 1, 2};
+  std::stable_sort(order.begin(), order.end(), [&](int i, int j) { return e_[i] > e_[j]; });
+  double e[3], y[3], x[3];
+  for (int k = 0; k < 3; ++k) {
+    e[k] = e_[order[k]];
+    y[k] = std::abs(q[order[k]]);
+  }
+  closest_on_ellipsoid(e, y, x);
+  SurfacePoint sp;
+  for (int k = 0; k < 3; ++k) sp.point_m[order[k]] = std::copysign(x[k], q[order[k]]);
+  sp.normal = normal_at(sp.point_m);
+  sp.distance_m = (q - sp.point_m).norm();
+  return sp;
+}
+
+Curvature Ellipsoid::curvature(const SurfacePoint& at) const {
+  // Shape operator of the level set f = sum x_i^2/e_i^2 = 1: S = P H P / |grad f| with
+  // H = 2 diag(1/e_i^2), grad f = 2 (x_i/e_i^2), P = I - n n^T. Its eigenvalues are 0 (normal)
+  // and the two principal curvatures (positive: convex), its eigenvectors the directions.
+  const Eigen::Vector3d& p = at.point_m;
+  const Eigen::Vector3d inv2 = e_.cwiseProduct(e_).cwiseInverse();
+  const Eigen::Vector3d grad = p.cwiseProduct(inv2);
+  const double gnorm = grad.norm();
+  const Eigen::Vector3d n = grad / gnorm;
+  const Eigen::Matrix3d P = Eigen::Matrix3d::Identity() - n * n.transpose();
+  const Eigen::Matrix3d S = P * inv2.asDiagonal() * P / gnorm;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(S);
+  // The normal's eigenvalue is 0; the two others are positive. Pick the two largest.
+  Curvature c;
+  c.k1_per_m = es.eigenvalues()[2];
+  c.k2_per_m = es.eigenvalues()[1];
+  c.d1 = es.eigenvectors().col(2);
+  c.d2 = es.eigenvectors().col(1);
+  c.error_estimate_per_m = 0.0;
+  c.sharp_feature = false;
+  return c;
+}
+
+double Ellipsoid::paper_radius_m(const SurfacePoint& at) const {
+  const Eigen::Vector3d& p = at.point_m;
+  double sum = 0.0;
+  int count = 0;
+  for (int i = 0; i < 3; ++i) {
+    const int j = (i + 1) % 3, k = (i + 2) % 3;
+    const double s2 = 1.0 - (p[i] / e_[i]) * (p[i] / e_[i]);
+    if (!(s2 > 1e-12)) continue;  // the plane is tangent to the surface: degenerate section
+    const double s = std::sqrt(s2);
+    const double alpha = e_[j] * s, beta = e_[k] * s;  // semi-axes of the section ellipse
+    // Parametric angle gamma: p_j = alpha cos(gamma), p_k = beta sin(gamma).
+    const double cg = p[j] / alpha, sg = p[k] / beta;
+    const double q = alpha * alpha * sg * sg + beta * beta * cg * cg;
+    sum += q * std::sqrt(q) / (alpha * beta);  // R = (a^2 sin^2 g + b^2 cos^2 g)^(3/2) / (a b)
+    ++count;
+  }
+  if (count == 0) throw InputError("", "point", "no non-degenerate section for the Eq. 26 radius");
+  return sum / count;
+}
+
+std::optional<SurfacePoint> Ellipsoid::ray_exit(const Eigen::Vector3d& o,
+                                                const Eigen::Vector3d& dir) const {
+  const Eigen::Vector3d inv = e_.cwiseInverse();
+  const Eigen::Vector3d os = o.cwiseProduct(inv), ds = dir.normalized().cwiseProduct(inv);
+  const double A = ds.squaredNorm(), B = os.dot(ds), C = os.squaredNorm() - 1.0;
+  if (C > 0.0) return std::nullopt;  // origin outside the solid
+  const double t = (-B + std::sqrt(B * B - A * C)) / A;
+  SurfacePoint sp;
+  sp.point_m = o + t * dir.normalized();
+  sp.normal = normal_at(sp.point_m);
+  sp.distance_m = 0.0;
+  return sp;
+}
+
+double ellipsoid_mean_curvature(const Eigen::Vector3d& e, const Eigen::Vector3d& p) {
+  const double abc2 = std::pow(e.prod(), 2);
+  const double h2 = p.cwiseQuotient(e.cwiseProduct(e)).squaredNorm();
+  return (e.squaredNorm() - p.squaredNorm()) / (2.0 * abc2 * h2 * std::sqrt(h2));
+}
+
+double ellipsoid_gaussian_curvature(const Eigen::Vector3d& e, const Eigen::Vector3d& p) {
+  const double abc2 = std::pow(e.prod(), 2);
+  const double h2 = p.cwiseQuotient(e.cwiseProduct(e)).squaredNorm();
+  return 1.0 / (abc2 * h2 * h2);
+}
+
+}  // namespace impactdeck::geometry

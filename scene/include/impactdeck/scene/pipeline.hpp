@@ -1,0 +1,78 @@
+#pragma once
+// The pipeline a scene drives: bodies -> contact geometry -> impact -> force table -> outputs.
+// Stages run only when the scene needs them; the report says which ran, which were skipped and
+// how long each took.
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "impactdeck/collision/impact.hpp"
+#include "impactdeck/geometry/shape.hpp"
+#include "impactdeck/scene/scene.hpp"
+
+namespace impactdeck::scene {
+
+/// A body made ready for impacts: its shape and rigid-body state in its own frame.
+struct PreparedBody {
+  const BodySpec* spec = nullptr;
+  std::shared_ptr<const geometry::Shape> shape;
+  geometry::VolumeProperties volume;
+  double mass_kg = 0;  ///< +infinity when fixed
+  Eigen::Matrix3d inertia_kg_m2 = Eigen::Matrix3d::Zero();
+  collision::ElasticMaterial material;
+};
+
+/// Contact geometry of one impact, in the target's frame.
+struct ContactGeometry {
+  geometry::SurfacePoint target_point;    ///< projected point and outward normal
+  geometry::SurfacePoint impactor_point;  ///< in the impactor's own frame
+  Eigen::Vector3d impactor_offset_m = Eigen::Vector3d::Zero();  ///< impactor frame -> target frame
+  double target_curvature_per_m = 0;      ///< 1/R used for the target (rule-dependent)
+  double impactor_curvature_per_m = 0;
+  geometry::Curvature target_curvature;   ///< principal curvatures at the contact point
+  geometry::Curvature impactor_curvature;
+};
+
+struct ImpactReport {
+  const ImpactSpec* spec = nullptr;
+  ContactGeometry contact;
+  collision::ImpactResult result;
+  std::optional<collision::ForceTable> table;
+  std::optional<std::filesystem::path> table_path;  ///< where the CSV was written
+};
+
+struct StageTiming {
+  std::string name;
+  double seconds = 0;
+};
+
+struct RunReport {
+  std::vector<ImpactReport> impacts;
+  std::vector<StageTiming> stages_run;
+  std::vector<std::string> stages_skipped;
+  std::vector<std::string> warnings;
+  std::vector<std::filesystem::path> files_written;
+  bool all_checks_passed() const;
+};
+
+struct RunOptions {
+  std::filesystem::path out_dir = ".";  ///< outputs are written here (must exist)
+};
+
+/// Builds the shape of a body (analytic or mesh). Throws InputError.
+std::shared_ptr<const geometry::Shape> make_shape(const BodySpec& body, const Scene& scene);
+
+/// Mass, inertia and material of a body from its spec.
+PreparedBody prepare_body(const BodySpec& body, const Scene& scene);
+
+/// Runs everything the scene asks for. Throws InputError on bad input; a failed self-check is
+/// reported (see all_checks_passed), not thrown. Outputs are written atomically after all impacts
+/// are solved, so a failure leaves no partial file set.
+RunReport run_scene(const Scene& scene, const RunOptions& options = {});
+
+/// Every stage the tool knows, in pipeline order (for stages_run / stages_skipped).
+const std::vector<std::string>& all_stages();
+
+}  // namespace impactdeck::scene

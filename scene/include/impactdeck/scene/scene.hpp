@@ -1,0 +1,94 @@
+#pragma once
+// Scene files (TOML): what to compute. Format documented in docs/scene-format.md.
+// Every length in a scene is in its declared `length_unit`; the parsed Scene is SI.
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "impactdeck/collision/hertz.hpp"
+#include "impactdeck/collision/force_history.hpp"
+#include "impactdeck/collision/impact.hpp"
+#include "impactdeck/common/units.hpp"
+
+namespace impactdeck::scene {
+
+/// Where a value came from in the scene file (for error messages).
+struct Place {
+  int line = 0;          ///< 1-based; 0 when unknown
+  std::string key;       ///< dotted key path, e.g. "bodies[0].radius"
+  std::string describe() const;  ///< "line 12, key 'bodies[0].radius'"
+};
+
+struct Material {
+  std::string name;
+  collision::ElasticMaterial elastic;
+  std::optional<double> density_kg_m3;
+  Place place;
+};
+
+enum class ShapeKind { sphere, ellipsoid, mesh };
+
+struct BodySpec {
+  std::string name;
+  ShapeKind shape = ShapeKind::sphere;
+  double radius_m = 0;                                     ///< sphere
+  Eigen::Vector3d semi_axes_m = Eigen::Vector3d::Zero();   ///< ellipsoid
+  std::filesystem::path mesh_path;                         ///< mesh, resolved against the scene
+  std::string material;
+  std::optional<double> mass_kg;  ///< overrides density x volume; inertia scales with it
+  bool fixed = false;             ///< infinite mass
+  Eigen::Vector3d velocity_m_s = Eigen::Vector3d::Zero();
+  Eigen::Vector3d angular_velocity_rad_s = Eigen::Vector3d::Zero();
+  Place place;
+};
+
+enum class ContactRadiusRule {
+  paper,  ///< Eq. 26: average radius of the three axis-normal sections
+  mean,   ///< 1 / mean curvature, from the principal curvatures
+};
+
+struct ImpactSpec {
+  std::string name;
+  std::string target;
+  std::string impactor;
+  Eigen::Vector3d point_m = Eigen::Vector3d::Zero();  ///< target frame; projected on its surface
+  collision::RestitutionModel restitution;            ///< unit and policy from the scene top level
+  ContactRadiusRule contact_radius = ContactRadiusRule::paper;
+  std::optional<double> approach_speed_m_s;  ///< if set: impactor velocity = -speed * n
+  std::optional<double> max_projection_distance_m;  ///< default: 1 % of the target's size
+  Place place;
+};
+
+struct Outputs {
+  std::optional<std::filesystem::path> force_table_csv;  ///< relative to the output folder
+  collision::ForceTableOptions force_table;
+};
+
+struct Scene {
+  std::filesystem::path file;  ///< as given (for messages); empty for in-memory text
+  LengthUnit length_unit = LengthUnit::m;
+  collision::ModulusConvention modulus_convention = collision::ModulusConvention::hertz;
+  collision::CheckThresholds thresholds;
+  std::map<std::string, Material> materials;
+  std::vector<BodySpec> bodies;
+  std::vector<ImpactSpec> impacts;
+  Outputs outputs;
+
+  const BodySpec& body(const std::string& name) const;  ///< throws InputError if unknown
+};
+
+/// Reads and validates a scene file. Throws InputError naming file, line, key and reason.
+Scene load_scene(const std::filesystem::path& file);
+
+/// Same from text; `name` is used in messages and relative mesh paths resolve against `base_dir`.
+Scene parse_scene(const std::string& text, const std::string& name,
+                  const std::filesystem::path& base_dir = ".");
+
+const char* to_string(ShapeKind k);
+const char* to_string(ContactRadiusRule r);
+
+}  // namespace impactdeck::scene

@@ -1,0 +1,256 @@
+#include "impactdeck/scene/pipeline.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "impactdeck/collision/hertz.hpp"
+#include "impactdeck/common/error.hpp"
+#include "impactdeck/fem_export/force_table.hpp"
+#include "impactdeck/geometry/ellipsoid.hpp"
+
+namespace impactdeck::scene {
+namespace fs = std::filesystem;
+
+const std::vector<std::string>& all_stages() {
+  static const std::vector<std::string> s = {
+      "scene",        "mesh_load",      "mesh_validation", "mass_properties",
+      "curvature_index", "contact_geometry", "impact",     "force_table",
+      "fem_mesh",     "fem_decks",      "fem_run",         "write_outputs"};
+  return s;
+}
+
+bool RunReport::all_checks_passed() const {
+  for (const auto& i : impacts)
+    if (!i.result.checks.passed) return false;
+  return true;
+}
+
+namespace {
+
+class StageClock {
+ public:
+  explicit StageClock(RunReport& r) : r_(r) {}
+  template <class F>
+  auto run(const std::string& name, F&& f) {
+    const auto t0 = std::chrono::steady_clock::now();
+    auto done = [&] {
+      const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      for (auto& st : r_.stages_run)
+        if (st.name == name) { st.seconds += s; return; }
+      r_.stages_run.push_back({name, s});
+    };
+    if constexpr (std::is_void_v<decltype(f())>) {
+      f();
+      done();
+    } else {
+      auto v = f();
+      done();
+      return v;
+    }
+  }
+
+ private:
+  RunReport& r_;
+};
+
+std::string where(const Scene& s) { return s.file.string(); }
+
+}  // namespace
+
+std::shared_ptr<const geometry::Shape> make_shape(const BodySpec& b, const Scene& scene) {
+  try {
+    switch (b.shape) {
+      case ShapeKind::sphere:
+        return std::make_shared<geometry::Ellipsoid>(geometry::Ellipsoid::sphere(b.radius_m));
+      case ShapeKind::ellipsoid:
+        return std::make_shared<geometry::Ellipsoid>(b.semi_axes_m.x(), b.semi_axes_m.y(),
+                                                     b.semi_axes_m.z());
+      case ShapeKind::mesh:
+        throw InputError(where(scene), b.place.describe(),
+                         "body '" + b.name + "': shape = \"mesh\" is not available in this build");
+    }
+  } catch (const InputError& e) {
+    if (!e.where().empty()) throw;
+    throw InputError(where(scene), b.place.describe(), "body '" + b.name + "': " + e.place() + ": " + e.reason());
+  }
+  throw Error(ExitCode::internal_error, "unknown shape kind");
+}
+
+PreparedBody prepare_body(const BodySpec& b, const Scene& scene) {
+  PreparedBody p;
+  p.spec = &b;
+  p.shape = make_shape(b, scene);
+  p.volume = p.shape->volume_properties();
+  const Material& m = scene.materials.at(b.material);
+  p.material = m.elastic;
+  if (b.fixed) {
+    p.mass_kg = std::numeric_limits<double>::infinity();
+    p.inertia_kg_m2 = Eigen::Matrix3d::Identity() * std::numeric_limits<double>::infinity();
+    return p;
+  }
+  if (!(p.volume.volume_m3 > 0.0)) {
+    throw InputError(where(scene), b.place.describe(), "body '" + b.name + "' has no volume");
+  }
+  const double density = b.mass_kg ? *b.mass_kg / p.volume.volume_m3 : *m.density_kg_m3;
+  p.mass_kg = density * p.volume.volume_m3;
+  p.inertia_kg_m2 = density * p.volume.inertia_per_density_m5;
+  return p;
+}
+
+namespace {
+
+double rule_curvature(const geometry::Shape& shape, const geometry::SurfacePoint& sp,
+                      const geometry::Curvature& k, ContactRadiusRule rule) {
+  if (rule == ContactRadiusRule::paper) return 1.0 / shape.paper_radius_m(sp);
+  return k.mean_per_m();
+}
+
+ContactGeometry contact_geometry(const Scene& scene, const ImpactSpec& s, const PreparedBody& target,
+                                 const PreparedBody& impactor) {
+  ContactGeometry g;
+  const std::string place = s.place.describe();
+  g.target_point = target.shape->closest_point(s.point_m);
+  const double tol = s.max_projection_distance_m.value_or(0.01 * target.shape->size_m());
+  if (g.target_point.distance_m > tol) {
+    std::ostringstream m;
+    m << "impact '" << s.name << "': point is " << g.target_point.distance_m
+      << " m from the surface of '" << s.target << "' (allowed: " << tol
+      << " m; set max_projection_distance to accept it)";
+    throw InputError(where(scene), Place{s.place.line, s.place.key + ".point"}.describe(), m.str());
+  }
+  g.target_curvature = target.shape->curvature(g.target_point);
+  if (g.target_curvature.sharp_feature) {
+    throw InputError(where(scene), Place{s.place.line, s.place.key + ".point"}.describe(),
+                     "impact '" + s.name + "': the point lies on a sharp edge or corner of '" +
+                         s.target + "', where the local radius is undefined");
+  }
+  // The impactor's centroid lies on the impact line; it touches the target where the ray from its
+  // centroid towards the target (-n) leaves its surface. Its axes are parallel to the target's.
+  const Eigen::Vector3d n = g.target_point.normal;
+  auto exit = impactor.shape->ray_exit(impactor.volume.centroid_m, -n);
+  if (!exit) {
+    throw InputError(where(scene), place, "impact '" + s.name + "': cannot find the contact point "
+                                          "on impactor '" + s.impactor + "' (centroid outside it)");
+  }
+  g.impactor_point = *exit;
+  g.impactor_offset_m = g.target_point.point_m - g.impactor_point.point_m;
+  g.impactor_curvature = impactor.shape->curvature(g.impactor_point);
+  g.target_curvature_per_m = rule_curvature(*target.shape, g.target_point, g.target_curvature, s.contact_radius);
+  g.impactor_curvature_per_m =
+      rule_curvature(*impactor.shape, g.impactor_point, g.impactor_curvature, s.contact_radius);
+  return g;
+}
+
+collision::RigidBody rigid(const PreparedBody& b, const Eigen::Vector3d& offset,
+                           const Eigen::Vector3d& velocity) {
+  collision::RigidBody r;
+  r.mass_kg = b.mass_kg;
+  r.inertia_kg_m2 = b.spec->fixed ? Eigen::Matrix3d::Identity() : b.inertia_kg_m2;
+  r.center_of_mass_m = b.volume.centroid_m + offset;
+  r.velocity_m_s = velocity;
+  r.angular_velocity_rad_s = b.spec->angular_velocity_rad_s;
+  return r;
+}
+
+// Rethrows an InputError raised without a file (the collision core's) with the scene's place.
+template <class F>
+auto in_impact(const Scene& scene, const ImpactSpec& s, F&& f) {
+  try {
+    return f();
+  } catch (const InputError& e) {
+    if (!e.where().empty()) throw;
+    throw InputError(where(scene), s.place.describe(),
+                     "impact '" + s.name + "': " + (e.place().empty() ? "" : e.place() + ": ") + e.reason());
+  }
+}
+
+}  // namespace
+
+RunReport run_scene(const Scene& scene, const RunOptions& opt) {
+  RunReport report;
+  StageClock clock(report);
+  report.stages_run.push_back({"scene", 0.0});
+
+  // Bodies that take part in an impact (others are not even built).
+  std::map<std::string, PreparedBody> bodies;
+  clock.run("mass_properties", [&] {
+    for (const auto& s : scene.impacts)
+      for (const std::string* name : {&s.target, &s.impactor})
+        if (!bodies.count(*name)) bodies.emplace(*name, prepare_body(scene.body(*name), scene));
+  });
+
+  for (const auto& s : scene.impacts) {
+    ImpactReport ir;
+    ir.spec = &s;
+    const PreparedBody& target = bodies.at(s.target);
+    const PreparedBody& impactor = bodies.at(s.impactor);
+    ir.contact = clock.run("contact_geometry", [&] { return in_impact(scene, s, [&] {
+      return contact_geometry(scene, s, target, impactor); }); });
+
+    ir.result = clock.run("impact", [&] {
+      return in_impact(scene, s, [&] {
+        collision::ImpactInput in;
+        in.target = rigid(target, Eigen::Vector3d::Zero(), target.spec->velocity_m_s);
+        Eigen::Vector3d v2 = impactor.spec->velocity_m_s;
+        if (s.approach_speed_m_s) v2 = -*s.approach_speed_m_s * ir.contact.target_point.normal;
+        in.impactor = rigid(impactor, ir.contact.impactor_offset_m, v2);
+        in.contact.point_m = ir.contact.target_point.point_m;
+        in.contact.normal = ir.contact.target_point.normal;
+        in.effective_radius_m = collision::effective_radius_m(ir.contact.target_curvature_per_m,
+                                                              ir.contact.impactor_curvature_per_m);
+        in.effective_modulus_Pa =
+            collision::effective_modulus_Pa(target.material, impactor.material, scene.modulus_convention);
+        in.restitution = s.restitution;
+        in.thresholds = scene.thresholds;
+        return collision::solve_impact(in);
+      });
+    });
+    for (const auto& w : ir.result.warnings) report.warnings.push_back("impact '" + s.name + "': " + w);
+    report.impacts.push_back(std::move(ir));
+  }
+
+  if (!report.all_checks_passed()) {
+    report.warnings.push_back("a self-check failed: no output file was written");
+  } else if (scene.outputs.force_table_csv) {
+    clock.run("force_table", [&] {
+      for (auto& ir : report.impacts) {
+        ir.table = collision::sample_force_table(ir.result.history, scene.outputs.force_table);
+        if (!ir.table->tolerance_met) {
+          std::ostringstream m;
+          m << "impact '" << ir.spec->name << "': force table impulse error "
+            << ir.table->impulse_relative_error << " exceeds the tolerance "
+            << ir.table->impulse_tolerance;
+          report.warnings.push_back(m.str());
+        }
+      }
+    });
+    clock.run("write_outputs", [&] {
+      const fs::path base = *scene.outputs.force_table_csv;
+      for (auto& ir : report.impacts) {
+        fs::path p = base;
+        if (report.impacts.size() > 1) {
+          p = base.parent_path() / (base.stem().string() + "_" + ir.spec->name + base.extension().string());
+        }
+        const fs::path full = p.is_absolute() ? p : opt.out_dir / p;
+        fem_export::ForceTableHeader h;
+        h.source = scene.file.string();
+        h.impact = ir.spec->name;
+        h.direction = -ir.contact.target_point.normal;  // force on the target: along -n
+        fem_export::write_force_table_csv(full, *ir.table, h);
+        ir.table_path = full;
+        report.files_written.push_back(full);
+      }
+    });
+  }
+
+  for (const auto& st : all_stages()) {
+    bool ran = false;
+    for (const auto& r : report.stages_run) ran = ran || r.name == st;
+    if (!ran) report.stages_skipped.push_back(st);
+  }
+  return report;
+}
+
+}  // namespace impactdeck::scene

@@ -1,0 +1,162 @@
+#include "impactdeck/scene/report.hpp"
+
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+
+#include "impactdeck/common/version.hpp"
+
+namespace impactdeck::scene {
+namespace {
+
+nlohmann::json vec(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+
+// Never NaN or Inf in an output: a non-finite value becomes null.
+nlohmann::json num(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
+
+nlohmann::json body_json(const std::string& name, const collision::VelocityJump& j) {
+  return {{"name", name},
+          {"delta_velocity_m_s", vec(j.delta_velocity_m_s)},
+          {"delta_angular_velocity_rad_s", vec(j.delta_angular_velocity_rad_s)}};
+}
+
+}  // namespace
+
+nlohmann::json to_json(const Scene& scene, const RunReport& rep) {
+  nlohmann::json j;
+  j["impactdeck_version"] = kVersion;
+  j["scene"] = scene.file.string();
+  j["length_unit"] = to_string(scene.length_unit);
+  j["modulus_convention"] =
+      scene.modulus_convention == collision::ModulusConvention::hertz ? "hertz" : "paper";
+  nlohmann::json impacts = nlohmann::json::array();
+  for (const auto& ir : rep.impacts) {
+    const auto& r = ir.result;
+    const auto& c = r.history.compression;
+    nlohmann::json i;
+    i["name"] = ir.spec->name;
+    i["target"] = body_json(ir.spec->target, r.target_jump);
+    i["impactor"] = body_json(ir.spec->impactor, r.impactor_jump);
+    i["contact_point_m"] = vec(ir.contact.target_point.point_m);
+    i["contact_normal"] = vec(ir.contact.target_point.normal);
+    i["projection_distance_m"] = num(ir.contact.target_point.distance_m);
+    i["contact_radius_rule"] = to_string(ir.spec->contact_radius);
+    i["target_principal_curvatures_1_per_m"] = {ir.contact.target_curvature.k1_per_m,
+                                                ir.contact.target_curvature.k2_per_m};
+    i["target_contact_curvature_1_per_m"] = num(ir.contact.target_curvature_per_m);
+    i["impactor_contact_curvature_1_per_m"] = num(ir.contact.impactor_curvature_per_m);
+    i["reduced_mass_kg"] = num(r.reduced_mass_kg);
+    i["effective_radius_m"] = num(r.effective_radius_m);
+    i["effective_modulus_Pa"] = num(r.effective_modulus_Pa);
+    i["hertz_constant_N_per_m1_5"] = num(r.hertz_constant);
+    i["approach_velocity_m_s"] = num(r.approach_velocity_m_s);
+    if (r.restitution_from_energy_flux) {
+      i["restitution_model"] = "energy-flux";
+      i["energy_flux_density"] = num(r.restitution.energy_flux_density);
+      i["energy_flux_density_unit"] = collision::to_string(ir.spec->restitution.flux_unit);
+      i["energy_flux_density_J_m3"] = num(r.restitution.energy_flux_density_J_m3);
+      i["ln_energy_flux_density"] = num(r.restitution.ln_energy_flux);
+      i["restitution_clamped"] = r.restitution.clamped;
+    } else {
+      i["restitution_model"] = "constant";
+      i["energy_flux_density"] = nullptr;
+    }
+    i["restitution"] = num(r.restitution.coefficient);
+    i["max_indentation_m"] = num(c.max_indentation_m);
+    i["max_force_N"] = num(c.max_force_N);
+    i["compression_time_s"] = num(c.compression_time_s);
+    i["contact_time_s"] = num(r.history.contact_time_s());
+    i["impulse_compression_Ns"] = num(r.history.impulse_compression_Ns());
+    i["impulse_total_Ns"] = num(r.history.impulse_total_Ns());
+    const auto& k = r.checks;
+    i["checks"] = {{"impulse_relative_error", num(k.impulse_relative_error)},
+                   {"energy_relative_error", num(k.energy_relative_error)},
+                   {"impulse_threshold", k.thresholds.impulse_relative},
+                   {"energy_threshold", k.thresholds.energy_relative},
+                   {"impulse_compression_numerical_Ns", num(k.impulse_compression_numerical_Ns)},
+                   {"carnot_loss_J", num(k.carnot_loss_J)},
+                   {"kinetic_energy_loss_J", num(k.kinetic_energy_loss_J)},
+                   {"passed", k.passed}};
+    if (ir.table) {
+      i["force_table"] = {{"samples", ir.table->time_s.size()},
+                          {"impulse_Ns", num(ir.table->impulse_Ns)},
+                          {"impulse_relative_error", num(ir.table->impulse_relative_error)},
+                          {"impulse_tolerance", ir.table->impulse_tolerance},
+                          {"tolerance_met", ir.table->tolerance_met}};
+      if (ir.table_path) i["force_table"]["path"] = ir.table_path->string();
+    }
+    impacts.push_back(std::move(i));
+  }
+  j["impacts"] = std::move(impacts);
+  nlohmann::json run = nlohmann::json::array(), times = nlohmann::json::object();
+  for (const auto& s : rep.stages_run) {
+    run.push_back(s.name);
+    times[s.name] = s.seconds;
+  }
+  j["stages_run"] = run;
+  j["stages_skipped"] = rep.stages_skipped;
+  j["stage_times_s"] = times;
+  j["warnings"] = rep.warnings;
+  nlohmann::json files = nlohmann::json::array();
+  for (const auto& f : rep.files_written) files.push_back(f.string());
+  j["files_written"] = files;
+  j["all_checks_passed"] = rep.all_checks_passed();
+  return j;
+}
+
+std::string format_summary(const Scene& scene, const RunReport& rep) {
+  std::ostringstream o;
+  o << std::setprecision(6);
+  o << "impactdeck " << kVersion << " — " << scene.file.string() << "\n";
+  for (const auto& ir : rep.impacts) {
+    const auto& r = ir.result;
+    const auto& c = r.history.compression;
+    const auto& p = ir.contact.target_point;
+    o << "\nimpact '" << ir.spec->name << "': " << ir.spec->impactor << " hits " << ir.spec->target
+      << " at (" << p.point_m.x() << ", " << p.point_m.y() << ", " << p.point_m.z() << ") m, normal ("
+      << p.normal.x() << ", " << p.normal.y() << ", " << p.normal.z() << ")\n";
+    o << "  reduced mass          " << r.reduced_mass_kg << " kg\n";
+    o << "  approach velocity     " << r.approach_velocity_m_s << " m/s\n";
+    o << "  effective radius      " << r.effective_radius_m << " m (" << to_string(ir.spec->contact_radius)
+      << " rule)\n";
+    o << "  effective modulus     " << r.effective_modulus_Pa << " Pa\n";
+    o << "  Hertz constant        " << r.hertz_constant << " N/m^1.5\n";
+    if (r.restitution_from_energy_flux) {
+      o << "  energy flux density   " << r.restitution.energy_flux_density << " "
+        << collision::to_string(ir.spec->restitution.flux_unit) << " (ln = " << r.restitution.ln_energy_flux
+        << (r.restitution.clamped ? ", clamped" : "") << ")\n";
+    }
+    o << "  restitution R         " << r.restitution.coefficient << "\n";
+    o << "  max indentation       " << c.max_indentation_m << " m\n";
+    o << "  max force             " << c.max_force_N << " N\n";
+    o << "  compression time      " << c.compression_time_s << " s\n";
+    o << "  contact time          " << r.history.contact_time_s() << " s\n";
+    o << "  impulse               " << r.history.impulse_total_Ns() << " N s (compression "
+      << r.history.impulse_compression_Ns() << ")\n";
+    o << "  target   dv = " << r.target_jump.delta_velocity_m_s.transpose() << " m/s, dw = "
+      << r.target_jump.delta_angular_velocity_rad_s.transpose() << " rad/s\n";
+    o << "  impactor dv = " << r.impactor_jump.delta_velocity_m_s.transpose() << " m/s, dw = "
+      << r.impactor_jump.delta_angular_velocity_rad_s.transpose() << " rad/s\n";
+    const auto& k = r.checks;
+    o << "  check impulse (Eq. 31)  rel. error " << std::setprecision(2) << std::scientific
+      << k.impulse_relative_error << " (limit " << k.thresholds.impulse_relative << ")\n";
+    o << "  check Carnot  (Eq. 32)  rel. error " << k.energy_relative_error << " (limit "
+      << k.thresholds.energy_relative << ")  -> " << (k.passed ? "passed" : "FAILED") << "\n";
+    o << std::defaultfloat << std::setprecision(6);
+    if (ir.table) {
+      o << "  force table           " << ir.table->time_s.size() << " samples, impulse error "
+        << std::setprecision(2) << std::scientific << ir.table->impulse_relative_error
+        << std::defaultfloat << std::setprecision(6);
+      if (ir.table_path) o << " -> " << ir.table_path->string();
+      o << "\n";
+    }
+  }
+  for (const auto& w : rep.warnings) o << "\nwarning: " << w;
+  if (!rep.warnings.empty()) o << "\n";
+  o << "\nstages run:";
+  for (const auto& s : rep.stages_run) o << " " << s.name;
+  o << "\n";
+  return o.str();
+}
+
+}  // namespace impactdeck::scene

@@ -1,0 +1,424 @@
+#include "impactdeck/scene/scene.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include <toml++/toml.h>
+
+#include "impactdeck/common/error.hpp"
+
+namespace impactdeck::scene {
+namespace fs = std::filesystem;
+
+std::string Place::describe() const {
+  std::ostringstream s;
+  if (line > 0) s << "line " << line;
+  if (!key.empty()) s << (line > 0 ? ", " : "") << "key '" << key << "'";
+  return s.str();
+}
+
+const char* to_string(ShapeKind k) {
+  switch (k) {
+    case ShapeKind::sphere: return "sphere";
+    case ShapeKind::ellipsoid: return "ellipsoid";
+    case ShapeKind::mesh: return "mesh";
+  }
+  return "?";
+}
+
+const char* to_string(ContactRadiusRule r) {
+  return r == ContactRadiusRule::paper ? "paper" : "mean";
+}
+
+const BodySpec& Scene::body(const std::string& name) const {
+  for (const auto& b : bodies)
+    if (b.name == name) return b;
+  throw InputError(file.string(), "bodies", "no body named '" + name + "'");
+}
+
+namespace {
+
+// Reads one TOML table, remembering which keys were used so that unknown keys are rejected, and
+// turning every problem into an InputError with file, line and dotted key.
+class Reader {
+ public:
+  Reader(const toml::table& t, std::string prefix, const std::string& file)
+      : t_(t), prefix_(std::move(prefix)), file_(file) {}
+
+  std::string key_path(const std::string& k) const { return prefix_.empty() ? k : prefix_ + "." + k; }
+  int line_of(const toml::node* n) const { return n ? static_cast<int>(n->source().begin.line) : 0; }
+  int table_line() const { return static_cast<int>(t_.source().begin.line); }
+  Place place(const std::string& k) const { return Place{line_of(t_.get(k)), key_path(k)}; }
+  Place self() const { return Place{table_line(), prefix_}; }
+
+  [[noreturn]] void fail(const std::string& k, const std::string& reason) const {
+    throw InputError(file_, place(k).describe(), reason);
+  }
+
+  const toml::node* get(const std::string& k) {
+    used_.insert(k);
+    return t_.get(k);
+  }
+  bool has(const std::string& k) const { return t_.contains(k); }
+
+  std::optional<double> number(const std::string& k) {
+    const toml::node* n = get(k);
+    if (!n) return std::nullopt;
+    if (!n->is_number()) fail(k, "must be a number, got " + type_name(*n));
+    const double v = n->value<double>().value();
+    if (!std::isfinite(v)) fail(k, "must be finite");
+    return v;
+  }
+  double required_number(const std::string& k) {
+    auto v = number(k);
+    if (!v) missing(k);
+    return *v;
+  }
+  double positive(const std::string& k) {
+    const double v = required_number(k);
+    if (!(v > 0.0)) fail(k, "must be > 0, got " + fmt(v));
+    return v;
+  }
+  std::optional<std::string> string(const std::string& k) {
+    const toml::node* n = get(k);
+    if (!n) return std::nullopt;
+    if (!n->is_string()) fail(k, "must be a string, got " + type_name(*n));
+    return n->value<std::string>().value();
+  }
+  std::string required_string(const std::string& k) {
+    auto v = string(k);
+    if (!v) missing(k);
+    if (v->empty()) fail(k, "must not be empty");
+    return *v;
+  }
+  std::optional<bool> boolean(const std::string& k) {
+    const toml::node* n = get(k);
+    if (!n) return std::nullopt;
+    if (!n->is_boolean()) fail(k, "must be true or false, got " + type_name(*n));
+    return n->value<bool>().value();
+  }
+  std::optional<Eigen::Vector3d> vec3(const std::string& k) {
+    const toml::node* n = get(k);
+    if (!n) return std::nullopt;
+    const toml::array* a = n->as_array();
+    if (!a || a->size() != 3) fail(k, "must be an array of 3 numbers");
+    Eigen::Vector3d v;
+    for (int i = 0; i < 3; ++i) {
+      const toml::node& e = *a->get(static_cast<std::size_t>(i));
+      if (!e.is_number()) fail(k, "must be an array of 3 numbers, element " + std::to_string(i) + " is " + type_name(e));
+      v[i] = e.value<double>().value();
+      if (!std::isfinite(v[i])) fail(k, "must be finite");
+    }
+    return v;
+  }
+  template <class Enum>
+  Enum choice(const std::string& k, const std::vector<std::pair<std::string, Enum>>& options,
+              std::optional<Enum> fallback) {
+    auto s = string(k);
+    if (!s) {
+      if (fallback) return *fallback;
+      missing(k);
+    }
+    std::string list;
+    for (const auto& [name, value] : options) {
+      if (*s == name) return value;
+      list += (list.empty() ? "" : ", ") + ("\"" + name + "\"");
+    }
+    fail(k, "unknown value \"" + *s + "\" (expected one of " + list + ")");
+  }
+
+  [[noreturn]] void missing(const std::string& k) const {
+    throw InputError(file_, self().describe(), "missing required key '" + key_path(k) + "'");
+  }
+
+  /// Rejects keys that were never read, naming the allowed ones.
+  void reject_unknown(const std::vector<std::string>& also_allowed = {}) const {
+    for (const auto& [key, node] : t_) {
+      const std::string k(key.str());
+      if (used_.count(k)) continue;
+      if (std::find(also_allowed.begin(), also_allowed.end(), k) != also_allowed.end()) continue;
+      std::string list;
+      for (const auto& u : used_) list += (list.empty() ? "" : ", ") + u;
+      for (const auto& u : also_allowed) list += (list.empty() ? "" : ", ") + u;
+      throw InputError(file_, Place{line_of(&node), key_path(k)}.describe(),
+                       "unknown key (allowed here: " + list + ")");
+    }
+  }
+
+  static std::string type_name(const toml::node& n) {
+    switch (n.type()) {
+      case toml::node_type::string: return "a string";
+      case toml::node_type::integer: return "an integer";
+      case toml::node_type::floating_point: return "a number";
+      case toml::node_type::boolean: return "a boolean";
+      case toml::node_type::array: return "an array";
+      case toml::node_type::table: return "a table";
+      default: return "a date/time";
+    }
+  }
+  static std::string fmt(double v) {
+    std::ostringstream s;
+    s << v;
+    return s.str();
+  }
+
+ private:
+  const toml::table& t_;
+  std::string prefix_;
+  const std::string& file_;
+  std::set<std::string> used_;
+};
+
+// All keys a reader may see are declared by reading them; sub-tables are read by their own reader.
+Material read_material(const std::string& name, const toml::table& t, const std::string& file) {
+  Reader r(t, "materials." + name, file);
+  Material m;
+  m.name = name;
+  m.place = r.self();
+  m.elastic.youngs_modulus_Pa = r.positive("youngs_modulus_Pa");
+  m.elastic.poisson_ratio = r.required_number("poisson_ratio");
+  if (!(m.elastic.poisson_ratio > -1.0 && m.elastic.poisson_ratio < 0.5)) {
+    r.fail("poisson_ratio", "must lie in (-1, 0.5), got " + Reader::fmt(m.elastic.poisson_ratio));
+  }
+  if (r.has("density_kg_m3")) m.density_kg_m3 = r.positive("density_kg_m3");
+  r.reject_unknown();
+  return m;
+}
+
+BodySpec read_body(std::size_t index, const toml::table& t, const std::string& file,
+                   double to_m, const fs::path& base_dir) {
+  Reader r(t, "bodies[" + std::to_string(index) + "]", file);
+  BodySpec b;
+  b.place = r.self();
+  b.name = r.required_string("name");
+  b.shape = r.choice<ShapeKind>("shape", {{"sphere", ShapeKind::sphere},
+                                          {"ellipsoid", ShapeKind::ellipsoid},
+                                          {"mesh", ShapeKind::mesh}}, std::nullopt);
+  switch (b.shape) {
+    case ShapeKind::sphere:
+      b.radius_m = r.positive("radius") * to_m;
+      break;
+    case ShapeKind::ellipsoid: {
+      auto e = r.vec3("semi_axes");
+      if (!e) r.missing("semi_axes");
+      if (!((*e).array() > 0.0).all()) r.fail("semi_axes", "every semi-axis must be > 0");
+      b.semi_axes_m = *e * to_m;
+      break;
+    }
+    case ShapeKind::mesh: {
+      const std::string p = r.required_string("mesh");
+      b.mesh_path = fs::path(p).is_absolute() ? fs::path(p) : base_dir / p;
+      break;
+    }
+  }
+  b.material = r.required_string("material");
+  if (r.has("mass_kg")) b.mass_kg = r.positive("mass_kg");
+  b.fixed = r.boolean("fixed").value_or(false);
+  if (b.fixed && b.mass_kg) r.fail("mass_kg", "a fixed body has infinite mass; remove mass_kg or fixed");
+  b.velocity_m_s = r.vec3("velocity_m_s").value_or(Eigen::Vector3d::Zero());
+  b.angular_velocity_rad_s = r.vec3("angular_velocity_rad_s").value_or(Eigen::Vector3d::Zero());
+  r.reject_unknown();
+  return b;
+}
+
+ImpactSpec read_impact(std::size_t index, const toml::table& t, const std::string& file,
+                       double to_m, const collision::RestitutionModel& defaults) {
+  Reader r(t, "impacts[" + std::to_string(index) + "]", file);
+  ImpactSpec s;
+  s.place = r.self();
+  s.name = r.string("name").value_or("impact" + std::to_string(index + 1));
+  s.target = r.required_string("target");
+  s.impactor = r.required_string("impactor");
+  if (s.target == s.impactor) r.fail("impactor", "a body cannot hit itself");
+  auto p = r.vec3("point");
+  if (!p) r.missing("point");
+  s.point_m = *p * to_m;
+  s.restitution = defaults;
+  if (const toml::node* n = r.get("restitution")) {
+    if (n->is_string()) {
+      if (n->value<std::string>().value() != "energy-flux") {
+        r.fail("restitution", "must be \"energy-flux\" or a number in [0, 1]");
+      }
+      s.restitution.from_energy_flux = true;
+    } else if (n->is_number()) {
+      const double R = n->value<double>().value();
+      if (!(R >= 0.0 && R <= 1.0)) r.fail("restitution", "must lie in [0, 1], got " + Reader::fmt(R));
+      s.restitution.from_energy_flux = false;
+      s.restitution.constant = R;
+    } else {
+      r.fail("restitution", "must be \"energy-flux\" or a number in [0, 1]");
+    }
+  }
+  s.contact_radius = r.choice<ContactRadiusRule>(
+      "contact_radius", {{"paper", ContactRadiusRule::paper}, {"mean", ContactRadiusRule::mean}},
+      ContactRadiusRule::paper);
+  if (r.has("approach_speed_m_s")) s.approach_speed_m_s = r.positive("approach_speed_m_s");
+  if (r.has("max_projection_distance")) {
+    const double d = r.required_number("max_projection_distance");
+    if (!(d >= 0.0)) r.fail("max_projection_distance", "must be >= 0");
+    s.max_projection_distance_m = d * to_m;
+  }
+  r.reject_unknown();
+  return s;
+}
+
+Outputs read_outputs(const toml::table& t, const std::string& file) {
+  Reader r(t, "outputs", file);
+  Outputs o;
+  if (auto s = r.string("force_table_csv")) {
+    if (s->empty()) r.fail("force_table_csv", "must not be empty");
+    o.force_table_csv = fs::path(*s);
+  }
+  if (r.has("force_table_impulse_tolerance")) {
+    o.force_table.impulse_tolerance = r.positive("force_table_impulse_tolerance");
+    if (o.force_table.impulse_tolerance >= 0.5) {
+      r.fail("force_table_impulse_tolerance", "must be < 0.5");
+    }
+  }
+  if (r.has("force_table_time_step_s")) o.force_table.time_step_s = r.positive("force_table_time_step_s");
+  r.reject_unknown();
+  return o;
+}
+
+const toml::table& sub_table(const toml::node* n, const std::string& key, const std::string& file) {
+  if (!n->is_table()) {
+    throw InputError(file, Place{static_cast<int>(n->source().begin.line), key}.describe(),
+                     "must be a table");
+  }
+  return *n->as_table();
+}
+
+const toml::array& table_array(const toml::node* n, const std::string& key, const std::string& file) {
+  const toml::array* a = n->as_array();
+  if (!a || !a->is_array_of_tables()) {
+    throw InputError(file, Place{static_cast<int>(n->source().begin.line), key}.describe(),
+                     "must be an array of tables ([[" + key + "]])");
+  }
+  return *a;
+}
+
+Scene build(const toml::table& root, const std::string& file, const fs::path& base_dir) {
+  Scene sc;
+  sc.file = file;
+  Reader r(root, "", file);
+  const std::string unit_text = r.required_string("length_unit");
+  auto unit = parse_length_unit(unit_text);
+  if (!unit) r.fail("length_unit", "unknown unit \"" + unit_text + "\" (expected m, cm, mm or in)");
+  sc.length_unit = *unit;
+  const double to_m = metres_per(*unit);
+
+  sc.modulus_convention = r.choice<collision::ModulusConvention>(
+      "modulus_convention",
+      {{"hertz", collision::ModulusConvention::hertz}, {"paper", collision::ModulusConvention::paper}},
+      collision::ModulusConvention::hertz);
+  collision::RestitutionModel rdefaults;
+  rdefaults.flux_unit = r.choice<collision::EnergyFluxUnit>(
+      "energy_flux_unit",
+      {{"J/cm3", collision::EnergyFluxUnit::J_per_cm3},
+       {"J/m3", collision::EnergyFluxUnit::J_per_m3},
+       {"J/mm3", collision::EnergyFluxUnit::J_per_mm3}},
+      collision::EnergyFluxUnit::J_per_cm3);
+  rdefaults.range_policy = r.choice<collision::RangePolicy>(
+      "restitution_range_policy",
+      {{"warn", collision::RangePolicy::warn},
+       {"error", collision::RangePolicy::error},
+       {"extrapolate", collision::RangePolicy::extrapolate}},
+      collision::RangePolicy::warn);
+
+  if (const toml::node* n = r.get("checks")) {
+    Reader c(sub_table(n, "checks", file), "checks", file);
+    if (c.has("impulse_relative")) sc.thresholds.impulse_relative = c.positive("impulse_relative");
+    if (c.has("energy_relative")) sc.thresholds.energy_relative = c.positive("energy_relative");
+    c.reject_unknown();
+  }
+
+  if (const toml::node* n = r.get("materials")) {
+    for (const auto& [k, v] : sub_table(n, "materials", file)) {
+      const std::string name(k.str());
+      sc.materials[name] = read_material(name, sub_table(&v, "materials." + name, file), file);
+    }
+  }
+
+  const toml::node* bodies = r.get("bodies");
+  if (!bodies) r.missing("bodies");
+  const toml::array& ba = table_array(bodies, "bodies", file);
+  for (std::size_t i = 0; i < ba.size(); ++i) {
+    BodySpec b = read_body(i, *ba.get(i)->as_table(), file, to_m, base_dir);
+    for (const auto& other : sc.bodies) {
+      if (other.name == b.name) {
+        throw InputError(file, Place{b.place.line, "bodies[" + std::to_string(i) + "].name"}.describe(),
+                         "duplicate body name '" + b.name + "'");
+      }
+    }
+    auto m = sc.materials.find(b.material);
+    if (m == sc.materials.end()) {
+      throw InputError(file, Place{b.place.line, "bodies[" + std::to_string(i) + "].material"}.describe(),
+                       "unknown material '" + b.material + "' (define it under [materials." + b.material + "])");
+    }
+    if (!b.fixed && !b.mass_kg && !m->second.density_kg_m3) {
+      throw InputError(file, Place{b.place.line, "bodies[" + std::to_string(i) + "]"}.describe(),
+                       "body '" + b.name + "' needs a mass: give mass_kg, fixed = true, or "
+                       "density_kg_m3 in material '" + b.material + "'");
+    }
+    sc.bodies.push_back(std::move(b));
+  }
+
+  const toml::node* impacts = r.get("impacts");
+  if (!impacts) r.missing("impacts");
+  const toml::array& ia = table_array(impacts, "impacts", file);
+  for (std::size_t i = 0; i < ia.size(); ++i) {
+    ImpactSpec s = read_impact(i, *ia.get(i)->as_table(), file, to_m, rdefaults);
+    for (const std::string* who : {&s.target, &s.impactor}) {
+      bool found = false;
+      for (const auto& b : sc.bodies) found = found || b.name == *who;
+      if (!found) {
+        const char* key = who == &s.target ? "target" : "impactor";
+        throw InputError(file, Place{s.place.line, "impacts[" + std::to_string(i) + "]." + key}.describe(),
+                         "no body named '" + *who + "'");
+      }
+    }
+    for (const auto& other : sc.impacts) {
+      if (other.name == s.name) {
+        throw InputError(file, Place{s.place.line, "impacts[" + std::to_string(i) + "].name"}.describe(),
+                         "duplicate impact name '" + s.name + "'");
+      }
+    }
+    sc.impacts.push_back(std::move(s));
+  }
+  if (sc.impacts.empty()) r.fail("impacts", "at least one impact is needed");
+
+  if (const toml::node* n = r.get("outputs")) sc.outputs = read_outputs(sub_table(n, "outputs", file), file);
+  r.reject_unknown();
+  return sc;
+}
+
+}  // namespace
+
+Scene parse_scene(const std::string& text, const std::string& name, const fs::path& base_dir) {
+  toml::table root;
+  try {
+    root = toml::parse(text, name);
+  } catch (const toml::parse_error& e) {
+    std::ostringstream place;
+    place << "line " << e.source().begin.line << ", column " << e.source().begin.column;
+    throw InputError(name, place.str(), "TOML syntax error: " + std::string(e.description()));
+  }
+  return build(root, name, base_dir);
+}
+
+Scene load_scene(const fs::path& file) {
+  std::error_code ec;
+  if (fs::is_directory(file, ec)) throw InputError(file.string(), "file", "is a directory, not a scene file");
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw InputError(file.string(), "file", "cannot be opened (missing or unreadable)");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  const fs::path base = file.has_parent_path() ? file.parent_path() : fs::path(".");
+  Scene s = parse_scene(ss.str(), file.string(), base);
+  s.file = file;
+  return s;
+}
+
+}  // namespace impactdeck::scene

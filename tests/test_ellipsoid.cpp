@@ -1,0 +1,108 @@
+// Analytic ellipsoid: exact volume, inertia, area, normal (Eq. 25), closest point, principal
+// curvatures against the closed-form mean and Gaussian curvature, Eq. 26 radius.
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "impactdeck/geometry/ellipsoid.hpp"
+
+using namespace impactdeck::geometry;
+
+TEST(Ellipsoid, VolumeInertiaArea) {
+  const Ellipsoid e(2.0, 0.5, 0.5);
+  const auto v = e.volume_properties();
+  EXPECT_NEAR(v.volume_m3, 4.0 / 3.0 * M_PI * 0.5, 1e-14);
+  EXPECT_NEAR(v.inertia_per_density_m5(0, 0), v.volume_m3 / 5 * 0.5, 1e-14);
+  EXPECT_NEAR(v.inertia_per_density_m5(1, 1), v.volume_m3 / 5 * 4.25, 1e-14);
+  // Prolate spheroid area: 2 pi b^2 (1 + a/(b e) asin e), e = sqrt(1 - b^2/a^2).
+  const double ecc = std::sqrt(1 - 0.25 / 4.0);
+  EXPECT_NEAR(v.area_m2, 2 * M_PI * 0.25 * (1 + 2.0 / (0.5 * ecc) * std::asin(ecc)), 1e-12);
+  EXPECT_NEAR(Ellipsoid::sphere(3.0).area_m2(), 4 * M_PI * 9, 1e-12);
+  // Oblate spheroid: 2 pi a^2 (1 + (1-e^2)/e atanh e), a = b > c.
+  const Ellipsoid o(1.0, 1.0, 0.5);
+  const double eo = std::sqrt(1 - 0.25);
+  EXPECT_NEAR(o.area_m2(), 2 * M_PI * (1 + (1 - eo * eo) / eo * std::atanh(eo)), 1e-12);
+}
+
+TEST(Ellipsoid, ClosestPointIsOnSurfaceAndAlongNormal) {
+  const Ellipsoid e(3.0, 2.0, 1.0);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-5.0, 5.0);
+  for (int i = 0; i < 2000; ++i) {
+    const Eigen::Vector3d q(u(rng), u(rng), u(rng));
+    const SurfacePoint sp = e.closest_point(q);
+    const Eigen::Vector3d& p = sp.point_m;
+    EXPECT_NEAR((p.cwiseQuotient(e.semi_axes_m())).squaredNorm(), 1.0, 1e-12);
+    const Eigen::Vector3d d = q - p;
+    if (d.norm() > 1e-9) EXPECT_LT(d.normalized().cross(sp.normal).norm(), 1e-7);
+    // No sampled surface point is closer (brute force over a parametric grid).
+    if (i < 50) {
+      double best = INFINITY;
+      for (int a = 0; a <= 200; ++a)
+        for (int b = 0; b < 400; ++b) {
+          const double th = M_PI * a / 200, ph = 2 * M_PI * b / 400;
+          const Eigen::Vector3d s(3 * std::sin(th) * std::cos(ph), 2 * std::sin(th) * std::sin(ph), std::cos(th));
+          best = std::min(best, (q - s).norm());
+        }
+      EXPECT_LE(sp.distance_m, best + 1e-12);
+    }
+  }
+  // Points on axes and at the centre.
+  EXPECT_NEAR(e.closest_point({0, 0, 0}).point_m.z(), 1.0, 1e-15);
+  EXPECT_NEAR(e.closest_point({0, 7, 0}).point_m.y(), 2.0, 1e-15);
+}
+
+TEST(Ellipsoid, PrincipalCurvaturesMatchClosedForms) {
+  const Eigen::Vector3d ax(3.0, 2.0, 1.0);
+  const Ellipsoid e(ax.x(), ax.y(), ax.z());
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int i = 0; i < 500; ++i) {
+    const SurfacePoint sp = e.closest_point(Eigen::Vector3d(u(rng), u(rng), u(rng)) * 4);
+    const Curvature k = e.curvature(sp);
+    const double H = ellipsoid_mean_curvature(ax, sp.point_m), K = ellipsoid_gaussian_curvature(ax, sp.point_m);
+    EXPECT_NEAR(k.mean_per_m(), H, 1e-12 * H);
+    EXPECT_NEAR(k.k1_per_m * k.k2_per_m, K, 1e-11 * K);
+    EXPECT_GE(k.k1_per_m, k.k2_per_m);
+    EXPECT_LT(std::abs(k.d1.dot(sp.normal)), 1e-10);
+    EXPECT_LT(std::abs(k.d1.dot(k.d2)), 1e-10);
+  }
+  // At the tip (a, 0, 0): curvatures a/b^2 and a/c^2 along y and z.
+  const Curvature tip = e.curvature(e.closest_point({5, 0, 0}));
+  EXPECT_NEAR(tip.k1_per_m, 3.0 / 1.0, 1e-12);
+  EXPECT_NEAR(tip.k2_per_m, 3.0 / 4.0, 1e-12);
+  EXPECT_NEAR(std::abs(tip.d1.z()), 1.0, 1e-12);
+}
+
+TEST(Ellipsoid, NormalIsEq25) {
+  const Ellipsoid e(2.0, 0.5, 0.5);
+  const Eigen::Vector3d p(1.0, 0.5 * std::sqrt(0.75) * std::cos(0.3), 0.5 * std::sqrt(0.75) * std::sin(0.3));
+  const Eigen::Vector3d n25 = Eigen::Vector3d(2 * p.x() / 4, 2 * p.y() / 0.25, 2 * p.z() / 0.25) /
+                              std::sqrt(4 * p.x() * p.x() / 16 + 4 * p.y() * p.y() / 0.0625 + 4 * p.z() * p.z() / 0.0625);
+  EXPECT_LT((e.normal_at(p) - n25).norm(), 1e-15);
+}
+
+TEST(Ellipsoid, PaperRadiusEq26) {
+  const Ellipsoid e(2.0, 0.5, 0.5);
+  // Tip of a spheroid: both non-degenerate sections give b^2/a.
+  EXPECT_NEAR(e.paper_radius_m(e.closest_point({3, 0, 0})), 0.25 / 2.0, 1e-14);
+  // Equator point (0, b, 0): section x = 0 is a circle of radius b; section z = 0 is the ellipse
+  // (a, b) at its minor vertex, radius a^2/b; section y = b is tangent (left out).
+  EXPECT_NEAR(e.paper_radius_m(e.closest_point({0, 1, 0})), 0.5 * (0.5 + 4.0 / 0.5), 1e-14);
+  // Sphere: at (0, r, 0) exactly r; elsewhere the average of section radii, below r.
+  const Ellipsoid s = Ellipsoid::sphere(0.05);
+  EXPECT_NEAR(s.paper_radius_m(s.closest_point({0, 1, 0})), 0.05, 1e-16);
+  const SurfacePoint g = s.closest_point({1, 1, 1});
+  const double sec = 0.05 * std::sqrt(2.0 / 3.0);  // each section circle has radius r sqrt(1 - 1/3)
+  EXPECT_NEAR(s.paper_radius_m(g), sec, 1e-15);
+}
+
+TEST(Ellipsoid, RayExit) {
+  const Ellipsoid e(2.0, 1.0, 0.5);
+  auto p = e.ray_exit({0, 0, 0}, {0, -1, 0});
+  ASSERT_TRUE(p);
+  EXPECT_NEAR(p->point_m.y(), -1.0, 1e-15);
+  EXPECT_NEAR(p->normal.y(), -1.0, 1e-15);
+  EXPECT_FALSE(e.ray_exit({5, 0, 0}, {1, 0, 0}));
+}

@@ -1,0 +1,181 @@
+// Scene files: the samples run, and bad scenes give one-line errors naming file, line and key.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+
+#include <gtest/gtest.h>
+
+#include "impactdeck/common/error.hpp"
+#include "impactdeck/scene/pipeline.hpp"
+#include "impactdeck/scene/report.hpp"
+#include "impactdeck/scene/scene.hpp"
+#include "tolerances.hpp"
+
+using namespace impactdeck;
+using namespace impactdeck::scene;
+namespace fs = std::filesystem;
+
+namespace {
+
+const fs::path kSamples = fs::path(IMPACTDECK_SOURCE_DIR) / "samples";
+
+const std::string kBase = R"(length_unit = "mm"
+[materials.steel]
+youngs_modulus_Pa = 2.05e11
+poisson_ratio = 0.3
+density_kg_m3 = 7850
+[[bodies]]
+name = "target"
+shape = "ellipsoid"
+semi_axes = [2000, 500, 500]
+material = "steel"
+[[bodies]]
+name = "ball"
+shape = "sphere"
+radius = 50
+material = "steel"
+velocity_m_s = [0, -1, 0]
+[[impacts]]
+target = "target"
+impactor = "ball"
+point = [0, 500, 0]
+)";
+
+// Expects parse_scene or run_scene to throw an InputError whose one-line message matches `re`.
+void expect_error(const std::string& text, const std::string& re) {
+  try {
+    const Scene s = parse_scene(text, "bad.toml");
+    run_scene(s, RunOptions{fs::temp_directory_path()});
+    FAIL() << "no error; expected /" << re << "/";
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+    EXPECT_TRUE(std::regex_search(msg, std::regex(re))) << "message: " << msg << "\nexpected /" << re << "/";
+    EXPECT_EQ(msg.rfind("bad.toml: ", 0), 0u) << msg;
+  }
+}
+
+std::string replace(std::string s, const std::string& from, const std::string& to) {
+  const auto p = s.find(from);
+  EXPECT_NE(p, std::string::npos) << from;
+  return s.replace(p, from.size(), to);
+}
+
+}  // namespace
+
+TEST(Scene, BaseRuns) {
+  const Scene s = parse_scene(kBase, "base.toml");
+  EXPECT_EQ(s.bodies.size(), 2u);
+  EXPECT_DOUBLE_EQ(s.bodies[0].semi_axes_m.x(), 2.0);
+  const RunReport r = run_scene(s);
+  ASSERT_EQ(r.impacts.size(), 1u);
+  EXPECT_TRUE(r.all_checks_passed());
+  EXPECT_TRUE(r.files_written.empty());
+}
+
+TEST(Scene, PaperSampleReproducesHandCalculation) {
+  const Scene s = load_scene(kSamples / "paper_table2.toml");
+  const fs::path out = fs::temp_directory_path() / "impactdeck_test_paper";
+  fs::create_directories(out);
+  const RunReport r = run_scene(s, RunOptions{out});
+  ASSERT_EQ(r.impacts.size(), 1u);
+  const auto& res = r.impacts[0].result;
+  const double rho = 7850, m1 = 4.0 / 3 * M_PI * 2.0 * 0.5 * 0.5 * rho, m2 = 4.0 / 3 * M_PI * 0.05 * 0.05 * 0.05 * rho;
+  // Central hit on the side: r x n = 0 for both bodies.
+  EXPECT_NEAR(res.reduced_mass_kg, m1 * m2 / (m1 + m2), 1e-12 * m2);
+  EXPECT_NEAR(res.approach_velocity_m_s, 400.0, 1e-9);
+  // Eq. 26 at (0, b, 0): sections x = 0 (circle, 0.5 m) and z = 0 (ellipse vertex, a^2/b = 8 m).
+  const double R1 = 0.5 * (0.5 + 8.0), r2 = 0.05;  // sphere at its own (0, -r, 0): Eq. 26 gives r
+  EXPECT_NEAR(res.effective_radius_m, R1 * r2 / (R1 + r2), 1e-12);
+  EXPECT_NEAR(res.effective_modulus_Pa, 1.025e11, 1);
+  EXPECT_TRUE(res.restitution.clamped);  // ln Phi = 8.3 > 6
+  EXPECT_NEAR(res.restitution.coefficient, 0.55 - 0.047 * 6, 1e-15);
+  EXPECT_LT(res.checks.impulse_relative_error, impactdeck::test::kSelfCheckRel);
+  EXPECT_LT(res.checks.energy_relative_error, impactdeck::test::kSelfCheckRel);
+  // Pi/m of the ellipsoid: (1 + R) * m_w v / m1 (MODEL.md: (1 + R) * 0.09998 m/s).
+  EXPECT_NEAR(-res.target_jump.delta_velocity_m_s.y(), (1 + res.restitution.coefficient) * 0.09998, 2e-5);
+  ASSERT_EQ(r.files_written.size(), 1u);
+  EXPECT_TRUE(fs::exists(out / "force_table2.csv"));
+  const auto j = to_json(s, r);
+  for (const char* k : {"reduced_mass_kg", "effective_radius_m", "effective_modulus_Pa",
+                        "hertz_constant_N_per_m1_5", "approach_velocity_m_s", "energy_flux_density",
+                        "restitution", "max_indentation_m", "max_force_N", "compression_time_s",
+                        "contact_time_s", "impulse_compression_Ns", "impulse_total_Ns", "checks"}) {
+    EXPECT_TRUE(j["impacts"][0].contains(k)) << k;
+  }
+  for (const char* k : {"impulse_relative_error", "energy_relative_error", "passed"})
+    EXPECT_TRUE(j["impacts"][0]["checks"].contains(k)) << k;
+  for (const char* who : {"target", "impactor"}) {
+    EXPECT_TRUE(j["impacts"][0][who].contains("delta_velocity_m_s"));
+    EXPECT_TRUE(j["impacts"][0][who].contains("delta_angular_velocity_rad_s"));
+  }
+  EXPECT_TRUE(j.contains("stages_run"));
+  EXPECT_TRUE(j.contains("stages_skipped"));
+}
+
+TEST(Scene, TwoSpheresSample) {
+  const Scene s = load_scene(kSamples / "two_spheres.toml");
+  const RunReport r = run_scene(s, RunOptions{fs::temp_directory_path()});
+  const auto& res = r.impacts[0].result;
+  const double m = 4.0 / 3 * M_PI * 0.05 * 0.05 * 0.05 * 7850;
+  EXPECT_NEAR(res.reduced_mass_kg, m / 2, 1e-12 * m);
+  EXPECT_NEAR(res.effective_radius_m, 0.025, 1e-15);
+  EXPECT_NEAR(res.approach_velocity_m_s, 1.0, 1e-15);
+  EXPECT_NEAR(res.impactor_jump.delta_velocity_m_s.x(), -1.0, 1e-9);  // elastic: velocities swap
+  EXPECT_NEAR(res.target_jump.delta_velocity_m_s.x(), 1.0, 1e-9);
+  EXPECT_TRUE(r.impacts[0].table->tolerance_met);
+  EXPECT_LE(r.impacts[0].table->impulse_relative_error, 1e-5);
+}
+
+TEST(Scene, AnalyticSceneRunsOnlyWhatItNeeds) {
+  const RunReport r = run_scene(parse_scene(kBase, "base.toml"));
+  const auto skipped = r.stages_skipped;
+  for (const char* s : {"mesh_load", "mesh_validation", "curvature_index", "force_table", "fem_mesh",
+                        "fem_decks", "fem_run", "write_outputs"}) {
+    EXPECT_NE(std::find(skipped.begin(), skipped.end(), s), skipped.end()) << s;
+  }
+}
+
+TEST(SceneErrors, NameFileLineKeyAndReason) {
+  expect_error(replace(kBase, "youngs_modulus_Pa = 2.05e11", "youngs_modulus_Pa = -2e11"),
+               R"(line 3, key 'materials\.steel\.youngs_modulus_Pa': must be > 0)");
+  expect_error(replace(kBase, "poisson_ratio = 0.3", "poisson_ratio = 0.5"),
+               R"(key 'materials\.steel\.poisson_ratio': must lie in \(-1, 0\.5\))");
+  expect_error(replace(kBase, "radius = 50", "radius = 0"), R"(line 14, key 'bodies\[1\]\.radius': must be > 0)");
+  expect_error(replace(kBase, "radius = 50", "radius = \"50\""), R"(bodies\[1\]\.radius': must be a number, got a string)");
+  expect_error(replace(kBase, "radius = 50", "radus = 50"), R"(missing required key 'bodies\[1\]\.radius')");
+  expect_error(kBase + "colour = \"red\"\n", R"(unknown key \(allowed here)");
+  expect_error(replace(kBase, "material = \"steel\"\n[[bodies]]", "material = \"stel\"\n[[bodies]]"),
+               R"(key 'bodies\[0\]\.material': unknown material 'stel')");
+  expect_error(replace(kBase, "length_unit = \"mm\"", "length_unit = \"furlong\""),
+               R"(key 'length_unit': unknown unit)");
+  expect_error(replace(kBase, "length_unit = \"mm\"\n", ""), R"(missing required key 'length_unit')");
+  expect_error(replace(kBase, "impactor = \"ball\"", "impactor = \"bal\""), R"(impacts\[0\]\.impactor': no body named 'bal')");
+  expect_error(replace(kBase, "semi_axes = [2000, 500, 500]", "semi_axes = [2000, 500]"),
+               R"(semi_axes': must be an array of 3 numbers)");
+  expect_error(kBase + "restitution = 1.5\n", R"(restitution': must lie in \[0, 1\])");
+  expect_error(kBase + "contact_radius = \"median\"\n", R"(contact_radius': unknown value "median")");
+  expect_error(replace(kBase, "name = \"ball\"", "name = \"target\""), R"(duplicate body name 'target')");
+  expect_error(replace(kBase, "[[impacts]]", "[[impacts]\n"), R"(line \d+, column \d+: TOML syntax error)");
+  expect_error(replace(kBase, "density_kg_m3 = 7850\n", ""), R"(needs a mass)");
+  expect_error(replace(kBase, "velocity_m_s = [0, -1, 0]", "velocity_m_s = [0, 1, 0]"),
+               R"(impact 'impact1': .*no impact)");
+  expect_error(replace(kBase, "point = [0, 500, 0]", "point = [0, 900, 0]"),
+               R"(impacts\[0\]\.point': impact 'impact1': point is 0\.4 m from the surface)");
+  expect_error(replace(kBase, "velocity_m_s = [0, -1, 0]", "velocity_m_s = [0, -1, nan]"), R"(must be finite)");
+}
+
+TEST(SceneErrors, FilesThatAreNotScenes) {
+  EXPECT_THROW(load_scene("/nonexistent/scene.toml"), InputError);
+  EXPECT_THROW(load_scene(fs::temp_directory_path()), InputError);
+}
+
+TEST(Outputs, MissingFolderIsAnErrorAndNothingIsWritten) {
+  const fs::path out = fs::temp_directory_path() / "impactdeck_missing_dir_test";
+  fs::remove_all(out);
+  const Scene s = parse_scene(kBase + "[outputs]\nforce_table_csv = \"sub/force.csv\"\n", "o.toml");
+  fs::create_directories(out);
+  EXPECT_THROW(run_scene(s, RunOptions{out}), InputError);
+  EXPECT_TRUE(fs::is_empty(out));
+}
