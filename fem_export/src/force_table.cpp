@@ -14,8 +14,9 @@ void write_force_table_csv(const std::filesystem::path& path, const collision::F
     if (!h.source.empty()) out << "# scene: " << h.source << "\n";
     if (!h.impact.empty()) out << "# impact: " << h.impact << "\n";
     out << std::setprecision(17);
-    out << "# force direction on the target (unit vector): " << h.direction.x() << " "
-        << h.direction.y() << " " << h.direction.z() << "\n";
+    const Eigen::Vector3d d = h.direction + Eigen::Vector3d::Zero();  // no "-0" in the file
+    out << "# force direction on the target (unit vector): " << d.x() + 0.0 << " " << d.y() + 0.0
+        << " " << d.z() + 0.0 << "\n";
     out << "# table impulse " << t.impulse_Ns << " N s, relative error "
         << std::setprecision(3) << t.impulse_relative_error << " against the exact impulse\n";
     out << std::setprecision(17);

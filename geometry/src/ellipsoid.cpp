@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <numeric>
+#include <random>
 #include <sstream>
 
 #include <gsl/gsl_mode.h>
@@ -230,6 +231,28 @@ std::optional<SurfacePoint> Ellipsoid::ray_exit(const Eigen::Vector3d& o,
   sp.normal = normal_at(sp.point_m);
   sp.distance_m = 0.0;
   return sp;
+}
+
+std::vector<SurfacePoint> Ellipsoid::sample_surface(std::size_t count, std::uint64_t seed) const {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  std::uniform_real_distribution<double> uni(0.0, 1.0);
+  const Eigen::Vector3d inv = e_.cwiseInverse();
+  const double stretch_max = inv.maxCoeff();
+  std::vector<SurfacePoint> out;
+  out.reserve(count);
+  while (out.size() < count) {
+    Eigen::Vector3d u(gauss(rng), gauss(rng), gauss(rng));
+    const double len = u.norm();
+    if (!(len > 0.0)) continue;
+    u /= len;
+    if (uni(rng) * stretch_max > u.cwiseProduct(inv).norm()) continue;
+    SurfacePoint sp;
+    sp.point_m = u.cwiseProduct(e_);
+    sp.normal = normal_at(sp.point_m);
+    out.push_back(sp);
+  }
+  return out;
 }
 
 double ellipsoid_mean_curvature(const Eigen::Vector3d& e, const Eigen::Vector3d& p) {

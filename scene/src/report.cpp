@@ -9,7 +9,13 @@
 namespace impactdeck::scene {
 namespace {
 
-nlohmann::json vec(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+// + 0.0 turns -0 into 0 so that outputs never show "-0".
+nlohmann::json vec(const Eigen::Vector3d& v) { return {v.x() + 0.0, v.y() + 0.0, v.z() + 0.0}; }
+std::string text(const Eigen::Vector3d& v) {
+  std::ostringstream s;
+  s << std::setprecision(6) << "(" << v.x() + 0.0 << ", " << v.y() + 0.0 << ", " << v.z() + 0.0 << ")";
+  return s.str();
+}
 
 // Never NaN or Inf in an output: a non-finite value becomes null.
 nlohmann::json num(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
@@ -113,8 +119,7 @@ std::string format_summary(const Scene& scene, const RunReport& rep) {
     const auto& c = r.history.compression;
     const auto& p = ir.contact.target_point;
     o << "\nimpact '" << ir.spec->name << "': " << ir.spec->impactor << " hits " << ir.spec->target
-      << " at (" << p.point_m.x() << ", " << p.point_m.y() << ", " << p.point_m.z() << ") m, normal ("
-      << p.normal.x() << ", " << p.normal.y() << ", " << p.normal.z() << ")\n";
+      << " at " << text(p.point_m) << " m, normal " << text(p.normal) << "\n";
     o << "  reduced mass          " << r.reduced_mass_kg << " kg\n";
     o << "  approach velocity     " << r.approach_velocity_m_s << " m/s\n";
     o << "  effective radius      " << r.effective_radius_m << " m (" << to_string(ir.spec->contact_radius)
@@ -133,10 +138,10 @@ std::string format_summary(const Scene& scene, const RunReport& rep) {
     o << "  contact time          " << r.history.contact_time_s() << " s\n";
     o << "  impulse               " << r.history.impulse_total_Ns() << " N s (compression "
       << r.history.impulse_compression_Ns() << ")\n";
-    o << "  target   dv = " << r.target_jump.delta_velocity_m_s.transpose() << " m/s, dw = "
-      << r.target_jump.delta_angular_velocity_rad_s.transpose() << " rad/s\n";
-    o << "  impactor dv = " << r.impactor_jump.delta_velocity_m_s.transpose() << " m/s, dw = "
-      << r.impactor_jump.delta_angular_velocity_rad_s.transpose() << " rad/s\n";
+    o << "  target   dv = " << text(r.target_jump.delta_velocity_m_s) << " m/s, dw = "
+      << text(r.target_jump.delta_angular_velocity_rad_s) << " rad/s\n";
+    o << "  impactor dv = " << text(r.impactor_jump.delta_velocity_m_s) << " m/s, dw = "
+      << text(r.impactor_jump.delta_angular_velocity_rad_s) << " rad/s\n";
     const auto& k = r.checks;
     o << "  check impulse (Eq. 31)  rel. error " << std::setprecision(2) << std::scientific
       << k.impulse_relative_error << " (limit " << k.thresholds.impulse_relative << ")\n";

@@ -23,6 +23,9 @@ class Ellipsoid final : public Shape {
   std::optional<SurfacePoint> ray_exit(const Eigen::Vector3d& origin_m,
                                        const Eigen::Vector3d& direction) const override;
   double size_m() const override { return 2.0 * e_.maxCoeff(); }
+  /// Area-uniform: uniform directions on the unit sphere mapped by diag(a, b, c), accepted with
+  /// probability proportional to the area stretch abc |diag(1/a, 1/b, 1/c) u|.
+  std::vector<SurfacePoint> sample_surface(std::size_t count, std::uint64_t seed) const override;
 
   /// Outward unit normal at a surface point (Eq. 25).
   Eigen::Vector3d normal_at(const Eigen::Vector3d& p_m) const;

@@ -2,8 +2,10 @@
 // What the collision pipeline asks of a body's shape, whatever it is (analytic or a mesh):
 // mass properties, closest surface point, outward normal, local curvature and the paper's
 // Eq. 26 radius. All in the shape's own frame, SI units.
+#include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <Eigen/Dense>
 
@@ -51,6 +53,9 @@ class Shape {
                                                const Eigen::Vector3d& direction) const = 0;
   /// Largest extent, m (for relative tolerances).
   virtual double size_m() const = 0;
+  /// `count` points distributed uniformly by area over the surface, with outward normals;
+  /// deterministic for a given seed.
+  virtual std::vector<SurfacePoint> sample_surface(std::size_t count, std::uint64_t seed) const = 0;
 };
 
 }  // namespace impactdeck::geometry
