@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "impactdeck/collision/elliptical.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/scene/pipeline.hpp"
 #include "impactdeck/scene/report.hpp"
@@ -178,4 +179,26 @@ TEST(Outputs, MissingFolderIsAnErrorAndNothingIsWritten) {
   fs::create_directories(out);
   EXPECT_THROW(run_scene(s, RunOptions{out}), InputError);
   EXPECT_TRUE(fs::is_empty(out));
+}
+
+TEST(Scene, EllipticalContactRadius) {
+  // On two spheres the elliptical contact is the spherical one.
+  std::string two = kBase;
+  two = replace(two, "shape = \"ellipsoid\"\nsemi_axes = [2000, 500, 500]", "shape = \"sphere\"\nradius = 500");
+  for (const char* rule : {"mean", "elliptical"}) {
+    const RunReport r = run_scene(parse_scene(two + "contact_radius = \"" + rule + "\"\n", "s.toml"));
+    EXPECT_NEAR(r.impacts[0].result.effective_radius_m, 0.5 * 0.05 / 0.55, 1e-15) << rule;
+  }
+  // Ellipsoid 2000/500/500 mm at (0, b, 0), ball r = 50 mm: target curvatures b/a^2 (along x) and
+  // 1/b (along z); the ball's 1/r both ways. A = (b/a^2 + 1/r)/2, B = (1/b + 1/r)/2.
+  const RunReport e = run_scene(parse_scene(kBase + "contact_radius = \"elliptical\"\n", "e.toml"));
+  const auto& g = e.impacts[0].contact;
+  EXPECT_NEAR(g.relative_curvature_A_per_m, 0.5 * (0.5 / 4.0 + 20.0), 1e-12);
+  EXPECT_NEAR(g.relative_curvature_B_per_m, 0.5 * (2.0 + 20.0), 1e-12);
+  const auto ec = impactdeck::collision::elliptical_contact({0.5 * (0.125 + 20.0), 11.0});
+  EXPECT_NEAR(e.impacts[0].result.effective_radius_m, ec.equivalent_radius_m, 1e-15);
+  EXPECT_GT(g.contact_ellipse_axis_ratio, 1.0);
+  // The elliptical R_eq lies between the two principal relative radii 1/(2B) and 1/(2A).
+  EXPECT_GT(ec.equivalent_radius_m, 1.0 / 22.0);
+  EXPECT_LT(ec.equivalent_radius_m, 1.0 / 20.125);
 }

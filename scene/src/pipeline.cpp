@@ -5,6 +5,7 @@
 #include <limits>
 #include <sstream>
 
+#include "impactdeck/collision/elliptical.hpp"
 #include "impactdeck/collision/hertz.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/fem_export/force_table.hpp"
@@ -101,6 +102,20 @@ PreparedBody prepare_body(const BodySpec& b, const Scene& scene) {
 
 namespace {
 
+// Rethrows an InputError raised without a file (the collision core's) with the scene's place.
+template <class F>
+auto in_impact(const Scene& scene, const ImpactSpec& s, F&& f) {
+  try {
+    return f();
+  } catch (const InputError& e) {
+    if (!e.where().empty()) throw;
+    throw InputError(where(scene), s.place.describe(),
+                     "impact '" + s.name + "': " + (e.place().empty() ? "" : e.place() + ": ") + e.reason());
+  }
+}
+
+// The curvature (1/m) a rule assigns to one body at its contact point; for the elliptical rule
+// this is only reported (the radius comes from both bodies' curvature tensors).
 double rule_curvature(const geometry::Shape& shape, const geometry::SurfacePoint& sp,
                       const geometry::Curvature& k, ContactRadiusRule rule) {
   if (rule == ContactRadiusRule::paper) return 1.0 / shape.paper_radius_m(sp);
@@ -140,6 +155,20 @@ ContactGeometry contact_geometry(const Scene& scene, const ImpactSpec& s, const 
   g.target_curvature_per_m = rule_curvature(*target.shape, g.target_point, g.target_curvature, s.contact_radius);
   g.impactor_curvature_per_m =
       rule_curvature(*impactor.shape, g.impactor_point, g.impactor_curvature, s.contact_radius);
+  g.effective_radius_m = in_impact(scene, s, [&] {
+    if (s.contact_radius != ContactRadiusRule::elliptical) {
+      return collision::effective_radius_m(g.target_curvature_per_m, g.impactor_curvature_per_m);
+    }
+    const geometry::Curvature& a = g.target_curvature;
+    const geometry::Curvature& b = g.impactor_curvature;
+    const collision::RelativeCurvatures rc = collision::relative_curvatures(
+        a.k1_per_m, a.k2_per_m, a.d1, a.d2, b.k1_per_m, b.k2_per_m, b.d1, b.d2, n);
+    const collision::EllipticalContact ec = collision::elliptical_contact(rc);
+    g.relative_curvature_A_per_m = rc.A_per_m;
+    g.relative_curvature_B_per_m = rc.B_per_m;
+    g.contact_ellipse_axis_ratio = ec.axis_ratio;
+    return ec.equivalent_radius_m;
+  });
   return g;
 }
 
@@ -152,18 +181,6 @@ collision::RigidBody rigid(const PreparedBody& b, const Eigen::Vector3d& offset,
   r.velocity_m_s = velocity;
   r.angular_velocity_rad_s = b.spec->angular_velocity_rad_s;
   return r;
-}
-
-// Rethrows an InputError raised without a file (the collision core's) with the scene's place.
-template <class F>
-auto in_impact(const Scene& scene, const ImpactSpec& s, F&& f) {
-  try {
-    return f();
-  } catch (const InputError& e) {
-    if (!e.where().empty()) throw;
-    throw InputError(where(scene), s.place.describe(),
-                     "impact '" + s.name + "': " + (e.place().empty() ? "" : e.place() + ": ") + e.reason());
-  }
 }
 
 }  // namespace
@@ -198,8 +215,7 @@ RunReport run_scene(const Scene& scene, const RunOptions& opt) {
         in.impactor = rigid(impactor, ir.contact.impactor_offset_m, v2);
         in.contact.point_m = ir.contact.target_point.point_m;
         in.contact.normal = ir.contact.target_point.normal;
-        in.effective_radius_m = collision::effective_radius_m(ir.contact.target_curvature_per_m,
-                                                              ir.contact.impactor_curvature_per_m);
+        in.effective_radius_m = ir.contact.effective_radius_m;
         in.effective_modulus_Pa =
             collision::effective_modulus_Pa(target.material, impactor.material, scene.modulus_convention);
         in.restitution = s.restitution;

@@ -51,6 +51,11 @@ nlohmann::json to_json(const Scene& scene, const RunReport& rep) {
                                                 ir.contact.target_curvature.k2_per_m};
     i["target_contact_curvature_1_per_m"] = num(ir.contact.target_curvature_per_m);
     i["impactor_contact_curvature_1_per_m"] = num(ir.contact.impactor_curvature_per_m);
+    if (ir.spec->contact_radius == ContactRadiusRule::elliptical) {
+      i["relative_curvatures_1_per_m"] = {ir.contact.relative_curvature_A_per_m,
+                                          ir.contact.relative_curvature_B_per_m};
+      i["contact_ellipse_axis_ratio"] = num(ir.contact.contact_ellipse_axis_ratio);
+    }
     i["reduced_mass_kg"] = num(r.reduced_mass_kg);
     i["effective_radius_m"] = num(r.effective_radius_m);
     i["effective_modulus_Pa"] = num(r.effective_modulus_Pa);

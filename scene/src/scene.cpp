@@ -29,7 +29,12 @@ const char* to_string(ShapeKind k) {
 }
 
 const char* to_string(ContactRadiusRule r) {
-  return r == ContactRadiusRule::paper ? "paper" : "mean";
+  switch (r) {
+    case ContactRadiusRule::paper: return "paper";
+    case ContactRadiusRule::mean: return "mean";
+    case ContactRadiusRule::elliptical: return "elliptical";
+  }
+  return "?";
 }
 
 const BodySpec& Scene::body(const std::string& name) const {
@@ -252,7 +257,10 @@ ImpactSpec read_impact(std::size_t index, const toml::table& t, const std::strin
     }
   }
   s.contact_radius = r.choice<ContactRadiusRule>(
-      "contact_radius", {{"paper", ContactRadiusRule::paper}, {"mean", ContactRadiusRule::mean}},
+      "contact_radius",
+      {{"paper", ContactRadiusRule::paper},
+       {"mean", ContactRadiusRule::mean},
+       {"elliptical", ContactRadiusRule::elliptical}},
       ContactRadiusRule::paper);
   if (r.has("approach_speed_m_s")) s.approach_speed_m_s = r.positive("approach_speed_m_s");
   if (r.has("max_projection_distance")) {

@@ -33,6 +33,10 @@ struct ContactGeometry {
   double impactor_curvature_per_m = 0;
   geometry::Curvature target_curvature;   ///< principal curvatures at the contact point
   geometry::Curvature impactor_curvature;
+  double effective_radius_m = 0;          ///< R* (Eq. 29), or R_eq of the elliptical contact
+  /// Elliptical rule only: relative curvatures A <= B and the contact ellipse's axis ratio a/b.
+  double relative_curvature_A_per_m = 0, relative_curvature_B_per_m = 0;
+  double contact_ellipse_axis_ratio = 1;
 };
 
 struct ImpactReport {

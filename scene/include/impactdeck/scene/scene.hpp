@@ -49,6 +49,7 @@ struct BodySpec {
 enum class ContactRadiusRule {
   paper,  ///< Eq. 26: average radius of the three axis-normal sections
   mean,   ///< 1 / mean curvature, from the principal curvatures
+  elliptical,  ///< full elliptical Hertz contact from both bodies' principal curvatures
 };
 
 struct ImpactSpec {
