@@ -82,6 +82,23 @@ TEST(Compression, FastShapeEqualsExactInverse) {
   }
   RecordProperty("max_abs_difference", sci(worst));
   EXPECT_LT(worst, kShapeAbs);
+  double worst_f = 0;
+  for (int i = 0; i <= 2000; ++i) {
+    const double tau = i / 2000.0, z = compression_shape_exact(tau);
+    worst_f = std::max(worst_f, std::abs(compression_force_fraction(tau) - z * std::sqrt(z)));
+  }
+  RecordProperty("max_abs_difference_force", sci(worst_f));
+  EXPECT_LT(worst_f, kShapeAbs);
+}
+
+TEST(Compression, BatchCurveEqualsPointwise) {
+  const CompressionPhase c = solve_compression(2.0, 3.0, 1e9);
+  std::vector<double> t, f(1003);
+  for (int i = -1; i <= 1001; ++i) t.push_back(c.compression_time_s * i / 1000.0);  // one each side
+  c.force_curve(t.data(), f.data(), t.size());
+  for (std::size_t i = 0; i < t.size(); ++i) EXPECT_NEAR(f[i], c.force_N(t[i]), 1e-14 * c.max_force_N) << i;
+  EXPECT_EQ(f.front(), 0.0);
+  EXPECT_EQ(f.back(), c.max_force_N);
 }
 
 TEST(Compression, ExactInverseSatisfiesTheTimeIntegral) {

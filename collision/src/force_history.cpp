@@ -55,26 +55,32 @@ namespace {
 void fill_uniform(const ForceHistory& h, std::size_t n_comp, std::size_t n_rest, ForceTable& t) {
   const double tm = h.compression.compression_time_s;
   const double tr = h.restitution * tm;
-  t.time_s.clear();
-  t.force_N.clear();
-  t.time_s.reserve(n_comp + n_rest + 1);
-  t.force_N.reserve(n_comp + n_rest + 1);
+  const std::size_t n_total = n_comp + 1 + (tr > 0.0 ? n_rest : 1);
+  t.time_s.resize(n_total);
+  t.force_N.resize(n_total);
+  // Times, and the compression-phase times at which the force is evaluated (the restitution
+  // curve is the compression curve mirrored: F(t) = F_comp(t_m - (t - t_m)/R)).
+  std::vector<double> eval(n_total);
   for (std::size_t i = 0; i <= n_comp; ++i) {
-    const double time = tm * static_cast<double>(i) / static_cast<double>(n_comp);
-    t.time_s.push_back(time);
-    t.force_N.push_back(i == 0 ? 0.0 : h.force_N(time));
+    t.time_s[i] = tm * static_cast<double>(i) / static_cast<double>(n_comp);
+    eval[i] = t.time_s[i];
   }
   if (tr > 0.0) {
     for (std::size_t i = 1; i <= n_rest; ++i) {
-      const double time = tm + tr * static_cast<double>(i) / static_cast<double>(n_rest);
-      t.time_s.push_back(time);
-      t.force_N.push_back(i == n_rest ? 0.0 : h.force_N(time));
+      const double u = static_cast<double>(i) / static_cast<double>(n_rest);
+      t.time_s[n_comp + i] = tm + tr * u;
+      eval[n_comp + i] = tm * (1.0 - u);
     }
   } else {
     // Perfectly plastic impact: the force drops to zero at t_m (a step in the table).
-    t.time_s.push_back(tm);
-    t.force_N.push_back(0.0);
+    t.time_s[n_comp + 1] = tm;
+    eval[n_comp + 1] = 0.0;
   }
+  h.compression.force_curve(eval.data(), t.force_N.data(), n_total);
+  t.force_N[n_comp] = h.compression.max_force_N;  // t_m exactly, whatever t_m / t_m rounds to
+  t.force_N.front() = 0.0;
+  t.force_N.back() = 0.0;
+  t.time_s.back() = h.contact_time_s();
   double imp = 0.0;
   for (std::size_t i = 1; i < t.time_s.size(); ++i) {
     imp += 0.5 * (t.force_N[i] + t.force_N[i - 1]) * (t.time_s[i] - t.time_s[i - 1]);

@@ -7,9 +7,11 @@
 //   t/t_m = I_{z^p}(1/p, 1/2),  z = x/x_max  (regularized incomplete beta; Eq. 10)
 //
 // The shape is universal: x(t) = x_max Z(t/t_m), F(t) = F_max Z^n, with one function Z on [0, 1].
-// Z is evaluated by a Chebyshev expansion of g(s) = Z(tau)/(C_n tau) in s = tau^(5/2), a variable
-// in which g is analytic (Z - C_n tau ~ tau^(7/2) is not analytic in tau at 0). The expansion is
-// built once from the exact inverse of the incomplete beta function.
+// Z is evaluated by a degree-15 polynomial of g(s) = Z(tau)/(C_n tau) in s = tau^(5/2), a variable
+// in which g is analytic (Z - C_n tau ~ tau^(7/2) is not analytic in tau at 0); the force fraction
+// Z^(3/2) has its own. Both are built once from the exact inverse of the incomplete beta function.
+
+#include <cstddef>
 
 namespace impactdeck::collision {
 
@@ -22,6 +24,10 @@ double compression_time_factor();
 /// Universal compression shape Z(tau) = x/x_max at tau = t/t_m, tau clamped to [0, 1].
 /// Fast (a few ns); absolute error below 1e-14 (tests/test_compression.cpp).
 double compression_shape(double tau);
+
+/// Force fraction F/F_max = Z(tau)^(3/2) at tau = t/t_m, from its own expansion (one square root
+/// per call). Absolute error below 1e-14.
+double compression_force_fraction(double tau);
 
 /// Same, by direct inversion of the regularized incomplete beta function (GSL beta_inc plus a
 /// safeguarded Newton iteration, about a microsecond). Reference for tests and for building the
@@ -46,6 +52,8 @@ struct CompressionPhase {
   double indentation_m(double t_s) const;
   /// F(t) = k_H x(t)^n for 0 <= t <= t_m (0 before, F_max after).
   double force_N(double t_s) const;
+  /// The same at n times at once (a few ns per sample): the way to sample a curve.
+  void force_curve(const double* t_s, double* force_N, std::size_t n) const;
 };
 
 /// Closed-form compression phase. Throws InputError unless m_w > 0, v_w > 0, k_H > 0 (finite).
