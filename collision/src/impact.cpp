@@ -22,7 +22,7 @@ ImpactResult solve_impact(const ImpactInput& in) {
   if (!(r.approach_velocity_m_s > 0.0)) {
     std::ostringstream s;
     s << "no impact: the bodies do not approach at the contact point (approach velocity "
-      << r.approach_velocity_m_s << " m/s along the inward normal)";
+      << r.approach_velocity_m_s + 0.0 << " m/s along the inward normal)";
     throw InputError("", "velocity", s.str());
   }
   if (!(in.effective_radius_m > 0.0) || !std::isfinite(in.effective_radius_m)) {

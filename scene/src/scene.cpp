@@ -66,6 +66,10 @@ class Reader {
     used_.insert(k);
     return t_.get(k);
   }
+  /// Declares the keys this table may hold (listed in the unknown-key message).
+  void allow(std::initializer_list<const char*> keys) {
+    for (const char* k : keys) allowed_.insert(k);
+  }
   bool has(const std::string& k) const { return t_.contains(k); }
 
   std::optional<double> number(const std::string& k) {
@@ -138,15 +142,15 @@ class Reader {
     throw InputError(file_, self().describe(), "missing required key '" + key_path(k) + "'");
   }
 
-  /// Rejects keys that were never read, naming the allowed ones.
-  void reject_unknown(const std::vector<std::string>& also_allowed = {}) const {
+  /// Rejects keys that are neither declared with allow() nor read, naming the allowed ones.
+  void reject_unknown() const {
     for (const auto& [key, node] : t_) {
       const std::string k(key.str());
-      if (used_.count(k)) continue;
-      if (std::find(also_allowed.begin(), also_allowed.end(), k) != also_allowed.end()) continue;
+      if (used_.count(k) || allowed_.count(k)) continue;
+      std::set<std::string> all = allowed_;
+      all.insert(used_.begin(), used_.end());
       std::string list;
-      for (const auto& u : used_) list += (list.empty() ? "" : ", ") + u;
-      for (const auto& u : also_allowed) list += (list.empty() ? "" : ", ") + u;
+      for (const auto& u : all) list += (list.empty() ? "" : ", ") + u;
       throw InputError(file_, Place{line_of(&node), key_path(k)}.describe(),
                        "unknown key (allowed here: " + list + ")");
     }
@@ -174,11 +178,13 @@ class Reader {
   std::string prefix_;
   const std::string& file_;
   std::set<std::string> used_;
+  std::set<std::string> allowed_;
 };
 
 // All keys a reader may see are declared by reading them; sub-tables are read by their own reader.
 Material read_material(const std::string& name, const toml::table& t, const std::string& file) {
   Reader r(t, "materials." + name, file);
+  r.allow({"youngs_modulus_Pa", "poisson_ratio", "density_kg_m3"});
   Material m;
   m.name = name;
   m.place = r.self();
@@ -195,6 +201,8 @@ Material read_material(const std::string& name, const toml::table& t, const std:
 BodySpec read_body(std::size_t index, const toml::table& t, const std::string& file,
                    double to_m, const fs::path& base_dir) {
   Reader r(t, "bodies[" + std::to_string(index) + "]", file);
+  r.allow({"name", "shape", "radius", "semi_axes", "mesh", "material", "mass_kg", "fixed",
+           "velocity_m_s", "angular_velocity_rad_s"});
   BodySpec b;
   b.place = r.self();
   b.name = r.required_string("name");
@@ -231,6 +239,8 @@ BodySpec read_body(std::size_t index, const toml::table& t, const std::string& f
 ImpactSpec read_impact(std::size_t index, const toml::table& t, const std::string& file,
                        double to_m, const collision::RestitutionModel& defaults) {
   Reader r(t, "impacts[" + std::to_string(index) + "]", file);
+  r.allow({"name", "target", "impactor", "point", "restitution", "contact_radius",
+           "approach_speed_m_s", "max_projection_distance"});
   ImpactSpec s;
   s.place = r.self();
   s.name = r.string("name").value_or("impact" + std::to_string(index + 1));
@@ -274,6 +284,7 @@ ImpactSpec read_impact(std::size_t index, const toml::table& t, const std::strin
 
 Outputs read_outputs(const toml::table& t, const std::string& file) {
   Reader r(t, "outputs", file);
+  r.allow({"force_table_csv", "force_table_impulse_tolerance", "force_table_time_step_s"});
   Outputs o;
   if (auto s = r.string("force_table_csv")) {
     if (s->empty()) r.fail("force_table_csv", "must not be empty");
@@ -311,6 +322,8 @@ Scene build(const toml::table& root, const std::string& file, const fs::path& ba
   Scene sc;
   sc.file = file;
   Reader r(root, "", file);
+  r.allow({"length_unit", "modulus_convention", "energy_flux_unit", "restitution_range_policy",
+           "checks", "materials", "bodies", "impacts", "outputs"});
   const std::string unit_text = r.required_string("length_unit");
   auto unit = parse_length_unit(unit_text);
   if (!unit) r.fail("length_unit", "unknown unit \"" + unit_text + "\" (expected m, cm, mm or in)");
@@ -337,6 +350,7 @@ Scene build(const toml::table& root, const std::string& file, const fs::path& ba
 
   if (const toml::node* n = r.get("checks")) {
     Reader c(sub_table(n, "checks", file), "checks", file);
+    c.allow({"impulse_relative", "energy_relative"});
     if (c.has("impulse_relative")) sc.thresholds.impulse_relative = c.positive("impulse_relative");
     if (c.has("energy_relative")) sc.thresholds.energy_relative = c.positive("energy_relative");
     c.reject_unknown();

@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# Runs every case of tests/data/bad/cases.tsv through the CLI: the exit code must match, stderr
+# must be exactly one line matching the case's pattern, and the output folder must stay empty.
+# usage: bad_inputs.sh IMPACTDECK SOURCE_DIR
+set -u
+bin=$1; src=$2
+bad="$src/tests/data/bad"
+pass=0; fail=0
+while IFS=$'\t' read -r name args code pattern; do
+  case "$name" in ''|'#'*) continue ;; esac
+  out=$(mktemp -d)
+  a=${args//\{BAD\}/$bad}
+  a=${a//\{OUT\}/$out}
+  a=${a//\{SRC\}/$src}
+  # shellcheck disable=SC2086
+  "$bin" $a >"$out.stdout" 2>"$out.stderr" </dev/null
+  rc=$?
+  lines=$(wc -l <"$out.stderr")
+  msg=$(head -n 1 "$out.stderr")
+  problems=""
+  [ "$rc" = "$code" ] || problems="$problems exit $rc (expected $code);"
+  [ "$lines" -eq 1 ] || problems="$problems $lines stderr lines (expected 1);"
+  printf '%s' "$msg" | grep -Eq -- "$pattern" || problems="$problems message does not match /$pattern/;"
+  [ -z "$(ls -A "$out" 2>/dev/null)" ] || problems="$problems output folder not empty: $(ls -A "$out");"
+  if [ -n "$problems" ]; then
+    echo "FAILED $name:$problems"
+    echo "  message: $msg"
+    fail=$((fail+1))
+  else
+    pass=$((pass+1))
+  fi
+  rm -rf "$out" "$out.stdout" "$out.stderr"
+done <"$bad/cases.tsv"
+echo "bad_inputs: $pass passed, $fail failed"
+[ "$fail" -eq 0 ] && [ "$pass" -ge 1 ]
