@@ -8,7 +8,6 @@
 
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_sf_gamma.h>
-#include <gsl/gsl_sf_hyperg.h>
 
 #include "impactdeck/common/error.hpp"
 
@@ -152,12 +151,6 @@ double compression_force_fraction(double tau) {
   const double t15 = tau * std::sqrt(tau);  // tau^(3/2)
   const double f = cn15 * t15 * ShapePolynomials::eval(shape_polynomials().h, 2.0 * tau * t15 - 1.0);
   return f < 1.0 ? f : 1.0;
-}
-
-double compression_time_fraction_hypergeometric(double z) {
-  if (!(z > 0.0)) return 0.0;
-  const double f = gsl_sf_hyperg_2F1(0.5, kA, 1.0 + kA, std::pow(z, kP));
-  return z * f / compression_time_factor();
 }
 
 void CompressionPhase::force_curve(const double* t_s, double* force_N, std::size_t n) const {

@@ -34,10 +34,6 @@ double compression_force_fraction(double tau);
 /// fast expansion.
 double compression_shape_exact(double tau);
 
-/// The paper's Eq. 10: tau = t/t_m for a given z = x/x_max in [0, 1), through the Gauss
-/// hypergeometric function 2F1(1/2, 1/p; 1+1/p; z^p). Used only as a cross-check.
-double compression_time_fraction_hypergeometric(double z);
-
 /// The compression phase of one impact; all SI.
 struct CompressionPhase {
   double reduced_mass_kg = 0;          ///< m_w
