@@ -35,7 +35,10 @@ void sync_file(const fs::path& p) {
 
 }  // namespace
 
-void write_file_atomically(const fs::path& path, const std::function<void(std::ostream&)>& fill) {
+namespace {
+
+// Writes `fill` into a temporary file beside `path` and returns the temporary's name.
+fs::path write_temporary(const fs::path& path, const std::function<void(std::ostream&)>& fill) {
   const fs::path dir = path.has_parent_path() ? path.parent_path() : fs::path(".");
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) {
@@ -59,11 +62,45 @@ void write_file_atomically(const fs::path& path, const std::function<void(std::o
     }
   }
   sync_file(tmp);
+  return tmp;
+}
+
+void rename_into_place(const fs::path& tmp, const fs::path& path) {
+  std::error_code ec;
   fs::rename(tmp, path, ec);
   if (ec) {
     fs::remove(tmp, ec);
     throw InputError(path.string(), "output", "cannot rename temporary file into place");
   }
+}
+
+}  // namespace
+
+void write_file_atomically(const fs::path& path, const std::function<void(std::ostream&)>& fill) {
+  rename_into_place(write_temporary(path, fill), path);
+}
+
+AtomicFileSet::~AtomicFileSet() {
+  std::error_code ec;
+  for (const auto& [tmp, target] : staged_) fs::remove(tmp, ec);
+}
+
+void AtomicFileSet::add(const fs::path& path, const std::function<void(std::ostream&)>& fill) {
+  staged_.emplace_back(write_temporary(path, fill), path);
+}
+
+void AtomicFileSet::add(const fs::path& path, const std::string& content) {
+  add(path, [&](std::ostream& out) { out << content; });
+}
+
+std::vector<fs::path> AtomicFileSet::commit() {
+  std::vector<fs::path> done;
+  for (const auto& [tmp, target] : staged_) {
+    rename_into_place(tmp, target);
+    done.push_back(target);
+  }
+  staged_.clear();
+  return done;
 }
 
 void write_file_atomically(const fs::path& path, const std::string& content) {

@@ -7,6 +7,7 @@
 
 #include "impactdeck/collision/elliptical.hpp"
 #include "impactdeck/collision/hertz.hpp"
+#include "impactdeck/common/atomic_file.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/fem_export/force_table.hpp"
 #include "impactdeck/geometry/ellipsoid.hpp"
@@ -243,6 +244,7 @@ RunReport run_scene(const Scene& scene, const RunOptions& opt) {
       }
     });
     clock.run("write_outputs", [&] {
+      AtomicFileSet files;  // all or nothing: a failure leaves the previous outputs as they were
       const fs::path base = *scene.outputs.force_table_csv;
       for (auto& ir : report.impacts) {
         fs::path p = base;
@@ -254,10 +256,10 @@ RunReport run_scene(const Scene& scene, const RunOptions& opt) {
         h.source = scene.file.string();
         h.impact = ir.spec->name;
         h.direction = -ir.contact.target_point.normal;  // force on the target: along -n
-        fem_export::write_force_table_csv(full, *ir.table, h);
+        files.add(full, [&](std::ostream& out) { fem_export::write_force_table_csv(out, *ir.table, h); });
         ir.table_path = full;
-        report.files_written.push_back(full);
       }
+      for (const auto& f : files.commit()) report.files_written.push_back(f);
     });
   }
 

@@ -1,6 +1,6 @@
 #pragma once
 // The force table handed to an FEM code: the impactor replaced by F(t) at the contact node.
-#include <filesystem>
+#include <ostream>
 #include <string>
 
 #include <Eigen/Dense>
@@ -17,8 +17,8 @@ struct ForceTableHeader {
 };
 
 /// Writes `# ...` comment lines (units, source, direction, impulse and its error), then
-/// `time_s,force_N` and one row per sample with 17 significant digits. Atomic.
-void write_force_table_csv(const std::filesystem::path& path, const collision::ForceTable& table,
+/// `time_s,force_N` and one row per sample with 17 significant digits.
+void write_force_table_csv(std::ostream& out, const collision::ForceTable& table,
                            const ForceTableHeader& header);
 
 }  // namespace impactdeck::fem_export
