@@ -295,6 +295,87 @@ TEST(Table1Files, CsvMarkdownHeatmap) {
   fs::remove_all(dir);
 }
 
+TEST(ForcePlot, RunWritesTheSvgNextToTheCsv) {
+  const fs::path dir = temp_dir("run");
+  scene::Scene sc = scene::load_scene(std::string(IMPACTDECK_SOURCE_DIR) + "/samples/fig4_sweep.toml");
+  ASSERT_TRUE(sc.outputs.force_plot_svg);
+  scene::RunOptions ro;
+  ro.out_dir = dir;
+  const scene::RunReport rep = scene::run_scene(sc, ro);
+  ASSERT_TRUE(rep.impacts.at(0).plot_path);
+  const fs::path svg = *rep.impacts[0].plot_path;
+  EXPECT_EQ(svg, dir / "force_fig4.svg");
+  EXPECT_TRUE(fs::exists(dir / "force_fig4.csv"));
+  Xml x(svg);
+  const auto* root = x.doc.RootElement();
+  ASSERT_NE(root, nullptr);
+  // Two curves (compression, restitution) with 301 vertices each, then the two dashed marks.
+  std::size_t curves = 0, marks = 0;
+  for (const auto* p : all(root, "polyline")) {
+    const std::string pts = p->Attribute("points");
+    const std::size_t vertices = std::count(pts.begin(), pts.end(), ' ') + 1;
+    if (vertices == 301) ++curves;
+    if (p->Attribute("stroke-dasharray")) ++marks;
+  }
+  EXPECT_EQ(curves, 2u);
+  EXPECT_EQ(marks, 2u);
+  std::string texts;
+  for (const auto* t : all(root, "text")) texts += std::string(t->GetText() ? t->GetText() : "") + "|";
+  EXPECT_NE(texts.find("t_m = "), std::string::npos) << texts;
+  EXPECT_NE(texts.find("end = "), std::string::npos);
+  EXPECT_NE(texts.find("\xCE\xA0 = (1 + R)"), std::string::npos);  // total impulse in the legend
+  // The legend's total impulse is the core's, to the 4 digits shown.
+  std::ostringstream pi;
+  pi << plot::format_number(rep.impacts[0].result.history.impulse_total_Ns()) << " N s";
+  EXPECT_NE(texts.find(pi.str()), std::string::npos) << pi.str();
+  fs::remove_all(dir);
+}
+
+TEST(ForcePlot, SceneKeyIsCheckedAndUnknownKeysStillRejected) {
+  const std::string base = R"(
+length_unit = "m"
+[materials.s]
+youngs_modulus_Pa = 2e11
+poisson_ratio = 0.3
+density_kg_m3 = 7800
+[[bodies]]
+name = "a"
+shape = "sphere"
+radius = 0.05
+material = "s"
+velocity_m_s = [1, 0, 0]
+[[bodies]]
+name = "b"
+shape = "sphere"
+radius = 0.05
+material = "s"
+[[impacts]]
+target = "b"
+impactor = "a"
+point = [-0.05, 0, 0]
+restitution = 1.0
+[outputs]
+)";
+  EXPECT_NO_THROW(scene::parse_scene(base + "force_plot_svg = \"f.svg\"\n", "ok.toml"));
+  try {
+    scene::parse_scene(base + "force_plot_svg = \"f.png\"\n", "bad.toml");
+    FAIL() << "no throw";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("bad.toml"), std::string::npos) << m;
+    EXPECT_NE(m.find("outputs.force_plot_svg"), std::string::npos) << m;
+    EXPECT_NE(m.find(".svg"), std::string::npos) << m;
+  }
+  try {
+    scene::parse_scene(base + "force_plot = \"f.svg\"\n", "typo.toml");
+    FAIL() << "no throw";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("unknown key"), std::string::npos) << m;
+    EXPECT_NE(m.find("force_plot_svg"), std::string::npos) << m;  // listed among the allowed keys
+  }
+}
+
 TEST(Drawing, SvgEscapesTextAndRejectsNonFinite) {
   plot::Drawing d(100, 50);
   d.text({1, 2}, "a < b & \"c\"", 10);
