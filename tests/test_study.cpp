@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
+#include <sstream>
 #include <new>
 
 #include <gtest/gtest.h>
@@ -70,6 +72,30 @@ TEST(Table1, PaperPresetReproducesThePaper) {
   EXPECT_DOUBLE_EQ(r.excluded_cell_paper, 0.379);
   EXPECT_NEAR(r.excluded_cell_model, 0.394, 0.001);
   EXPECT_GT(std::abs(r.excluded_cell_model - r.excluded_cell_paper), kTable1MaxAbs);
+}
+
+TEST(Table1, EmbeddedPaperValuesEqualTheDataFile) {
+  // tests/data/paper_table1.csv is the shared transcription (rows mu, columns g); the study embeds
+  // the same numbers transposed (rows g, columns mu).
+  std::ifstream f(std::string(IMPACTDECK_SOURCE_DIR) + "/tests/data/paper_table1.csv");
+  ASSERT_TRUE(f) << "tests/data/paper_table1.csv";
+  const PaperTable1& p = paper_table1();
+  std::string line;
+  std::size_t mi = 0;
+  while (std::getline(f, line)) {
+    if (line.empty() || !std::isdigit(static_cast<unsigned char>(line[0]))) continue;
+    std::stringstream s(line);
+    std::string cell;
+    std::getline(s, cell, ',');
+    ASSERT_LT(mi, 9u);
+    EXPECT_DOUBLE_EQ(std::stod(cell), p.mass_ratios[mi]);
+    for (std::size_t gi = 0; gi < 9; ++gi) {
+      ASSERT_TRUE(std::getline(s, cell, ','));
+      EXPECT_DOUBLE_EQ(std::stod(cell), p.ratio[gi][mi]) << "g index " << gi << ", mu index " << mi;
+    }
+    ++mi;
+  }
+  EXPECT_EQ(mi, 9u);
 }
 
 TEST(Table1, SizeRatioIsSharp) {

@@ -279,18 +279,18 @@ plot::Drawing force_map_drawing(const geometry::Shape& target, const Eigen::Vect
   draw_points(true);
 
   // Extremes.
-  auto mark = [&](std::size_t i, const char* label) {
+  auto mark = [&](std::size_t i, const char* label, double dy) {
     const PointResult& p = r.points[i];
     const plot::Point2 s = screen(p.point_m);
     plot::Style ring;
     ring.stroke = {0.85, 0.1, 0.1};
     ring.stroke_width = 1.6;
     dr.circle(s, rmax * p.max_force_N / fmax + 3.0, ring);
-    dr.text({s.x + rmax * p.max_force_N / fmax + 6.0, s.y - 4.0}, label, 12, plot::Anchor::start,
+    dr.text({s.x + rmax * p.max_force_N / fmax + 6.0, s.y + dy}, label, 12, plot::Anchor::start,
             {0.75, 0.05, 0.05}, true);
   };
-  mark(r.min_index, "min");
-  mark(r.max_index, "max");
+  mark(r.min_index, "min", 14.0);  // below right: the two labels stay apart when the points are close
+  mark(r.max_index, "max", -4.0);
 
   // Titles.
   const Scaled fu = force_unit(fmax);
