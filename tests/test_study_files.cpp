@@ -259,6 +259,19 @@ TEST_F(SweepFiles, ForceMapSvgAndPng) {
   EXPECT_GT(png.dark_fraction, 0.002);      // dark circles / text present
 }
 
+TEST_F(SweepFiles, LargeCloudPictureIsThinned) {
+  const auto cloud = make_cloud(*ss->setup.target.shape, CloudKind::area_uniform, 8, 12000, 9);
+  const SweepResult big = run_sweep(ss->setup, cloud);
+  ForceMapOptions fo;
+  fo.max_points = 5000;  // stride 3: points 0, 3, 6, ... (4000) plus the extremes if off-stride
+  const std::string svg = plot::to_svg(force_map_drawing(*ss->setup.target.shape, ss->setup.target.centroid_m, big, fo));
+  std::size_t circles = 0;
+  for (std::size_t k = svg.find("<circle"); k != std::string::npos; k = svg.find("<circle", k + 1)) ++circles;
+  const std::size_t extra = (big.min_index % 3 != 0) + (big.max_index % 3 != 0);
+  EXPECT_EQ(circles, 4000 + extra + 2);
+  EXPECT_NE(svg.find("12000 points (" + std::to_string(4000 + extra) + " drawn)"), std::string::npos);
+}
+
 TEST(Table1Files, CsvMarkdownHeatmap) {
   const fs::path dir = temp_dir("table1");
   Table1Options o = table1_preset("paper");

@@ -227,7 +227,8 @@ plot::Drawing force_map_drawing(const geometry::Shape& target, const Eigen::Vect
   // Circle size: radius proportional to F_max, the largest about half the spacing of the points
   // seen from the front.
   const double fmin = r.points[r.min_index].max_force_N, fmax = r.points[r.max_index].max_force_N;
-  const double front_count = std::max(1.0, 0.5 * static_cast<double>(r.points.size()));
+  const double shown = o.max_points > 0 ? std::min<double>(r.points.size(), o.max_points) : r.points.size();
+  const double front_count = std::max(1.0, 0.5 * shown);
   const double area = M_PI / 4.0 * std::max(scale * bw, 1.0) * std::max(scale * bh, 8.0);
   const double rmax = std::clamp(0.4 * std::sqrt(area / front_count), 2.0, 20.0);
   auto shade = [&](double f) { return fmax > fmin ? (f - fmin) / (fmax - fmin) : 1.0; };
@@ -254,9 +255,14 @@ plot::Drawing force_map_drawing(const geometry::Shape& target, const Eigen::Vect
     }
   };
 
-  // Points back to front.
-  std::vector<std::size_t> order(r.points.size());
-  std::iota(order.begin(), order.end(), std::size_t{0});
+  // Points back to front; a large cloud thinned by a fixed stride (deterministic), extremes kept.
+  const std::size_t stride =
+      o.max_points > 0 && r.points.size() > o.max_points ? (r.points.size() + o.max_points - 1) / o.max_points : 1;
+  std::vector<std::size_t> order;
+  order.reserve(r.points.size() / stride + 2);
+  for (std::size_t i = 0; i < r.points.size(); i += stride) order.push_back(i);
+  for (std::size_t e : {r.min_index, r.max_index})
+    if (e % stride != 0) order.push_back(e);
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
     return r.points[a].point_m.dot(d) < r.points[b].point_m.dot(d);
   });
@@ -297,7 +303,9 @@ plot::Drawing force_map_drawing(const geometry::Shape& target, const Eigen::Vect
   dr.text({left, 26}, o.title.empty() ? "Maximal collision force over the surface" : o.title, 16,
           plot::Anchor::start, plot::kBlack, true);
   std::ostringstream sub;
-  sub << r.points.size() << " points, min/max = " << plot::format_number(r.force_ratio, 4) << "; min "
+  sub << r.points.size() << " points";
+  if (stride > 1) sub << " (" << order.size() << " drawn)";
+  sub << ", min/max = " << plot::format_number(r.force_ratio, 4) << "; min "
       << plot::format_number(fmin * fu.factor, 4) << " " << fu.unit << " at " << coords(r.points[r.min_index].point_m)
       << ", max " << plot::format_number(fmax * fu.factor, 4) << " " << fu.unit << " at "
       << coords(r.points[r.max_index].point_m);

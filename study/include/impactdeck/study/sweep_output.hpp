@@ -46,6 +46,9 @@ struct ForceMapOptions {
   double elevation_deg = 22;    ///< above the xy plane
   int meridians = 16;           ///< wireframe lines
   int parallels = 11;
+  /// Circles drawn at most: a larger cloud is thinned by a fixed stride (the extremes are always
+  /// drawn), and the subtitle says so. 0 = all.
+  std::size_t max_points = 5000;
 };
 
 /// The Fig. 4-like picture. The wireframe comes from `target.ray_exit` from the centroid, along
