@@ -13,6 +13,8 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   impactdeck::cli::Context ctx;
   impactdeck::cli::register_run(app, ctx);
+  impactdeck::cli::register_sweep(app, ctx);
+  impactdeck::cli::register_study(app, ctx);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

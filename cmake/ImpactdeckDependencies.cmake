@@ -31,3 +31,15 @@ find_package(CLI11 QUIET)
 impactdeck_require(CLI11_FOUND "CLI11" libcli11-dev)
 
 find_package(Threads REQUIRED)
+
+# cairo renders the pictures (SVG is written by our own code, PNG by cairo's image surface).
+find_package(PkgConfig QUIET)
+impactdeck_require(PKG_CONFIG_FOUND "pkg-config" pkgconf)
+pkg_check_modules(Cairo QUIET IMPORTED_TARGET cairo)
+impactdeck_require(Cairo_FOUND "cairo" libcairo2-dev)
+
+# The tests parse the written SVG / VTP files back with tinyxml2.
+if(IMPACTDECK_BUILD_TESTS)
+  find_package(tinyxml2 CONFIG QUIET)
+  impactdeck_require(tinyxml2_FOUND "tinyxml2 (tests only)" libtinyxml2-dev)
+endif()

@@ -67,5 +67,47 @@ rc=$?
 check "failed check exit 4 (got $rc)" test $rc -eq 4
 check "failed check writes nothing" test ! -e "$tmp/out4/force_table2.csv"
 
+# 6. Sweep: files, JSON summary, quiet progress, errors.
+"$bin" sweep "$src/samples/fig4_sweep.toml" --out "$tmp/sw" --json --quiet --no-png >"$tmp/sw.json" 2>"$tmp/sw.err"
+check "sweep exit 0" test $? -eq 0
+for f in sweep_fig4.csv sweep_fig4.pos sweep_fig4.vtp sweep_fig4.svg; do
+  check "sweep wrote $f" test -s "$tmp/sw/$f"
+done
+check "sweep --no-png writes no PNG" test ! -e "$tmp/sw/sweep_fig4.png"
+check "sweep stderr silent (not a tty)" test ! -s "$tmp/sw.err"
+python3 - "$tmp/sw.json" <<'PY' || { echo "FAILED: sweep JSON"; fails=$((fails+1)); }
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert d["points"] == 390, d["points"]
+assert 0 < d["force_ratio"] <= 1
+assert d["min"]["max_force_N"] <= d["max"]["max_force_N"]
+assert abs(d["min"]["max_force_N"] / d["max"]["max_force_N"] - d["force_ratio"]) < 1e-12
+PY
+passes=$((passes+1))
+"$bin" sweep "$src/samples/fig4_sweep.toml" --impact nope --out "$tmp/sw2" >/dev/null 2>"$tmp/sw2.err"
+check "sweep unknown impact exit 3" test $? -eq 3
+check "sweep error names the impact" grep -q "no impact named 'nope'" "$tmp/sw2.err"
+"$bin" sweep "$src/samples/fig4_sweep.toml" --cloud bogus >/dev/null 2>&1
+check "sweep bad --cloud exit 2" test $? -eq 2
+
+# 7. Study table1: JSON rows g, columns mu; the paper preset meets the acceptance figures.
+"$bin" study table1 --preset paper --json --quiet --no-png --out "$tmp/t1" >"$tmp/t1.json"
+check "table1 exit 0" test $? -eq 0
+check "table1 wrote csv, md, svg" test -s "$tmp/t1/table1.csv" -a -s "$tmp/t1/table1.md" -a -s "$tmp/t1/table1_heatmap.svg"
+python3 - "$tmp/t1.json" <<'PY' || { echo "FAILED: table1 JSON"; fails=$((fails+1)); }
+import json, sys
+d = json.load(open(sys.argv[1]))
+g, mu, r = d["geometric_ratios"], d["mass_ratios"], d["collision_force_ratio"]
+assert len(g) == 9 and len(mu) == 9 and len(r) == 9 and all(len(row) == 9 for row in r)
+assert g[0] == 1e-4 and g[-1] == 1e4
+assert d["agreement"]["mean_abs_delta"] <= 0.002 and d["agreement"]["max_abs_delta"] <= 0.005
+assert r[8][0] < 0.3 and r[0][8] > 0.99   # rows g: g = 1e4 is curvature-dominated; g = 1e-4, mu = 1e4 ~ 1
+PY
+passes=$((passes+1))
+"$bin" study table1 --preset nope >/dev/null 2>"$tmp/t1b.err"
+check "unknown preset exit 3" test $? -eq 3
+"$bin" study table1 --mass-ratios 1,abc >/dev/null 2>&1
+check "bad list exit 2" test $? -eq 2
+
 echo "cli_end_to_end: $passes passed, $fails failed"
 test $fails -eq 0

@@ -30,6 +30,13 @@ double energy_flux_density_J_m3(double m_w, double v_w, double r_w) {
   return std::exp(std::log(m_w) + 2.0 * std::log(v_w) - std::log(2.0) - 3.0 * std::log(r_w));
 }
 
+double ln_energy_flux(double m_w, double v_w, double r_w, EnergyFluxUnit unit) {
+  return std::log(m_w) + 2.0 * std::log(v_w) - std::log(2.0) - 3.0 * std::log(r_w) +
+         std::log(cubic_metres_per(unit));
+}
+
+double restitution_eq30(double ln_phi) { return 0.55 - 0.047 * ln_phi; }
+
 RestitutionResult restitution_from_energy_flux(double m_w, double v_w, double r_w,
                                                EnergyFluxUnit unit, RangePolicy policy) {
   RestitutionResult r;
@@ -59,7 +66,7 @@ RestitutionResult restitution_from_energy_flux(double m_w, double v_w, double r_
         break;
     }
   }
-  r.coefficient = 0.55 - 0.047 * ln_used;
+  r.coefficient = restitution_eq30(ln_used);
   if (!(r.coefficient >= 0.0 && r.coefficient <= 1.0)) {
     std::ostringstream s;
     s << "Eq. 30 extrapolated to ln Phi = " << ln_used << " gives R = " << r.coefficient

@@ -95,12 +95,32 @@ void AtomicFileSet::add(const fs::path& path, const std::string& content) {
 
 std::vector<fs::path> AtomicFileSet::commit() {
   std::vector<fs::path> done;
+  fs::path marker;
+  if (staged_.size() > 1) {
+    const fs::path& first = staged_.front().second;
+    marker = (first.has_parent_path() ? first.parent_path() : fs::path(".")) / kMarker;
+    std::string list;
+    for (const auto& st : staged_) list += st.second.string() + "\n";
+    write_file_atomically(marker, list);
+  }
   for (const auto& [tmp, target] : staged_) {
     rename_into_place(tmp, target);
     done.push_back(target);
   }
   staged_.clear();
+  if (!marker.empty()) {
+    std::error_code ec;
+    fs::remove(marker, ec);
+  }
   return done;
+}
+
+std::vector<std::string> AtomicFileSet::interrupted_commit(const fs::path& folder) {
+  std::vector<std::string> targets;
+  std::ifstream in(folder / kMarker);
+  for (std::string line; std::getline(in, line);)
+    if (!line.empty()) targets.push_back(line);
+  return targets;
 }
 
 void write_file_atomically(const fs::path& path, const std::string& content) {

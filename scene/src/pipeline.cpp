@@ -11,6 +11,7 @@
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/fem_export/force_table.hpp"
 #include "impactdeck/geometry/ellipsoid.hpp"
+#include "impactdeck/plot/force_plot.hpp"
 
 namespace impactdeck::scene {
 namespace fs = std::filesystem;
@@ -190,6 +191,12 @@ RunReport run_scene(const Scene& scene, const RunOptions& opt) {
   RunReport report;
   StageClock clock(report);
   report.stages_run.push_back({"scene", 0.0});
+  if (const auto left = AtomicFileSet::interrupted_commit(opt.out_dir); !left.empty()) {
+    report.warnings.push_back("a previous run was killed while replacing its " + std::to_string(left.size()) +
+                              " output files in '" + opt.out_dir.string() +
+                              "': they may mix two runs until this run replaces them (see " +
+                              AtomicFileSet::kMarker + ")");
+  }
 
   // Bodies that take part in an impact (others are not even built).
   std::map<std::string, PreparedBody> bodies;
@@ -230,37 +237,54 @@ RunReport run_scene(const Scene& scene, const RunOptions& opt) {
 
   if (!report.all_checks_passed()) {
     report.warnings.push_back("a self-check failed: no output file was written");
-  } else if (scene.outputs.force_table_csv) {
-    clock.run("force_table", [&] {
-      for (auto& ir : report.impacts) {
-        ir.table = collision::sample_force_table(ir.result.history, scene.outputs.force_table);
-        if (!ir.table->tolerance_met) {
-          std::ostringstream m;
-          m << "impact '" << ir.spec->name << "': force table impulse error "
-            << ir.table->impulse_relative_error << " exceeds the tolerance "
-            << ir.table->impulse_tolerance;
-          report.warnings.push_back(m.str());
-        }
+  } else {
+    // One file per impact; with several impacts the impact's name is appended to the stem.
+    auto per_impact = [&](const fs::path& base, const ImpactReport& ir) {
+      fs::path p = base;
+      if (report.impacts.size() > 1) {
+        p = base.parent_path() / (base.stem().string() + "_" + ir.spec->name + base.extension().string());
       }
-    });
-    clock.run("write_outputs", [&] {
-      AtomicFileSet files;  // all or nothing: a failure leaves the previous outputs as they were
-      const fs::path base = *scene.outputs.force_table_csv;
-      for (auto& ir : report.impacts) {
-        fs::path p = base;
-        if (report.impacts.size() > 1) {
-          p = base.parent_path() / (base.stem().string() + "_" + ir.spec->name + base.extension().string());
+      return p.is_absolute() ? p : opt.out_dir / p;
+    };
+    if (scene.outputs.force_table_csv) {
+      clock.run("force_table", [&] {
+        for (auto& ir : report.impacts) {
+          ir.table = collision::sample_force_table(ir.result.history, scene.outputs.force_table);
+          if (!ir.table->tolerance_met) {
+            std::ostringstream m;
+            m << "impact '" << ir.spec->name << "': force table impulse error "
+              << ir.table->impulse_relative_error << " exceeds the tolerance "
+              << ir.table->impulse_tolerance;
+            report.warnings.push_back(m.str());
+          }
         }
-        const fs::path full = p.is_absolute() ? p : opt.out_dir / p;
-        fem_export::ForceTableHeader h;
-        h.source = scene.file.string();
-        h.impact = ir.spec->name;
-        h.direction = -ir.contact.target_point.normal;  // force on the target: along -n
-        files.add(full, [&](std::ostream& out) { fem_export::write_force_table_csv(out, *ir.table, h); });
-        ir.table_path = full;
-      }
-      for (const auto& f : files.commit()) report.files_written.push_back(f);
-    });
+      });
+    }
+    if (scene.outputs.force_table_csv || scene.outputs.force_plot_svg) {
+      clock.run("write_outputs", [&] {
+        AtomicFileSet files;  // all or nothing: a failure leaves the previous outputs as they were
+        for (auto& ir : report.impacts) {
+          if (scene.outputs.force_table_csv) {
+            const fs::path full = per_impact(*scene.outputs.force_table_csv, ir);
+            fem_export::ForceTableHeader h;
+            h.source = scene.file.string();
+            h.impact = ir.spec->name;
+            h.direction = -ir.contact.target_point.normal;  // force on the target: along -n
+            files.add(full, [&](std::ostream& out) { fem_export::write_force_table_csv(out, *ir.table, h); });
+            ir.table_path = full;
+          }
+          if (scene.outputs.force_plot_svg) {
+            const fs::path full = per_impact(*scene.outputs.force_plot_svg, ir);
+            plot::ForcePlotOptions po;
+            po.title = "Contact force, impact '" + ir.spec->name + "': " + ir.spec->impactor + " hits " +
+                       ir.spec->target;
+            files.add(full, plot::to_svg(plot::force_time_drawing(ir.result.history, po)));
+            ir.plot_path = full;
+          }
+        }
+        for (const auto& f : files.commit()) report.files_written.push_back(f);
+      });
+    }
   }
 
   for (const auto& st : all_stages()) {

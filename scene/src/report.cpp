@@ -96,6 +96,9 @@ nlohmann::json to_json(const Scene& scene, const RunReport& rep) {
                           {"tolerance_met", ir.table->tolerance_met}};
       if (ir.table_path) i["force_table"]["path"] = ir.table_path->string();
     }
+    if (ir.plot_path) {
+      i["force_plot_svg"] = ir.plot_path->string();
+    }
     impacts.push_back(std::move(i));
   }
   j["impacts"] = std::move(impacts);
@@ -160,6 +163,7 @@ std::string format_summary(const Scene& scene, const RunReport& rep) {
       if (ir.table_path) o << " -> " << ir.table_path->string();
       o << "\n";
     }
+    if (ir.plot_path) o << "  force plot            " << ir.plot_path->string() << "\n";
   }
   for (const auto& w : rep.warnings) o << "\nwarning: " << w;
   if (!rep.warnings.empty()) o << "\n";

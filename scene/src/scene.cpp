@@ -290,6 +290,11 @@ Outputs read_outputs(const toml::table& t, const std::string& file) {
     if (s->empty()) r.fail("force_table_csv", "must not be empty");
     o.force_table_csv = fs::path(*s);
   }
+  if (auto s = r.string("force_plot_svg")) {
+    if (s->empty()) r.fail("force_plot_svg", "must not be empty");
+    if (fs::path(*s).extension() != ".svg") r.fail("force_plot_svg", "must name an .svg file, got \"" + *s + "\"");
+    o.force_plot_svg = fs::path(*s);
+  }
   if (r.has("force_table_impulse_tolerance")) {
     o.force_table.impulse_tolerance = r.positive("force_table_impulse_tolerance");
     if (o.force_table.impulse_tolerance >= 0.5) {

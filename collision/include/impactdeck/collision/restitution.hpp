@@ -39,6 +39,13 @@ RestitutionResult restitution_from_energy_flux(double reduced_mass_kg, double ap
                                                double reduced_radius_m, EnergyFluxUnit unit,
                                                RangePolicy policy);
 
+/// ln Phi with Phi in `unit` (Eq. 14), without allocation or range handling (for sweeps).
+double ln_energy_flux(double reduced_mass_kg, double approach_velocity_m_s, double reduced_radius_m,
+                      EnergyFluxUnit unit);
+
+/// Eq. 30 itself, R = 0.55 - 0.047 ln Phi, with no range handling (the caller applies its policy).
+double restitution_eq30(double ln_energy_flux);
+
 inline constexpr double kEnergyFluxLnMin = -5.0;  ///< Eq. 30 validity, lower edge of ln Phi
 inline constexpr double kEnergyFluxLnMax = 6.0;   ///< Eq. 30 validity, upper edge of ln Phi
 

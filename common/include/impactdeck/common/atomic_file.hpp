@@ -23,8 +23,11 @@ void write_file_atomically(const std::filesystem::path& path, const std::string&
 /// Several output files replaced together: add() writes each to a temporary file beside its
 /// target; commit() renames them all only once every one is complete. If anything throws before
 /// commit() (or the object is destroyed uncommitted), the temporaries are removed and the previous
-/// outputs stay byte for byte. The renames run back to back, so a kill can only interrupt the
-/// set in that window of a few system calls.
+/// outputs stay byte for byte. Renaming several files cannot be one atomic step: before the
+/// renames, commit() writes a marker file `.impactdeck-commit` (listing the targets) in the folder
+/// of the first target and removes it after the last rename. A run killed inside that window
+/// leaves the marker behind, so a mixed set of old and new files is always detectable
+/// (interrupted_commit()).
 class AtomicFileSet {
  public:
   AtomicFileSet() = default;
@@ -36,6 +39,11 @@ class AtomicFileSet {
   void add(const std::filesystem::path& path, const std::string& content);
   /// Renames every temporary into place; returns the final paths.
   std::vector<std::filesystem::path> commit();
+
+  /// Name of the marker file left by a commit that was interrupted.
+  static constexpr const char* kMarker = ".impactdeck-commit";
+  /// Targets listed by an interrupted commit's marker in `folder` (empty when there is none).
+  static std::vector<std::string> interrupted_commit(const std::filesystem::path& folder);
 
  private:
   std::vector<std::pair<std::filesystem::path, std::filesystem::path>> staged_;  // tmp, target

@@ -45,6 +45,7 @@ struct ImpactReport {
   collision::ImpactResult result;
   std::optional<collision::ForceTable> table;
   std::optional<std::filesystem::path> table_path;  ///< where the CSV was written
+  std::optional<std::filesystem::path> plot_path;   ///< where the F(t) SVG was written
 };
 
 struct StageTiming {

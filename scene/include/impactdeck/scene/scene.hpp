@@ -66,6 +66,7 @@ struct ImpactSpec {
 
 struct Outputs {
   std::optional<std::filesystem::path> force_table_csv;  ///< relative to the output folder
+  std::optional<std::filesystem::path> force_plot_svg;   ///< F(t) picture, relative to the output folder
   collision::ForceTableOptions force_table;
 };
 

@@ -1,0 +1,74 @@
+// Speed of the sweep and of the Table 1 study: points per second for F_max only and for the full
+// force curve (201 samples per point), on 1 thread and on all cores, and the whole paper table.
+//
+//   build/bench/bench_study                      # points/s in the "items_per_second" column
+#include <benchmark/benchmark.h>
+
+#include <memory>
+#include <thread>
+
+#include "impactdeck/geometry/ellipsoid.hpp"
+#include "impactdeck/study/cloud.hpp"
+#include "impactdeck/study/sweep.hpp"
+#include "impactdeck/study/table1.hpp"
+
+using namespace impactdeck;
+
+namespace {
+
+study::SweepSetup setup() {
+  study::SweepSetup s;
+  auto target = std::make_shared<geometry::Ellipsoid>(2.0, 0.5, 0.5);
+  auto ball = std::make_shared<geometry::Ellipsoid>(geometry::Ellipsoid::sphere(0.05));
+  const auto tv = target->volume_properties(), bv = ball->volume_properties();
+  s.target = {target, 7850 * tv.volume_m3, tv.inertia_per_density_m5 * 7850, tv.centroid_m,
+              study::RadiusRule::paper};
+  s.impactor = {ball, 7850 * bv.volume_m3, bv.inertia_per_density_m5 * 7850, bv.centroid_m,
+                study::RadiusRule::paper};
+  s.effective_modulus_Pa = 1.025e11;
+  s.approach_speed_m_s = 1.0;
+  s.restitution.from_energy_flux = true;
+  return s;
+}
+
+const std::vector<geometry::SurfacePoint>& cloud() {
+  static const auto c = study::area_uniform_cloud(*setup().target.shape, 200000, 1);
+  return c;
+}
+
+void sweep(benchmark::State& st, bool curves) {
+  const study::SweepSetup s = setup();
+  study::SweepOptions o;
+  o.threads = static_cast<unsigned>(st.range(0));
+  o.curves = curves;
+  o.curve_samples = 201;
+  const auto& c = cloud();
+  for (auto _ : st) {
+    const study::SweepResult r = study::run_sweep(s, c, o);
+    benchmark::DoNotOptimize(r.force_ratio);
+  }
+  st.SetItemsProcessed(static_cast<int64_t>(st.iterations()) * static_cast<int64_t>(c.size()));
+  st.counters["threads"] = o.threads;
+}
+
+void BM_SweepFmax(benchmark::State& st) { sweep(st, false); }
+void BM_SweepFullCurve(benchmark::State& st) { sweep(st, true); }
+
+const int kCores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+
+void BM_Table1Paper(benchmark::State& st) {
+  study::Table1Options o = study::table1_preset("paper");
+  o.threads = static_cast<unsigned>(st.range(0));
+  for (auto _ : st) {
+    const study::Table1Result r = study::run_table1(o);
+    benchmark::DoNotOptimize(r.mean_abs_delta);
+  }
+  st.SetItemsProcessed(static_cast<int64_t>(st.iterations()) * 81 * 390);
+}
+
+}  // namespace
+
+BENCHMARK(BM_SweepFmax)->Arg(1)->Arg(kCores)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_SweepFullCurve)->Arg(1)->Arg(kCores)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Table1Paper)->Arg(1)->Arg(kCores)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_MAIN();

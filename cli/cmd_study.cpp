@@ -1,0 +1,117 @@
+// `impactdeck study table1`: the configuration study of the paper's Table 1.
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include "commands.hpp"
+#include "impactdeck/common/atomic_file.hpp"
+#include "impactdeck/common/error.hpp"
+#include "impactdeck/plot/drawing.hpp"
+#include "impactdeck/study/progress.hpp"
+#include "impactdeck/study/table1.hpp"
+#include "impactdeck/study/table1_output.hpp"
+
+namespace impactdeck::cli {
+namespace fs = std::filesystem;
+
+namespace {
+
+std::vector<double> parse_list(const std::string& text, const char* option) {
+  std::vector<double> v;
+  std::stringstream s(text);
+  std::string item;
+  while (std::getline(s, item, ',')) {
+    try {
+      std::size_t used = 0;
+      const double x = std::stod(item, &used);
+      if (item.find_first_not_of(" \t", used) != std::string::npos) throw std::invalid_argument(item);
+      v.push_back(x);
+    } catch (const std::exception&) {
+      throw UsageError(std::string(option) + ": not a number: \"" + item + "\"");
+    }
+  }
+  if (v.empty()) throw UsageError(std::string(option) + ": give a comma-separated list of numbers");
+  return v;
+}
+
+}  // namespace
+
+void register_study(CLI::App& app, Context& ctx) {
+  struct Args {
+    std::string preset = "paper", g, mu, rule, cloud, out = ".";
+    double size_ratio = 0;
+    int grid_steps = 0;
+    std::size_t count = 0;
+    std::uint64_t seed = 1;
+    unsigned threads = 0;
+    bool json = false, quiet = false, no_png = false;
+  };
+  auto a = std::make_shared<Args>();
+  CLI::App* study = app.add_subcommand("study", "Configuration studies");
+  study->require_subcommand(1);
+  CLI::App* cmd = study->add_subcommand(
+      "table1", "The paper's Table 1: collision force ratio over geometric ratio g = a/b and mass ratio m1/m2");
+  cmd->add_option("--preset", a->preset, "Starting setting (default and only preset: paper, MODEL.md)");
+  cmd->add_option("--geometric-ratios", a->g, "Comma-separated g = a/b values (rows)");
+  cmd->add_option("--mass-ratios", a->mu, "Comma-separated m1/m2 values (columns)");
+  cmd->add_option("--size-ratio", a->size_ratio, "Smaller semi-axis / sphere radius (paper preset: 20)");
+  cmd->add_option("--radius-rule", a->rule, "Ellipsoid's local radius: paper (Eq. 26) | mean (curvature)");
+  cmd->add_option("--cloud", a->cloud, "grid | uniform | both (paper preset: grid)");
+  cmd->add_option("--grid-steps", a->grid_steps, "Grid step 1/N (paper preset: 8)");
+  cmd->add_option("--count", a->count, "Area-uniform points per cell (default 2000)");
+  cmd->add_option("--seed", a->seed, "Seed of the area-uniform cloud");
+  cmd->add_option("--threads", a->threads, "Worker threads (default 0: all cores)");
+  cmd->add_option("--out", a->out, "Output folder for table1.csv/.md/_heatmap.svg/.png (default: .)");
+  cmd->add_flag("--no-png", a->no_png, "Do not render the PNG heat map");
+  cmd->add_flag("--json", a->json, "Print the JSON document on stdout");
+  cmd->add_flag("--quiet", a->quiet, "No progress bar");
+  cmd->callback([a, &ctx] {
+    study::Table1Options o = study::table1_preset(a->preset);
+    if (!a->g.empty()) o.geometric_ratios = parse_list(a->g, "--geometric-ratios");
+    if (!a->mu.empty()) o.mass_ratios = parse_list(a->mu, "--mass-ratios");
+    if (a->size_ratio != 0) o.size_ratio = a->size_ratio;
+    if (!a->rule.empty()) {
+      if (a->rule == "paper") o.target_radius_rule = study::RadiusRule::paper;
+      else if (a->rule == "mean") o.target_radius_rule = study::RadiusRule::mean;
+      else throw UsageError("--radius-rule: expected paper or mean, got \"" + a->rule + "\"");
+    }
+    if (!a->cloud.empty()) {
+      if (a->cloud == "grid") o.cloud = study::CloudKind::paper_grid;
+      else if (a->cloud == "uniform") o.cloud = study::CloudKind::area_uniform;
+      else if (a->cloud == "both") o.cloud = study::CloudKind::both;
+      else throw UsageError("--cloud: expected grid, uniform or both, got \"" + a->cloud + "\"");
+    }
+    if (a->grid_steps != 0) o.grid_steps = a->grid_steps;
+    if (a->count != 0) o.uniform_count = a->count;
+    o.seed = a->seed;
+    o.threads = a->threads;
+    study::ProgressBar bar("table1", !a->quiet);
+    o.progress = [&bar](std::size_t done, std::size_t total) { bar.update(done, total); };
+    const study::Table1Result r = study::run_table1(o);
+    bar.finish();
+
+    std::error_code ec;
+    fs::create_directories(a->out, ec);
+    if (!fs::is_directory(a->out)) throw InputError(a->out, "--out", "cannot create the output folder");
+    const fs::path out(a->out);
+    study::write_table1_csv(out / "table1.csv", r);
+    write_file_atomically(out / "table1.md", "# Table 1 study (impactdeck study table1)\n\n" + study::table1_markdown(r));
+    const plot::Drawing heat = study::table1_heatmap(r);
+    plot::write_svg(out / "table1_heatmap.svg", heat);
+    if (!a->no_png) plot::write_png(out / "table1_heatmap.png", heat, 1.25);
+
+    if (a->json) {
+      std::cout << study::table1_json(r).dump(2) << "\n";
+    } else {
+      std::cout << study::table1_markdown(r);
+      std::cout << "time " << std::setprecision(3) << r.seconds << " s; wrote " << (out / "table1.csv").string()
+                << ", " << (out / "table1.md").string() << ", " << (out / "table1_heatmap.svg").string()
+                << (a->no_png ? "" : ", " + (out / "table1_heatmap.png").string()) << "\n";
+    }
+    (void)ctx;
+  });
+}
+
+}  // namespace impactdeck::cli

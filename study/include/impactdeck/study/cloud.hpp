@@ -1,0 +1,36 @@
+#pragma once
+// Point clouds on a target's surface for force maps (paper Sect. 2.3: "the simulation generates a
+// cloud of points on its surface"). Each point carries its outward unit normal.
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "impactdeck/geometry/ellipsoid.hpp"
+#include "impactdeck/geometry/shape.hpp"
+
+namespace impactdeck::study {
+
+/// The grid that reproduces the paper's Table 1 (MODEL.md "Table 1"): (y/b, z/c) on the square
+/// [-1, 1]^2 with step 1/`steps`, kept where (y/b)^2 + (z/c)^2 <= 1, lifted to both sides
+/// x = +-a sqrt(1 - (y/b)^2 - (z/c)^2); points on the rim (x = 0) appear once.
+/// For steps = 8: 390 points, both tips and the rim included. Throws InputError for steps < 1.
+std::vector<geometry::SurfacePoint> paper_grid_cloud(const geometry::Ellipsoid& target, int steps = 8);
+
+/// `count` points uniform by area (Shape::sample_surface), deterministic for a seed.
+/// Throws InputError for count = 0.
+std::vector<geometry::SurfacePoint> area_uniform_cloud(const geometry::Shape& target, std::size_t count,
+                                                       std::uint64_t seed);
+
+enum class CloudKind {
+  paper_grid,    ///< paper_grid_cloud(steps); the target must be an analytic ellipsoid
+  area_uniform,  ///< area_uniform_cloud(count, seed); any shape
+  both,          ///< the grid followed by the uniform points
+};
+const char* to_string(CloudKind k);
+
+/// The cloud of a kind. Throws InputError when the grid is asked of a shape that is not an
+/// analytic ellipsoid.
+std::vector<geometry::SurfacePoint> make_cloud(const geometry::Shape& target, CloudKind kind,
+                                               int grid_steps, std::size_t count, std::uint64_t seed);
+
+}  // namespace impactdeck::study

@@ -1,0 +1,22 @@
+#pragma once
+// A sweep set up from a scene: one impact of the scene names the target and the impactor; their
+// shapes, masses, inertias and materials, the modulus convention, the radius rule and the
+// restitution model come from the scene. The target is at rest and the impactor approaches along
+// the inward normal at every point with the impact's approach_speed_m_s, or else with the speed
+// of the impactor relative to the target as given in the scene (paper Sect. 3.1).
+#include <string>
+
+#include "impactdeck/scene/scene.hpp"
+#include "impactdeck/study/sweep.hpp"
+
+namespace impactdeck::study {
+
+struct SceneSweep {
+  SweepSetup setup;
+  const scene::ImpactSpec* impact = nullptr;
+};
+
+/// `impact_name` empty: the scene's first impact. Throws InputError naming the scene file.
+SceneSweep sweep_from_scene(const scene::Scene& scene, const std::string& impact_name = "");
+
+}  // namespace impactdeck::study

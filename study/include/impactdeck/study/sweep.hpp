@@ -1,0 +1,102 @@
+#pragma once
+// Force map of a target: at each point of a cloud on its surface, the impactor hits along the
+// inward normal (paper Sect. 2.3, 3.1) and the closed-form Hertz impact gives F_max (and, on
+// request, the whole force curve). The target is at rest, the impactor translates with a fixed
+// approach speed, so that only the configuration (reduced mass at the point, local radius)
+// varies over the map.
+//
+// Speed and determinism: points are independent, so they run on all cores (std::thread, chunks
+// handed out by an atomic counter). Each point writes only its own slot of preallocated arrays:
+// no allocation per point, and the result is bit for bit the same whatever the thread count.
+#include <cstddef>
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "impactdeck/collision/hertz.hpp"
+#include "impactdeck/collision/impact.hpp"
+#include "impactdeck/geometry/shape.hpp"
+
+namespace impactdeck::study {
+
+/// Which local radius a body gets at the contact point.
+enum class RadiusRule {
+  paper,  ///< Eq. 26: average radius of the axis-normal sections (Shape::paper_radius_m)
+  mean,   ///< 1 / mean curvature from the principal curvatures (exact on a sphere)
+};
+const char* to_string(RadiusRule r);
+
+/// One body of a sweep, in its own frame (SI).
+struct SweepBody {
+  std::shared_ptr<const geometry::Shape> shape;
+  double mass_kg = 0;                                       ///< > 0, or +infinity (fixed)
+  Eigen::Matrix3d inertia_kg_m2 = Eigen::Matrix3d::Identity();  ///< about the centroid
+  Eigen::Vector3d centroid_m = Eigen::Vector3d::Zero();
+  RadiusRule radius_rule = RadiusRule::paper;
+};
+
+struct SweepSetup {
+  SweepBody target;
+  SweepBody impactor;
+  double effective_modulus_Pa = 0;   ///< E* (Eq. 28 or Hertz convention)
+  double approach_speed_m_s = 1.0;   ///< impactor velocity = -speed * n at every point
+  collision::RestitutionModel restitution;  ///< used for the curve (R, contact time, impulse)
+};
+
+/// Called from the calling thread about ten times a second with (points done, total).
+using ProgressFn = std::function<void(std::size_t done, std::size_t total)>;
+
+struct SweepOptions {
+  unsigned threads = 0;             ///< 0: std::thread::hardware_concurrency()
+  bool curves = false;              ///< also sample F(t) at every point
+  std::size_t curve_samples = 201;  ///< samples per curve, uniform over [0, contact time], >= 2
+  std::size_t chunk = 64;           ///< points per work item
+  ProgressFn progress;              ///< optional
+};
+
+/// Everything computed at one point (SI).
+struct PointResult {
+  Eigen::Vector3d point_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  ///< target's outward unit normal
+  double target_radius_m = 0;       ///< local radius of the target by its rule
+  double impactor_radius_m = 0;     ///< local radius of the impactor at its contact point
+  double effective_radius_m = 0;    ///< R* (Eq. 29)
+  double reduced_mass_kg = 0;       ///< m_w at the point (tensor form of Eq. 21)
+  double hertz_constant = 0;        ///< k_H, N/m^1.5
+  double max_indentation_m = 0;
+  double max_force_N = 0;
+  double compression_time_s = 0;
+  double restitution = 0;           ///< R
+  bool restitution_clamped = false; ///< ln Phi clamped into Eq. 30's range (policy "warn")
+  double contact_time_s = 0;        ///< (1 + R) t_m
+  double impulse_total_Ns = 0;      ///< (1 + R) m_w v_w
+};
+
+struct SweepResult {
+  std::vector<PointResult> points;  ///< in cloud order
+  /// With options.curves: points.size() x curve_samples forces in N, row-major; sample k of
+  /// point i is at time k / (curve_samples - 1) * points[i].contact_time_s.
+  std::vector<double> curves_N;
+  std::size_t curve_samples = 0;
+  std::size_t min_index = 0, max_index = 0;  ///< points with the smallest / largest F_max
+  double force_ratio = 0;                    ///< min F_max / max F_max (the paper's ratio)
+  /// (min m_w / max m_w)^(n/(n+1)): the part of the ratio due to the reduced mass alone.
+  double mass_only_ratio = 0;
+  std::size_t restitution_clamped_count = 0;
+  unsigned threads_used = 0;
+  double seconds = 0;                        ///< wall time of the point loop
+};
+
+/// One point (the sweep's kernel). Throws InputError naming the point when it cannot be solved.
+PointResult sweep_point(const SweepSetup& setup, const geometry::SurfacePoint& at);
+
+/// The whole cloud. Throws InputError (the first failing point's message) on bad input.
+SweepResult run_sweep(const SweepSetup& setup, const std::vector<geometry::SurfacePoint>& cloud,
+                      const SweepOptions& options = {});
+
+/// Samples F(t) of one point into `out` (size >= samples), uniform over [0, contact time].
+void sample_curve(const PointResult& p, std::size_t samples, double* out);
+
+}  // namespace impactdeck::study

@@ -1,0 +1,255 @@
+#include "impactdeck/study/table1.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "impactdeck/collision/compression.hpp"
+#include "impactdeck/collision/eccentric.hpp"
+#include "impactdeck/common/error.hpp"
+#include "impactdeck/geometry/ellipsoid.hpp"
+#include "impactdeck/study/cloud.hpp"
+
+namespace impactdeck::study {
+
+namespace {
+
+const std::vector<double> kDecades = {1e-4, 1e-3, 1e-2, 1e-1, 1.0, 1e1, 1e2, 1e3, 1e4};
+
+// Quantities that cancel from the ratio (MODEL.md); fixed, plausible values. Steel sphere of
+// r = 50 mm at 1 m/s, the paper's Eq. 28 modulus.
+constexpr double kSphereRadius_m = 0.05;
+constexpr double kDensity_kg_m3 = 7850.0;
+constexpr double kYoungs_Pa = 2.05e11;
+constexpr double kSpeed_m_s = 1.0;
+
+bool same_grid(const std::vector<double>& a, const std::vector<double>& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    if (std::abs(a[i] - b[i]) > 1e-12 * b[i]) return false;
+  return true;
+}
+
+void check_ratios(const std::vector<double>& v, const char* what) {
+  if (v.empty()) throw InputError("", what, "needs at least one value");
+  for (double x : v) {
+    if (!(x > 0.0) || !std::isfinite(x)) {
+      std::ostringstream s;
+      s << "every value must be positive and finite, got " << x;
+      throw InputError("", what, s.str());
+    }
+  }
+}
+
+// Semi-axes of the target for a geometric ratio (see Table1Options::size_ratio).
+Eigen::Vector3d semi_axes(double g, double size_ratio) {
+  const double s = size_ratio * kSphereRadius_m;
+  if (g >= 1.0) return {g * s, s, s};
+  return {s, s / g, s / g};
+}
+
+// Eq. 26 factor on a unit sphere at a unit vector u: mean of sqrt(1 - u_i^2) over the sections
+// that are not tangent (written out independently of geometry::Ellipsoid, as a check).
+double sphere_eq26_factor(const Eigen::Vector3d& u) {
+  double sum = 0.0;
+  int count = 0;
+  for (int i = 0; i < 3; ++i) {
+    const double s2 = 1.0 - u[i] * u[i];
+    if (!(s2 > 1e-12)) continue;
+    sum += std::sqrt(s2);
+    ++count;
+  }
+  return sum / count;
+}
+
+}  // namespace
+
+Table1Options table1_preset(const std::string& name) {
+  if (name != "paper") {
+    throw InputError("", "--preset", "unknown preset \"" + name + "\" (available: \"paper\")");
+  }
+  Table1Options o;
+  o.geometric_ratios = kDecades;
+  o.mass_ratios = kDecades;
+  o.size_ratio = 20.0;
+  o.target_radius_rule = RadiusRule::paper;
+  o.cloud = CloudKind::paper_grid;
+  o.grid_steps = 8;
+  return o;
+}
+
+const PaperTable1& paper_table1() {
+  // Table 1 of the seed paper as printed (shared/data/paper_table1.csv), transposed to rows g,
+  // columns mu. Reference data for the comparison; nothing of it feeds the computation.
+  static const PaperTable1 t = [] {
+    PaperTable1 p;
+    p.geometric_ratios = kDecades;
+    p.mass_ratios = kDecades;
+    const double by_mu[9][9] = {
+        // g:  1e-4   1e-3   1e-2   1e-1  1   1e1    1e2    1e3    1e4
+        {0.350, 0.350, 0.351, 0.381, 1, 0.378, 0.345, 0.344, 0.288},  // mu = 1e-4
+        {0.351, 0.350, 0.351, 0.381, 1, 0.378, 0.345, 0.344, 0.288},  // 1e-3
+        {0.352, 0.352, 0.352, 0.382, 1, 0.379, 0.346, 0.346, 0.288},  // 1e-2
+        {0.367, 0.367, 0.367, 0.398, 1, 0.379, 0.361, 0.361, 0.288},  // 1e-1
+        {0.482, 0.482, 0.483, 0.517, 1, 0.513, 0.476, 0.456, 0.288},  // 1
+        {0.806, 0.806, 0.807, 0.829, 1, 0.821, 0.699, 0.456, 0.288},  // 1e1
+        {0.973, 0.973, 0.973, 0.976, 1, 0.922, 0.699, 0.456, 0.288},  // 1e2
+        {0.997, 0.997, 0.997, 0.996, 1, 0.922, 0.699, 0.456, 0.288},  // 1e3
+        {0.999, 0.999, 0.999, 0.997, 1, 0.922, 0.699, 0.456, 0.288},  // 1e4
+    };
+    p.ratio.assign(9, std::vector<double>(9));
+    for (int g = 0; g < 9; ++g)
+      for (int m = 0; m < 9; ++m) p.ratio[g][m] = by_mu[m][g];
+    return p;
+  }();
+  return t;
+}
+
+Table1Result run_table1(const Table1Options& o) {
+  check_ratios(o.geometric_ratios, "geometric ratios");
+  check_ratios(o.mass_ratios, "mass ratios");
+  if (!(o.size_ratio > 0.0) || !std::isfinite(o.size_ratio)) {
+    throw InputError("", "size ratio", "must be positive and finite");
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  Table1Result res;
+  res.options = o;
+  res.options.progress = nullptr;
+  const std::size_t ng = o.geometric_ratios.size(), nm = o.mass_ratios.size();
+  res.ratio.assign(ng, std::vector<double>(nm));
+  res.mass_only.assign(ng, std::vector<double>(nm));
+
+  const double r = kSphereRadius_m;
+  auto sphere = std::make_shared<geometry::Ellipsoid>(geometry::Ellipsoid::sphere(r));
+  const geometry::VolumeProperties sv = sphere->volume_properties();
+  const double m2 = kDensity_kg_m3 * sv.volume_m3;
+
+  // Clouds first (the per-cell count is needed for the progress total).
+  std::vector<std::shared_ptr<geometry::Ellipsoid>> targets;
+  std::vector<std::vector<geometry::SurfacePoint>> clouds;
+  std::size_t total = 0;
+  for (double g : o.geometric_ratios) {
+    const Eigen::Vector3d e = semi_axes(g, o.size_ratio);
+    auto target = std::make_shared<geometry::Ellipsoid>(e.x(), e.y(), e.z());
+    std::vector<geometry::SurfacePoint> cloud = make_cloud(*target, o.cloud, o.grid_steps, o.uniform_count, o.seed);
+    total += cloud.size() * nm;
+    targets.push_back(std::move(target));
+    clouds.push_back(std::move(cloud));
+  }
+  res.points_per_cell = clouds.front().size();
+
+  std::size_t done_before = 0;
+  for (std::size_t gi = 0; gi < ng; ++gi) {
+    const geometry::VolumeProperties tv = targets[gi]->volume_properties();
+    for (std::size_t mi = 0; mi < nm; ++mi) {
+      SweepSetup s;
+      const double m1 = o.mass_ratios[mi] * m2;
+      s.target.shape = targets[gi];
+      s.target.mass_kg = m1;
+      s.target.inertia_kg_m2 = tv.inertia_per_density_m5 * (m1 / tv.volume_m3);
+      s.target.centroid_m = tv.centroid_m;
+      s.target.radius_rule = o.target_radius_rule;
+      s.impactor.shape = sphere;
+      s.impactor.mass_kg = m2;
+      s.impactor.inertia_kg_m2 = sv.inertia_per_density_m5 * kDensity_kg_m3;
+      s.impactor.centroid_m = sv.centroid_m;
+      s.impactor.radius_rule = RadiusRule::mean;  // the sphere's own radius r, exactly
+      s.effective_modulus_Pa = collision::effective_modulus_Pa(
+          {kYoungs_Pa, 0.3}, {kYoungs_Pa, 0.3}, collision::ModulusConvention::paper);
+      s.approach_speed_m_s = kSpeed_m_s;
+      s.restitution.from_energy_flux = false;
+      s.restitution.constant = 1.0;
+      SweepOptions so;
+      so.threads = o.threads;
+      if (o.progress) {
+        so.progress = [&](std::size_t done, std::size_t) { o.progress(done_before + done, total); };
+      }
+      const SweepResult sr = run_sweep(s, clouds[gi], so);
+      done_before += clouds[gi].size();
+      res.ratio[gi][mi] = sr.force_ratio;
+      res.mass_only[gi][mi] = sr.mass_only_ratio;
+    }
+  }
+
+  // Comparison with the paper, when the grid is the paper's.
+  const PaperTable1& p = paper_table1();
+  if (same_grid(o.geometric_ratios, p.geometric_ratios) && same_grid(o.mass_ratios, p.mass_ratios)) {
+    res.compared = true;
+    res.paper = p.ratio;
+    res.delta.assign(ng, std::vector<double>(nm));
+    double sum = 0.0;
+    for (std::size_t gi = 0; gi < ng; ++gi) {
+      for (std::size_t mi = 0; mi < nm; ++mi) {
+        res.delta[gi][mi] = res.ratio[gi][mi] - p.ratio[gi][mi];
+        const double g = o.geometric_ratios[gi], mu = o.mass_ratios[mi];
+        if (g == 1.0) continue;
+        if (g == kExcludedGeometricRatio && mu == kExcludedMassRatio) {
+          res.excluded_cell_model = res.ratio[gi][mi];
+          res.excluded_cell_paper = p.ratio[gi][mi];
+          continue;
+        }
+        const double a = std::abs(res.delta[gi][mi]);
+        sum += a;
+        res.max_abs_delta = std::max(res.max_abs_delta, a);
+        ++res.cells_compared;
+      }
+    }
+    res.mean_abs_delta = sum / static_cast<double>(res.cells_compared);
+  }
+
+  // The sphere row, explained: Eq. 26 on a sphere.
+  for (std::size_t gi = 0; gi < ng; ++gi) {
+    if (o.geometric_ratios[gi] != 1.0 || o.target_radius_rule != RadiusRule::paper) continue;
+    res.has_sphere_row = true;
+    const double R = targets[gi]->semi_axes_m().x();
+    double fmin = std::numeric_limits<double>::infinity(), fmax = 0.0;
+    for (const auto& sp : clouds[gi]) {
+      const double f = sphere_eq26_factor(sp.point_m / R);
+      fmin = std::min(fmin, f);
+      fmax = std::max(fmax, f);
+    }
+    auto rstar = [&](double f) { return 1.0 / (1.0 / (f * R) + 1.0 / r); };
+    res.sphere_min_radius_factor = fmin;
+    res.sphere_row_prediction = std::pow(rstar(fmin) / rstar(fmax), 0.2);
+  }
+
+  // Analytic limit (Eq. 39-41): the paper's Case 2 through the core, and Eq. 40 itself.
+  const double expo = collision::kHertzExponent / (collision::kHertzExponent + 1.0);
+  const std::size_t gmax = static_cast<std::size_t>(
+      std::max_element(o.geometric_ratios.begin(), o.geometric_ratios.end()) - o.geometric_ratios.begin());
+  res.limit_row_geometric_ratio = o.geometric_ratios[gmax];
+  for (std::size_t mi = 0; mi < nm; ++mi) {
+    LimitCheckRow row;
+    const double mu = o.mass_ratios[mi];
+    row.mass_ratio = mu;
+    row.eq40 = std::pow((1.0 + mu) / (6.0 + mu), expo);
+    // Case 2 (Fig. 10): slender spheroid g = 1e4, mass m = mu m2, hit perpendicular to its axis at
+    // its end point, against the central hit; the same k_H in both, so F ~ m_w^(n/(n+1)).
+    const double b = 1.0, a = 1e4 * b, m = mu * m2;
+    collision::RigidBody rod;
+    rod.mass_kg = m;
+    rod.inertia_kg_m2 = (m / 5.0) * Eigen::Vector3d(2 * b * b, a * a + b * b, a * a + b * b).asDiagonal();
+    collision::RigidBody ball;
+    ball.mass_kg = m2;
+    ball.inertia_kg_m2 = 0.4 * m2 * r * r * Eigen::Matrix3d::Identity();
+    collision::Contact end, centre;
+    end.point_m = {a, 0, 0};
+    end.normal = {0, 1, 0};
+    centre.point_m = {0, b, 0};
+    centre.normal = {0, 1, 0};
+    ball.center_of_mass_m = end.point_m + r * end.normal;
+    const double mw_end = collision::reduced_mass_kg(rod, ball, end);
+    ball.center_of_mass_m = centre.point_m + r * centre.normal;
+    const double mw_centre = collision::reduced_mass_kg(rod, ball, centre);
+    row.case2_core = std::pow(mw_end / mw_centre, expo);
+    row.cloud_mass_only = res.mass_only[gmax][mi];
+    row.cloud_ratio = res.ratio[gmax][mi];
+    res.limit_check.push_back(row);
+  }
+  res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return res;
+}
+
+}  // namespace impactdeck::study

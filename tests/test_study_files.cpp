@@ -1,0 +1,404 @@
+// Files of sweeps, of the Table 1 study and of `run`'s force plot, parsed back: XML well-formed
+// (tinyxml2), element and value counts, numbers finite, PNGs decodable by cairo with the expected
+// size and content.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include <cairo.h>
+#include <gtest/gtest.h>
+#include <tinyxml2.h>
+
+#include "impactdeck/common/error.hpp"
+#include "impactdeck/geometry/ellipsoid.hpp"
+#include "impactdeck/plot/drawing.hpp"
+#include "impactdeck/plot/force_plot.hpp"
+#include "impactdeck/scene/pipeline.hpp"
+#include "impactdeck/scene/scene.hpp"
+#include "impactdeck/study/cloud.hpp"
+#include "impactdeck/study/scene_sweep.hpp"
+#include "impactdeck/study/sweep_output.hpp"
+#include "impactdeck/study/table1.hpp"
+#include "impactdeck/study/table1_output.hpp"
+
+namespace impactdeck::study {
+namespace {
+namespace fs = std::filesystem;
+
+fs::path temp_dir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("impactdeck_study_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  std::ostringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+// Parses an XML file; fails the test if it is not well-formed.
+struct Xml {
+  tinyxml2::XMLDocument doc;
+  explicit Xml(const fs::path& p) {
+    const tinyxml2::XMLError e = doc.LoadFile(p.string().c_str());
+    EXPECT_EQ(e, tinyxml2::XML_SUCCESS) << p << ": " << doc.ErrorStr();
+  }
+};
+
+// Elements named `name` anywhere below `e`.
+void collect(const tinyxml2::XMLElement* e, const char* name, std::vector<const tinyxml2::XMLElement*>& out) {
+  for (const tinyxml2::XMLElement* c = e->FirstChildElement(); c; c = c->NextSiblingElement()) {
+    if (std::string(c->Name()) == name) out.push_back(c);
+    collect(c, name, out);
+  }
+}
+std::vector<const tinyxml2::XMLElement*> all(const tinyxml2::XMLElement* root, const char* name) {
+  std::vector<const tinyxml2::XMLElement*> v;
+  collect(root, name, v);
+  return v;
+}
+
+// Every number in an attribute list is finite and parses completely.
+void expect_finite_attributes(const tinyxml2::XMLElement* e, std::initializer_list<const char*> names) {
+  for (const char* n : names) {
+    const char* v = e->Attribute(n);
+    ASSERT_NE(v, nullptr) << n;
+    char* end = nullptr;
+    const double x = std::strtod(v, &end);
+    EXPECT_TRUE(std::isfinite(x) && *end == '\0') << n << "=\"" << v << "\"";
+  }
+}
+
+std::vector<double> numbers(const char* text) {
+  std::vector<double> v;
+  std::istringstream s(text ? text : "");
+  std::string tok;
+  while (s >> tok) {
+    char* end = nullptr;
+    const double x = std::strtod(tok.c_str(), &end);
+    EXPECT_TRUE(*end == '\0' && std::isfinite(x)) << tok;
+    v.push_back(x);
+  }
+  return v;
+}
+
+struct Png {
+  int width = 0, height = 0;
+  double non_white_fraction = 0;
+  double dark_fraction = 0;  // luminance < 0.25
+};
+
+Png read_png(const fs::path& p) {
+  Png out;
+  cairo_surface_t* s = cairo_image_surface_create_from_png(p.string().c_str());
+  EXPECT_EQ(cairo_surface_status(s), CAIRO_STATUS_SUCCESS) << p;
+  if (cairo_surface_status(s) == CAIRO_STATUS_SUCCESS) {
+    cairo_surface_flush(s);
+    out.width = cairo_image_surface_get_width(s);
+    out.height = cairo_image_surface_get_height(s);
+    const int stride = cairo_image_surface_get_stride(s);
+    const unsigned char* data = cairo_image_surface_get_data(s);
+    std::size_t non_white = 0, dark = 0;
+    for (int y = 0; y < out.height; ++y) {
+      const auto* row = reinterpret_cast<const std::uint32_t*>(data + y * stride);
+      for (int x = 0; x < out.width; ++x) {
+        const std::uint32_t px = row[x];
+        const double r = ((px >> 16) & 0xff) / 255.0, g = ((px >> 8) & 0xff) / 255.0, b = (px & 0xff) / 255.0;
+        if (r + g + b < 2.95) ++non_white;
+        if (0.2126 * r + 0.7152 * g + 0.0722 * b < 0.25) ++dark;
+      }
+    }
+    const double n = static_cast<double>(out.width) * out.height;
+    out.non_white_fraction = non_white / n;
+    out.dark_fraction = dark / n;
+  }
+  cairo_surface_destroy(s);
+  return out;
+}
+
+struct SweepFiles : ::testing::Test {
+  static void SetUpTestSuite() {
+    dir = new fs::path(temp_dir("sweep"));
+    sc = new scene::Scene(scene::load_scene(std::string(IMPACTDECK_SOURCE_DIR) + "/samples/fig4_sweep.toml"));
+    ss = new SceneSweep(sweep_from_scene(*sc));
+    const auto cloud = make_cloud(*ss->setup.target.shape, CloudKind::both, 8, 300, 1);
+    SweepOptions o;
+    o.curves = true;
+    o.curve_samples = 21;
+    result = new SweepResult(run_sweep(ss->setup, cloud, o));
+    SweepMeta meta{"fig4_sweep.toml", "fig4", "ellipsoid", "ball", "both -- test"};
+    write_sweep_csv(*dir / "s.csv", *result, meta);
+    write_sweep_curves_csv(*dir / "s_curves.csv", *result, meta);
+    write_sweep_pos(*dir / "s.pos", *result, meta);
+    write_sweep_vtp(*dir / "s.vtp", *result, meta);
+    const plot::Drawing d = force_map_drawing(*ss->setup.target.shape, ss->setup.target.centroid_m, *result);
+    plot::write_svg(*dir / "s.svg", d);
+    plot::write_png(*dir / "s.png", d, 1.0);
+  }
+  static void TearDownTestSuite() {
+    fs::remove_all(*dir);
+    delete result;
+    delete ss;
+    delete sc;
+    delete dir;
+  }
+  static inline fs::path* dir = nullptr;
+  static inline scene::Scene* sc = nullptr;
+  static inline SceneSweep* ss = nullptr;
+  static inline SweepResult* result = nullptr;
+};
+
+TEST_F(SweepFiles, CsvHasOneRowPerPoint) {
+  std::istringstream s(slurp(*dir / "s.csv"));
+  std::string line;
+  std::size_t rows = 0, header_cols = 0;
+  bool header = false;
+  while (std::getline(s, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    const std::size_t cols = std::count(line.begin(), line.end(), ',') + 1;
+    if (!header) {
+      header = true;
+      header_cols = cols;
+      EXPECT_NE(line.find("max_force_N"), std::string::npos);
+      continue;
+    }
+    EXPECT_EQ(cols, header_cols) << line;
+    EXPECT_EQ(line.find("nan"), std::string::npos);
+    EXPECT_EQ(line.find("inf"), std::string::npos);
+    ++rows;
+  }
+  EXPECT_EQ(header_cols, 19u);
+  EXPECT_EQ(rows, result->points.size());
+  EXPECT_EQ(result->points.size(), 690u);  // 390 grid + 300 uniform
+
+  const std::string curves = slurp(*dir / "s_curves.csv");
+  EXPECT_EQ(static_cast<std::size_t>(std::count(curves.begin(), curves.end(), '\n')),
+            result->points.size() * 21 + 1 + static_cast<std::size_t>(std::count(curves.begin(), curves.end(), '#')));
+}
+
+TEST_F(SweepFiles, GmshPosViews) {
+  const std::string pos = slurp(*dir / "s.pos");
+  const std::regex sp(R"(SP\(([^,]+),([^,]+),([^)]+)\)\{([^}]+)\};)");
+  std::size_t count = 0;
+  for (auto it = std::sregex_iterator(pos.begin(), pos.end(), sp); it != std::sregex_iterator(); ++it) {
+    for (int k = 1; k <= 4; ++k) {
+      char* end = nullptr;
+      const std::string v = (*it)[k].str();
+      const double x = std::strtod(v.c_str(), &end);
+      EXPECT_TRUE(std::isfinite(x) && *end == '\0') << v;
+    }
+    ++count;
+  }
+  EXPECT_EQ(count, 2 * result->points.size());
+  const std::regex view(R"re(View "(max_force_N|force_ratio)" \{)re");
+  EXPECT_EQ(std::distance(std::sregex_iterator(pos.begin(), pos.end(), view), std::sregex_iterator()), 2);
+  EXPECT_EQ(std::count(pos.begin(), pos.end(), '{'), std::count(pos.begin(), pos.end(), '}'));
+}
+
+TEST_F(SweepFiles, VtpIsWellFormedPolyData) {
+  Xml x(*dir / "s.vtp");
+  const auto* root = x.doc.RootElement();
+  ASSERT_NE(root, nullptr);
+  EXPECT_STREQ(root->Name(), "VTKFile");
+  EXPECT_STREQ(root->Attribute("type"), "PolyData");
+  const auto pieces = all(root, "Piece");
+  ASSERT_EQ(pieces.size(), 1u);
+  const std::size_t n = result->points.size();
+  EXPECT_EQ(pieces[0]->UnsignedAttribute("NumberOfPoints"), n);
+  EXPECT_EQ(pieces[0]->UnsignedAttribute("NumberOfVerts"), n);
+  std::size_t arrays = 0;
+  for (const auto* a : all(root, "DataArray")) {
+    const int comps = a->IntAttribute("NumberOfComponents", 1);
+    const auto v = numbers(a->GetText());
+    const std::string name = a->Attribute("Name");
+    if (name == "offsets") {
+      ASSERT_EQ(v.size(), n);
+      EXPECT_EQ(v.back(), static_cast<double>(n));
+    } else {
+      EXPECT_EQ(v.size(), n * static_cast<std::size_t>(comps)) << name;
+    }
+    if (name == "max_force_N") {
+      EXPECT_EQ(v[result->max_index], result->points[result->max_index].max_force_N);  // 17 digits round-trip
+    }
+    ++arrays;
+  }
+  EXPECT_EQ(arrays, 9u);  // 5 scalars + normals + points + connectivity + offsets
+}
+
+TEST_F(SweepFiles, ForceMapSvgAndPng) {
+  Xml x(*dir / "s.svg");
+  const auto* root = x.doc.RootElement();
+  ASSERT_NE(root, nullptr);
+  EXPECT_STREQ(root->Name(), "svg");
+  const auto circles = all(root, "circle");
+  EXPECT_EQ(circles.size(), result->points.size() + 2);  // one per point, two rings at the extremes
+  double rmin = 1e300, rmax = 0;
+  for (const auto* c : circles) {
+    expect_finite_attributes(c, {"cx", "cy", "r"});
+    rmin = std::min(rmin, c->DoubleAttribute("r"));
+    rmax = std::max(rmax, c->DoubleAttribute("r"));
+  }
+  // Radius proportional to F_max (the rings are 3 px larger than their circle; SVG keeps 2 decimals).
+  EXPECT_NEAR(rmin / (rmax - 3.0), result->force_ratio, 0.01);
+  std::string texts;
+  for (const auto* t : all(root, "text")) texts += std::string(t->GetText() ? t->GetText() : "") + "|";
+  EXPECT_NE(texts.find("F_max [kN]"), std::string::npos) << texts;  // colour bar with its unit
+  EXPECT_NE(texts.find("min/max"), std::string::npos);
+  EXPECT_GT(all(root, "polyline").size(), 20u);  // the wireframe
+
+  const Png png = read_png(*dir / "s.png");
+  EXPECT_EQ(png.width, 960);
+  EXPECT_EQ(png.height, 640);
+  EXPECT_GT(png.non_white_fraction, 0.05);  // something drawn
+  EXPECT_LT(png.non_white_fraction, 0.8);   // not a filled canvas
+  EXPECT_GT(png.dark_fraction, 0.002);      // dark circles / text present
+}
+
+TEST_F(SweepFiles, LargeCloudPictureIsThinned) {
+  const auto cloud = make_cloud(*ss->setup.target.shape, CloudKind::area_uniform, 8, 12000, 9);
+  const SweepResult big = run_sweep(ss->setup, cloud);
+  ForceMapOptions fo;
+  fo.max_points = 5000;  // stride 3: points 0, 3, 6, ... (4000) plus the extremes if off-stride
+  const std::string svg = plot::to_svg(force_map_drawing(*ss->setup.target.shape, ss->setup.target.centroid_m, big, fo));
+  std::size_t circles = 0;
+  for (std::size_t k = svg.find("<circle"); k != std::string::npos; k = svg.find("<circle", k + 1)) ++circles;
+  const std::size_t extra = (big.min_index % 3 != 0) + (big.max_index % 3 != 0);
+  EXPECT_EQ(circles, 4000 + extra + 2);
+  EXPECT_NE(svg.find("12000 points (" + std::to_string(4000 + extra) + " drawn)"), std::string::npos);
+}
+
+TEST(Table1Files, CsvMarkdownHeatmap) {
+  const fs::path dir = temp_dir("table1");
+  Table1Options o = table1_preset("paper");
+  const Table1Result r = run_table1(o);
+  write_table1_csv(dir / "t.csv", r);
+  const std::string csv = slurp(dir / "t.csv");
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 2 + 1 + 81);  // 2 comments, header, 81 cells
+  const std::string md = table1_markdown(r);
+  EXPECT_NE(md.find("| **1e4** |"), std::string::npos);
+  EXPECT_NE(md.find("Eq. 40"), std::string::npos);
+  EXPECT_EQ(md.find("nan"), std::string::npos);
+
+  const plot::Drawing heat = table1_heatmap(r);
+  plot::write_svg(dir / "t.svg", heat);
+  plot::write_png(dir / "t.png", heat, 1.0);
+  Xml x(dir / "t.svg");
+  const auto* root = x.doc.RootElement();
+  ASSERT_NE(root, nullptr);
+  std::size_t cells = 0;
+  for (const auto* rect : all(root, "rect")) {
+    expect_finite_attributes(rect, {"x", "y", "width", "height"});
+    if (rect->DoubleAttribute("width") == 52 && rect->DoubleAttribute("height") == 28) ++cells;
+  }
+  EXPECT_EQ(cells, 3u * 81u);  // model, paper, difference
+  const Png png = read_png(dir / "t.png");
+  EXPECT_EQ(png.width, static_cast<int>(std::lround(heat.width())));
+  EXPECT_GT(png.non_white_fraction, 0.2);
+
+  const auto j = table1_json(r);
+  ASSERT_EQ(j["collision_force_ratio"].size(), 9u);
+  ASSERT_EQ(j["collision_force_ratio"][0].size(), 9u);
+  EXPECT_EQ(j["geometric_ratios"][8], 1e4);
+  EXPECT_EQ(j["collision_force_ratio"][3][0], r.ratio[3][0]);  // rows g, columns mu
+  fs::remove_all(dir);
+}
+
+TEST(ForcePlot, RunWritesTheSvgNextToTheCsv) {
+  const fs::path dir = temp_dir("run");
+  scene::Scene sc = scene::load_scene(std::string(IMPACTDECK_SOURCE_DIR) + "/samples/fig4_sweep.toml");
+  ASSERT_TRUE(sc.outputs.force_plot_svg);
+  scene::RunOptions ro;
+  ro.out_dir = dir;
+  const scene::RunReport rep = scene::run_scene(sc, ro);
+  ASSERT_TRUE(rep.impacts.at(0).plot_path);
+  const fs::path svg = *rep.impacts[0].plot_path;
+  EXPECT_EQ(svg, dir / "force_fig4.svg");
+  EXPECT_TRUE(fs::exists(dir / "force_fig4.csv"));
+  Xml x(svg);
+  const auto* root = x.doc.RootElement();
+  ASSERT_NE(root, nullptr);
+  // Two curves (compression, restitution) with 301 vertices each, then the two dashed marks.
+  std::size_t curves = 0, marks = 0;
+  for (const auto* p : all(root, "polyline")) {
+    const std::string pts = p->Attribute("points");
+    const std::size_t vertices = std::count(pts.begin(), pts.end(), ' ') + 1;
+    if (vertices == 301) ++curves;
+    if (p->Attribute("stroke-dasharray")) ++marks;
+  }
+  EXPECT_EQ(curves, 2u);
+  EXPECT_EQ(marks, 2u);
+  std::string texts;
+  for (const auto* t : all(root, "text")) texts += std::string(t->GetText() ? t->GetText() : "") + "|";
+  EXPECT_NE(texts.find("t_m = "), std::string::npos) << texts;
+  EXPECT_NE(texts.find("end = "), std::string::npos);
+  EXPECT_NE(texts.find("\xCE\xA0 = (1 + R)"), std::string::npos);  // total impulse in the legend
+  // The legend's total impulse is the core's, to the 4 digits shown.
+  std::ostringstream pi;
+  pi << plot::format_number(rep.impacts[0].result.history.impulse_total_Ns()) << " N s";
+  EXPECT_NE(texts.find(pi.str()), std::string::npos) << pi.str();
+  fs::remove_all(dir);
+}
+
+TEST(ForcePlot, SceneKeyIsCheckedAndUnknownKeysStillRejected) {
+  const std::string base = R"(
+length_unit = "m"
+[materials.s]
+youngs_modulus_Pa = 2e11
+poisson_ratio = 0.3
+density_kg_m3 = 7800
+[[bodies]]
+name = "a"
+shape = "sphere"
+radius = 0.05
+material = "s"
+velocity_m_s = [1, 0, 0]
+[[bodies]]
+name = "b"
+shape = "sphere"
+radius = 0.05
+material = "s"
+[[impacts]]
+target = "b"
+impactor = "a"
+point = [-0.05, 0, 0]
+restitution = 1.0
+[outputs]
+)";
+  EXPECT_NO_THROW(scene::parse_scene(base + "force_plot_svg = \"f.svg\"\n", "ok.toml"));
+  try {
+    scene::parse_scene(base + "force_plot_svg = \"f.png\"\n", "bad.toml");
+    FAIL() << "no throw";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("bad.toml"), std::string::npos) << m;
+    EXPECT_NE(m.find("outputs.force_plot_svg"), std::string::npos) << m;
+    EXPECT_NE(m.find(".svg"), std::string::npos) << m;
+  }
+  try {
+    scene::parse_scene(base + "force_plot = \"f.svg\"\n", "typo.toml");
+    FAIL() << "no throw";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("unknown key"), std::string::npos) << m;
+    EXPECT_NE(m.find("force_plot_svg"), std::string::npos) << m;  // listed among the allowed keys
+  }
+}
+
+TEST(Drawing, SvgEscapesTextAndRejectsNonFinite) {
+  plot::Drawing d(100, 50);
+  d.text({1, 2}, "a < b & \"c\"", 10);
+  const std::string s = plot::to_svg(d);
+  EXPECT_NE(s.find("a &lt; b &amp; &quot;c&quot;"), std::string::npos);
+  d.circle({std::nan(""), 1}, 2, plot::Style{});
+  EXPECT_THROW(plot::to_svg(d), Error);
+  EXPECT_EQ(plot::nice_ticks(0, 59.6, 5), (std::vector<double>{0, 20, 40}));
+  EXPECT_EQ(plot::format_number(-0.0), "0");
+}
+
+}  // namespace
+}  // namespace impactdeck::study
