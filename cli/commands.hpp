@@ -10,5 +10,6 @@ struct Context {
 };
 
 void register_run(CLI::App& app, Context& ctx);
+void register_inspect(CLI::App& app, Context& ctx); void register_mesh_ellipsoid(CLI::App& app, Context& ctx);
 
 }  // namespace impactdeck::cli

@@ -31,3 +31,12 @@ find_package(CLI11 QUIET)
 impactdeck_require(CLI11_FOUND "CLI11" libcli11-dev)
 
 find_package(Threads REQUIRED)
+
+# Geometry front end: assimp reads the part files, CGAL (header-only, GPL packages Polygon Mesh
+# Processing and Jet fitting) validates and queries them. CGAL is linked PRIVATE to
+# impactdeck::geometry only: no public header includes it.
+find_package(assimp QUIET)
+impactdeck_require(assimp_FOUND "assimp" libassimp-dev)
+
+find_package(CGAL 5.0 QUIET)
+impactdeck_require(CGAL_FOUND "CGAL" libcgal-dev)
