@@ -224,7 +224,9 @@ void write_stl_ascii(const fs::path& file, const TriangleMesh& mesh, LengthUnit 
       if (nrm.norm() > 0) nrm.normalize();
       o << "  facet normal " << nrm.x() + 0.0 << " " << nrm.y() + 0.0 << " " << nrm.z() + 0.0 << "\n    outer loop\n";
       for (const auto* p : {&a, &b, &c})
-        o << "      vertex " << (*p)[0] * s + 0.0 << " " << (*p)[1] * s + 0.0 << " " << (*p)[2] * s + 0.0 << "\n";
+        // The float32 values a binary STL would hold, printed with 9 digits (float round trip).
+        o << "      vertex " << static_cast<float>((*p)[0] * s) + 0.0f << " " << static_cast<float>((*p)[1] * s) + 0.0f
+          << " " << static_cast<float>((*p)[2] * s) + 0.0f << "\n";
       o << "    endloop\n  endfacet\n";
     }
     o << "endsolid " << name << "\n";

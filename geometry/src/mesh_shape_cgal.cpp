@@ -53,6 +53,7 @@ struct MeshShape::Index {
   std::vector<double> face_area;
   std::vector<Eigen::Vector3d> vertex_normal;  // area-weighted, unit
   std::vector<int> adj_start, adj;             // vertex adjacency (CSR)
+  std::vector<std::array<int, 3>> face_across; // face across edge k (k, k+1); -1: sharp/boundary
   std::unordered_set<std::uint64_t> sharp_edges;
   std::vector<char> vertex_sharp;
   std::vector<double> cumulative_area;
@@ -125,6 +126,15 @@ MeshShape::MeshShape(TriangleMesh mesh, const MeshMassProperties& mass, const Me
       ix.vertex_sharp[key & 0xffffffffu] = 1;
     }
   }
+  ix.face_across.assign(nf, {-1, -1, -1});
+  for (std::size_t f = 0; f < nf; ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int a = F[f][k], b = F[f][(k + 1) % 3];
+      const std::uint64_t key = edge_key(a, b);
+      const auto& fs = edge_faces.at(key);
+      const int other = fs.second < 0 ? -1 : (fs.first == int(f) ? fs.second : fs.first);
+      if (!ix.sharp_edges.count(key)) ix.face_across[f][k] = other;
+    }
   ix.adj_start.assign(nv + 1, 0);
   for (std::size_t v = 0; v < nv; ++v) ix.adj_start[v + 1] = ix.adj_start[v] + int(nb[v].size());
   ix.adj.reserve(ix.adj_start[nv]);
@@ -210,23 +220,27 @@ CurvatureFit MeshShape::curvature_fit(const Eigen::Vector3d& point) const {
     }
   }
 
-  // Vertices within `rings` geodesic rings of the triangle's corners, not crossing sharp edges.
+  // The neighbourhood: vertices of the faces within 2·rings - 1 edge-adjacency steps of the hit
+  // face (about `rings` vertex rings around it), never crossing a sharp edge: a fit does not
+  // straddle one. (Measured on the 3:2:1 ellipsoid at 20k triangles: 3 steps 0.87 % max error,
+  // 5 steps 2.2 %, 7 steps 4 %: the cubic jet's model error grows faster than the noise drops.)
   auto gather = [&](int rings) {
-    std::vector<int> pts(t.begin(), t.end());
-    std::unordered_set<int> seen(t.begin(), t.end());
+    const int depth = 2 * rings - 1;
+    std::vector<int> faces{f};
+    std::unordered_set<int> seen_f{f};
     std::size_t begin = 0;
-    for (int r = 0; r < rings; ++r) {
-      const std::size_t end = pts.size();
-      for (std::size_t i = begin; i < end; ++i) {
-        const int v = pts[i];
-        for (int j = ix.adj_start[v]; j < ix.adj_start[v + 1]; ++j) {
-          const int w = ix.adj[j];
-          if (ix.sharp_edges.count(edge_key(v, w))) continue;
-          if (seen.insert(w).second) pts.push_back(w);
-        }
-      }
+    for (int r = 0; r < depth; ++r) {
+      const std::size_t end = faces.size();
+      for (std::size_t i = begin; i < end; ++i)
+        for (int g : ix.face_across[faces[i]])
+          if (g >= 0 && seen_f.insert(g).second) faces.push_back(g);
       begin = end;
     }
+    std::vector<int> pts(t.begin(), t.end());
+    std::unordered_set<int> seen(t.begin(), t.end());
+    for (int g : faces)
+      for (int v : mesh_.triangles[g])
+        if (seen.insert(v).second) pts.push_back(v);
     return pts;
   };
   const int d = options_.jet_degree;
@@ -303,69 +317,39 @@ CurvatureFit MeshShape::curvature_fit(const Eigen::Vector3d& point) const {
 }
 
 double MeshShape::paper_radius_m(const SurfacePoint& at) const {
-  const Index& ix = *index_;
-  const auto& V = mesh_.vertices_m;
-  const Eigen::Vector3d p = at.point_m, n = at.normal;
-  const double W = options_.section_window_edges * ix.mean_edge;
-  std::vector<Primitive::Id> near;
-  const CGAL::Bbox_3 box(p.x() - W, p.y() - W, p.z() - W, p.x() + W, p.y() + W, p.z() + W);
-  ix.tree.all_intersected_primitives(box, std::back_inserter(near));
+  // Eq. 26 on the mesh. The section of the surface by the plane through p with unit normal e has,
+  // at p, tangent t = n×e/|n×e| and curvature κ = κ_n(t) / |n×e| (Meusnier's theorem: the section
+  // plane is tilted from the normal plane by φ with cos φ = |n×e|), where κ_n(t) = k1 (t·d1)² +
+  // k2 (t·d2)² is the normal curvature from the jet-fitted curvature tensor (Euler). The section
+  // radius is 1/κ, the result the mean over the non-degenerate sections, as Eq. 26 does on the
+  // ellipsoid. (Fitting the facet polyline of each section directly was tried and rejected: the
+  // facets' chordal error, h² k_max / 8, swamps the curvature of nearly straight sections; on the
+  // 20k-triangle 3:2:1 ellipsoid it gave up to 32 % error against Eq. 26, this gives ≤ 2 %.)
+  const CurvatureFit fit = curvature_fit(at.point_m);
+  if (fit.curvature.sharp_feature) {
+    throw InputError("", "point", "lies on a sharp edge or corner: the Eq. 26 radius is undefined there");
+  }
+  const Eigen::Vector3d n = at.normal;
+  const Curvature& c = fit.curvature;
+  // A cut is tangent (degenerate, left out as in the analytic Eq. 26) when the surface normal is
+  // within 1e-3 rad of the cut's normal: the mesh normal is not more accurate than that (the
+  // analytic shape uses the exact condition s² <= 1e-12).
+  constexpr double kTangentCut = 1e-3;
   double sum = 0;
   int count = 0;
   for (int i = 0; i < 3; ++i) {
     const Eigen::Vector3d e = Eigen::Vector3d::Unit(i);
-    Eigen::Vector3d tan = n.cross(e);
-    if (tan.norm() < 1e-9) continue;  // plane tangent to the surface
-    tan.normalize();
-    Eigen::Vector3d m = e.cross(tan);
-    if (m.dot(n) < 0) m = -m;
-    // Section points: crossings of the plane x_i = p_i with the edges of nearby faces that face
-    // the same way as n (the far side of a thin wall is not this section).
-    std::unordered_map<std::uint64_t, Eigen::Vector2d> crossings;
-    for (const auto& id : near) {
-      const int f = static_cast<int>(id - ix.triangles.begin());
-      if (ix.face_normal[f].dot(n) <= 0) continue;
-      const auto& t = mesh_.triangles[f];
-      for (int k = 0; k < 3; ++k) {
-        const int a = t[k], b = t[(k + 1) % 3];
-        const double sa = V[a][i] - p[i], sb = V[b][i] - p[i];
-        if ((sa > 0 && sb > 0) || (sa < 0 && sb < 0) || (sa == 0 && sb == 0)) continue;
-        const std::uint64_t key = sa == 0 ? (std::uint64_t(a) | (1ull << 63))
-                                 : sb == 0 ? (std::uint64_t(b) | (1ull << 63)) : edge_key(a, b);
-        const Eigen::Vector3d q = sa == 0 ? V[a] : sb == 0 ? V[b] : Eigen::Vector3d(V[a] + (sa / (sa - sb)) * (V[b] - V[a]));
-        const Eigen::Vector3d r = q - p;
-        crossings.emplace(key, Eigen::Vector2d(r.dot(tan), r.dot(m)));
-      }
-    }
-    std::vector<Eigen::Vector2d> pts;
-    double umin = 0, umax = 0;
-    for (const auto& [k, uv] : crossings) {
-      if (std::abs(uv.x()) > W || std::abs(uv.y()) > W) continue;
-      pts.push_back(uv);
-      umin = std::min(umin, uv.x());
-      umax = std::max(umax, uv.x());
-    }
-    // Tangent at the mesh's resolution: the section does not reach across the window.
-    if (pts.size() < 6 || umin > -0.5 * W || umax < 0.5 * W) continue;
-    Eigen::MatrixXd A(pts.size(), 4);
-    Eigen::VectorXd b(pts.size());
-    for (std::size_t r = 0; r < pts.size(); ++r) {
-      const double u = pts[r].x() / W;
-      A(r, 0) = 1;
-      A(r, 1) = u;
-      A(r, 2) = u * u;
-      A(r, 3) = u * u * u;
-      b[r] = pts[r].y();
-    }
-    const Eigen::Vector4d c = A.colPivHouseholderQr().solve(b);
-    const double c1 = c[1] / W, c2 = c[2] / (W * W);
-    const double kappa = -2.0 * c2 / std::pow(1.0 + c1 * c1, 1.5);  // positive: convex
-    sum += 1.0 / kappa;
+    const Eigen::Vector3d txe = n.cross(e);
+    const double cos_phi = txe.norm();
+  
+    if (!(cos_phi > kTangentCut)) continue;
+    const Eigen::Vector3d t = txe / cos_phi;
+    const double a1 = t.dot(c.d1), a2 = t.dot(c.d2);
+    const double kn = (c.k1_per_m * a1 * a1 + c.k2_per_m * a2 * a2) / std::max(a1 * a1 + a2 * a2, 1e-300);
+    sum += cos_phi / kn;  // radius of the section: 1/κ = |n×e| / κ_n
     ++count;
   }
-  if (count == 0) {
-    throw InputError("", "point", "no non-degenerate section for the Eq. 26 radius at this mesh resolution");
-  }
+  if (count == 0) throw InputError("", "point", "no non-degenerate section for the Eq. 26 radius");
   return sum / count;
 }
 

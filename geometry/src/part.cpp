@@ -45,7 +45,10 @@ Part load_part(const std::filesystem::path& file, const PartOptions& opt) {
     part.warnings.push_back(where + ": self-intersections were not checked (turned off)");
   }
   // Orientation is not a matter of approximation: a reversed shell would count as negative volume.
-  if (!report.consistently_oriented || !report.outward_oriented) {
+  // (For an open or non-manifold surface, "outward" is undefined: that case is the approximation
+  // handled below.)
+  const bool solid_topology = report.closed && report.non_manifold_edges == 0;
+  if (solid_topology && (!report.consistently_oriented || !report.outward_oriented)) {
     std::ostringstream s;
     if (!report.consistently_oriented) {
       s << "the orientation of the triangles is inconsistent (" << report.orientation_conflicts
@@ -57,8 +60,7 @@ Part load_part(const std::filesystem::path& file, const PartOptions& opt) {
       s << "the surface is oriented inward (negative signed volume)";
     }
     s << "; rerun with --repair (scene: repair = true) to orient it outward";
-    if (report.closed && report.non_manifold_edges == 0) throw InputError(where, "orientation", s.str());
-    if (!opt.accept_approximate_mass) throw InputError(where, "orientation", s.str());
+    throw InputError(where, "orientation", s.str());
   }
   if (!report.valid_solid()) {
     part.approximation_reason = report.approximation_reason();
@@ -73,9 +75,17 @@ Part load_part(const std::filesystem::path& file, const PartOptions& opt) {
     part.warnings.push_back(where + ": APPROXIMATE mass properties: " + part.approximation_reason);
   }
 
-  const MeshMassProperties mass = timed(part.stages, "mass_properties", [&] {
+  MeshMassProperties mass = timed(part.stages, "mass_properties", [&] {
     return compute_mass_properties(mesh, label_shells(mesh));
   });
+  if (part.approximate_mass && mass.volume.volume_m3 < 0) {
+    // An open surface has no inside: a negative signed volume means its normals point the other
+    // way. Accepted approximation: take the orientation as reversed, and say so.
+    for (auto& t : mesh.triangles) std::swap(t[1], t[2]);
+    mass = compute_mass_properties(mesh, label_shells(mesh));
+    part.warnings.push_back(where + ": the open surface's signed volume was negative: its orientation "
+                            "was taken as reversed for the approximation");
+  }
   if (!(mass.volume.volume_m3 > 0) || !mass.volume.inertia_per_density_m5.allFinite()) {
     std::ostringstream s;
     s << "the enclosed volume is not positive (" << mass.volume.volume_m3 << " m^3)";

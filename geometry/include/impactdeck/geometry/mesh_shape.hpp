@@ -18,8 +18,6 @@ struct MeshShapeOptions {
   int curvature_rings = 2;
   /// Degree of the fitted jet (CGAL Monge_via_jet_fitting; 2..4). 3 gives O(h^2) curvature.
   int jet_degree = 3;
-  /// Half-width of the window along a section curve for the Eq. 26 radius, in mean edge lengths.
-  double section_window_edges = 6.0;
 };
 
 /// Curvature with the details of its fit.
@@ -48,9 +46,9 @@ class MeshShape final : public Shape {
   Curvature curvature(const SurfacePoint& at) const override;
   CurvatureFit curvature_fit(const Eigen::Vector3d& point_m) const;
   /// Eq. 26 on the mesh: the three axis-normal planes through the point cut the surface; each
-  /// section's radius at the point comes from a cubic least-squares fit of the section points
-  /// within ±section_window_edges·h; a section is left out when it is tangent at the mesh's
-  /// resolution (it does not reach across the window on both sides). InputError when none is left.
+  /// section's radius at the point follows from the jet-fitted curvature tensor by Euler's and
+  /// Meusnier's theorems (κ = κ_n(t)/|n×e|, t = n×e/|n×e|); tangent cuts (|n×e| ≤ 1e-3) are left
+  /// out. InputError on a sharp feature or when no cut is left.
   double paper_radius_m(const SurfacePoint& at) const override;
   std::optional<SurfacePoint> ray_exit(const Eigen::Vector3d& origin_m,
                                        const Eigen::Vector3d& direction) const override;
