@@ -2,7 +2,7 @@
 
 #include <cmath>
 #include <numeric>
-#include <unordered_map>
+#include <algorithm>
 
 namespace impactdeck::geometry {
 
@@ -45,32 +45,35 @@ int find_root(std::vector<int>& parent, int i) {
 }  // namespace
 
 ShellLabels label_shells(const TriangleMesh& mesh) {
+  // Faces sharing an undirected edge are joined: sort the 3F edge records by key (faster and
+  // leaner than a hash map at a million triangles), then union each run.
   const int nf = static_cast<int>(mesh.triangles.size());
   std::vector<int> parent(nf);
   std::iota(parent.begin(), parent.end(), 0);
-  std::unordered_map<std::uint64_t, int> first_face;
-  first_face.reserve(static_cast<std::size_t>(nf) * 2);
+  std::vector<std::pair<std::uint64_t, int>> edges;
+  edges.reserve(static_cast<std::size_t>(nf) * 3);
   for (int f = 0; f < nf; ++f) {
     const auto& t = mesh.triangles[f];
     for (int k = 0; k < 3; ++k) {
       std::uint64_t a = static_cast<std::uint32_t>(t[k]), b = static_cast<std::uint32_t>(t[(k + 1) % 3]);
       if (a == b) continue;
       if (a > b) std::swap(a, b);
-      auto [it, inserted] = first_face.emplace((a << 32) | b, f);
-      if (!inserted) {
-        const int ra = find_root(parent, f), rb = find_root(parent, it->second);
-        if (ra != rb) parent[ra] = rb;
-      }
+      edges.emplace_back((a << 32) | b, f);
     }
+  }
+  std::sort(edges.begin(), edges.end());
+  for (std::size_t i = 1; i < edges.size(); ++i) {
+    if (edges[i].first != edges[i - 1].first) continue;
+    const int ra = find_root(parent, edges[i].second), rb = find_root(parent, edges[i - 1].second);
+    if (ra != rb) parent[ra] = rb;
   }
   ShellLabels s;
   s.shell_of_triangle.assign(nf, -1);
-  std::unordered_map<int, int> id;
+  std::vector<int> id(nf, -1);
   for (int f = 0; f < nf; ++f) {
     const int r = find_root(parent, f);
-    auto [it, inserted] = id.emplace(r, s.shell_count);
-    if (inserted) ++s.shell_count;
-    s.shell_of_triangle[f] = it->second;
+    if (id[r] < 0) id[r] = s.shell_count++;
+    s.shell_of_triangle[f] = id[r];
   }
   return s;
 }
