@@ -81,6 +81,11 @@ LoadedMesh load_mesh(const fs::path& file, LengthUnit unit) {
   }
 
   std::unordered_map<Eigen::Vector3d, int, Vec3Hash, Vec3Eq> index;
+  {
+    std::size_t total = 0;
+    for (unsigned m = 0; m < scene->mNumMeshes; ++m) total += scene->mMeshes[m]->mNumVertices;
+    index.reserve(total);  // no rehashing while merging (STL: 3 records per triangle)
+  }
   const double to_m = metres_per(unit);
   std::size_t face_counter = 0;  // faces in file order over all meshes (for messages)
 
