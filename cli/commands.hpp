@@ -12,5 +12,7 @@ struct Context {
 void register_run(CLI::App& app, Context& ctx);
 void register_sweep(CLI::App& app, Context& ctx);
 void register_study(CLI::App& app, Context& ctx);
+void register_inspect(CLI::App& app, Context& ctx);
+void register_mesh_ellipsoid(CLI::App& app, Context& ctx);
 
 }  // namespace impactdeck::cli

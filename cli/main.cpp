@@ -15,6 +15,8 @@ int main(int argc, char** argv) {
   impactdeck::cli::register_run(app, ctx);
   impactdeck::cli::register_sweep(app, ctx);
   impactdeck::cli::register_study(app, ctx);
+  impactdeck::cli::register_inspect(app, ctx);
+  impactdeck::cli::register_mesh_ellipsoid(app, ctx);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -43,3 +43,12 @@ if(IMPACTDECK_BUILD_TESTS)
   find_package(tinyxml2 CONFIG QUIET)
   impactdeck_require(tinyxml2_FOUND "tinyxml2 (tests only)" libtinyxml2-dev)
 endif()
+
+# Geometry front end: assimp reads the part files, CGAL (header-only, GPL packages Polygon Mesh
+# Processing and Jet fitting) validates and queries them. CGAL is linked PRIVATE to
+# impactdeck::geometry only: no public header includes it.
+find_package(assimp QUIET)
+impactdeck_require(assimp_FOUND "assimp" libassimp-dev)
+
+find_package(CGAL 5.0 QUIET)
+impactdeck_require(CGAL_FOUND "CGAL" libcgal-dev)

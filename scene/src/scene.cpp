@@ -223,6 +223,9 @@ BodySpec read_body(std::size_t index, const toml::table& t, const std::string& f
     case ShapeKind::mesh: {
       const std::string p = r.required_string("mesh");
       b.mesh_path = fs::path(p).is_absolute() ? fs::path(p) : base_dir / p;
+      b.mesh_repair = r.boolean("repair").value_or(false);
+      b.mesh_approximate_mass = r.boolean("approximate_mass_properties").value_or(false);
+      b.mesh_self_intersection_check = r.boolean("self_intersection_check").value_or(true);
       break;
     }
   }

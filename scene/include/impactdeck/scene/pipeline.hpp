@@ -67,10 +67,13 @@ struct RunOptions {
 };
 
 /// Builds the shape of a body (analytic or mesh). Throws InputError.
-std::shared_ptr<const geometry::Shape> make_shape(const BodySpec& body, const Scene& scene);
+/// For a mesh body, the stages mesh_load, mesh_validation and curvature_index, and the part's
+/// warnings, are recorded in `report` when given.
+std::shared_ptr<const geometry::Shape> make_shape(const BodySpec& body, const Scene& scene,
+                                                  RunReport* report = nullptr);
 
 /// Mass, inertia and material of a body from its spec.
-PreparedBody prepare_body(const BodySpec& body, const Scene& scene);
+PreparedBody prepare_body(const BodySpec& body, const Scene& scene, RunReport* report = nullptr);
 
 /// Runs everything the scene asks for. Throws InputError on bad input; a failed self-check is
 /// reported (see all_checks_passed), not thrown. Outputs are written atomically after all impacts

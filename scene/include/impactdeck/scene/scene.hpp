@@ -38,6 +38,9 @@ struct BodySpec {
   double radius_m = 0;                                     ///< sphere
   Eigen::Vector3d semi_axes_m = Eigen::Vector3d::Zero();   ///< ellipsoid
   std::filesystem::path mesh_path;                         ///< mesh, resolved against the scene
+  bool mesh_repair = false;                  ///< mesh: `repair = true` (stitch, merge, orient outward)
+  bool mesh_approximate_mass = false;        ///< mesh: `approximate_mass_properties = true`
+  bool mesh_self_intersection_check = true;  ///< mesh: `self_intersection_check = false` skips it
   std::string material;
   std::optional<double> mass_kg;  ///< overrides density x volume; inertia scales with it
   bool fixed = false;             ///< infinite mass

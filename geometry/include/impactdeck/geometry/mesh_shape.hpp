@@ -1,0 +1,72 @@
+#pragma once
+// A triangulated part as a Shape: surface queries on a closed, outward-oriented mesh. Built once
+// (AABB tree, adjacency, vertex normals, sharp edges), then every query is cheap.
+// CGAL stays in the .cpp (pimpl); this header uses Eigen and the standard library only.
+#include <memory>
+
+#include "impactdeck/geometry/mass_properties.hpp"
+#include "impactdeck/geometry/shape.hpp"
+#include "impactdeck/geometry/triangle_mesh.hpp"
+
+namespace impactdeck::geometry {
+
+struct MeshShapeOptions {
+  /// An edge is sharp when the angle between its two face normals exceeds this (degrees).
+  double sharp_angle_deg = 30.0;
+  /// Geodesic rings (around the three corners of the hit triangle) in the curvature fit; the
+  /// error estimate refits with one ring more and reports the difference.
+  int curvature_rings = 2;
+  /// Degree of the fitted jet (CGAL Monge_via_jet_fitting; 2..4). 3 gives O(h^2) curvature.
+  int jet_degree = 3;
+};
+
+/// Curvature with the details of its fit.
+struct CurvatureFit {
+  Curvature curvature;             ///< k1 >= k2, positive convex; error estimate included
+  double condition_number = 0;     ///< of the jet least-squares system (CGAL)
+  int neighbourhood_points = 0;    ///< points in the main fit
+  bool planar = false;             ///< neighbourhood too small but coplanar: k = 0 exactly
+};
+
+class MeshShape final : public Shape {
+ public:
+  /// `mesh` must be closed and oriented outward (see validate_mesh / repair_mesh); `mass` its
+  /// mass properties (compute_mass_properties). Throws InputError for an empty mesh.
+  MeshShape(TriangleMesh mesh, const MeshMassProperties& mass, const MeshShapeOptions& options = {});
+  ~MeshShape() override;
+  MeshShape(const MeshShape&) = delete;
+  MeshShape& operator=(const MeshShape&) = delete;
+
+  std::string kind() const override { return "mesh"; }
+  VolumeProperties volume_properties() const override { return mass_.volume; }
+  /// Closest point (AABB tree) and outward normal there: the face normal on or next to a sharp
+  /// edge, the barycentric blend of area-weighted vertex normals elsewhere.
+  SurfacePoint closest_point(const Eigen::Vector3d& query_m) const override;
+  /// Principal curvatures by jet fitting at the closest surface point (see curvature_fit).
+  Curvature curvature(const SurfacePoint& at) const override;
+  CurvatureFit curvature_fit(const Eigen::Vector3d& point_m) const;
+  /// Eq. 26 on the mesh: the three axis-normal planes through the point cut the surface; each
+  /// section's radius at the point follows from the jet-fitted curvature tensor by Euler's and
+  /// Meusnier's theorems (κ = κ_n(t)/|n×e|, t = n×e/|n×e|); tangent cuts (|n×e| ≤ 1e-3) are left
+  /// out. InputError on a sharp feature or when no cut is left.
+  double paper_radius_m(const SurfacePoint& at) const override;
+  std::optional<SurfacePoint> ray_exit(const Eigen::Vector3d& origin_m,
+                                       const Eigen::Vector3d& direction) const override;
+  double size_m() const override;
+  /// Area-uniform over the triangles (cumulative areas, deterministic mt19937_64).
+  std::vector<SurfacePoint> sample_surface(std::size_t count, std::uint64_t seed) const override;
+
+  const TriangleMesh& mesh() const { return mesh_; }
+  const MeshMassProperties& mass_properties() const { return mass_; }
+  std::size_t sharp_edge_count() const;
+  double mean_edge_length_m() const;
+
+ private:
+  struct Index;  // CGAL AABB tree and adjacency
+  TriangleMesh mesh_;
+  MeshMassProperties mass_;
+  MeshShapeOptions options_;
+  std::unique_ptr<Index> index_;
+};
+
+}  // namespace impactdeck::geometry

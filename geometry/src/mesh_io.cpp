@@ -1,0 +1,241 @@
+#include "impactdeck/geometry/mesh_io.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+#include <unordered_map>
+
+#include <assimp/Importer.hpp>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include "impactdeck/common/atomic_file.hpp"
+#include "impactdeck/common/error.hpp"
+
+namespace impactdeck::geometry {
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Vec3Hash {
+  std::size_t operator()(const Eigen::Vector3d& v) const {
+    std::size_t h = 1469598103934665603ull;
+    for (int i = 0; i < 3; ++i) {
+      double x = v[i] + 0.0;  // -0 and +0 are the same point
+      std::uint64_t bits;
+      std::memcpy(&bits, &x, sizeof bits);
+      h ^= bits + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2);
+    }
+    return h;
+  }
+};
+struct Vec3Eq {
+  bool operator()(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const { return a == b; }
+};
+
+bool is_identity(const aiMatrix4x4& m) { return m.IsIdentity(); }
+
+}  // namespace
+
+LoadedMesh load_mesh(const fs::path& file, LengthUnit unit) {
+  const std::string where = file.string();
+  std::error_code ec;
+  if (!fs::exists(file, ec)) throw InputError(where, "file", "does not exist");
+  if (fs::is_directory(file, ec)) throw InputError(where, "file", "is a directory, not a part file");
+  {
+    std::ifstream probe(file, std::ios::binary);
+    if (!probe) throw InputError(where, "file", "cannot be opened (unreadable)");
+  }
+  if (fs::file_size(file, ec) == 0) throw InputError(where, "file", "is empty (0 bytes): no triangles");
+  std::string ext = file.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  if (ext != ".stl" && ext != ".obj" && ext != ".ply" && ext != ".off") {
+    throw InputError(where, "file", "unsupported format '" + ext + "' (expected .stl, .obj, .ply or .off)");
+  }
+
+  LoadedMesh out;
+  out.format = ext.substr(1);
+  Assimp::Importer importer;
+  // Lines and points are kept by assimp and skipped below (with a warning). No vertex joining by
+  // assimp: it would keep STL's per-face normals apart; we merge exact positions ourselves.
+  const aiScene* scene = importer.ReadFile(where, aiProcess_ValidateDataStructure);
+  if (!scene) {
+    std::string msg = importer.GetErrorString();
+    std::replace(msg.begin(), msg.end(), '\n', ' ');
+    throw InputError(where, "parse", "cannot read the file (assimp: " + msg + ")");
+  }
+  // Count polygons before assimp triangulates them (ear clipping, concave faces included).
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m)
+    for (unsigned f = 0; f < scene->mMeshes[m]->mNumFaces; ++f)
+      if (scene->mMeshes[m]->mFaces[f].mNumIndices > 3) ++out.polygons_triangulated;
+  if (out.polygons_triangulated > 0) {
+    scene = importer.ApplyPostProcessing(aiProcess_Triangulate);
+    if (!scene) {
+      throw InputError(where, "parse", std::string("cannot triangulate its polygons (assimp: ") +
+                                           importer.GetErrorString() + ")");
+    }
+  }
+
+  std::unordered_map<Eigen::Vector3d, int, Vec3Hash, Vec3Eq> index;
+  {
+    std::size_t total = 0;
+    for (unsigned m = 0; m < scene->mNumMeshes; ++m) total += scene->mMeshes[m]->mNumVertices;
+    index.reserve(total);  // no rehashing while merging (STL: 3 records per triangle)
+  }
+  const double to_m = metres_per(unit);
+  std::size_t face_counter = 0;  // faces in file order over all meshes (for messages)
+
+  // Walk the node tree so that node transforms (rare in these formats) are honoured.
+  struct Item { const aiNode* node; aiMatrix4x4 transform; };
+  std::vector<Item> stack;
+  if (scene->mRootNode) stack.push_back({scene->mRootNode, scene->mRootNode->mTransformation});
+  std::vector<bool> mesh_seen(scene->mNumMeshes, false);
+  std::vector<std::pair<unsigned, aiMatrix4x4>> mesh_order;
+  while (!stack.empty()) {
+    Item it = stack.back();
+    stack.pop_back();
+    for (unsigned i = 0; i < it.node->mNumMeshes; ++i) {
+      const unsigned mi = it.node->mMeshes[i];
+      if (mi < scene->mNumMeshes) mesh_order.emplace_back(mi, it.transform);
+    }
+    for (unsigned c = 0; c < it.node->mNumChildren; ++c) {
+      const aiNode* child = it.node->mChildren[c];
+      stack.push_back({child, it.transform * child->mTransformation});
+    }
+  }
+  if (mesh_order.empty())
+    for (unsigned m = 0; m < scene->mNumMeshes; ++m) mesh_order.emplace_back(m, aiMatrix4x4());
+  std::sort(mesh_order.begin(), mesh_order.end(),
+            [](const auto& a, const auto& b) { return a.first < b.first; });
+
+  for (const auto& [mi, xf] : mesh_order) {
+    const aiMesh* mesh = scene->mMeshes[mi];
+    const bool transform = !is_identity(xf);
+    std::vector<int> local(mesh->mNumVertices, -1);
+    out.file_vertices += mesh->mNumVertices;
+    auto vertex_id = [&](unsigned v) {
+      if (local[v] >= 0) return local[v];
+      aiVector3D p = mesh->mVertices[v];
+      if (transform) p = xf * p;
+      // Double from the first conversion on: the float is converted exactly, then scaled.
+      Eigen::Vector3d x(static_cast<double>(p.x), static_cast<double>(p.y), static_cast<double>(p.z));
+      if (!x.allFinite()) {
+        throw InputError(where, "vertex " + std::to_string(v) + " of mesh " + std::to_string(mi),
+                         "coordinate is not a finite number");
+      }
+      x *= to_m;
+      auto [found, inserted] = index.emplace(x, static_cast<int>(out.mesh.vertices_m.size()));
+      if (inserted) out.mesh.vertices_m.push_back(x);
+      else ++out.merged_vertices;
+      local[v] = found->second;
+      return found->second;
+    };
+    for (unsigned f = 0; f < mesh->mNumFaces; ++f, ++face_counter) {
+      const aiFace& face = mesh->mFaces[f];
+      if (face.mNumIndices == 1) { ++out.points_ignored; continue; }
+      if (face.mNumIndices == 2) { ++out.lines_ignored; continue; }
+      if (face.mNumIndices != 3) {
+        throw InputError(where, "face " + std::to_string(face_counter),
+                         "has " + std::to_string(face.mNumIndices) + " corners after triangulation");
+      }
+      std::array<int, 3> t{};
+      for (int k = 0; k < 3; ++k) {
+        const unsigned v = face.mIndices[k];
+        if (v >= mesh->mNumVertices) {
+          throw InputError(where, "face " + std::to_string(face_counter),
+                           "vertex index " + std::to_string(v) + " out of range (" +
+                               std::to_string(mesh->mNumVertices) + " vertices)");
+        }
+        t[k] = vertex_id(v);
+      }
+      out.mesh.triangles.push_back(t);
+    }
+  }
+  // Vertices used only by skipped points/lines are dropped: keep only triangle corners.
+  {
+    std::vector<int> remap(out.mesh.vertices_m.size(), -1);
+    std::vector<Eigen::Vector3d> kept;
+    for (auto& t : out.mesh.triangles)
+      for (int& v : t) {
+        if (remap[v] < 0) {
+          remap[v] = static_cast<int>(kept.size());
+          kept.push_back(out.mesh.vertices_m[v]);
+        }
+        v = remap[v];
+      }
+    out.mesh.vertices_m.swap(kept);
+  }
+  if (out.lines_ignored + out.points_ignored > 0) {
+    out.warnings.push_back(where + ": ignored " + std::to_string(out.lines_ignored) + " line(s) and " +
+                           std::to_string(out.points_ignored) +
+                           " point(s): only triangles and polygons describe a surface");
+  }
+  if (out.mesh.triangles.empty()) {
+    std::string detail;
+    if (out.lines_ignored + out.points_ignored > 0) {
+      detail = " (only " + std::to_string(out.points_ignored) + " point(s) and " +
+               std::to_string(out.lines_ignored) + " line(s))";
+    }
+    throw InputError(where, "faces", "the file contains no triangles" + detail);
+  }
+  return out;
+}
+
+namespace {
+void put_f32(std::ostream& o, float x) {
+  char b[4];
+  std::memcpy(b, &x, 4);
+  o.write(b, 4);
+}
+}  // namespace
+
+void write_stl_binary(const fs::path& file, const TriangleMesh& mesh, LengthUnit unit,
+                      const std::string& header) {
+  const double s = 1.0 / metres_per(unit);
+  write_file_atomically(file, [&](std::ostream& o) {
+    char h[80] = {};
+    std::string text = header;
+    if (text.rfind("solid", 0) == 0) text = "binary " + text;  // readers sniff "solid" as ascii
+    std::memcpy(h, text.data(), std::min<std::size_t>(text.size(), 80));
+    o.write(h, 80);
+    const std::uint32_t n = static_cast<std::uint32_t>(mesh.triangles.size());
+    char nb[4];
+    std::memcpy(nb, &n, 4);
+    o.write(nb, 4);
+    for (const auto& t : mesh.triangles) {
+      const Eigen::Vector3d &a = mesh.vertices_m[t[0]], &b = mesh.vertices_m[t[1]], &c = mesh.vertices_m[t[2]];
+      Eigen::Vector3d nrm = (b - a).cross(c - a);
+      if (nrm.norm() > 0) nrm.normalize();
+      for (int i = 0; i < 3; ++i) put_f32(o, static_cast<float>(nrm[i]));
+      for (const auto* p : {&a, &b, &c})
+        for (int i = 0; i < 3; ++i) put_f32(o, static_cast<float>((*p)[i] * s));
+      o.write("\0\0", 2);
+    }
+  });
+}
+
+void write_stl_ascii(const fs::path& file, const TriangleMesh& mesh, LengthUnit unit,
+                     const std::string& name) {
+  const double s = 1.0 / metres_per(unit);
+  write_file_atomically(file, [&](std::ostream& o) {
+    o << std::setprecision(9) << "solid " << name << "\n";
+    for (const auto& t : mesh.triangles) {
+      const Eigen::Vector3d &a = mesh.vertices_m[t[0]], &b = mesh.vertices_m[t[1]], &c = mesh.vertices_m[t[2]];
+      Eigen::Vector3d nrm = (b - a).cross(c - a);
+      if (nrm.norm() > 0) nrm.normalize();
+      o << "  facet normal " << nrm.x() + 0.0 << " " << nrm.y() + 0.0 << " " << nrm.z() + 0.0 << "\n    outer loop\n";
+      for (const auto* p : {&a, &b, &c})
+        // The float32 values a binary STL would hold, printed with 9 digits (float round trip).
+        o << "      vertex " << static_cast<float>((*p)[0] * s) + 0.0f << " " << static_cast<float>((*p)[1] * s) + 0.0f
+          << " " << static_cast<float>((*p)[2] * s) + 0.0f << "\n";
+      o << "    endloop\n  endfacet\n";
+    }
+    o << "endsolid " << name << "\n";
+  });
+}
+
+}  // namespace impactdeck::geometry

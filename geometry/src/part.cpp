@@ -1,0 +1,100 @@
+#include "impactdeck/geometry/part.hpp"
+
+#include <chrono>
+#include <sstream>
+
+#include "impactdeck/common/error.hpp"
+
+namespace impactdeck::geometry {
+
+namespace {
+template <class F>
+auto timed(std::vector<StageSeconds>& stages, const std::string& name, F&& f) {
+  const auto t0 = std::chrono::steady_clock::now();
+  auto record = [&] {
+    stages.push_back({name, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()});
+  };
+  if constexpr (std::is_void_v<decltype(f())>) {
+    f();
+    record();
+  } else {
+    auto v = f();
+    record();
+    return v;
+  }
+}
+}  // namespace
+
+Part load_part(const std::filesystem::path& file, const PartOptions& opt) {
+  Part part;
+  part.file = file;
+  const std::string where = file.string();
+  part.loaded = timed(part.stages, "mesh_load", [&] { return load_mesh(file, opt.length_unit); });
+  part.warnings = part.loaded.warnings;
+  TriangleMesh mesh = part.loaded.mesh;
+
+  ValidationReport report = timed(part.stages, "mesh_validation", [&] {
+    part.validation = validate_mesh(mesh, opt.validation);
+    if (!opt.repair) return part.validation;
+    part.repairs = repair_mesh(mesh);
+    part.validation_after_repair = validate_mesh(mesh, opt.validation);
+    return *part.validation_after_repair;
+  });
+  if (mesh.triangles.empty()) throw InputError(where, "faces", "no triangle is left after repair");
+  if (!report.self_intersections_checked) {
+    part.warnings.push_back(where + ": self-intersections were not checked (turned off)");
+  }
+  // Orientation is not a matter of approximation: a reversed shell would count as negative volume.
+  // (For an open or non-manifold surface, "outward" is undefined: that case is the approximation
+  // handled below.)
+  const bool solid_topology = report.closed && report.non_manifold_edges == 0;
+  if (solid_topology && (!report.consistently_oriented || !report.outward_oriented)) {
+    std::ostringstream s;
+    if (!report.consistently_oriented) {
+      s << "the orientation of the triangles is inconsistent (" << report.orientation_conflicts
+        << " edges traversed twice in the same direction)";
+    } else if (!report.inward_shells.empty()) {
+      s << "shell " << report.inward_shells.front() << " (of " << report.shells
+        << ") is oriented inward (normals point into the material)";
+    } else {
+      s << "the surface is oriented inward (negative signed volume)";
+    }
+    s << "; rerun with --repair (scene: repair = true) to orient it outward";
+    throw InputError(where, "orientation", s.str());
+  }
+  if (!report.valid_solid()) {
+    part.approximation_reason = report.approximation_reason();
+    if (!opt.accept_approximate_mass) {
+      throw InputError(where, "mass properties",
+                       part.approximation_reason +
+                           ": volume, mass and inertia would be approximate; rerun with --repair, or "
+                           "accept the approximation with --accept-approximate (scene: "
+                           "approximate_mass_properties = true)");
+    }
+    part.approximate_mass = true;
+    part.warnings.push_back(where + ": APPROXIMATE mass properties: " + part.approximation_reason);
+  }
+
+  MeshMassProperties mass = timed(part.stages, "mass_properties", [&] {
+    return compute_mass_properties(mesh, label_shells(mesh));
+  });
+  if (part.approximate_mass && mass.volume.volume_m3 < 0) {
+    // An open surface has no inside: a negative signed volume means its normals point the other
+    // way. Accepted approximation: take the orientation as reversed, and say so.
+    for (auto& t : mesh.triangles) std::swap(t[1], t[2]);
+    mass = compute_mass_properties(mesh, label_shells(mesh));
+    part.warnings.push_back(where + ": the open surface's signed volume was negative: its orientation "
+                            "was taken as reversed for the approximation");
+  }
+  if (!(mass.volume.volume_m3 > 0) || !mass.volume.inertia_per_density_m5.allFinite()) {
+    std::ostringstream s;
+    s << "the enclosed volume is not positive (" << mass.volume.volume_m3 << " m^3)";
+    throw InputError(where, "mass properties", s.str());
+  }
+  part.shape = timed(part.stages, "curvature_index", [&] {
+    return std::make_shared<const MeshShape>(std::move(mesh), mass, opt.shape);
+  });
+  return part;
+}
+
+}  // namespace impactdeck::geometry
