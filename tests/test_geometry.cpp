@@ -397,6 +397,20 @@ TEST(FileErrors, OpenInvertedNonManifoldPointsEmpty) {
   // edge, not as pinched vertices.
   EXPECT_EQ(nm.non_manifold_vertices, 0u);
   EXPECT_EQ(nm.shells, 1);
+  // Two cubes touching at one corner: a pinched (non-manifold) vertex, two shells.
+  TriangleMesh pinched = make_unit_cube_mesh(), second = make_unit_cube_mesh();
+  transform_mesh(second, Eigen::Matrix3d::Identity(), Eigen::Vector3d(1, 1, 1));
+  const int off = static_cast<int>(pinched.vertices_m.size()) - 1;  // second's vertex 0 is pinched's 7
+  for (int i = 1; i < 8; ++i) pinched.vertices_m.push_back(second.vertices_m[i]);
+  for (auto t : second.triangles) {
+    for (int& v : t) v = v == 0 ? 7 : v + off;
+    pinched.triangles.push_back(t);
+  }
+  const auto pv = validate_mesh(pinched);
+  EXPECT_EQ(pv.non_manifold_vertices, 1u);
+  EXPECT_EQ(pv.non_manifold_edges, 0u);
+  EXPECT_EQ(pv.shells, 2);
+  EXPECT_NE(pv.approximation_reason().find("1 non-manifold vertices"), std::string::npos);
 }
 
 TEST(FileErrors, LinesAreIgnoredWithAWarningAndSelfIntersectionsAreFound) {
