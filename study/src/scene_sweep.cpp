@@ -33,7 +33,7 @@ SceneSweep sweep_from_scene(const scene::Scene& sc, const std::string& name) {
     case scene::ContactRadiusRule::mean: mapped = RadiusRule::mean; break;
   }
   if (!mapped) {
-    throw InputError(file, s.place.describe() + ", key 'contact_radius'",
+    throw InputError(file, scene::Place{s.place.line, s.place.key + ".contact_radius"}.describe(),
                      std::string("impact '") + s.name + "': the sweep does not support contact_radius = \"" +
                          scene::to_string(s.contact_radius) + "\" (use \"paper\" or \"mean\")");
   }
