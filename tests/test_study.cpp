@@ -202,7 +202,9 @@ TEST(Sweep, BitForBitWhateverTheThreadCount) {
                           {a.effective_radius_m, b.effective_radius_m}, {a.hertz_constant, b.hertz_constant},
                           {a.max_indentation_m, b.max_indentation_m}, {a.compression_time_s, b.compression_time_s},
                           {a.restitution, b.restitution}, {a.contact_time_s, b.contact_time_s},
-                          {a.impulse_total_Ns, b.impulse_total_Ns}}) {
+                          {a.impulse_total_Ns, b.impulse_total_Ns},
+                          {a.target_delta_velocity_m_s.x(), b.target_delta_velocity_m_s.x()},
+                          {a.target_delta_angular_velocity_rad_s.z(), b.target_delta_angular_velocity_rad_s.z()}}) {
         differing += !same_bits(x, y);
       }
     }
@@ -309,6 +311,14 @@ contact_radius = "RULE"
       EXPECT_LE(relative_difference(p.max_force_N, res.history.compression.max_force_N), kKernelVsPipelineRel) << rule;
       EXPECT_LE(relative_difference(p.reduced_mass_kg, res.reduced_mass_kg), kKernelVsPipelineRel) << rule;
       EXPECT_LE(relative_difference(p.contact_time_s, res.history.contact_time_s()), kKernelVsPipelineRel) << rule;
+      // Velocity jumps: the pipeline uses the quadrature impulse (rel. 1e-12 of the closed form).
+      const double dv_scale = res.target_jump.delta_velocity_m_s.norm();
+      EXPECT_LE((p.target_delta_velocity_m_s - res.target_jump.delta_velocity_m_s).norm(), 1e-9 * dv_scale) << rule;
+      // Delta omega may be exactly 0 (hits through the centroid): scale it by dv over the part's size.
+      const double dw_scale = res.target_jump.delta_angular_velocity_rad_s.norm() +
+                              dv_scale / ss.setup.target.shape->size_m();
+      EXPECT_LE((p.target_delta_angular_velocity_rad_s - res.target_jump.delta_angular_velocity_rad_s).norm(),
+                1e-9 * dw_scale) << rule;
     }
   }
 }

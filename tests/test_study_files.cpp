@@ -172,7 +172,7 @@ TEST_F(SweepFiles, CsvHasOneRowPerPoint) {
     EXPECT_EQ(line.find("inf"), std::string::npos);
     ++rows;
   }
-  EXPECT_EQ(header_cols, 19u);
+  EXPECT_EQ(header_cols, 25u);
   EXPECT_EQ(rows, result->points.size());
   EXPECT_EQ(result->points.size(), 690u);  // 390 grid + 300 uniform
 

@@ -1,6 +1,7 @@
 #include "impactdeck/study/scene_sweep.hpp"
 
 #include <cmath>
+#include <optional>
 #include <sstream>
 
 #include "impactdeck/common/error.hpp"
@@ -24,7 +25,19 @@ SceneSweep sweep_from_scene(const scene::Scene& sc, const std::string& name) {
   const scene::ImpactSpec& s = *out.impact;
   const scene::PreparedBody t = scene::prepare_body(sc.body(s.target), sc);
   const scene::PreparedBody i = scene::prepare_body(sc.body(s.impactor), sc);
-  const RadiusRule rule = s.contact_radius == scene::ContactRadiusRule::paper ? RadiusRule::paper : RadiusRule::mean;
+  // Every scene rule is mapped explicitly: a rule added to the scene format must be taught to the
+  // sweep (the compiler warns about the switch; at run time the sweep refuses it by name).
+  std::optional<RadiusRule> mapped;
+  switch (s.contact_radius) {
+    case scene::ContactRadiusRule::paper: mapped = RadiusRule::paper; break;
+    case scene::ContactRadiusRule::mean: mapped = RadiusRule::mean; break;
+  }
+  if (!mapped) {
+    throw InputError(file, scene::Place{s.place.line, s.place.key + ".contact_radius"}.describe(),
+                     std::string("impact '") + s.name + "': the sweep does not support contact_radius = \"" +
+                         scene::to_string(s.contact_radius) + "\" (use \"paper\" or \"mean\")");
+  }
+  const RadiusRule rule = *mapped;
   auto body = [&](const scene::PreparedBody& p) {
     SweepBody b;
     b.shape = p.shape;

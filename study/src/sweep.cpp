@@ -100,6 +100,10 @@ PointResult sweep_point(const SweepSetup& s, const geometry::SurfacePoint& at) {
     }
     r.contact_time_s = (1.0 + r.restitution) * r.compression_time_s;
     r.impulse_total_Ns = (1.0 + r.restitution) * comp.impulse_Ns;
+    collision::VelocityJump target_jump, impactor_jump;
+    collision::velocity_jumps(target, impactor, c, r.impulse_total_Ns, target_jump, impactor_jump);
+    r.target_delta_velocity_m_s = target_jump.delta_velocity_m_s;
+    r.target_delta_angular_velocity_rad_s = target_jump.delta_angular_velocity_rad_s;
   } catch (const InputError& e) {
     if (e.place().rfind("sweep point", 0) == 0) throw;
     point_error(at, (e.place().empty() ? "" : e.place() + ": ") + e.reason());

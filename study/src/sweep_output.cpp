@@ -41,7 +41,8 @@ void write_sweep_csv(const std::filesystem::path& path, const SweepResult& r, co
     header(o, "#", meta, r);
     o << "index,x_m,y_m,z_m,nx,ny,nz,target_radius_m,impactor_radius_m,effective_radius_m,"
          "reduced_mass_kg,hertz_constant_N_per_m1_5,max_indentation_m,max_force_N,force_ratio,"
-         "compression_time_s,restitution,contact_time_s,impulse_total_Ns\n";
+         "compression_time_s,restitution,contact_time_s,impulse_total_Ns,"
+         "target_dvx_m_s,target_dvy_m_s,target_dvz_m_s,target_dwx_rad_s,target_dwy_rad_s,target_dwz_rad_s\n";
     const double fmax = max_force(r);
     for (std::size_t i = 0; i < r.points.size(); ++i) {
       const PointResult& p = r.points[i];
@@ -49,7 +50,10 @@ void write_sweep_csv(const std::filesystem::path& path, const SweepResult& r, co
       for (double v : {p.point_m.x(), p.point_m.y(), p.point_m.z(), p.normal.x(), p.normal.y(), p.normal.z(),
                        p.target_radius_m, p.impactor_radius_m, p.effective_radius_m, p.reduced_mass_kg,
                        p.hertz_constant, p.max_indentation_m, p.max_force_N, p.max_force_N / fmax,
-                       p.compression_time_s, p.restitution, p.contact_time_s, p.impulse_total_Ns}) {
+                       p.compression_time_s, p.restitution, p.contact_time_s, p.impulse_total_Ns,
+                       p.target_delta_velocity_m_s.x(), p.target_delta_velocity_m_s.y(),
+                       p.target_delta_velocity_m_s.z(), p.target_delta_angular_velocity_rad_s.x(),
+                       p.target_delta_angular_velocity_rad_s.y(), p.target_delta_angular_velocity_rad_s.z()}) {
         o << ',' << g17(v);
       }
       o << '\n';

@@ -72,6 +72,9 @@ struct PointResult {
   bool restitution_clamped = false; ///< ln Phi clamped into Eq. 30's range (policy "warn")
   double contact_time_s = 0;        ///< (1 + R) t_m
   double impulse_total_Ns = 0;      ///< (1 + R) m_w v_w
+  /// Velocity jumps of the target (Eq. 22-23) for that impulse; zero for a fixed target.
+  Eigen::Vector3d target_delta_velocity_m_s = Eigen::Vector3d::Zero();
+  Eigen::Vector3d target_delta_angular_velocity_rad_s = Eigen::Vector3d::Zero();
 };
 
 struct SweepResult {

@@ -25,7 +25,8 @@ struct SweepMeta {
 /// `# ...` comment lines, then one row per point: index, x_m, y_m, z_m, nx, ny, nz,
 /// target_radius_m, impactor_radius_m, effective_radius_m, reduced_mass_kg,
 /// hertz_constant_N_per_m1_5, max_indentation_m, max_force_N, force_ratio (F / largest F),
-/// compression_time_s, restitution, contact_time_s, impulse_total_Ns. 17 significant digits.
+/// compression_time_s, restitution, contact_time_s, impulse_total_Ns, the target's velocity jump
+/// target_dv{x,y,z}_m_s and angular velocity jump target_dw{x,y,z}_rad_s. 17 significant digits.
 void write_sweep_csv(const std::filesystem::path& path, const SweepResult& r, const SweepMeta& meta);
 
 /// Long format `point,time_s,force_N`, one row per curve sample (needs r.curves_N).
