@@ -10,5 +10,6 @@ struct Context {
 };
 
 void register_run(CLI::App& app, Context& ctx);
+void register_fem_check(CLI::App& app, Context& ctx);
 
 }  // namespace impactdeck::cli

@@ -13,6 +13,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   impactdeck::cli::Context ctx;
   impactdeck::cli::register_run(app, ctx);
+  impactdeck::cli::register_fem_check(app, ctx);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
