@@ -63,7 +63,7 @@ if(NOT TARGET impactdeck_med)
 endif()
 
 # Programs the tests run: ccx (calculix-ccx) for the decks, gmsh (gmsh) for the .geo, mdump
-# (libmed-tools) to read the MED file back. Missing ones skip those tests with a clear message.
+# (libmed-tools) to read the MED file back. A missing one makes its tests fail with the package name.
 find_program(IMPACTDECK_CCX ccx)
 find_program(IMPACTDECK_GMSH_EXE gmsh)
 find_program(IMPACTDECK_MDUMP NAMES mdump mdump4 mdump3)
