@@ -72,6 +72,13 @@ check "tight tolerance -> exit 4" test $? -eq 4
 check "missing deck folder -> exit 3" test $? -eq 3
 check "missing deck folder message" grep -q "nowhere: deck folder: does not exist" "$tmp/e3.err"
 
+# A deck ccx rejects: exit 3 quoting ccx's first *ERROR line.
+cp -r "$tmp/ecc/fem_eccentric" "$tmp/broken"
+sed -i '/^\*SOLID SECTION/d' "$tmp/broken/impact.inp"
+"$bin" fem-check "$tmp/broken" >/dev/null 2>"$tmp/broken.err"
+check "ccx error -> exit 3" test $? -eq 3
+check "ccx error quoted" grep -q "ccx failed (exit code [0-9]*): .*ERROR in calinput: no material was assigned" "$tmp/broken.err"
+
 # 5. Nothing of this runs unless asked: no [outputs.fem] -> no meshing, stages skipped.
 "$bin" run "$src/samples/paper_table2.toml" --json --out "$tmp/plain" >"$tmp/plain.json" 2>/dev/null
 check "no FEM folder without [outputs.fem]" test ! -e "$tmp/plain/fem_table2"
@@ -95,7 +102,7 @@ check "run without calculix message" grep -q "outputs.fem.run" "$tmp/nocx.err"
 sed -e 's/^probes = .*/probes = [[0, 600, 0]]/' -e 's/^run = "calculix".*/run = "none"/' "$src/samples/paper_table2_fem.toml" >"$tmp/probe.toml"
 "$bin" run "$tmp/probe.toml" --out "$tmp/probe" >/dev/null 2>"$tmp/probe.err"
 check "probe outside -> exit 3" test $? -eq 3
-check "probe outside message" grep -q "PROBE1: probe point is not inside the ellipsoid" "$tmp/probe.err"
+check "probe outside message" grep -q "probe.toml: line [0-9]*, key 'outputs.fem': impact 'table2': FEM deck .*fem_table2/mesh.geo: PROBE1: probe point is not inside the ellipsoid" "$tmp/probe.err"
 check "no deck after a failure" test ! -e "$tmp/probe/fem_table2"
 
 echo "fem_samples_test: $passes passed, $fails failed"

@@ -347,6 +347,12 @@ DeckResult write_decks(const DeckRequest& r, const fs::path& folder) {
     out.quality = q;
     out.node_count = q.node_count;
     out.tet_count = q.tet_count;
+  } catch (const InputError& e) {
+    fs::remove_all(stage, ec);
+    // Name the deck folder, not the hidden staging folder that no longer exists.
+    std::string w = e.where();
+    if (w.rfind(stage.string(), 0) == 0) w = (folder / fs::path(w).lexically_relative(stage)).string();
+    throw InputError(w, e.place(), e.reason());
   } catch (...) {
     fs::remove_all(stage, ec);
     throw;

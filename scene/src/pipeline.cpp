@@ -285,7 +285,15 @@ RunReport run_scene(const Scene& scene, const RunOptions& opt) {
         fem_export::DeckRequest req = fem_request(scene, ir, bodies.at(ir.spec->target));
         const fs::path folder = opt.out_dir / ("fem_" + ir.spec->name);
         const auto t0 = std::chrono::steady_clock::now();
-        ir.fem_deck = in_impact(scene, *ir.spec, [&] { return fem_export::write_decks(req, folder); });
+        try {
+          ir.fem_deck = fem_export::write_decks(req, folder);
+        } catch (const InputError& e) {
+          // One line naming the scene, the [outputs.fem] table, and what failed where.
+          std::string what = "impact '" + ir.spec->name + "': FEM deck " + e.where() + ": ";
+          if (!e.place().empty()) what += e.place() + ": ";
+          throw InputError(where(scene), Place{scene.outputs.fem->place.line, "outputs.fem"}.describe(),
+                           what + e.reason());
+        }
         const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         add_stage(report, "fem_mesh", ir.fem_deck->mesh_seconds);
         add_stage(report, "fem_decks", total - ir.fem_deck->mesh_seconds);
