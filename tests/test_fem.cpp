@@ -69,6 +69,22 @@ DeckRequest ellipsoid_request() {
   return r;
 }
 
+// Tetrahedra (type 4) in the $Elements section of an MSH 2.2 file.
+std::size_t msh22_tet_count(const std::string& msh) {
+  std::istringstream in(msh);
+  std::string line;
+  bool inside = false;
+  std::size_t tets = 0;
+  while (std::getline(in, line)) {
+    if (line == "$Elements") { inside = true; std::getline(in, line); continue; }
+    if (line == "$EndElements") inside = false;
+    int id, type;
+    std::istringstream ls(line);
+    if (inside && ls >> id >> type && type == 4) ++tets;
+  }
+  return tets;
+}
+
 bool no_stage_left(const fs::path& parent) {
   for (const auto& e : fs::directory_iterator(parent)) {
     if (e.path().filename().string().find(".partial-") != std::string::npos) return false;
@@ -117,19 +133,7 @@ TEST(FemMesh, GeoScriptReproducesTheMeshWithTheGmshCli) {
   run("cd '" + d.string() + "' && " IMPACTDECK_GMSH_EXE " mesh.geo -3 -format msh22 -o cli.msh > cli.log 2>&1");
   const std::string cli = slurp(out);
   ASSERT_FALSE(cli.empty()) << slurp(d / "cli.log");
-  // Count tetrahedra (type 4) in the $Elements section and check the physical names.
-  std::istringstream in(cli);
-  std::string line;
-  bool inside = false;
-  std::size_t tets = 0;
-  while (std::getline(in, line)) {
-    if (line == "$Elements") { inside = true; std::getline(in, line); continue; }
-    if (line == "$EndElements") inside = false;
-    int id, type;
-    std::istringstream ls(line);
-    if (inside && ls >> id >> type && type == 4) ++tets;
-  }
-  EXPECT_EQ(tets, r.quality.tet_count);
+  EXPECT_EQ(msh22_tet_count(cli), r.quality.tet_count);
   for (const char* g : {"\"BODY\"", "\"LOAD\"", "\"PROBE1\""}) EXPECT_NE(cli.find(g), std::string::npos) << g;
 #endif
 }
@@ -433,6 +437,12 @@ TEST(FemCheck, MeshPartFromStlEccentricHitConservesLinearAndAngularMomentum) {
   // The STL encloses the gmsh-faceted ellipsoid: a little less than (4/3) pi a b c.
   EXPECT_NEAR(res.quality.part_volume_m3 / (4.0 / 3.0 * M_PI * 0.2 * 0.05 * 0.05), 1.0, 0.05);
   RecordProperty("nodes", static_cast<int>(res.node_count));
+#ifdef IMPACTDECK_GMSH_EXE
+  // The mesh-part .geo (Merge, ClassifySurfaces, CreateGeometry) reproduces the mesh too.
+  run("cd '" + (d / "deck").string() + "' && " IMPACTDECK_GMSH_EXE
+      " mesh.geo -3 -format msh22 -o ../cli.msh > ../cli.log 2>&1");
+  EXPECT_EQ(msh22_tet_count(slurp(d / "cli.msh")), res.tet_count) << slurp(d / "cli.log");
+#endif
   CheckOptions o;
 #ifdef IMPACTDECK_CCX
   o.ccx = IMPACTDECK_CCX;
