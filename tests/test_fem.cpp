@@ -479,3 +479,22 @@ TEST(FemCheck, MeshPartFromStlEccentricHitConservesLinearAndAngularMomentum) {
   EXPECT_FALSE(c2.passed);
   EXPECT_NEAR(c2.linear_momentum_relative_error, 0.01, 2e-3);
 }
+
+TEST(FemDecks, TimeScheduleRefinesThePulseAndDividesTheRest) {
+  DeckOptions o;  // 0.02 s at 1e-5 s, 100 increments across the pulse
+  const TimeSchedule t = time_schedule(o, 6.9e-5);
+  EXPECT_EQ(t.pulse_increments, 100u);
+  EXPECT_DOUBLE_EQ(t.pulse_step_s * 100, 6.9e-5);
+  EXPECT_EQ(t.main_increments, 1994u);  // ceil((0.02 - 6.9e-5) / 1e-5)
+  EXPECT_LE(t.main_step_s, 1e-5);
+  EXPECT_NEAR(t.pulse_end_s + t.main_increments * t.main_step_s, 0.02, 1e-15);
+  // A step already finer than pulse / 100: no refined phase.
+  o.time_step_s = 1e-7;
+  o.end_time_s = 1e-4;
+  const TimeSchedule u = time_schedule(o, 6.9e-5);
+  EXPECT_EQ(u.pulse_increments, 0u);
+  EXPECT_EQ(u.main_increments, 1000u);
+  o.pulse_increments = 0;
+  o.time_step_s = 1e-5;
+  EXPECT_EQ(time_schedule(o, 6.9e-5).pulse_increments, 0u);
+}
