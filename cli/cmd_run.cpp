@@ -32,6 +32,7 @@ void register_run(CLI::App& app, Context& ctx) {
     }
     scene::RunOptions opt;
     opt.out_dir = args->out;
+    opt.progress = &std::cerr;  // ccx progress when [outputs.fem] run = "calculix"
     const scene::RunReport rep = scene::run_scene(sc, opt);
     if (args->json) {
       std::cout << scene::to_json(sc, rep).dump(2) << "\n";

@@ -14,5 +14,6 @@ void register_sweep(CLI::App& app, Context& ctx);
 void register_study(CLI::App& app, Context& ctx);
 void register_inspect(CLI::App& app, Context& ctx);
 void register_mesh_ellipsoid(CLI::App& app, Context& ctx);
+void register_fem_check(CLI::App& app, Context& ctx);
 
 }  // namespace impactdeck::cli

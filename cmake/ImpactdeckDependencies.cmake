@@ -52,3 +52,39 @@ impactdeck_require(assimp_FOUND "assimp" libassimp-dev)
 
 find_package(CGAL 5.0 QUIET)
 impactdeck_require(CGAL_FOUND "CGAL" libcgal-dev)
+
+# Gmsh (C++ API, Debian libgmsh-dev): fem_export meshes with it; only fem_export/src sees gmsh.h.
+find_path(IMPACTDECK_GMSH_INCLUDE gmsh.h)
+find_library(IMPACTDECK_GMSH_LIBRARY gmsh)
+impactdeck_require(IMPACTDECK_GMSH_LIBRARY "the Gmsh library" libgmsh-dev)
+impactdeck_require(IMPACTDECK_GMSH_INCLUDE "the Gmsh C++ API header gmsh.h" libgmsh-dev)
+if(NOT TARGET impactdeck_gmsh)
+  add_library(impactdeck_gmsh INTERFACE)
+  target_include_directories(impactdeck_gmsh SYSTEM INTERFACE ${IMPACTDECK_GMSH_INCLUDE})
+  target_link_libraries(impactdeck_gmsh INTERFACE ${IMPACTDECK_GMSH_LIBRARY})
+endif()
+
+# MED (libmedc, Debian libmedc-dev): the mesh format Code_Aster reads. Debian's med.h defines
+# MED_HAVE_MPI and includes hdf5.h, so it needs the OpenMPI and parallel-HDF5 include folders.
+find_path(IMPACTDECK_MED_INCLUDE med.h)
+find_library(IMPACTDECK_MED_LIBRARY medC)
+impactdeck_require(IMPACTDECK_MED_LIBRARY "the MED library (libmedC)" libmedc-dev)
+impactdeck_require(IMPACTDECK_MED_INCLUDE "the MED header med.h" libmedc-dev)
+find_path(IMPACTDECK_MPI_INCLUDE mpi.h PATHS /usr/lib/x86_64-linux-gnu/openmpi/include
+          /usr/lib/${CMAKE_LIBRARY_ARCHITECTURE}/openmpi/include /usr/include/openmpi)
+impactdeck_require(IMPACTDECK_MPI_INCLUDE "MPI headers for med.h" libopenmpi-dev)
+find_path(IMPACTDECK_HDF5_INCLUDE hdf5.h PATHS /usr/include/hdf5/openmpi NO_DEFAULT_PATH)
+find_path(IMPACTDECK_HDF5_INCLUDE hdf5.h PATH_SUFFIXES hdf5/openmpi)
+impactdeck_require(IMPACTDECK_HDF5_INCLUDE "parallel HDF5 headers for med.h" libhdf5-openmpi-dev)
+if(NOT TARGET impactdeck_med)
+  add_library(impactdeck_med INTERFACE)
+  target_include_directories(impactdeck_med SYSTEM INTERFACE ${IMPACTDECK_MED_INCLUDE}
+                             ${IMPACTDECK_HDF5_INCLUDE} ${IMPACTDECK_MPI_INCLUDE})
+  target_link_libraries(impactdeck_med INTERFACE ${IMPACTDECK_MED_LIBRARY})
+endif()
+
+# Programs the tests run: ccx (calculix-ccx) for the decks, gmsh (gmsh) for the .geo, mdump
+# (libmed-tools) to read the MED file back. A missing one makes its tests fail with the package name.
+find_program(IMPACTDECK_CCX ccx)
+find_program(IMPACTDECK_GMSH_EXE gmsh)
+find_program(IMPACTDECK_MDUMP NAMES mdump mdump4 mdump3)

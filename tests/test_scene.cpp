@@ -202,3 +202,42 @@ TEST(Scene, EllipticalContactRadius) {
   EXPECT_GT(ec.equivalent_radius_m, 1.0 / 22.0);
   EXPECT_LT(ec.equivalent_radius_m, 1.0 / 20.125);
 }
+
+TEST(SceneFem, OutputsFemKeysAreReadInSceneUnitsAndOptional) {
+  EXPECT_FALSE(parse_scene(kBase, "base.toml").outputs.fem.has_value());
+  const Scene empty = parse_scene(kBase + "[outputs.fem]\n", "fem.toml");
+  ASSERT_TRUE(empty.outputs.fem.has_value());
+  EXPECT_FALSE(empty.outputs.fem->mesh_size_m.has_value());
+  EXPECT_EQ(empty.outputs.fem->end_time_s, 0.02);
+  EXPECT_EQ(empty.outputs.fem->time_step_s, 1e-5);
+  EXPECT_TRUE(empty.outputs.fem->code_aster);
+  EXPECT_TRUE(empty.outputs.fem->calculix);
+  EXPECT_EQ(empty.outputs.fem->run, FemOutputs::Run::none);
+  const Scene s = parse_scene(kBase + "[outputs.fem]\nmesh_size = 300\nload_mesh_size = 100\nend_time_s = 1e-3\n"
+                                      "time_step_s = 2e-5\nprobes = [[0, 400, 250], [1, 2, 3]]\n"
+                                      "code_aster = false\nrun = \"calculix\"\n",
+                              "fem.toml");
+  const FemOutputs& f = *s.outputs.fem;
+  EXPECT_DOUBLE_EQ(*f.mesh_size_m, 0.3);
+  EXPECT_DOUBLE_EQ(*f.load_mesh_size_m, 0.1);
+  EXPECT_EQ(f.end_time_s, 1e-3);
+  EXPECT_EQ(f.time_step_s, 2e-5);
+  ASSERT_EQ(f.probes_m.size(), 2u);
+  EXPECT_DOUBLE_EQ(f.probes_m[0].y(), 0.4);
+  EXPECT_DOUBLE_EQ(f.probes_m[1].z(), 0.003);
+  EXPECT_FALSE(f.code_aster);
+  EXPECT_EQ(f.run, FemOutputs::Run::calculix);
+}
+
+TEST(SceneFem, BadOutputsFemKeysNameTheKey) {
+  const std::string fem = kBase + "[outputs.fem]\n";
+  expect_error(fem + "mesh_sise = 300\n", R"(key 'outputs\.fem\.mesh_sise': unknown key \(allowed here)");
+  expect_error(fem + "mesh_size = -1\n", R"(key 'outputs\.fem\.mesh_size': must be > 0)");
+  expect_error(fem + "time_step_s = 0.1\n", R"(key 'outputs\.fem\.time_step_s': must be smaller than end_time_s)");
+  expect_error(fem + "probes = [[0, 1]]\n", R"(key 'outputs\.fem\.probes': element 0 must be \[x, y, z\])");
+  expect_error(fem + "run = \"aster\"\n", R"(key 'outputs\.fem\.run': unknown value "aster")");
+  expect_error(fem + "calculix = false\nrun = \"calculix\"\n", R"(outputs\.fem\.run': run = "calculix" needs calculix = true)");
+  expect_error(fem + "calculix = false\ncode_aster = false\n", R"(no deck to write)");
+  expect_error(replace(fem, "shape = \"ellipsoid\"", "shape = \"ellipsoid\"\nfixed = true"),
+               R"(target 'target' is fixed)");
+}

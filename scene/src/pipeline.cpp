@@ -26,8 +26,10 @@ const std::vector<std::string>& all_stages() {
 }
 
 bool RunReport::all_checks_passed() const {
-  for (const auto& i : impacts)
+  for (const auto& i : impacts) {
     if (!i.result.checks.passed) return false;
+    if (i.fem_check && !i.fem_check->passed) return false;
+  }
   return true;
 }
 
@@ -204,6 +206,55 @@ collision::RigidBody rigid(const PreparedBody& b, const Eigen::Vector3d& offset,
   return r;
 }
 
+void add_stage(RunReport& r, const std::string& name, double seconds) {
+  for (auto& st : r.stages_run)
+    if (st.name == name) { st.seconds += seconds; return; }
+  r.stages_run.push_back({name, seconds});
+}
+
+// The deck request of one impact: the target body alone, loaded by the force on it (along -n).
+fem_export::DeckRequest fem_request(const Scene& scene, const ImpactReport& ir, const PreparedBody& target) {
+  const FemOutputs& f = *scene.outputs.fem;
+  const BodySpec& b = *target.spec;
+  const Place place{f.place.line, "outputs.fem"};
+  if (b.fixed) {
+    throw InputError(where(scene), place.describe(), "impact '" + ir.spec->name + "': target '" + b.name +
+                     "' is fixed (infinite mass): the hybrid deck needs a free body");
+  }
+  fem_export::DeckRequest r;
+  r.source = scene.file.string();
+  r.impact = ir.spec->name;
+  switch (b.shape) {
+    case ShapeKind::sphere:
+      r.body.semi_axes_m = Eigen::Vector3d::Constant(b.radius_m);
+      break;
+    case ShapeKind::ellipsoid:
+      r.body.semi_axes_m = b.semi_axes_m;
+      break;
+    case ShapeKind::mesh:
+      r.body.kind = fem_export::BodyKind::stl;
+      r.body.stl = b.mesh_path;
+      r.body.stl_unit_m = metres_per(scene.length_unit);
+      break;
+  }
+  r.material.youngs_modulus_Pa = target.material.youngs_modulus_Pa;
+  r.material.poisson_ratio = target.material.poisson_ratio;
+  r.material.density_kg_m3 = target.mass_kg / target.volume.volume_m3;  // honours mass_kg
+  r.force = *ir.table;
+  r.impulse_Ns = ir.result.history.impulse_total_Ns();
+  r.direction = -ir.contact.target_point.normal;
+  r.load_point_m = ir.contact.target_point.point_m;
+  r.options.end_time_s = f.end_time_s;
+  r.options.time_step_s = f.time_step_s;
+  r.options.code_aster = f.code_aster;
+  r.options.calculix = f.calculix;
+  r.options.mesh.mesh_size_m = f.mesh_size_m.value_or(
+      b.shape == ShapeKind::mesh ? 0.25 * target.shape->size_m() : 0.5 * r.body.semi_axes_m.minCoeff());
+  r.options.mesh.load_mesh_size_m = f.load_mesh_size_m.value_or(0.0);
+  r.options.mesh.probes_m = f.probes_m;
+  return r;
+}
+
 }  // namespace
 
 RunReport run_scene(const Scene& scene, const RunOptions& opt) {
@@ -264,6 +315,7 @@ RunReport run_scene(const Scene& scene, const RunOptions& opt) {
     report.impacts.push_back(std::move(ir));
   }
 
+  const bool want_fem = scene.outputs.fem.has_value();
   if (!report.all_checks_passed()) {
     report.warnings.push_back("a self-check failed: no output file was written");
   } else {
@@ -275,7 +327,7 @@ RunReport run_scene(const Scene& scene, const RunOptions& opt) {
       }
       return p.is_absolute() ? p : opt.out_dir / p;
     };
-    if (scene.outputs.force_table_csv) {
+    if (scene.outputs.force_table_csv || want_fem) {
       clock.run("force_table", [&] {
         for (auto& ir : report.impacts) {
           ir.table = collision::sample_force_table(ir.result.history, scene.outputs.force_table);
@@ -288,6 +340,37 @@ RunReport run_scene(const Scene& scene, const RunOptions& opt) {
           }
         }
       });
+    }
+    // FEM decks first: a meshing failure then leaves no CSV behind either. Each deck folder is
+    // staged and renamed whole (fem_export::write_decks).
+    if (want_fem) {
+      for (auto& ir : report.impacts) {
+        fem_export::DeckRequest req = fem_request(scene, ir, bodies.at(ir.spec->target));
+        const fs::path folder = opt.out_dir / ("fem_" + ir.spec->name);
+        const auto t0 = std::chrono::steady_clock::now();
+        try {
+          ir.fem_deck = fem_export::write_decks(req, folder);
+        } catch (const InputError& e) {
+          // One line naming the scene, the [outputs.fem] table, and what failed where.
+          std::string what = "impact '" + ir.spec->name + "': FEM deck " + e.where() + ": ";
+          if (!e.place().empty()) what += e.place() + ": ";
+          throw InputError(where(scene), Place{scene.outputs.fem->place.line, "outputs.fem"}.describe(),
+                           what + e.reason());
+        }
+        const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        add_stage(report, "fem_mesh", ir.fem_deck->mesh_seconds);
+        add_stage(report, "fem_decks", total - ir.fem_deck->mesh_seconds);
+        for (const auto& f : ir.fem_deck->files) report.files_written.push_back(f);
+      }
+      if (scene.outputs.fem->run == FemOutputs::Run::calculix) {
+        clock.run("fem_run", [&] {
+          for (auto& ir : report.impacts) {
+            fem_export::CheckOptions co;
+            co.progress = opt.progress;
+            ir.fem_check = fem_export::run_check(ir.fem_deck->folder, co);
+          }
+        });
+      }
     }
     if (scene.outputs.force_table_csv || scene.outputs.force_plot_svg) {
       clock.run("write_outputs", [&] {

@@ -96,8 +96,18 @@ nlohmann::json to_json(const Scene& scene, const RunReport& rep) {
                           {"tolerance_met", ir.table->tolerance_met}};
       if (ir.table_path) i["force_table"]["path"] = ir.table_path->string();
     }
-    if (ir.plot_path) {
-      i["force_plot_svg"] = ir.plot_path->string();
+    if (ir.plot_path) i["force_plot_svg"] = ir.plot_path->string();
+    if (ir.fem_deck) {
+      const auto& d = *ir.fem_deck;
+      const auto& q = d.quality;
+      i["fem"] = {{"folder", d.folder.string()},
+                  {"node_count", q.node_count},
+                  {"tet_count", q.tet_count},
+                  {"min_quality", q.min_quality},
+                  {"fe_volume_m3", q.fe_volume_m3},
+                  {"part_volume_m3", q.part_volume_m3},
+                  {"volume_relative_difference", q.volume_relative_difference},
+                  {"check", ir.fem_check ? fem_export::to_json(*ir.fem_check) : nlohmann::json(nullptr)}};
     }
     impacts.push_back(std::move(i));
   }
@@ -164,6 +174,17 @@ std::string format_summary(const Scene& scene, const RunReport& rep) {
       o << "\n";
     }
     if (ir.plot_path) o << "  force plot            " << ir.plot_path->string() << "\n";
+    if (ir.fem_deck) {
+      const auto& q = ir.fem_deck->quality;
+      o << "  FEM deck              " << ir.fem_deck->folder.string() << ": " << q.node_count << " nodes, "
+        << q.tet_count << " tetrahedra, min quality " << std::setprecision(3) << q.min_quality
+        << ", FE volume " << std::showpos << 100.0 * q.volume_relative_difference << std::noshowpos
+        << " % vs the part" << std::setprecision(6) << "\n";
+    }
+    if (ir.fem_check) {
+      std::istringstream lines(fem_export::format_check(*ir.fem_check));
+      for (std::string l; std::getline(lines, l);) o << "  FEM check: " << l << "\n";
+    }
   }
   for (const auto& w : rep.warnings) o << "\nwarning: " << w;
   if (!rep.warnings.empty()) o << "\n";

@@ -285,7 +285,45 @@ ImpactSpec read_impact(std::size_t index, const toml::table& t, const std::strin
   return s;
 }
 
-Outputs read_outputs(const toml::table& t, const std::string& file) {
+const toml::table& sub_table(const toml::node* n, const std::string& key, const std::string& file);
+
+FemOutputs read_fem(const toml::table& t, const std::string& file, double to_m) {
+  Reader r(t, "outputs.fem", file);
+  FemOutputs f;
+  f.place = r.self();
+  if (r.has("mesh_size")) f.mesh_size_m = r.positive("mesh_size") * to_m;
+  if (r.has("load_mesh_size")) f.load_mesh_size_m = r.positive("load_mesh_size") * to_m;
+  if (r.has("end_time_s")) f.end_time_s = r.positive("end_time_s");
+  if (r.has("time_step_s")) f.time_step_s = r.positive("time_step_s");
+  if (!(f.time_step_s < f.end_time_s)) r.fail("time_step_s", "must be smaller than end_time_s");
+  if (f.end_time_s / f.time_step_s > 2e6) r.fail("time_step_s", "more than 2e6 increments");
+  if (const toml::node* n = r.get("probes")) {
+    const toml::array* a = n->as_array();
+    if (!a) r.fail("probes", "must be an array of points [[x, y, z], ...]");
+    for (std::size_t i = 0; i < a->size(); ++i) {
+      const toml::array* p = a->get(i)->as_array();
+      Eigen::Vector3d v;
+      if (!p || p->size() != 3) r.fail("probes", "element " + std::to_string(i) + " must be [x, y, z]");
+      for (int k = 0; k < 3; ++k) {
+        const toml::node* e = p->get(static_cast<std::size_t>(k));
+        if (!e->is_number()) r.fail("probes", "element " + std::to_string(i) + " must hold 3 numbers");
+        v[k] = e->value<double>().value() * to_m;
+      }
+      f.probes_m.push_back(v);
+    }
+    if (f.probes_m.size() > 99) r.fail("probes", "at most 99 probes");
+  }
+  f.code_aster = r.boolean("code_aster").value_or(true);
+  f.calculix = r.boolean("calculix").value_or(true);
+  f.run = r.choice<FemOutputs::Run>("run", {{"none", FemOutputs::Run::none}, {"calculix", FemOutputs::Run::calculix}},
+                                    FemOutputs::Run::none);
+  if (f.run == FemOutputs::Run::calculix && !f.calculix) r.fail("run", "run = \"calculix\" needs calculix = true");
+  if (!f.code_aster && !f.calculix) r.fail("calculix", "code_aster and calculix are both false: no deck to write");
+  r.reject_unknown();
+  return f;
+}
+
+Outputs read_outputs(const toml::table& t, const std::string& file, double to_m) {
   Reader r(t, "outputs", file);
   r.allow({"force_table_csv", "force_table_impulse_tolerance", "force_table_time_step_s"});
   Outputs o;
@@ -305,6 +343,7 @@ Outputs read_outputs(const toml::table& t, const std::string& file) {
     }
   }
   if (r.has("force_table_time_step_s")) o.force_table.time_step_s = r.positive("force_table_time_step_s");
+  if (const toml::node* n = r.get("fem")) o.fem = read_fem(sub_table(n, "outputs.fem", file), file, to_m);
   r.reject_unknown();
   return o;
 }
@@ -419,7 +458,7 @@ Scene build(const toml::table& root, const std::string& file, const fs::path& ba
   }
   if (sc.impacts.empty()) r.fail("impacts", "at least one impact is needed");
 
-  if (const toml::node* n = r.get("outputs")) sc.outputs = read_outputs(sub_table(n, "outputs", file), file);
+  if (const toml::node* n = r.get("outputs")) sc.outputs = read_outputs(sub_table(n, "outputs", file), file, to_m);
   r.reject_unknown();
   return sc;
 }

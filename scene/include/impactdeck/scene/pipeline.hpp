@@ -9,6 +9,8 @@
 #include <vector>
 
 #include "impactdeck/collision/impact.hpp"
+#include "impactdeck/fem_export/check.hpp"
+#include "impactdeck/fem_export/decks.hpp"
 #include "impactdeck/geometry/shape.hpp"
 #include "impactdeck/scene/scene.hpp"
 
@@ -46,6 +48,8 @@ struct ImpactReport {
   std::optional<collision::ForceTable> table;
   std::optional<std::filesystem::path> table_path;  ///< where the CSV was written
   std::optional<std::filesystem::path> plot_path;   ///< where the F(t) SVG was written
+  std::optional<fem_export::DeckResult> fem_deck;    ///< [outputs.fem]: the deck folder
+  std::optional<fem_export::CheckResult> fem_check;  ///< [outputs.fem] run = "calculix"
 };
 
 struct StageTiming {
@@ -64,6 +68,7 @@ struct RunReport {
 
 struct RunOptions {
   std::filesystem::path out_dir = ".";  ///< outputs are written here (must exist)
+  std::ostream* progress = nullptr;     ///< solver progress lines (e.g. &std::cerr)
 };
 
 /// Builds the shape of a body (analytic or mesh). Throws InputError.

@@ -67,10 +67,24 @@ struct ImpactSpec {
   Place place;
 };
 
+/// `[outputs.fem]`: FEM decks of the hybrid approach (docs/fem.md). Present = requested.
+struct FemOutputs {
+  std::optional<double> mesh_size_m;       ///< default: smallest semi-axis / 2 (ellipsoid)
+  std::optional<double> load_mesh_size_m;  ///< default: mesh size / 3
+  double end_time_s = 0.02;                ///< the paper's 0.02 s
+  double time_step_s = 1e-5;               ///< the paper's 1e-5 s
+  std::vector<Eigen::Vector3d> probes_m;   ///< in the target's frame
+  bool code_aster = true;
+  bool calculix = true;
+  enum class Run { none, calculix } run = Run::none;  ///< "calculix": run ccx and the check
+  Place place;
+};
+
 struct Outputs {
   std::optional<std::filesystem::path> force_table_csv;  ///< relative to the output folder
   std::optional<std::filesystem::path> force_plot_svg;   ///< F(t) picture, relative to the output folder
   collision::ForceTableOptions force_table;
+  std::optional<FemOutputs> fem;
 };
 
 struct Scene {

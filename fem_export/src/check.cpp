@@ -1,0 +1,405 @@
+// The CalculiX momentum check (see check.hpp).
+#include "impactdeck/fem_export/check.hpp"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <thread>
+
+#include "impactdeck/common/error.hpp"
+#include "impactdeck/fem_export/decks.hpp"
+#include "impactdeck/fem_export/mesh.hpp"
+
+namespace impactdeck::fem_export {
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+constexpr double kMm = 1000.0;
+
+std::string read_text(const fs::path& p, const std::string& what) {
+  std::ifstream in(p, std::ios::binary);
+  if (!in) throw InputError(p.string(), "file", what + " cannot be opened (missing or unreadable)");
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+Eigen::Vector3d vec3(const json& j) { return Eigen::Vector3d(j.at(0), j.at(1), j.at(2)); }
+
+struct Deck {
+  double impulse_Ns = 0, density_kg_m3 = 0, contact_end_s = 0, end_time_s = 0;
+  Eigen::Vector3d direction = Eigen::Vector3d::Zero();
+  int load_node = 0;  // 1-based
+  std::vector<std::string> probes;
+  TetMesh mesh;       // node i has ccx id i + 1
+};
+
+Deck read_deck(const fs::path& dir) {
+  Deck d;
+  const fs::path jp = dir / "deck.json";
+  json j;
+  try {
+    j = json::parse(read_text(jp, "deck description"));
+    d.impulse_Ns = j.at("impulse_Ns");
+    d.density_kg_m3 = j.at("density_kg_m3");
+    d.contact_end_s = j.at("contact_end_s");
+    d.end_time_s = j.at("end_time_s");
+    d.direction = vec3(j.at("direction"));
+    d.load_node = j.at("load_node");
+    for (const auto& p : j.at("probes")) d.probes.push_back(p.at("name"));
+    if (!j.at("calculix").get<bool>()) {
+      throw InputError(jp.string(), "calculix", "the deck has no CalculiX input (calculix = false)");
+    }
+  } catch (const json::exception& e) {
+    throw InputError(jp.string(), "json", std::string("not a deck description: ") + e.what());
+  }
+  // mesh.inp: *NODE, *ELEMENT and *NSET blocks as calculix_mesh_inp writes them.
+  const fs::path mp = dir / "mesh.inp";
+  std::istringstream in(read_text(mp, "mesh"));
+  std::string line, block;
+  int lineno = 0;
+  while (std::getline(in, line)) {
+    ++lineno;
+    if (line.rfind("**", 0) == 0 || line.empty()) continue;
+    if (line[0] == '*') {
+      block = line.substr(0, line.find(','));
+      continue;
+    }
+    std::replace(line.begin(), line.end(), ',', ' ');
+    std::istringstream ls(line);
+    if (block == "*NODE") {
+      long id;
+      Eigen::Vector3d x;
+      if (!(ls >> id >> x.x() >> x.y() >> x.z()) || id != static_cast<long>(d.mesh.nodes_m.size()) + 1) {
+        throw InputError(mp.string(), "line " + std::to_string(lineno), "bad node line");
+      }
+      d.mesh.nodes_m.push_back(x / kMm);
+    } else if (block == "*ELEMENT") {
+      long id;
+      std::array<int, 4> t{};
+      if (!(ls >> id >> t[0] >> t[1] >> t[2] >> t[3])) {
+        throw InputError(mp.string(), "line " + std::to_string(lineno), "bad element line");
+      }
+      for (int& k : t) {
+        if (k < 1 || k > static_cast<int>(d.mesh.nodes_m.size())) {
+          throw InputError(mp.string(), "line " + std::to_string(lineno), "unknown node");
+        }
+        --k;
+      }
+      d.mesh.tets.push_back(t);
+    }
+  }
+  if (d.mesh.tets.empty()) throw InputError(mp.string(), "*ELEMENT", "no tetrahedra");
+  return d;
+}
+
+// Velocity prints of the .dat: set -> list of (time, node -> velocity in m/s).
+struct DatFile {
+  std::map<std::string, std::vector<std::pair<double, std::map<int, Eigen::Vector3d>>>> velocities;
+  double total_mass_kg = -1;
+};
+
+DatFile read_dat(const fs::path& p) {
+  DatFile d;
+  std::istringstream in(read_text(p, "CalculiX results"));
+  std::string line;
+  enum { none, vel, mass } state = none;
+  std::map<int, Eigen::Vector3d>* current = nullptr;
+  while (std::getline(in, line)) {
+    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    const auto set_pos = line.find(" for set ");
+    if (set_pos != std::string::npos) {
+      const auto and_pos = line.find(" and time ", set_pos);
+      const std::string set = line.substr(set_pos + 9, and_pos - set_pos - 9);
+      const double t = std::stod(line.substr(and_pos + 10));
+      if (line.find("velocities (vx,vy,vz)") != std::string::npos) {
+        auto& v = d.velocities[set];
+        v.emplace_back(t, std::map<int, Eigen::Vector3d>{});
+        current = &v.back().second;
+        state = vel;
+      } else if (line.find("total mass for set") != std::string::npos) {
+        state = mass;
+      } else {
+        state = none;
+      }
+      continue;
+    }
+    std::istringstream ls(line);
+    if (state == vel) {
+      int node;
+      Eigen::Vector3d v;
+      if (ls >> node >> v.x() >> v.y() >> v.z()) (*current)[node] = v / kMm;
+    } else if (state == mass) {
+      double m;
+      if (ls >> m) d.total_mass_kg = m * kMm;  // tonne -> kg
+      state = none;
+    }
+  }
+  return d;
+}
+
+// Runs ccx in `dir`, output to impact.log; progress from impact.sta. Returns wall time.
+double run_ccx(const fs::path& dir, const CheckOptions& o, double end_time_s) {
+  const std::string job = kJobName;
+  for (const char* ext : {".dat", ".sta", ".frd", ".cvg", ".12d"}) {
+    std::error_code ec;
+    fs::remove(dir / (job + ext), ec);
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  const pid_t pid = ::fork();
+  if (pid < 0) throw Error(ExitCode::internal_error, "fork failed");
+  if (pid == 0) {
+    if (::chdir(dir.c_str()) != 0) ::_exit(126);
+    const int fd = ::open((job + ".log").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (fd >= 0) {
+      ::dup2(fd, 1);
+      ::dup2(fd, 2);
+      ::close(fd);
+    }
+    const std::string threads = std::to_string(std::max(1, o.threads));
+    ::setenv("OMP_NUM_THREADS", threads.c_str(), 1);
+    ::setenv("CCX_NPROC_EQUATION_SOLVER", threads.c_str(), 1);
+    ::execlp(o.ccx.c_str(), o.ccx.c_str(), "-i", job.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  int status = 0;
+  std::string last;
+  auto last_print = std::chrono::steady_clock::now();
+  for (;;) {
+    const pid_t w = ::waitpid(pid, &status, WNOHANG);
+    if (w == pid) break;
+    if (w < 0) throw Error(ExitCode::internal_error, "waitpid failed");
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    if (o.progress && std::chrono::steady_clock::now() - last_print > std::chrono::seconds(2)) {
+      std::ifstream sta(dir / (job + ".sta"));
+      std::string l, tail;
+      while (std::getline(sta, l))
+        if (!l.empty()) tail = l;
+      std::istringstream ls(tail);
+      int step, inc, att, it;
+      double tot;
+      if (ls >> step >> inc >> att >> it >> tot && tail != last) {
+        const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        *o.progress << "ccx: step " << step << ", increment " << inc << ", time " << tot << " s of "
+                    << end_time_s << " s (" << static_cast<int>(100.0 * std::min(1.0, tot / end_time_s))
+                    << " %), " << static_cast<int>(el) << " s elapsed\n";
+        o.progress->flush();
+        last = tail;
+      }
+      last_print = std::chrono::steady_clock::now();
+    }
+  }
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const std::string where = (dir / (job + ".log")).string();
+  if (WIFEXITED(status) && WEXITSTATUS(status) == 127) {
+    throw InputError(o.ccx, "solver", "cannot run '" + o.ccx + "' (install the Debian package calculix-ccx)");
+  }
+  std::ifstream log(dir / (job + ".log"));
+  std::string l, first_error;
+  while (std::getline(log, l)) {
+    if (first_error.empty() && l.find("*ERROR") != std::string::npos) first_error = l;
+  }
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || !first_error.empty()) {
+    std::ostringstream m;
+    m << "ccx failed (";
+    if (WIFSIGNALED(status)) m << "signal " << WTERMSIG(status);
+    else m << "exit code " << WEXITSTATUS(status);
+    m << ")" << (first_error.empty() ? "" : ": " + first_error);
+    throw InputError(where, "ccx", m.str());
+  }
+  return wall;
+}
+
+}  // namespace
+
+CheckResult run_check(const fs::path& dir, const CheckOptions& o) {
+  if (!fs::is_directory(dir)) throw InputError(dir.string(), "deck folder", "does not exist");
+  const Deck deck = read_deck(dir);
+  CheckResult r;
+  r.linear_tolerance = o.linear_tolerance;
+  r.angular_tolerance = o.angular_tolerance;
+  r.impulse_Ns = deck.impulse_Ns;
+  if (o.run_solver) r.solver_wall_time_s = run_ccx(dir, o, deck.end_time_s);
+  const fs::path dat_path = dir / (std::string(kJobName) + ".dat");
+  const DatFile dat = read_dat(dat_path);
+
+  // FE mass, centroid and inertia of the mesh (exact for linear tetrahedra).
+  const TetMesh& m = deck.mesh;
+  const double rho = deck.density_kg_m3;
+  std::vector<double> node_mass(m.nodes_m.size(), 0.0);
+  Eigen::Vector3d first = Eigen::Vector3d::Zero();
+  for (std::size_t e = 0; e < m.tets.size(); ++e) {
+    const double me = rho * tet_volume_m3(m, e);
+    r.fe_mass_kg += me;
+    Eigen::Vector3d s = Eigen::Vector3d::Zero();
+    for (int k : m.tets[e]) node_mass[k] += me / 4.0, s += m.nodes_m[k];
+    first += me * s / 4.0;
+  }
+  const Eigen::Vector3d c = first / r.fe_mass_kg;
+  r.solver_mass_kg = dat.total_mass_kg;
+
+  // Momentum from the all-node print of step 2.
+  auto all = dat.velocities.find("BODYN");
+  if (all == dat.velocities.end() || all->second.empty() ||
+      all->second.back().second.size() != m.nodes_m.size() || dat.total_mass_kg <= 0) {
+    throw InputError(dat_path.string(), "step 2", "missing the all-node velocity or total mass print "
+                     "(did ccx finish? see impact.log)");
+  }
+  const auto& [t_all, v_all] = all->second.back();
+  r.momentum_time_s = t_all;
+  std::vector<Eigen::Vector3d> v(m.nodes_m.size());
+  for (const auto& [node, vel] : v_all) v.at(static_cast<std::size_t>(node - 1)) = vel;
+  Eigen::Vector3d P = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < v.size(); ++i) P += node_mass[i] * v[i];
+  // ccx 2.20 integrates the C3D4 mass matrix at one point: M_e = m_e / 16 (1 1^T) (x) I_3, so
+  // L_e = m_e ybar_e x vbar_e exactly (DECKS.md facts; measured here: matches (p - c) x Pi to 1e-5,
+  // where the fully integrated matrix misses by several %). Its rigid-rotation inertia is the
+  // one-point one, sum m_e (|ybar|^2 1 - ybar ybar^T).
+  Eigen::Vector3d L = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();
+  for (std::size_t e = 0; e < m.tets.size(); ++e) {
+    const double me = rho * tet_volume_m3(m, e);
+    Eigen::Vector3d ybar = Eigen::Vector3d::Zero(), vbar = Eigen::Vector3d::Zero();
+    for (int k : m.tets[e]) ybar += (m.nodes_m[k] - c) / 4.0, vbar += v[k] / 4.0;
+    L += me * ybar.cross(vbar);
+    inertia += me * (ybar.squaredNorm() * Eigen::Matrix3d::Identity() - ybar * ybar.transpose());
+  }
+  const Eigen::Vector3d d = deck.direction;
+  const Eigen::Vector3d Pi = deck.impulse_Ns * d;
+  r.expected_velocity_m_s = deck.impulse_Ns / r.fe_mass_kg;
+  r.fe_velocity_m_s = P.dot(d) / r.fe_mass_kg;
+  r.linear_momentum_relative_error = (P - Pi).norm() / deck.impulse_Ns;
+
+  const Eigen::Vector3d arm = m.nodes_m.at(static_cast<std::size_t>(deck.load_node - 1)) - c;
+  const Eigen::Vector3d Lref = arm.cross(Pi);
+  const Eigen::Matrix3d Iinv = inertia.inverse();
+  r.angular_velocity_fe_rad_s = Iinv * L;
+  r.angular_velocity_expected_rad_s = Iinv * Lref;
+  const bool eccentric = arm.cross(d).norm() > 0.01 * arm.norm();
+  if (eccentric) {
+    r.angular_momentum_relative_error =
+        (r.angular_velocity_fe_rad_s - r.angular_velocity_expected_rad_s).norm() /
+        r.angular_velocity_expected_rad_s.norm();
+  }
+
+  // Probes: time average after the pulse, along d, with the spread of the quarter-window means.
+  const Eigen::Vector3d v_rigid = Pi / r.fe_mass_kg;
+  for (const auto& name : deck.probes) {
+    ProbeResult pr;
+    pr.name = name;
+    auto it = dat.velocities.find(name);
+    if (it == dat.velocities.end()) {
+      throw InputError(dat_path.string(), name, "no velocity print for this probe");
+    }
+    std::vector<double> vals;
+    int node = 0;
+    for (const auto& [t, nv] : it->second) {
+      if (nv.empty()) continue;
+      node = nv.begin()->first;
+      if (t > deck.contact_end_s && t <= deck.end_time_s * (1 + 1e-9)) vals.push_back(nv.begin()->second.dot(d));
+    }
+    if (vals.empty()) throw InputError(dat_path.string(), name, "no velocity after the pulse");
+    pr.point_m = m.nodes_m.at(static_cast<std::size_t>(node - 1));
+    pr.samples = vals.size();
+    double sum = 0;
+    for (double x : vals) sum += x;
+    pr.mean_velocity_m_s = sum / static_cast<double>(vals.size());
+    if (vals.size() >= 4) {
+      double lo = 1e300, hi = -1e300;
+      for (int q = 0; q < 4; ++q) {
+        const std::size_t a = vals.size() * q / 4, b = vals.size() * (q + 1) / 4;
+        double s = 0;
+        for (std::size_t i = a; i < b; ++i) s += vals[i];
+        const double mq = s / static_cast<double>(b - a);
+        lo = std::min(lo, mq), hi = std::max(hi, mq);
+      }
+      pr.scatter_m_s = hi - lo;
+    }
+    pr.rigid_body_velocity_m_s = (v_rigid + r.angular_velocity_expected_rad_s.cross(pr.point_m - c)).dot(d);
+    pr.relative_difference = (pr.mean_velocity_m_s - pr.rigid_body_velocity_m_s) /
+                             std::abs(pr.rigid_body_velocity_m_s);
+    r.probes.push_back(pr);
+  }
+
+  std::ostringstream f;
+  if (!(r.linear_momentum_relative_error <= o.linear_tolerance)) {
+    f << "linear momentum relative error " << r.linear_momentum_relative_error << " exceeds " << o.linear_tolerance;
+    r.failures.push_back(f.str());
+    f.str("");
+  }
+  if (r.angular_momentum_relative_error && !(*r.angular_momentum_relative_error <= o.angular_tolerance)) {
+    f << "angular momentum relative error " << *r.angular_momentum_relative_error << " exceeds "
+      << o.angular_tolerance;
+    r.failures.push_back(f.str());
+  }
+  r.passed = r.failures.empty();
+  return r;
+}
+
+json to_json(const CheckResult& r) {
+  auto v3 = [](const Eigen::Vector3d& v) { return json::array({v.x() + 0.0, v.y() + 0.0, v.z() + 0.0}); };
+  json probes = json::array();
+  for (const auto& p : r.probes) {
+    probes.push_back({{"name", p.name},
+                      {"point_m", v3(p.point_m)},
+                      {"mean_velocity_m_s", p.mean_velocity_m_s},
+                      {"mean_velocity_scatter_m_s", p.scatter_m_s},
+                      {"rigid_body_velocity_m_s", p.rigid_body_velocity_m_s},
+                      {"relative_difference", p.relative_difference},
+                      {"samples", p.samples}});
+  }
+  json j = {{"fe_mass_kg", r.fe_mass_kg},
+            {"solver_mass_kg", r.solver_mass_kg},
+            {"impulse_Ns", r.impulse_Ns},
+            {"expected_velocity_m_s", r.expected_velocity_m_s},
+            {"fe_velocity_m_s", r.fe_velocity_m_s},
+            {"linear_momentum_relative_error", r.linear_momentum_relative_error},
+            {"angular_momentum_relative_error", nullptr},
+            {"angular_velocity_fe_rad_s", v3(r.angular_velocity_fe_rad_s)},
+            {"angular_velocity_expected_rad_s", v3(r.angular_velocity_expected_rad_s)},
+            {"probes", probes},
+            {"solver_wall_time_s", r.solver_wall_time_s},
+            {"momentum_time_s", r.momentum_time_s},
+            {"linear_tolerance", r.linear_tolerance},
+            {"angular_tolerance", r.angular_tolerance},
+            {"passed", r.passed},
+            {"failures", r.failures}};
+  if (r.angular_momentum_relative_error) j["angular_momentum_relative_error"] = *r.angular_momentum_relative_error;
+  return j;
+}
+
+std::string format_check(const CheckResult& r) {
+  std::ostringstream s;
+  s.precision(4);
+  s << "FE mass " << r.fe_mass_kg << " kg (ccx: " << r.solver_mass_kg << " kg), impulse " << r.impulse_Ns << " N s\n";
+  s << "linear momentum: mean velocity " << r.fe_velocity_m_s << " m/s vs impulse / FE mass "
+    << r.expected_velocity_m_s << " m/s, relative error " << r.linear_momentum_relative_error
+    << " (tolerance " << r.linear_tolerance << ")\n";
+  if (r.angular_momentum_relative_error) {
+    s << "angular momentum: |omega_FE| " << r.angular_velocity_fe_rad_s.norm() << " rad/s vs I^-1 (r x Pi) "
+      << r.angular_velocity_expected_rad_s.norm() << " rad/s, relative error "
+      << *r.angular_momentum_relative_error << " (tolerance " << r.angular_tolerance << ")\n";
+  } else {
+    s << "angular momentum: not checked (central hit)\n";
+  }
+  for (const auto& p : r.probes) {
+    s << p.name << ": mean velocity " << p.mean_velocity_m_s << " m/s (scatter " << p.scatter_m_s
+      << " m/s over quarter windows), rigid body " << p.rigid_body_velocity_m_s << " m/s, difference "
+      << 100.0 * p.relative_difference << " %\n";
+  }
+  s << "solver wall time " << r.solver_wall_time_s << " s; " << (r.passed ? "PASSED" : "FAILED") << "\n";
+  for (const auto& f : r.failures) s << "  " << f << "\n";
+  return s.str();
+}
+
+}  // namespace impactdeck::fem_export

@@ -1,0 +1,500 @@
+// fem_export: Gmsh meshes, MED read back with mdump, Code_Aster keyword table, .export files,
+// failures that leave no deck, and a CalculiX run of the mesh-part (STL) deck with the checks.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <set>
+#include <sstream>
+
+#include "impactdeck/common/error.hpp"
+#include "impactdeck/fem_export/check.hpp"
+#include "impactdeck/fem_export/decks.hpp"
+#include "impactdeck/fem_export/mesh.hpp"
+#include "tolerances.hpp"
+
+namespace fs = std::filesystem;
+using namespace impactdeck;
+using namespace impactdeck::fem_export;
+
+namespace {
+
+const fs::path kData = fs::path(IMPACTDECK_SOURCE_DIR) / "tests" / "data";
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path d = fs::path(IMPACTDECK_BINARY_DIR) / "test_fem_out" / name;
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::string run(const std::string& cmd) {
+  std::string out;
+  FILE* f = ::popen(cmd.c_str(), "r");
+  if (!f) return out;
+  char buf[4096];
+  std::size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) out.append(buf, n);
+  ::pclose(f);
+  return out;
+}
+
+// A triangular pulse: its piecewise-linear table is exact, impulse F t_end / 2.
+DeckRequest ellipsoid_request() {
+  DeckRequest r;
+  r.source = "test_fem.cpp";
+  r.impact = "test";
+  r.body.kind = BodyKind::ellipsoid;
+  r.body.semi_axes_m = Eigen::Vector3d(2.0, 0.5, 0.5);
+  r.material = {2.05e11, 0.3, 7850};
+  r.force.time_s = {0, 5e-5, 1e-4};
+  r.force.force_N = {0, 2e5, 0};
+  r.impulse_Ns = 10.0;
+  r.direction = Eigen::Vector3d(0, -1, 0);
+  r.load_point_m = Eigen::Vector3d(0, 0.5, 0);
+  r.options.end_time_s = 3e-4;
+  r.options.time_step_s = 1e-5;
+  r.options.mesh.mesh_size_m = 0.4;
+  r.options.mesh.load_mesh_size_m = 0.15;
+  r.options.mesh.probes_m = {Eigen::Vector3d(0, 0.4, 0.25)};
+  return r;
+}
+
+// Tetrahedra (type 4) in the $Elements section of an MSH 2.2 file.
+std::size_t msh22_tet_count(const std::string& msh) {
+  std::istringstream in(msh);
+  std::string line;
+  bool inside = false;
+  std::size_t tets = 0;
+  while (std::getline(in, line)) {
+    if (line == "$Elements") { inside = true; std::getline(in, line); continue; }
+    if (line == "$EndElements") inside = false;
+    int id, type;
+    std::istringstream ls(line);
+    if (inside && ls >> id >> type && type == 4) ++tets;
+  }
+  return tets;
+}
+
+bool no_stage_left(const fs::path& parent) {
+  for (const auto& e : fs::directory_iterator(parent)) {
+    if (e.path().filename().string().find(".partial-") != std::string::npos) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+TEST(FemMesh, EllipsoidHasLoadNodeExactlyOnThePointAndPositiveTets) {
+  const fs::path d = fresh_dir("ellipsoid_mesh");
+  MeshOptions o;
+  o.mesh_size_m = 0.4;
+  o.probes_m = {Eigen::Vector3d(0, 0.4, 0.25), Eigen::Vector3d(-1.0, 0.0, 0.1)};
+  // An oblique point: the rotated sphere's pole must land on it.
+  const Eigen::Vector3d ax(2.0, 0.5, 0.5);
+  const Eigen::Vector3d p(1.2, 0.5 * std::sqrt(1 - 0.36 - 0.25), 0.5 * 0.5);
+  const MeshResult r = mesh_ellipsoid(ax, p, o, d, "mesh");
+  EXPECT_LT(r.quality.load_node_distance_m, 1e-9);
+  EXPECT_LT((r.mesh.nodes_m[r.mesh.node_of("LOAD")] - p).norm(), 1e-9);
+  ASSERT_EQ(r.quality.probe_node_distance_m.size(), 2u);
+  for (double dist : r.quality.probe_node_distance_m) EXPECT_LT(dist, 1e-9);
+  EXPECT_EQ(r.mesh.node_of("PROBE2") >= 0, true);
+  for (std::size_t e = 0; e < r.mesh.tets.size(); ++e) ASSERT_GT(tet_volume_m3(r.mesh, e), 0.0);
+  // Inscribed polyhedron: lighter than the ellipsoid, by less than 10 % at this size.
+  EXPECT_LT(r.quality.volume_relative_difference, 0.0);
+  EXPECT_GT(r.quality.volume_relative_difference, -0.10);
+  EXPECT_GT(r.quality.min_quality, 0.02);
+  EXPECT_EQ(slurp(r.msh41).rfind("$MeshFormat\n4.1", 0), 0u);
+  EXPECT_EQ(slurp(r.msh22).rfind("$MeshFormat\n2.2", 0), 0u);
+  RecordProperty("nodes", static_cast<int>(r.quality.node_count));
+  RecordProperty("tets", static_cast<int>(r.quality.tet_count));
+}
+
+TEST(FemMesh, GeoScriptReproducesTheMeshWithTheGmshCli) {
+#ifndef IMPACTDECK_GMSH_EXE
+  FAIL() << "gmsh CLI not found at configure time (Debian package gmsh)";
+#else
+  const fs::path d = fresh_dir("geo_cli");
+  MeshOptions o;
+  o.mesh_size_m = 0.4;
+  o.load_mesh_size_m = 0.15;
+  o.probes_m = {Eigen::Vector3d(0, 0.4, 0.25)};
+  const MeshResult r = mesh_ellipsoid({2.0, 0.5, 0.5}, {1.0, 0.5 * std::sqrt(0.75), 0}, o, d, "mesh");
+  const fs::path out = d / "cli.msh";
+  run("cd '" + d.string() + "' && " IMPACTDECK_GMSH_EXE " mesh.geo -3 -format msh22 -o cli.msh > cli.log 2>&1");
+  const std::string cli = slurp(out);
+  ASSERT_FALSE(cli.empty()) << slurp(d / "cli.log");
+  EXPECT_EQ(msh22_tet_count(cli), r.quality.tet_count);
+  for (const char* g : {"\"BODY\"", "\"LOAD\"", "\"PROBE1\""}) EXPECT_NE(cli.find(g), std::string::npos) << g;
+#endif
+}
+
+TEST(FemMed, ReadsBackWithMdumpWithCountsAndGroups) {
+#ifndef IMPACTDECK_MDUMP
+  FAIL() << "mdump not found at configure time (Debian package libmed-tools)";
+#else
+  const fs::path d = fresh_dir("med");
+  TetMesh m;
+  m.nodes_m = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 1}};
+  m.tets = {{0, 1, 2, 3}, {1, 2, 3, 4}};
+  m.node_groups = {{"LOAD", 4}, {"PROBE1", 0}, {"PROBE2", 0}};
+  write_med(m, d / "m.med", "BODYMESH");
+  const std::string dump = run(std::string(IMPACTDECK_MDUMP) + " '" + (d / "m.med").string() +
+                               "' NODALE FULL_INTERLACE 1 2>&1");
+  EXPECT_NE(dump.find("Nombre de noeuds : 5"), std::string::npos) << dump;
+  EXPECT_NE(dump.find("MED_TETRA4 : 2"), std::string::npos) << dump;
+  for (const char* g : {"gro = BODY", "gro = LOAD", "gro = PROBE1", "gro = PROBE2"}) {
+    EXPECT_NE(dump.find(g), std::string::npos) << g;
+  }
+  // Node 1 is in PROBE1 and PROBE2: one family holding both groups.
+  EXPECT_NE(dump.find("Famille de nom FAM_PROBE1_PROBE2"), std::string::npos);
+  // Coordinates in mm; MED tetra order swaps Gmsh's nodes 2 and 3.
+  EXPECT_NE(dump.find("+1000.000000"), std::string::npos);
+  EXPECT_NE(dump.find(":          1          3          2          4"), std::string::npos) << dump;
+#endif
+}
+
+// ---- Code_Aster keyword table (DECKS.md) ---------------------------------------------------
+
+namespace {
+
+struct Call {
+  std::string command;
+  std::map<std::string, std::string> keys;  // top-level keyword -> raw value
+  std::set<std::string> nested;             // keywords inside _F(...)
+};
+
+std::vector<std::string> split_top(const std::string& s) {
+  std::vector<std::string> parts;
+  int depth = 0;
+  bool quote = false;
+  std::string cur;
+  for (char c : s) {
+    if (c == '\'') quote = !quote;
+    if (!quote && (c == '(')) ++depth;
+    if (!quote && (c == ')')) --depth;
+    if (!quote && depth == 0 && c == ',') {
+      parts.push_back(cur);
+      cur.clear();
+      continue;
+    }
+    cur += c;
+  }
+  if (cur.find_first_not_of(" \n") != std::string::npos) parts.push_back(cur);
+  return parts;
+}
+
+std::vector<Call> parse_comm(const std::string& text) {
+  std::string code;
+  std::istringstream in(text);
+  for (std::string l; std::getline(in, l);) code += l.substr(0, l.find('#')) + "\n";
+  std::vector<Call> calls;
+  const std::regex head(R"(^\s*(?:[A-Za-z_][A-Za-z0-9_]*\s*=\s*)?([A-Z_]+)\s*\()");
+  std::size_t pos = 0;
+  while (pos < code.size()) {
+    std::smatch m;
+    const std::string rest = code.substr(pos);
+    if (!std::regex_search(rest, m, head)) break;
+    const std::size_t open = pos + m.position(0) + m.length(0) - 1;
+    int depth = 0;
+    std::size_t close = open;
+    for (; close < code.size(); ++close) {
+      if (code[close] == '(') ++depth;
+      if (code[close] == ')' && --depth == 0) break;
+    }
+    Call c;
+    c.command = m[1];
+    for (const std::string& part : split_top(code.substr(open + 1, close - open - 1))) {
+      const auto eq = part.find('=');
+      if (eq == std::string::npos) continue;
+      std::string k = part.substr(0, eq);
+      k.erase(0, k.find_first_not_of(" \n"));
+      k.erase(k.find_last_not_of(" \n") + 1);
+      const std::string v = part.substr(eq + 1);
+      c.keys[k] = v;
+      const std::regex nested_key(R"(([A-Z_]+)\s*=)");
+      for (auto it = std::sregex_iterator(v.begin(), v.end(), nested_key); it != std::sregex_iterator(); ++it) {
+        c.nested.insert((*it)[1]);
+      }
+    }
+    calls.push_back(c);
+    pos = close + 1;
+  }
+  return calls;
+}
+
+std::string strip(std::string v) {
+  v.erase(std::remove_if(v.begin(), v.end(), [](char ch) { return ch == ' ' || ch == '\n'; }), v.end());
+  return v;
+}
+
+}  // namespace
+
+TEST(FemCodeAster, CommMatchesTheKeywordTableOfDecksMd) {
+  const fs::path d = fresh_dir("comm");
+  DeckRequest r = ellipsoid_request();
+  r.options.calculix = false;
+  const DeckResult res = write_decks(r, d / "deck");
+  const std::string comm = slurp(d / "deck" / "impact.comm");
+  // Header: units, source scene, version.
+  EXPECT_NE(comm.find("Units: mm, N, s, tonne"), std::string::npos);
+  EXPECT_NE(comm.find("Scene: test_fem.cpp"), std::string::npos);
+  EXPECT_NE(comm.find("impactdeck "), std::string::npos);
+
+  // command -> allowed top-level keywords, allowed keywords inside _F (DECKS.md table).
+  const std::map<std::string, std::pair<std::set<std::string>, std::set<std::string>>> table = {
+      {"DEBUT", {{}, {}}},
+      {"LIRE_MAILLAGE", {{"FORMAT", "UNITE"}, {}}},
+      {"AFFE_MODELE", {{"MAILLAGE", "AFFE"}, {"GROUP_MA", "TOUT", "PHENOMENE", "MODELISATION"}}},
+      {"DEFI_MATERIAU", {{"ELAS"}, {"E", "NU", "RHO"}}},
+      {"AFFE_MATERIAU", {{"MAILLAGE", "AFFE"}, {"GROUP_MA", "TOUT", "MATER"}}},
+      {"DEFI_FONCTION", {{"NOM_PARA", "VALE", "INTERPOL", "PROL_GAUCHE", "PROL_DROITE"}, {}}},
+      {"AFFE_CHAR_MECA", {{"MODELE", "FORCE_NODALE"}, {"GROUP_NO", "FX", "FY", "FZ"}}},
+      {"DEFI_LIST_REEL", {{"DEBUT", "INTERVALLE"}, {"JUSQU_A", "PAS"}}},
+      {"ASSEMBLAGE", {{"MODELE", "CHAM_MATER", "NUME_DDL", "MATR_ASSE"}, {"MATRICE", "OPTION"}}},
+      {"DYNA_VIBRA", {{"TYPE_CALCUL", "BASE_CALCUL", "MODELE", "CHAM_MATER", "MATR_MASS", "MATR_RIGI",
+                       "SCHEMA_TEMPS", "INCREMENT", "EXCIT"},
+                      {"SCHEMA", "BETA", "GAMMA", "LIST_INST", "CHARGE", "FONC_MULT"}}},
+      {"CALC_CHAMP", {{"reuse", "RESULTAT", "CONTRAINTE", "CRITERES"}, {}}},
+      {"RECU_FONCTION", {{"RESULTAT", "NOM_CHAM", "NOM_CMP", "GROUP_NO"}, {}}},
+      {"IMPR_FONCTION", {{"FORMAT", "UNITE", "COURBE"}, {"FONCTION"}}},
+      {"IMPR_RESU", {{"FORMAT", "UNITE", "RESU"}, {"RESULTAT", "NOM_CHAM"}}},
+      {"FIN", {{}, {}}},
+  };
+  const std::vector<Call> calls = parse_comm(comm);
+  ASSERT_GE(calls.size(), 15u);
+  EXPECT_EQ(calls.front().command, "DEBUT");
+  EXPECT_TRUE(calls.front().keys.empty()) << "DEBUT() must be bare (15.x rejects CODE=)";
+  EXPECT_EQ(calls.back().command, "FIN");
+  std::map<std::string, const Call*> first;
+  for (const Call& c : calls) {
+    auto t = table.find(c.command);
+    ASSERT_NE(t, table.end()) << "command not in the DECKS.md table: " << c.command;
+    for (const auto& [k, v] : c.keys) EXPECT_TRUE(t->second.first.count(k)) << c.command << " " << k;
+    for (const auto& k : c.nested) {
+      EXPECT_TRUE(t->second.first.count(k) || t->second.second.count(k)) << c.command << " _F " << k;
+    }
+    first.emplace(c.command, &c);
+  }
+  for (const auto& [cmd, spec] : table) EXPECT_TRUE(first.count(cmd)) << "missing " << cmd;
+
+  const Call& dv = *first.at("DYNA_VIBRA");
+  EXPECT_EQ(strip(dv.keys.at("TYPE_CALCUL")), "'TRAN'");
+  EXPECT_EQ(strip(dv.keys.at("BASE_CALCUL")), "'PHYS'");
+  EXPECT_NE(strip(dv.keys.at("SCHEMA_TEMPS")).find("SCHEMA='NEWMARK'"), std::string::npos);
+  const Call& lm = *first.at("LIRE_MAILLAGE");
+  EXPECT_EQ(strip(lm.keys.at("FORMAT")), "'MED'");
+  EXPECT_EQ(strip(lm.keys.at("UNITE")), "20");
+  const Call& fn = *first.at("DEFI_FONCTION");
+  EXPECT_EQ(strip(fn.keys.at("NOM_PARA")), "'INST'");
+  EXPECT_EQ(strip(fn.keys.at("PROL_GAUCHE")), "'CONSTANT'");
+  EXPECT_EQ(strip(fn.keys.at("PROL_DROITE")), "'CONSTANT'");
+  // VALE: flat pairs, increasing times, closing zero, the request's table.
+  std::string vale = strip(fn.keys.at("VALE"));
+  vale = vale.substr(1, vale.size() - 2);
+  std::vector<double> v;
+  for (const auto& s : split_top(vale)) v.push_back(std::stod(s));
+  ASSERT_EQ(v.size(), 2 * r.force.time_s.size());
+  for (std::size_t i = 2; i < v.size(); i += 2) EXPECT_GT(v[i], v[i - 2]);
+  EXPECT_EQ(v.back(), 0.0);
+  EXPECT_DOUBLE_EQ(v[3], 2e5);
+  const Call& ch = *first.at("AFFE_CHAR_MECA");
+  const std::string fnod = strip(ch.keys.at("FORCE_NODALE"));
+  EXPECT_NE(fnod.find("GROUP_NO=('LOAD',)"), std::string::npos) << fnod;
+  EXPECT_NE(fnod.find("FY=-1.0"), std::string::npos) << fnod;  // the impact direction
+  EXPECT_NE(strip(first.at("CALC_CHAMP")->keys.at("CRITERES")).find("'SIEQ_NOEU'"), std::string::npos);
+  EXPECT_EQ(strip(first.at("RECU_FONCTION")->keys.at("NOM_CHAM")), "'VITE'");
+  EXPECT_EQ(strip(first.at("IMPR_RESU")->keys.at("FORMAT")), "'MED'");
+  // Every group named exists in the MED mesh and is at most 8 characters.
+  const std::regex grp(R"(GROUP_(?:MA|NO)=\('([A-Z0-9_]+)',\))");
+  for (auto it = std::sregex_iterator(comm.begin(), comm.end(), grp); it != std::sregex_iterator(); ++it) {
+    const std::string g = (*it)[1];
+    EXPECT_LE(g.size(), 8u);
+    EXPECT_TRUE(g == "BODY" || g == "LOAD" || g == "PROBE1") << g;
+  }
+  // Every Python name at most 8 characters (Code_Aster concept names).
+  const std::regex assign(R"(^([A-Za-z_][A-Za-z0-9_]*)\s*=)");
+  std::istringstream in(comm);
+  for (std::string l; std::getline(in, l);) {
+    std::smatch m;
+    if (std::regex_search(l, m, assign)) EXPECT_LE(m[1].length(), 8) << l;
+  }
+}
+
+TEST(FemCodeAster, ExportNamesEveryFileAndUnitTheCommUses) {
+  const fs::path d = fresh_dir("export");
+  const DeckResult res = write_decks(ellipsoid_request(), d / "deck");
+  const std::string exp = slurp(d / "deck" / "impact.export");
+  const std::string comm = slurp(d / "deck" / "impact.comm");
+  std::map<int, std::string> unit_file;
+  std::istringstream in(exp);
+  for (std::string l; std::getline(in, l);) {
+    std::istringstream ls(l);
+    std::string tag, type, path, dir;
+    int unit;
+    if (!(ls >> tag) || tag != "F") continue;
+    ASSERT_TRUE(ls >> type >> path >> dir >> unit) << l;
+    unit_file[unit] = path;
+    if (dir == "D") EXPECT_TRUE(fs::exists(d / "deck" / path)) << "input file missing: " << path;
+  }
+  EXPECT_EQ(unit_file.at(1), "impact.comm");
+  EXPECT_EQ(unit_file.at(20), "mesh.med");
+  EXPECT_TRUE(unit_file.count(6));
+  const std::regex unite(R"(UNITE=(\d+))");
+  for (auto it = std::sregex_iterator(comm.begin(), comm.end(), unite); it != std::sregex_iterator(); ++it) {
+    EXPECT_TRUE(unit_file.count(std::stoi((*it)[1]))) << "unit " << (*it)[1] << " not in the .export";
+  }
+  // The deck's file list matches the folder.
+  for (const auto& f : res.files) EXPECT_TRUE(fs::exists(f)) << f;
+}
+
+TEST(FemDecks, MeshingFailuresGiveClearErrorsAndNoDeck) {
+  const fs::path d = fresh_dir("failures");
+  DeckRequest r = ellipsoid_request();
+  r.body.kind = BodyKind::stl;
+  r.body.stl = kData / "no_triangles.stl";
+  r.body.stl_unit_m = 1e-3;
+  try {
+    write_decks(r, d / "deck");
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("no_triangles.stl"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("no triangles"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(d / "deck"));
+  r.body.stl = kData / "open_surface.stl";
+  r.load_point_m = Eigen::Vector3d(0, 0.05, 0);
+  r.options.mesh.mesh_size_m = 0.02;
+  r.options.mesh.probes_m.clear();
+  try {
+    write_decks(r, d / "deck");
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    // Gmsh's own reason ("No elements in volume 1"), prefixed by the file and the step.
+    EXPECT_NE(std::string(e.what()).find("open_surface.stl: gmsh mesh: "), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(d / "deck"));
+  // A probe outside the body is refused before Gmsh runs.
+  DeckRequest p = ellipsoid_request();
+  p.options.mesh.probes_m = {Eigen::Vector3d(0, 0.6, 0)};
+  try {
+    write_decks(p, d / "deck");
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("PROBE1: probe point is not inside the ellipsoid"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(d / "deck"));
+  EXPECT_TRUE(no_stage_left(d));
+}
+
+TEST(FemDecks, FailedRewriteLeavesThePreviousDeckUntouched) {
+  const fs::path d = fresh_dir("atomic");
+  write_decks(ellipsoid_request(), d / "deck");
+  const std::string before = slurp(d / "deck" / "deck.json");
+  DeckRequest bad = ellipsoid_request();
+  bad.options.end_time_s = 5e-5;  // ends inside the contact
+  try {
+    write_decks(bad, d / "deck");
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("end_time_s"), std::string::npos) << e.what();
+  }
+  // A failure inside Gmsh, after the staging folder exists.
+  DeckRequest bad2 = ellipsoid_request();
+  bad2.body.kind = BodyKind::stl;
+  bad2.body.stl = kData / "no_triangles.stl";
+  EXPECT_THROW(write_decks(bad2, d / "deck"), InputError);
+  EXPECT_EQ(slurp(d / "deck" / "deck.json"), before);
+  EXPECT_TRUE(no_stage_left(d));
+  EXPECT_EQ(slurp(d / "deck" / "impact.inp").find("*END STEP") != std::string::npos, true);
+}
+
+TEST(FemCheck, MeshPartFromStlEccentricHitConservesLinearAndAngularMomentum) {
+  // The mesh-part route end to end: STL (written by Gmsh) -> volume mesh -> decks -> ccx -> checks.
+  const fs::path d = fresh_dir("stl_ccx");
+  DeckRequest r = ellipsoid_request();
+  r.body.kind = BodyKind::stl;
+  r.body.stl = kData / "ellipsoid_200x50x50.stl";
+  r.body.stl_unit_m = 1e-3;
+  const Eigen::Vector3d p(0.1, 0.05 * std::sqrt(0.75), 0);
+  r.load_point_m = p;
+  r.direction = -Eigen::Vector3d(p.x() / 0.04, p.y() / 0.0025, 0).normalized();
+  r.force.time_s = {0, 2e-5, 4e-5};
+  r.force.force_N = {0, 1e3, 0};
+  r.impulse_Ns = 1e3 * 4e-5 / 2;
+  r.options.end_time_s = 1e-4;
+  r.options.time_step_s = 5e-6;
+  r.options.mesh.mesh_size_m = 0.03;
+  r.options.mesh.load_mesh_size_m = 0.012;
+  r.options.mesh.probes_m = {Eigen::Vector3d(-0.1, 0.0, 0.0)};
+  const DeckResult res = write_decks(r, d / "deck");
+  EXPECT_LT(res.quality.load_node_distance_m, 0.012);
+  // Gmsh re-meshes the reparametrized surface at 30 mm on a body 100 mm thick: chords cut ~6 %.
+  EXPECT_LT(std::abs(res.quality.volume_relative_difference), 0.10);
+  // The STL encloses the gmsh-faceted ellipsoid: a little less than (4/3) pi a b c.
+  EXPECT_NEAR(res.quality.part_volume_m3 / (4.0 / 3.0 * M_PI * 0.2 * 0.05 * 0.05), 1.0, 0.05);
+  RecordProperty("nodes", static_cast<int>(res.node_count));
+#ifdef IMPACTDECK_GMSH_EXE
+  // The mesh-part .geo (Merge, ClassifySurfaces, CreateGeometry) reproduces the mesh too.
+  run("cd '" + (d / "deck").string() + "' && " IMPACTDECK_GMSH_EXE
+      " mesh.geo -3 -format msh22 -o ../cli.msh > ../cli.log 2>&1");
+  EXPECT_EQ(msh22_tet_count(slurp(d / "cli.msh")), res.tet_count) << slurp(d / "cli.log");
+#endif
+  CheckOptions o;
+#ifdef IMPACTDECK_CCX
+  o.ccx = IMPACTDECK_CCX;
+#endif
+  const CheckResult c = run_check(d / "deck", o);
+  ASSERT_TRUE(c.angular_momentum_relative_error.has_value());
+  std::cout << "[ STL part  ] " << res.node_count << " nodes, " << res.tet_count << " tets; linear momentum "
+            << test::sci(c.linear_momentum_relative_error) << ", angular momentum "
+            << test::sci(*c.angular_momentum_relative_error) << ", ccx " << c.solver_wall_time_s << " s\n";
+  RecordProperty("linear_momentum_relative_error", test::sci(c.linear_momentum_relative_error));
+  RecordProperty("angular_momentum_relative_error", test::sci(*c.angular_momentum_relative_error));
+  EXPECT_LE(c.linear_momentum_relative_error, 1e-3);
+  EXPECT_LE(*c.angular_momentum_relative_error, 1e-2);
+  EXPECT_TRUE(c.passed);
+  EXPECT_NEAR(c.solver_mass_kg / c.fe_mass_kg, 1.0, 1e-5);  // ccx's EMAS vs our sum of rho V_e
+  // With the solver's own results, a wrong impulse must fail: the check can fail.
+  fs::path bad = d / "deck";
+  std::string deck = slurp(bad / "deck.json");
+  const std::string key = "\"impulse_Ns\": ";
+  const auto at = deck.find(key);
+  ASSERT_NE(at, std::string::npos);
+  const auto end = deck.find(',', at);
+  deck.replace(at + key.size(), end - at - key.size(), "0.0202");  // +1 %
+  std::ofstream(bad / "deck.json") << deck;
+  CheckOptions again = o;
+  again.run_solver = false;
+  const CheckResult c2 = run_check(bad, again);
+  EXPECT_FALSE(c2.passed);
+  EXPECT_NEAR(c2.linear_momentum_relative_error, 0.01, 2e-3);
+}
+
+TEST(FemDecks, TimeScheduleRefinesThePulseAndDividesTheRest) {
+  DeckOptions o;  // 0.02 s at 1e-5 s, 100 increments across the pulse
+  const TimeSchedule t = time_schedule(o, 6.9e-5);
+  EXPECT_EQ(t.pulse_increments, 100u);
+  EXPECT_DOUBLE_EQ(t.pulse_step_s * 100, 6.9e-5);
+  EXPECT_EQ(t.main_increments, 1994u);  // ceil((0.02 - 6.9e-5) / 1e-5)
+  EXPECT_LE(t.main_step_s, 1e-5);
+  EXPECT_NEAR(t.pulse_end_s + t.main_increments * t.main_step_s, 0.02, 1e-15);
+  // A step already finer than pulse / 100: no refined phase.
+  o.time_step_s = 1e-7;
+  o.end_time_s = 1e-4;
+  const TimeSchedule u = time_schedule(o, 6.9e-5);
+  EXPECT_EQ(u.pulse_increments, 0u);
+  EXPECT_EQ(u.main_increments, 1000u);
+  o.pulse_increments = 0;
+  o.time_step_s = 1e-5;
+  EXPECT_EQ(time_schedule(o, 6.9e-5).pulse_increments, 0u);
+}
