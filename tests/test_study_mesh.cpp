@@ -1,10 +1,6 @@
-// The sweep on a triangulated part against the analytic ellipsoid it approximates. MeshShape comes
-// from the geometry front end (issue 3, another branch): this file compiles to nothing until that
-// code is in the tree, then checks the issue's acceptance point "on a mesh part the sweep runs,
-// its picture renders, and its ratio agrees with the analytic-ellipsoid sweep".
-#if __has_include("impactdeck/geometry/mesh_shape.hpp") && \
-    __has_include("impactdeck/geometry/ellipsoid_mesh.hpp") && \
-    __has_include("impactdeck/geometry/mass_properties.hpp")
+// The sweep on a triangulated part against the analytic ellipsoid it approximates: the issue's
+// acceptance point "on a mesh part the sweep runs, its picture renders, and its ratio agrees with
+// the analytic-ellipsoid sweep".
 
 #include <algorithm>
 #include <cmath>
@@ -79,5 +75,3 @@ TEST(SweepMesh, FineEllipsoidMeshAgreesWithTheAnalyticSweep) {
 
 }  // namespace
 }  // namespace impactdeck::study
-
-#endif
