@@ -182,7 +182,10 @@ SweepSetup ellipsoid_setup(double mu = 1.0) {
 bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
 TEST(Sweep, BitForBitWhateverTheThreadCount) {
-  const SweepSetup s = ellipsoid_setup(0.3);
+ for (RadiusRule rule : {RadiusRule::paper, RadiusRule::elliptical}) {
+  SCOPED_TRACE(to_string(rule));
+  SweepSetup s = ellipsoid_setup(0.3);
+  s.target.radius_rule = s.impactor.radius_rule = rule;
   const auto cloud = make_cloud(*s.target.shape, CloudKind::both, 8, 3000, 7);
   SweepOptions o;
   o.curves = true;
@@ -215,11 +218,15 @@ TEST(Sweep, BitForBitWhateverTheThreadCount) {
     EXPECT_EQ(many.min_index, one.min_index);
     EXPECT_EQ(many.max_index, one.max_index);
   }
+ }
 }
 
 TEST(Sweep, NoAllocationPerPoint) {
   // The number of heap allocations of a sweep does not grow with the number of points.
-  const SweepSetup s = ellipsoid_setup();
+  for (RadiusRule rule : {RadiusRule::paper, RadiusRule::elliptical}) {
+  SCOPED_TRACE(to_string(rule));
+  SweepSetup s = ellipsoid_setup();
+  s.target.radius_rule = s.impactor.radius_rule = rule;
   const auto small = make_cloud(*s.target.shape, CloudKind::area_uniform, 8, 500, 3);
   const auto large = make_cloud(*s.target.shape, CloudKind::area_uniform, 8, 4000, 3);
   SweepOptions o;
@@ -235,10 +242,36 @@ TEST(Sweep, NoAllocationPerPoint) {
     return g_allocations.load();
   };
   const long a = count(small), b = count(large);
-  RecordProperty("allocations_500", std::to_string(a));
-  RecordProperty("allocations_4000", std::to_string(b));
+  RecordProperty(std::string("allocations_500_") + to_string(rule), std::to_string(a));
+  RecordProperty(std::string("allocations_4000_") + to_string(rule), std::to_string(b));
   EXPECT_EQ(a, b);
   EXPECT_LT(b, 20);  // result arrays and thread start-up only
+  }
+}
+
+TEST(Sweep, EllipticalRuleIsThePairsAndDiffersFromTheMeanRadius) {
+  SweepSetup s = ellipsoid_setup();
+  s.target.radius_rule = RadiusRule::elliptical;  // impactor keeps "paper": a mix is refused
+  const auto cloud = make_cloud(*s.target.shape, CloudKind::area_uniform, 8, 50, 5);
+  EXPECT_THROW(run_sweep(s, cloud), InputError);
+  s.impactor.radius_rule = RadiusRule::elliptical;
+  const SweepResult e = run_sweep(s, cloud);
+  s.target.radius_rule = s.impactor.radius_rule = RadiusRule::mean;
+  const SweepResult m = run_sweep(s, cloud);
+  // On the 4:1:1 target hit by a 50 mm ball, the side (k = 2 and 0.125 1/m against the ball's
+  // 20 1/m) gives B/A ~ 1.09, a/b ~ 1.06: the contact is elliptical and R_eq is not
+  // 1/(H_t + H_i), though close to it (both are between 1/(2B) and 1/(2A)).
+  double max_ratio = 1.0, max_rel = 0.0;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    max_ratio = std::max(max_ratio, e.points[i].contact_ellipse_axis_ratio);
+    EXPECT_EQ(m.points[i].contact_ellipse_axis_ratio, 1.0);
+    max_rel = std::max(max_rel, relative_difference(e.points[i].effective_radius_m, m.points[i].effective_radius_m));
+    EXPECT_LT(relative_difference(e.points[i].effective_radius_m, m.points[i].effective_radius_m), 0.05) << i;
+  }
+  RecordProperty("max_axis_ratio", std::to_string(max_ratio));
+  RecordProperty("max_rel_Req_vs_mean", std::to_string(max_rel));
+  EXPECT_GT(max_ratio, 1.03);
+  EXPECT_GT(max_rel, 1e-9);
 }
 
 TEST(Sweep, CurvesMatchTheCoreForceHistory) {
@@ -289,7 +322,7 @@ approach_speed_m_s = 2.0
 restitution = 0.7
 contact_radius = "RULE"
 )";
-  for (const char* rule : {"paper", "mean"}) {
+  for (const char* rule : {"paper", "mean", "elliptical"}) {
     std::string t = text;
     t.replace(t.find("RULE"), 4, rule);
     const std::string probe = t;
@@ -309,6 +342,12 @@ contact_radius = "RULE"
       const PointResult p = sweep_point(ss.setup, sp);
       const auto& res = rep.impacts.at(0).result;
       EXPECT_LE(relative_difference(p.max_force_N, res.history.compression.max_force_N), kKernelVsPipelineRel) << rule;
+      const scene::ContactGeometry& cg = rep.impacts.at(0).contact;
+      EXPECT_LE(relative_difference(p.effective_radius_m, cg.effective_radius_m), kKernelVsPipelineRel) << rule;
+      if (std::string(rule) == "elliptical") {
+        EXPECT_LE(relative_difference(p.contact_ellipse_axis_ratio, cg.contact_ellipse_axis_ratio),
+                  kKernelVsPipelineRel);
+      }
       EXPECT_LE(relative_difference(p.reduced_mass_kg, res.reduced_mass_kg), kKernelVsPipelineRel) << rule;
       EXPECT_LE(relative_difference(p.contact_time_s, res.history.contact_time_s()), kKernelVsPipelineRel) << rule;
       // Velocity jumps: the pipeline uses the quadrature impulse (rel. 1e-12 of the closed form).

@@ -31,11 +31,12 @@ SceneSweep sweep_from_scene(const scene::Scene& sc, const std::string& name) {
   switch (s.contact_radius) {
     case scene::ContactRadiusRule::paper: mapped = RadiusRule::paper; break;
     case scene::ContactRadiusRule::mean: mapped = RadiusRule::mean; break;
+    case scene::ContactRadiusRule::elliptical: mapped = RadiusRule::elliptical; break;
   }
   if (!mapped) {
     throw InputError(file, scene::Place{s.place.line, s.place.key + ".contact_radius"}.describe(),
                      std::string("impact '") + s.name + "': the sweep does not support contact_radius = \"" +
-                         scene::to_string(s.contact_radius) + "\" (use \"paper\" or \"mean\")");
+                         scene::to_string(s.contact_radius) + "\" (use \"paper\", \"mean\" or \"elliptical\")");
   }
   const RadiusRule rule = *mapped;
   auto body = [&](const scene::PreparedBody& p) {

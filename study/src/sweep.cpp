@@ -7,13 +7,21 @@
 
 #include "impactdeck/collision/compression.hpp"
 #include "impactdeck/collision/eccentric.hpp"
+#include "impactdeck/collision/elliptical.hpp"
 #include "impactdeck/collision/restitution.hpp"
 #include "impactdeck/common/error.hpp"
 #include "parallel.hpp"
 
 namespace impactdeck::study {
 
-const char* to_string(RadiusRule r) { return r == RadiusRule::paper ? "paper" : "mean"; }
+const char* to_string(RadiusRule r) {
+  switch (r) {
+    case RadiusRule::paper: return "paper";
+    case RadiusRule::mean: return "mean";
+    case RadiusRule::elliptical: return "elliptical";
+  }
+  return "?";
+}
 
 namespace {
 
@@ -39,6 +47,16 @@ collision::RigidBody rigid(const SweepBody& b) {
 
 }  // namespace
 
+void check_radius_rules(const SweepSetup& s) {
+  const bool et = s.target.radius_rule == RadiusRule::elliptical;
+  const bool ei = s.impactor.radius_rule == RadiusRule::elliptical;
+  if (et != ei) {
+    throw InputError("", "radius rule",
+                     std::string("the elliptical rule belongs to the pair of bodies: target has \"") +
+                         to_string(s.target.radius_rule) + "\", impactor has \"" + to_string(s.impactor.radius_rule) + "\"");
+  }
+}
+
 PointResult sweep_point(const SweepSetup& s, const geometry::SurfacePoint& at) {
   PointResult r;
   r.point_m = at.point_m;
@@ -48,16 +66,29 @@ PointResult sweep_point(const SweepSetup& s, const geometry::SurfacePoint& at) {
     point_error(at, "point or normal is not finite / not a unit vector");
   }
   try {
-    // Target: local radius at the point.
-    const double kt = curvature_by_rule(s.target, at);
     // Impactor: its centroid lies on the impact line; it touches where the ray from its centroid
     // towards the target (-n) leaves its surface (as in the scene pipeline).
     const auto exit = s.impactor.shape->ray_exit(s.impactor.centroid_m, -n);
     if (!exit) point_error(at, "no contact point on the impactor (its centroid lies outside it)");
-    const double ki = curvature_by_rule(s.impactor, *exit);
-    r.target_radius_m = 1.0 / kt;
-    r.impactor_radius_m = 1.0 / ki;
-    r.effective_radius_m = collision::effective_radius_m(kt, ki);
+    if (s.target.radius_rule == RadiusRule::elliptical) {
+      // As the scene pipeline: relative curvatures A, B from both curvature tensors projected on
+      // the tangent plane normal to n, then the contact ellipse (no allocation: fixed-size Eigen).
+      const geometry::Curvature a = s.target.shape->curvature(at);
+      const geometry::Curvature b = s.impactor.shape->curvature(*exit);
+      const collision::RelativeCurvatures rc =
+          collision::relative_curvatures(a.k1_per_m, a.k2_per_m, a.d1, a.d2, b.k1_per_m, b.k2_per_m, b.d1, b.d2, n);
+      const collision::EllipticalContact ec = collision::elliptical_contact(rc);
+      r.target_radius_m = 1.0 / a.mean_per_m();
+      r.impactor_radius_m = 1.0 / b.mean_per_m();
+      r.effective_radius_m = ec.equivalent_radius_m;
+      r.contact_ellipse_axis_ratio = ec.axis_ratio;
+    } else {
+      const double kt = curvature_by_rule(s.target, at);
+      const double ki = curvature_by_rule(s.impactor, *exit);
+      r.target_radius_m = 1.0 / kt;
+      r.impactor_radius_m = 1.0 / ki;
+      r.effective_radius_m = collision::effective_radius_m(kt, ki);
+    }
     r.hertz_constant = collision::hertz_constant(s.effective_modulus_Pa, r.effective_radius_m);
 
     // Reduced mass at the point: the impactor moved so that its contact point is on the target's.
@@ -131,6 +162,7 @@ SweepResult run_sweep(const SweepSetup& s, const std::vector<geometry::SurfacePo
                       const SweepOptions& o) {
   if (cloud.empty()) throw InputError("", "sweep", "the point cloud is empty");
   if (!s.target.shape || !s.impactor.shape) throw InputError("", "sweep", "a body has no shape");
+  check_radius_rules(s);
   if (!(s.approach_speed_m_s > 0.0) || !std::isfinite(s.approach_speed_m_s)) {
     throw InputError("", "approach speed", "must be positive and finite");
   }

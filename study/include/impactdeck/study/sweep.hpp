@@ -25,6 +25,10 @@ namespace impactdeck::study {
 enum class RadiusRule {
   paper,  ///< Eq. 26: average radius of the axis-normal sections (Shape::paper_radius_m)
   mean,   ///< 1 / mean curvature from the principal curvatures (exact on a sphere)
+  /// Full elliptical Hertz contact (collision/elliptical.hpp) from both bodies' curvature tensors,
+  /// as `impactdeck run` with contact_radius = "elliptical". A rule of the pair: both bodies of a
+  /// sweep must have it (the sweep refuses a mix).
+  elliptical,
 };
 const char* to_string(RadiusRule r);
 
@@ -60,9 +64,10 @@ struct SweepOptions {
 struct PointResult {
   Eigen::Vector3d point_m = Eigen::Vector3d::Zero();
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  ///< target's outward unit normal
-  double target_radius_m = 0;       ///< local radius of the target by its rule
+  double target_radius_m = 0;       ///< local radius of the target by its rule (elliptical: 1/H)
   double impactor_radius_m = 0;     ///< local radius of the impactor at its contact point
-  double effective_radius_m = 0;    ///< R* (Eq. 29)
+  double effective_radius_m = 0;    ///< R* (Eq. 29), or R_eq of the elliptical rule
+  double contact_ellipse_axis_ratio = 1;  ///< a/b of the contact ellipse (1 unless elliptical)
   double reduced_mass_kg = 0;       ///< m_w at the point (tensor form of Eq. 21)
   double hertz_constant = 0;        ///< k_H, N/m^1.5
   double max_indentation_m = 0;
@@ -91,6 +96,10 @@ struct SweepResult {
   unsigned threads_used = 0;
   double seconds = 0;                        ///< wall time of the point loop
 };
+
+/// Throws InputError when one body has the elliptical rule and the other not (run_sweep checks it;
+/// call it before sweep_point on a setup built by hand).
+void check_radius_rules(const SweepSetup& setup);
 
 /// One point (the sweep's kernel). Throws InputError naming the point when it cannot be solved.
 PointResult sweep_point(const SweepSetup& setup, const geometry::SurfacePoint& at);
