@@ -39,6 +39,48 @@ struct Vec3Eq {
 
 bool is_identity(const aiMatrix4x4& m) { return m.IsIdentity(); }
 
+// An OFF header declaring more vertices and faces than the file can hold (each needs at least two
+// bytes: a digit and a separator) is refused before assimp reserves memory for them: assimp's
+// `models/invalid/OutOfMemory.off` (353535235358 vertices in 309 bytes) otherwise runs for minutes.
+std::string count_text(long double n) {
+  std::ostringstream o;
+  o << std::fixed << std::setprecision(0) << n;
+  return o.str();
+}
+
+void check_off_header(const fs::path& file, const std::string& where, std::uintmax_t bytes) {
+  std::ifstream in(file, std::ios::binary);
+  std::string line;
+  int line_no = 0, seen = 0;
+  while (seen < 2 && std::getline(in, line)) {
+    ++line_no;
+    const auto hash = line.find('#');
+    if (hash != std::string::npos) line.erase(hash);
+    std::istringstream ls(line);
+    std::string first;
+    if (!(ls >> first)) continue;
+    if (seen == 0) {
+      ++seen;
+      if (first.size() >= 3 && first.compare(first.size() - 3, 3, "OFF") == 0) {
+        if (!(ls >> first)) continue;  // counts on the next line
+      }
+    }
+    ++seen;
+    long double nv = 0, nf = 0;
+    std::string rest;
+    std::getline(ls, rest);
+    std::istringstream cs(first + " " + rest);
+    if (!(cs >> nv >> nf)) return;  // malformed counts: assimp reports them
+    if (nv < 0 || nf < 0 || 2.0L * (nv + nf) > static_cast<long double>(bytes)) {
+      throw InputError(where, "line " + std::to_string(line_no),
+                       "the OFF header declares " + count_text(nv) + " vertices and " +
+                           count_text(nf) + " faces, more than a file of " +
+                           std::to_string(bytes) + " bytes can hold");
+    }
+    return;
+  }
+}
+
 }  // namespace
 
 LoadedMesh load_mesh(const fs::path& file, LengthUnit unit) {
@@ -56,6 +98,8 @@ LoadedMesh load_mesh(const fs::path& file, LengthUnit unit) {
   if (ext != ".stl" && ext != ".obj" && ext != ".ply" && ext != ".off") {
     throw InputError(where, "file", "unsupported format '" + ext + "' (expected .stl, .obj, .ply or .off)");
   }
+
+  if (ext == ".off") check_off_header(file, where, fs::file_size(file, ec));
 
   LoadedMesh out;
   out.format = ext.substr(1);
@@ -112,7 +156,11 @@ LoadedMesh load_mesh(const fs::path& file, LengthUnit unit) {
   std::sort(mesh_order.begin(), mesh_order.end(),
             [](const auto& a, const auto& b) { return a.first < b.first; });
 
-  for (const auto& [mi, xf] : mesh_order) {
+  for (const auto& entry : mesh_order) {
+    // Named copies, not a structured binding: lambdas below use them (clang 14 refuses to capture
+    // bindings before C++20).
+    const auto mi = entry.first;
+    const auto& xf = entry.second;
     const aiMesh* mesh = scene->mMeshes[mi];
     const bool transform = !is_identity(xf);
     std::vector<int> local(mesh->mNumVertices, -1);
