@@ -128,6 +128,28 @@ int add_size_field(const Eigen::Vector3d& p_mm, double h0_mm, double h_mm) {
   return f;
 }
 
+std::string probe_name(std::size_t i) { return "PROBE" + std::to_string(i + 1); }
+
+// Probe points embedded in volume 1 (numbered from 1000) and their physical groups PROBEk: the
+// same in both .geo routes.
+std::string geo_probe_points(const MeshOptions& o) {
+  std::ostringstream g;
+  for (std::size_t i = 0; i < o.probes_m.size(); ++i) {
+    const Eigen::Vector3d pm = o.probes_m[i] * kMmPerM;
+    g << "Point(" << 1000 + i << ") = {" << fmt(pm.x()) << ", " << fmt(pm.y()) << ", " << fmt(pm.z())
+      << "};\nPoint{" << 1000 + i << "} In Volume{1};\n";
+  }
+  return g.str();
+}
+
+std::string geo_probe_groups(const MeshOptions& o) {
+  std::ostringstream g;
+  for (std::size_t i = 0; i < o.probes_m.size(); ++i) {
+    g << "Physical Point(\"" << probe_name(i) << "\") = {" << 1000 + i << "};\n";
+  }
+  return g.str();
+}
+
 std::string geo_size_field(const Eigen::Vector3d& p_mm, double h0_mm, double h_mm) {
   return "Field[1] = MathEval;\nField[1].F = \"" + size_formula(p_mm, h0_mm, h_mm) +
          "\";\nBackground Field = 1;\n";
@@ -228,7 +250,6 @@ void write_msh(const fs::path& folder, const std::string& name, MeshResult& r) {
   gmsh::write(r.msh22.string());
 }
 
-std::string probe_name(std::size_t i) { return "PROBE" + std::to_string(i + 1); }
 
 std::string geo_header(const std::string& what) {
   return "// impactdeck " + std::string(kVersion) + ": " + what +
@@ -370,16 +391,10 @@ MeshResult mesh_ellipsoid(const Eigen::Vector3d& semi_axes_m, const Eigen::Vecto
   g << "load() = Point In BoundingBox {" << fmt(p_mm.x() - e) << ", " << fmt(p_mm.y() - e) << ", "
     << fmt(p_mm.z() - e) << ", " << fmt(p_mm.x() + e) << ", " << fmt(p_mm.y() + e) << ", "
     << fmt(p_mm.z() + e) << "};\n";
-  for (std::size_t i = 0; i < o.probes_m.size(); ++i) {
-    const Eigen::Vector3d pm = o.probes_m[i] * kMmPerM;
-    g << "Point(" << 1000 + i << ") = {" << fmt(pm.x()) << ", " << fmt(pm.y()) << ", " << fmt(pm.z())
-      << "};\nPoint{" << 1000 + i << "} In Volume{1};\n";
-  }
+  g << geo_probe_points(o);
   g << geo_size_field(p_mm, h0, h);
   g << "Physical Volume(\"BODY\") = {1};\nPhysical Point(\"LOAD\") = {load()};\n";
-  for (std::size_t i = 0; i < o.probes_m.size(); ++i) {
-    g << "Physical Point(\"" << probe_name(i) << "\") = {" << 1000 + i << "};\n";
-  }
+  g << geo_probe_groups(o);
   r.geo = folder / (name + ".geo");
   write_file_atomically(r.geo, g.str());
   return r;
@@ -508,16 +523,10 @@ MeshResult mesh_stl(const fs::path& stl, double stl_unit_m, const Eigen::Vector3
     << "ClassifySurfaces{" << fmt(o.feature_angle_deg * kPi / 180.0) << ", 1, 1, " << fmt(kPi) << "};\n"
     << "CreateGeometry;\n"
     << "Surface Loop(1) = Surface{:};\nVolume(1) = {1};\n";
-  for (std::size_t i = 0; i < o.probes_m.size(); ++i) {
-    const Eigen::Vector3d pm = o.probes_m[i] * kMmPerM;
-    g << "Point(" << 1000 + i << ") = {" << fmt(pm.x()) << ", " << fmt(pm.y()) << ", " << fmt(pm.z())
-      << "};\nPoint{" << 1000 + i << "} In Volume{1};\n";
-  }
+  g << geo_probe_points(o);
   g << geo_size_field(p_mm, h0, h);
   g << "Physical Volume(\"BODY\") = {1};\n";
-  for (std::size_t i = 0; i < o.probes_m.size(); ++i) {
-    g << "Physical Point(\"" << probe_name(i) << "\") = {" << 1000 + i << "};\n";
-  }
+  g << geo_probe_groups(o);
   r.geo = folder / (name + ".geo");
   write_file_atomically(r.geo, g.str());
   return r;
