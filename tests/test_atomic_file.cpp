@@ -70,3 +70,14 @@ TEST(AtomicFile, MissingFolderIsAnInputError) {
     EXPECT_NE(std::string(e.what()).find("does not exist"), std::string::npos);
   }
 }
+
+TEST(AtomicFile, CompletedCommitClearsAnInterruptedCommitsMarker) {
+  const fs::path d = fresh_dir("impactdeck_atomic_3");
+  write_file_atomically(d / AtomicFileSet::kMarker, std::string((d / "a.txt").string() + "\n"));
+  EXPECT_EQ(AtomicFileSet::interrupted_commit(d).size(), 1u);
+  AtomicFileSet one;
+  one.add(d / "a.txt", std::string("a"));
+  one.commit();
+  EXPECT_TRUE(AtomicFileSet::interrupted_commit(d).empty());
+  EXPECT_FALSE(fs::exists(d / AtomicFileSet::kMarker));
+}

@@ -95,10 +95,10 @@ void AtomicFileSet::add(const fs::path& path, const std::string& content) {
 
 std::vector<fs::path> AtomicFileSet::commit() {
   std::vector<fs::path> done;
-  fs::path marker;
+  if (staged_.empty()) return done;
+  const fs::path& first = staged_.front().second;
+  const fs::path marker = (first.has_parent_path() ? first.parent_path() : fs::path(".")) / kMarker;
   if (staged_.size() > 1) {
-    const fs::path& first = staged_.front().second;
-    marker = (first.has_parent_path() ? first.parent_path() : fs::path(".")) / kMarker;
     std::string list;
     for (const auto& st : staged_) list += st.second.string() + "\n";
     write_file_atomically(marker, list);
@@ -108,10 +108,9 @@ std::vector<fs::path> AtomicFileSet::commit() {
     done.push_back(target);
   }
   staged_.clear();
-  if (!marker.empty()) {
-    std::error_code ec;
-    fs::remove(marker, ec);
-  }
+  // Also clears the marker an earlier, interrupted run left: this complete set replaces it.
+  std::error_code ec;
+  fs::remove(marker, ec);
   return done;
 }
 
