@@ -130,6 +130,23 @@ int add_size_field(const Eigen::Vector3d& p_mm, double h0_mm, double h_mm) {
 
 std::string probe_name(std::size_t i) { return "PROBE" + std::to_string(i + 1); }
 
+// Size field around the load point, then the 3D mesh (both routes).
+void generate_tets(const std::string& where, const MeshOptions& o, const Eigen::Vector3d& p_mm, double h0,
+                   double h) {
+  gmsh_step(where, "mesh", [&] {
+    set_common_options(h, o.algorithm_3d);
+    add_size_field(p_mm, h0, h);
+    gmsh::model::mesh::generate(3);
+  });
+}
+
+// Physical groups PROBEk of the embedded probe points (both routes).
+void add_probe_groups(const std::vector<int>& probe_tags) {
+  for (std::size_t i = 0; i < probe_tags.size(); ++i) {
+    gmsh::model::setPhysicalName(0, gmsh::model::addPhysicalGroup(0, {probe_tags[i]}), probe_name(i));
+  }
+}
+
 // Probe points embedded in volume 1 (numbered from 1000) and their physical groups PROBEk: the
 // same in both .geo routes.
 std::string geo_probe_points(const MeshOptions& o) {
@@ -351,15 +368,9 @@ MeshResult mesh_ellipsoid(const Eigen::Vector3d& semi_axes_m, const Eigen::Vecto
     }
     gmsh::model::setPhysicalName(3, gmsh::model::addPhysicalGroup(3, {vol}), "BODY");
     gmsh::model::setPhysicalName(0, gmsh::model::addPhysicalGroup(0, {load_tag}), "LOAD");
-    for (std::size_t i = 0; i < probe_tags.size(); ++i) {
-      gmsh::model::setPhysicalName(0, gmsh::model::addPhysicalGroup(0, {probe_tags[i]}), probe_name(i));
-    }
+    add_probe_groups(probe_tags);
   });
-  gmsh_step(where, "mesh", [&] {
-    set_common_options(h, o.algorithm_3d);
-    add_size_field(p_mm, h0, h);
-    gmsh::model::mesh::generate(3);
-  });
+  generate_tets(where, o, p_mm, h0, h);
   std::map<std::size_t, int> index;
   gmsh_step(where, "mesh", [&] {
     index = extract(r.mesh, where);
@@ -468,15 +479,9 @@ MeshResult mesh_stl(const fs::path& stl, double stl_unit_m, const Eigen::Vector3
     gmsh::model::geo::synchronize();
     if (!probe_tags.empty()) gmsh::model::mesh::embed(0, probe_tags, 3, vol);
     gmsh::model::setPhysicalName(3, gmsh::model::addPhysicalGroup(3, {vol}), "BODY");
-    for (std::size_t i = 0; i < probe_tags.size(); ++i) {
-      gmsh::model::setPhysicalName(0, gmsh::model::addPhysicalGroup(0, {probe_tags[i]}), probe_name(i));
-    }
+    add_probe_groups(probe_tags);
   });
-  gmsh_step(where, "mesh", [&] {
-    set_common_options(h, o.algorithm_3d);
-    add_size_field(p_mm, h0, h);
-    gmsh::model::mesh::generate(3);
-  });
+  generate_tets(where, o, p_mm, h0, h);
   std::map<std::size_t, int> index;
   std::size_t load_gmsh_tag = 0;
   gmsh_step(where, "mesh", [&] {
