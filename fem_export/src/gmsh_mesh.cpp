@@ -1,4 +1,5 @@
-// Gmsh meshing of the target body (see mesh.hpp). gmsh.h is used only in this file.
+// Gmsh meshing of the target body (see mesh.hpp). gmsh.h is used only in this file, which is
+// built into the plugin libimpactdeck_gmsh_mesher.so (gmsh_plugin.hpp, gmsh_loader.cpp).
 #include <gmsh.h>
 
 #include <algorithm>
@@ -11,6 +12,7 @@
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/common/version.hpp"
 #include "impactdeck/fem_export/mesh.hpp"
+#include "gmsh_plugin.hpp"
 
 namespace impactdeck::fem_export {
 namespace fs = std::filesystem;
@@ -275,42 +277,7 @@ std::string geo_header(const std::string& what) {
 
 }  // namespace
 
-int TetMesh::node_of(const std::string& group) const {
-  for (const auto& [n, i] : node_groups)
-    if (n == group) return i;
-  throw std::out_of_range("no node group " + group);
-}
-
-double tet_volume_m3(const TetMesh& m, std::size_t e) {
-  const auto& t = m.tets[e];
-  const Eigen::Vector3d& x0 = m.nodes_m[t[0]];
-  return (m.nodes_m[t[1]] - x0).cross(m.nodes_m[t[2]] - x0).dot(m.nodes_m[t[3]] - x0) / 6.0;
-}
-
-double TetMesh::volume_m3() const {
-  double v = 0;
-  for (std::size_t e = 0; e < tets.size(); ++e) v += tet_volume_m3(*this, e);
-  return v;
-}
-
-double tet_quality(const TetMesh& m, std::size_t e) {
-  const auto& t = m.tets[e];
-  const Eigen::Vector3d a = m.nodes_m[t[0]], b = m.nodes_m[t[1]], c = m.nodes_m[t[2]],
-                        d = m.nodes_m[t[3]];
-  const double V = std::abs(tet_volume_m3(m, e));
-  const double area = 0.5 * ((b - a).cross(c - a).norm() + (b - a).cross(d - a).norm() +
-                             (c - a).cross(d - a).norm() + (c - b).cross(d - b).norm());
-  if (!(V > 0) || !(area > 0)) return 0.0;
-  const double r_in = 3.0 * V / area;
-  // Circumradius: |A|^2 (B x C) + |B|^2 (C x A) + |C|^2 (A x B) over 12 V, edges from a.
-  const Eigen::Vector3d A = b - a, B = c - a, C = d - a;
-  const Eigen::Vector3d num = A.squaredNorm() * B.cross(C) + B.squaredNorm() * C.cross(A) +
-                              C.squaredNorm() * A.cross(B);
-  const double r_circ = num.norm() / (12.0 * V);
-  return std::clamp(3.0 * r_in / r_circ, 0.0, 1.0);
-}
-
-MeshResult mesh_ellipsoid(const Eigen::Vector3d& semi_axes_m, const Eigen::Vector3d& load_point_m,
+MeshResult mesh_ellipsoid_with_gmsh(const Eigen::Vector3d& semi_axes_m, const Eigen::Vector3d& load_point_m,
                           const MeshOptions& o, const fs::path& folder, const std::string& name) {
   const std::string where = (folder / (name + ".geo")).string();
   check_options(o, where);
@@ -411,7 +378,7 @@ MeshResult mesh_ellipsoid(const Eigen::Vector3d& semi_axes_m, const Eigen::Vecto
   return r;
 }
 
-MeshResult mesh_stl(const fs::path& stl, double stl_unit_m, const Eigen::Vector3d& load_point_m,
+MeshResult mesh_stl_with_gmsh(const fs::path& stl, double stl_unit_m, const Eigen::Vector3d& load_point_m,
                     const MeshOptions& o, const fs::path& folder, const std::string& name) {
   const std::string where = stl.string();
   check_options(o, where);
@@ -538,3 +505,12 @@ MeshResult mesh_stl(const fs::path& stl, double stl_unit_m, const Eigen::Vector3
 }
 
 }  // namespace impactdeck::fem_export
+
+// The plugin's entry point (gmsh_plugin.hpp); everything else in this library is hidden.
+extern "C" __attribute__((visibility("default"))) const impactdeck::fem_export::detail::GmshMesherV1*
+impactdeck_gmsh_mesher_v1() {
+  using namespace impactdeck::fem_export;
+  static const detail::GmshMesherV1 table{impactdeck::kVersion, sizeof(MeshResult), sizeof(MeshOptions),
+                                          &mesh_ellipsoid_with_gmsh, &mesh_stl_with_gmsh};
+  return &table;
+}
