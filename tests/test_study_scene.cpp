@@ -129,6 +129,11 @@ TEST(SweepSharp, BoxCornersAndEdgesAreFlaggedAndLeftOut) {
   std::stringstream ps;
   ps << pos.rdbuf();
   EXPECT_NE(ps.str().find("View \"sharp_feature\""), std::string::npos);
+  const std::string svg = plot::to_svg(force_map_drawing(part, ss.setup.target.centroid_m, r));
+  std::size_t circles = 0;
+  for (std::size_t k = 0; (k = svg.find("<circle", k)) != std::string::npos; ++k) ++circles;
+  EXPECT_EQ(circles, cloud.size() - 20 + 2);  // sharp points are crosses; two rings at the extremes
+  EXPECT_NE(svg.find("20 on sharp edges/corners"), std::string::npos);
 
   // Every point sharp: an error, not a ratio.
   std::vector<geometry::SurfacePoint> corners(cloud.begin(), cloud.begin() + 8);
