@@ -8,7 +8,10 @@
 #include "commands.hpp"
 #include "impactdeck/common/atomic_file.hpp"
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/geometry/ellipsoid.hpp"
 #include "impactdeck/plot/drawing.hpp"
+#include "impactdeck/scene/scene.hpp"
+#include "impactdeck/study/scene_sweep.hpp"
 #include "impactdeck/study/progress.hpp"
 #include "impactdeck/study/table1.hpp"
 #include "impactdeck/study/table1_output.hpp"
@@ -40,7 +43,7 @@ std::vector<double> parse_list(const std::string& text, const char* option) {
 
 void register_study(CLI::App& app, Context& ctx) {
   struct Args {
-    std::string preset = "paper", g, mu, rule, cloud, out = ".";
+    std::string preset = "paper", g, mu, rule, cloud, out = ".", scene, impact, stretch_axis;
     double size_ratio = 0;
     int grid_steps = 0;
     std::size_t count = 0;
@@ -58,7 +61,16 @@ void register_study(CLI::App& app, Context& ctx) {
   cmd->add_option("--mass-ratios", a->mu, "Comma-separated m1/m2 values (columns)");
   cmd->add_option("--size-ratio", a->size_ratio, "Smaller semi-axis / sphere radius (paper preset: 20)");
   cmd->add_option("--radius-rule", a->rule, "Ellipsoid's local radius: paper (Eq. 26) | mean (curvature)");
-  cmd->add_option("--cloud", a->cloud, "grid | uniform | both (paper preset: grid)");
+  cmd->add_option("--scene", a->scene,
+                  "Scene file (TOML) giving the target, impactor, materials and speed instead of the paper's "
+                  "ellipsoid and sphere (docs/study.md)");
+  cmd->add_option("--impact", a->impact, "With --scene: which impact (default: the first)");
+  cmd->add_option("--stretch-axis", a->stretch_axis,
+                  "With --scene: x | y | z, the target axis g stretches (default x; g = half-extent along it / "
+                  "along the next axis)");
+  cmd->add_option("--cloud", a->cloud,
+                  "grid | uniform | both | vertices (mesh only) (paper preset: grid; --scene: grid for an "
+                  "ellipsoid, uniform for a mesh)");
   cmd->add_option("--grid-steps", a->grid_steps, "Grid step 1/N (paper preset: 8)");
   cmd->add_option("--count", a->count, "Area-uniform points per cell (default 2000)");
   cmd->add_option("--seed", a->seed, "Seed of the area-uniform cloud");
@@ -71,6 +83,14 @@ void register_study(CLI::App& app, Context& ctx) {
     study::Table1Options o = study::table1_preset(a->preset);
     if (!a->g.empty()) o.geometric_ratios = parse_list(a->g, "--geometric-ratios");
     if (!a->mu.empty()) o.mass_ratios = parse_list(a->mu, "--mass-ratios");
+    if (a->scene.empty() && (!a->impact.empty() || !a->stretch_axis.empty())) {
+      throw UsageError(std::string(a->impact.empty() ? "--stretch-axis" : "--impact") + " needs --scene");
+    }
+    if (!a->scene.empty() && (a->size_ratio != 0 || !a->rule.empty())) {
+      throw UsageError(std::string(a->size_ratio != 0 ? "--size-ratio" : "--radius-rule") +
+                       " applies to the paper's setting only: with --scene, sizes come from the scene and the "
+                       "radius rule from its impact's contact_radius");
+    }
     if (a->size_ratio != 0) o.size_ratio = a->size_ratio;
     if (!a->rule.empty()) {
       if (a->rule == "paper") o.target_radius_rule = study::RadiusRule::paper;
@@ -81,7 +101,19 @@ void register_study(CLI::App& app, Context& ctx) {
       if (a->cloud == "grid") o.cloud = study::CloudKind::paper_grid;
       else if (a->cloud == "uniform") o.cloud = study::CloudKind::area_uniform;
       else if (a->cloud == "both") o.cloud = study::CloudKind::both;
-      else throw UsageError("--cloud: expected grid, uniform or both, got \"" + a->cloud + "\"");
+      else if (a->cloud == "vertices") o.cloud = study::CloudKind::vertices;
+      else throw UsageError("--cloud: expected grid, uniform, both or vertices, got \"" + a->cloud + "\"");
+    }
+    if (!a->scene.empty()) {
+      int axis;
+      if (a->stretch_axis.empty() || a->stretch_axis == "x") axis = 0;
+      else if (a->stretch_axis == "y") axis = 1;
+      else if (a->stretch_axis == "z") axis = 2;
+      else throw UsageError("--stretch-axis: expected x, y or z, got \"" + a->stretch_axis + "\"");
+      study::Table1Scene ts = study::table1_scene_from(scene::load_scene(a->scene), a->impact, axis);
+      const bool analytic = dynamic_cast<const geometry::Ellipsoid*>(ts.setup.target.shape.get()) != nullptr;
+      if (a->cloud.empty()) o.cloud = analytic ? study::CloudKind::paper_grid : study::CloudKind::area_uniform;
+      o.scene = std::move(ts);
     }
     if (a->grid_steps != 0) o.grid_steps = a->grid_steps;
     if (a->count != 0) o.uniform_count = a->count;

@@ -31,6 +31,7 @@ nlohmann::json point_json(std::size_t index, const study::PointResult& p) {
           {"max_force_N", p.max_force_N},
           {"reduced_mass_kg", p.reduced_mass_kg},
           {"effective_radius_m", p.effective_radius_m},
+          {"contact_ellipse_axis_ratio", p.contact_ellipse_axis_ratio},
           {"target_radius_m", p.target_radius_m}};
 }
 
@@ -53,7 +54,7 @@ void register_sweep(CLI::App& app, Context& ctx) {
   cmd->add_option("--impact", a->impact, "Which impact of the scene (default: the first)");
   cmd->add_option("--cloud", a->cloud,
                   "grid (the paper's, analytic ellipsoid only) | uniform (area-uniform, any shape) | both | "
-                  "auto (grid for an ellipsoid, else uniform)");
+                  "vertices (the mesh's vertices, mesh only) | auto (grid for an ellipsoid, else uniform)");
   cmd->add_option("--grid-steps", a->grid_steps, "Paper grid step 1/N on (y/b, z/c) (default 8: 390 points)");
   cmd->add_option("--count", a->count, "Points of the area-uniform cloud (default 2000)");
   cmd->add_option("--seed", a->seed, "Seed of the area-uniform cloud (default 1)");
@@ -76,7 +77,8 @@ void register_sweep(CLI::App& app, Context& ctx) {
     else if (a->cloud == "grid") kind = study::CloudKind::paper_grid;
     else if (a->cloud == "uniform") kind = study::CloudKind::area_uniform;
     else if (a->cloud == "both") kind = study::CloudKind::both;
-    else throw UsageError("--cloud: expected grid, uniform, both or auto, got \"" + a->cloud + "\"");
+    else if (a->cloud == "vertices") kind = study::CloudKind::vertices;
+    else throw UsageError("--cloud: expected grid, uniform, both, vertices or auto, got \"" + a->cloud + "\"");
     std::vector<geometry::SurfacePoint> cloud;
     try {
       cloud = study::make_cloud(*ss.setup.target.shape, kind, a->grid_steps, a->count, a->seed);
@@ -109,8 +111,9 @@ void register_sweep(CLI::App& app, Context& ctx) {
     meta.target = imp.target;
     meta.impactor = imp.impactor;
     meta.cloud = study::to_string(kind);
-    if (kind != study::CloudKind::area_uniform) meta.cloud += ", grid step 1/" + std::to_string(a->grid_steps);
-    if (kind != study::CloudKind::paper_grid)
+    if (kind == study::CloudKind::paper_grid || kind == study::CloudKind::both)
+      meta.cloud += ", grid step 1/" + std::to_string(a->grid_steps);
+    if (kind == study::CloudKind::area_uniform || kind == study::CloudKind::both)
       meta.cloud += ", " + std::to_string(a->count) + " area-uniform (seed " + std::to_string(a->seed) + ")";
 
     const std::string prefix = a->prefix.empty() ? "sweep_" + imp.name : a->prefix;
@@ -147,6 +150,7 @@ void register_sweep(CLI::App& app, Context& ctx) {
       j["max"] = point_json(r.max_index, pmax);
       j["approach_speed_m_s"] = ss.setup.approach_speed_m_s;
       j["restitution_clamped_points"] = r.restitution_clamped_count;
+      j["sharp_points"] = r.sharp_count;
       j["threads"] = r.threads_used;
       j["seconds"] = r.seconds;
       nlohmann::json fl = nlohmann::json::array();
@@ -171,6 +175,10 @@ void register_sweep(CLI::App& app, Context& ctx) {
                 << ")\n"
                 << "  time                  " << r.seconds << " s on " << r.threads_used << " threads ("
                 << std::setprecision(3) << rate << " points/s)\n";
+      if (r.sharp_count > 0) {
+        std::cout << "  sharp points          " << r.sharp_count
+                  << " on sharp edges or corners (no local radius; left out of min/max, flagged in the files)\n";
+      }
       if (r.restitution_clamped_count > 0) {
         std::cout << "  warning: ln(Phi) clamped into Eq. 30's range at " << r.restitution_clamped_count
                   << " points\n";

@@ -109,5 +109,41 @@ check "unknown preset exit 3" test $? -eq 3
 "$bin" study table1 --mass-ratios 1,abc >/dev/null 2>&1
 check "bad list exit 2" test $? -eq 2
 
+# 8. Study table1 on a scene's own target and impactor: the JSON keys, no paper comparison.
+"$bin" study table1 --scene "$src/samples/fig4_sweep.toml" --geometric-ratios 1,4 --mass-ratios 0.1,10 \
+  --json --quiet --no-png --out "$tmp/t1s" >"$tmp/t1s.json"
+check "table1 --scene exit 0" test $? -eq 0
+check "table1 --scene wrote csv, md, svg" test -s "$tmp/t1s/table1.csv" -a -s "$tmp/t1s/table1.md" -a -s "$tmp/t1s/table1_heatmap.svg"
+check "table1 --scene says there is no paper comparison" grep -q "No comparison with the paper" "$tmp/t1s/table1.md"
+python3 - "$tmp/t1s.json" <<'PY' || { echo "FAILED: table1 --scene JSON"; fails=$((fails+1)); }
+import json, sys
+d = json.load(open(sys.argv[1]))
+g, mu, r = d["geometric_ratios"], d["mass_ratios"], d["collision_force_ratio"]
+assert g == [1, 4] and mu == [0.1, 10] and len(r) == 2 and all(len(row) == 2 for row in r)
+assert all(0 < x <= 1 for row in r for x in row)
+assert "delta" not in d and "paper_comparison" in d
+assert d["scene"]["stretch_axis"] == "x" and d["scene"]["impact"] == "fig4" and d["sharp_points"] == [0, 0]
+PY
+passes=$((passes+1))
+
+# 9. Sweep over a cube's vertices and faces: corners flagged, counted, left out.
+"$bin" sweep "$src/tests/data/bad/scenes/mesh_sharp_edge.toml" --cloud uniform --count 100 --json --quiet --no-png \
+  --out "$tmp/sh" >"$tmp/sh.json"
+check "sweep on a cube exit 0" test $? -eq 0
+python3 - "$tmp/sh.json" "$tmp/sh/sweep_impact1.csv" <<'PY' || { echo "FAILED: sweep on a cube"; fails=$((fails+1)); }
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert d["sharp_points"] == 0 and d["points"] == 100
+rows = [l for l in open(sys.argv[2]) if not l.startswith("#")]
+head = rows[0].strip().split(",")
+assert head[-2:] == ["contact_ellipse_axis_ratio", "sharp_feature"], head[-2:]
+assert all(l.strip().endswith(",0") for l in rows[1:])
+PY
+passes=$((passes+1))
+"$bin" sweep "$src/tests/data/bad/scenes/mesh_sharp_edge.toml" --cloud vertices --quiet --no-png --out "$tmp/sh2" \
+  >/dev/null 2>"$tmp/sh2.err"
+check "sweep with every point on a corner exit 3" test $? -eq 3
+check "sweep names the sharp points" grep -q "all 8 points of the cloud lie on sharp edges or corners" "$tmp/sh2.err"
+
 echo "cli_end_to_end: $passes passed, $fails failed"
 test $fails -eq 0

@@ -172,7 +172,7 @@ TEST_F(SweepFiles, CsvHasOneRowPerPoint) {
     EXPECT_EQ(line.find("inf"), std::string::npos);
     ++rows;
   }
-  EXPECT_EQ(header_cols, 25u);
+  EXPECT_EQ(header_cols, 27u);  // ... target_dwz_rad_s, contact_ellipse_axis_ratio, sharp_feature
   EXPECT_EQ(rows, result->points.size());
   EXPECT_EQ(result->points.size(), 690u);  // 390 grid + 300 uniform
 
@@ -194,9 +194,9 @@ TEST_F(SweepFiles, GmshPosViews) {
     }
     ++count;
   }
-  EXPECT_EQ(count, 2 * result->points.size());
-  const std::regex view(R"re(View "(max_force_N|force_ratio)" \{)re");
-  EXPECT_EQ(std::distance(std::sregex_iterator(pos.begin(), pos.end(), view), std::sregex_iterator()), 2);
+  EXPECT_EQ(count, 3 * result->points.size());  // no sharp point on an ellipsoid: no fourth view
+  const std::regex view(R"re(View "(max_force_N|force_ratio|contact_ellipse_axis_ratio)" \{)re");
+  EXPECT_EQ(std::distance(std::sregex_iterator(pos.begin(), pos.end(), view), std::sregex_iterator()), 3);
   EXPECT_EQ(std::count(pos.begin(), pos.end(), '{'), std::count(pos.begin(), pos.end(), '}'));
 }
 
@@ -227,7 +227,7 @@ TEST_F(SweepFiles, VtpIsWellFormedPolyData) {
     }
     ++arrays;
   }
-  EXPECT_EQ(arrays, 9u);  // 5 scalars + normals + points + connectivity + offsets
+  EXPECT_EQ(arrays, 11u);  // 7 scalars + normals + points + connectivity + offsets
 }
 
 TEST_F(SweepFiles, ForceMapSvgAndPng) {

@@ -212,6 +212,31 @@ SurfacePoint MeshShape::closest_point(const Eigen::Vector3d& q) const {
   return sp;
 }
 
+// p (on face f) lies within 1e-6 mean edge lengths of a sharp edge of f or of a corner of f that
+// touches a sharp edge.
+bool MeshShape::near_sharp_feature(int f, const Eigen::Vector3d& p) const {
+  const Index& ix = *index_;
+  const auto& V = mesh_.vertices_m;
+  const auto& t = mesh_.triangles[f];
+  const double tol = 1e-6 * ix.mean_edge;
+  for (int k = 0; k < 3; ++k) {
+    const int a = t[k], b = t[(k + 1) % 3];
+    const bool edge_sharp = ix.face_edge_sharp[f][k] != 0;
+    if ((edge_sharp && point_segment_distance(p, V[a], V[b]) <= tol) ||
+        (ix.vertex_sharp[a] && (p - V[a]).norm() <= tol)) {
+      return true;
+    }
+  }
+  return false;
+}
+
+bool MeshShape::on_sharp_feature(const SurfacePoint& at) const {
+  const Index& ix = *index_;
+  const auto hit = ix.tree.closest_point_and_primitive(cp(at.point_m));
+  const int f = static_cast<int>(hit.second - ix.triangles.begin());
+  return near_sharp_feature(f, ev(hit.first));
+}
+
 Curvature MeshShape::curvature(const SurfacePoint& at) const { return curvature_fit(at.point_m).curvature; }
 
 CurvatureFit MeshShape::curvature_fit(const Eigen::Vector3d& point) const {
@@ -225,16 +250,10 @@ CurvatureFit MeshShape::curvature_fit(const Eigen::Vector3d& point) const {
   CurvatureFit out;
 
   // On a sharp edge or corner the curvature is undefined: say so, do not fit.
-  const double tol = 1e-6 * ix.mean_edge;
-  for (int k = 0; k < 3; ++k) {
-    const int a = t[k], b = t[(k + 1) % 3];
-    const bool edge_sharp = ix.face_edge_sharp[f][k] != 0;
-    if ((edge_sharp && point_segment_distance(p, V[a], V[b]) <= tol) ||
-        (ix.vertex_sharp[a] && (p - V[a]).norm() <= tol)) {
-      out.curvature.sharp_feature = true;
-      out.curvature.k1_per_m = out.curvature.k2_per_m = 0;
-      return out;
-    }
+  if (near_sharp_feature(f, p)) {
+    out.curvature.sharp_feature = true;
+    out.curvature.k1_per_m = out.curvature.k2_per_m = 0;
+    return out;
   }
 
   // The neighbourhood: vertices of the faces within 2·rings - 1 edge-adjacency steps of the hit

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/geometry/mesh_shape.hpp"
 
 namespace impactdeck::study {
 
@@ -45,12 +46,39 @@ const char* to_string(CloudKind k) {
     case CloudKind::paper_grid: return "paper-grid";
     case CloudKind::area_uniform: return "area-uniform";
     case CloudKind::both: return "both";
+    case CloudKind::vertices: return "vertices";
   }
   return "?";
 }
 
+std::vector<geometry::SurfacePoint> mesh_vertex_cloud(const geometry::Shape& target) {
+  const auto* m = dynamic_cast<const geometry::MeshShape*>(&target);
+  if (!m) throw InputError("", "cloud", "the vertex cloud needs a mesh target; this target is a " + target.kind());
+  std::vector<geometry::SurfacePoint> out;
+  out.reserve(m->mesh().vertices_m.size());
+  for (const Eigen::Vector3d& v : m->mesh().vertices_m) {
+    geometry::SurfacePoint sp = m->closest_point(v);
+    sp.point_m = v;  // exactly the vertex
+    sp.distance_m = 0.0;
+    out.push_back(sp);
+  }
+  return out;
+}
+
+std::vector<geometry::SurfacePoint> projected_grid_cloud(const geometry::Shape& target,
+                                                         const Eigen::Vector3d& box_min_m,
+                                                         const Eigen::Vector3d& box_max_m, int steps) {
+  const Eigen::Vector3d half = 0.5 * (box_max_m - box_min_m), centre = 0.5 * (box_max_m + box_min_m);
+  if (!(half.minCoeff() > 0.0)) throw InputError("", "cloud", "the target's bounding box is flat");
+  const geometry::Ellipsoid box(half.x(), half.y(), half.z());
+  std::vector<geometry::SurfacePoint> out = paper_grid_cloud(box, steps);
+  for (auto& sp : out) sp = target.closest_point(centre + sp.point_m);
+  return out;
+}
+
 std::vector<geometry::SurfacePoint> make_cloud(const geometry::Shape& target, CloudKind kind,
                                                int grid_steps, std::size_t count, std::uint64_t seed) {
+  if (kind == CloudKind::vertices) return mesh_vertex_cloud(target);
   std::vector<geometry::SurfacePoint> cloud;
   if (kind != CloudKind::area_uniform) {
     const auto* e = dynamic_cast<const geometry::Ellipsoid*>(&target);

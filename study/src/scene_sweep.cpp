@@ -71,4 +71,16 @@ SceneSweep sweep_from_scene(const scene::Scene& sc, const std::string& name) {
   return out;
 }
 
+Table1Scene table1_scene_from(const scene::Scene& sc, const std::string& impact_name, int stretch_axis) {
+  const SceneSweep ss = sweep_from_scene(sc, impact_name);
+  Table1Scene t;
+  t.setup = ss.setup;
+  t.stretch_axis = stretch_axis;
+  t.source = sc.file.string();
+  t.impact = ss.impact->name;
+  t.target = ss.impact->target;
+  t.impactor = ss.impact->impactor;
+  return t;
+}
+
 }  // namespace impactdeck::study

@@ -65,6 +65,10 @@ PointResult sweep_point(const SweepSetup& s, const geometry::SurfacePoint& at) {
   if (!at.point_m.allFinite() || !(std::abs(n.norm() - 1.0) < 1e-9)) {
     point_error(at, "point or normal is not finite / not a unit vector");
   }
+  if (s.target.shape->on_sharp_feature(at)) {
+    r.sharp_feature = true;  // flagged, not given a radius (as `run` refuses the point)
+    return r;
+  }
   try {
     // Impactor: its centroid lies on the impact line; it touches where the ray from its centroid
     // towards the target (-n) leaves its surface (as in the scene pipeline).
@@ -179,15 +183,31 @@ SweepResult run_sweep(const SweepSetup& s, const std::vector<geometry::SurfacePo
       n, o.threads, o.chunk,
       [&](std::size_t i) {
         res.points[i] = sweep_point(s, cloud[i]);
-        if (o.curves) sample_curve(res.points[i], o.curve_samples, &res.curves_N[i * o.curve_samples]);
+        if (o.curves && !res.points[i].sharp_feature) sample_curve(res.points[i], o.curve_samples, &res.curves_N[i * o.curve_samples]);
       },
       o.progress);
   res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
-  // Serial reductions in cloud order: ties go to the first point, independent of threads.
-  double mw_min = res.points[0].reduced_mass_kg, mw_max = mw_min;
+  // Serial reductions in cloud order: ties go to the first point, independent of threads. Points
+  // on sharp features are counted and left out.
+  std::size_t first = n;
   for (std::size_t i = 0; i < n; ++i) {
+    if (res.points[i].sharp_feature) {
+      ++res.sharp_count;
+    } else if (first == n) {
+      first = i;
+    }
+  }
+  if (first == n) {
+    throw InputError("", "sweep", "all " + std::to_string(n) +
+                                      " points of the cloud lie on sharp edges or corners of the target, "
+                                      "where the local radius is undefined");
+  }
+  res.min_index = res.max_index = first;
+  double mw_min = res.points[first].reduced_mass_kg, mw_max = mw_min;
+  for (std::size_t i = first; i < n; ++i) {
     const PointResult& p = res.points[i];
+    if (p.sharp_feature) continue;
     if (p.max_force_N < res.points[res.min_index].max_force_N) res.min_index = i;
     if (p.max_force_N > res.points[res.max_index].max_force_N) res.max_index = i;
     mw_min = std::min(mw_min, p.reduced_mass_kg);

@@ -30,9 +30,15 @@ void header(std::ostream& o, const char* comment, const SweepMeta& m, const Swee
   o << comment << " units: SI (m, kg, N, s); coordinates in the target's frame\n";
   o << comment << " force ratio min/max = " << g17(r.force_ratio) << " (min at point " << r.min_index
     << ", max at point " << r.max_index << ")\n";
+  o << comment << " sharp points: " << r.sharp_count
+    << " (on sharp edges or corners: no local radius, left out of min/max; flagged sharp_feature = 1)\n";
 }
 
 double max_force(const SweepResult& r) { return r.points[r.max_index].max_force_N; }
+
+// A body's local radius as written: a flat place (zero curvature, e.g. a face of a box) has an
+// infinite radius, written as 0 (no real radius is 0), since the files hold no Inf.
+double radius_out(double r) { return std::isinf(r) ? 0.0 : r; }
 
 }  // namespace
 
@@ -42,21 +48,24 @@ void write_sweep_csv(const std::filesystem::path& path, const SweepResult& r, co
     o << "index,x_m,y_m,z_m,nx,ny,nz,target_radius_m,impactor_radius_m,effective_radius_m,"
          "reduced_mass_kg,hertz_constant_N_per_m1_5,max_indentation_m,max_force_N,force_ratio,"
          "compression_time_s,restitution,contact_time_s,impulse_total_Ns,"
-         "target_dvx_m_s,target_dvy_m_s,target_dvz_m_s,target_dwx_rad_s,target_dwy_rad_s,target_dwz_rad_s\n";
+         "target_dvx_m_s,target_dvy_m_s,target_dvz_m_s,target_dwx_rad_s,target_dwy_rad_s,target_dwz_rad_s,"
+         "contact_ellipse_axis_ratio,sharp_feature\n";
     const double fmax = max_force(r);
     for (std::size_t i = 0; i < r.points.size(); ++i) {
       const PointResult& p = r.points[i];
       o << i;
       for (double v : {p.point_m.x(), p.point_m.y(), p.point_m.z(), p.normal.x(), p.normal.y(), p.normal.z(),
-                       p.target_radius_m, p.impactor_radius_m, p.effective_radius_m, p.reduced_mass_kg,
+                       radius_out(p.target_radius_m), radius_out(p.impactor_radius_m), p.effective_radius_m,
+                       p.reduced_mass_kg,
                        p.hertz_constant, p.max_indentation_m, p.max_force_N, p.max_force_N / fmax,
                        p.compression_time_s, p.restitution, p.contact_time_s, p.impulse_total_Ns,
                        p.target_delta_velocity_m_s.x(), p.target_delta_velocity_m_s.y(),
                        p.target_delta_velocity_m_s.z(), p.target_delta_angular_velocity_rad_s.x(),
-                       p.target_delta_angular_velocity_rad_s.y(), p.target_delta_angular_velocity_rad_s.z()}) {
+                       p.target_delta_angular_velocity_rad_s.y(), p.target_delta_angular_velocity_rad_s.z(),
+                       p.contact_ellipse_axis_ratio}) {
         o << ',' << g17(v);
       }
-      o << '\n';
+      o << ',' << (p.sharp_feature ? 1 : 0) << '\n';
     }
   });
 }
@@ -71,6 +80,7 @@ void write_sweep_curves_csv(const std::filesystem::path& path, const SweepResult
     o << "point,time_s,force_N\n";
     const double last = static_cast<double>(r.curve_samples - 1);
     for (std::size_t i = 0; i < r.points.size(); ++i) {
+      if (r.points[i].sharp_feature) continue;  // no curve: no local radius there
       const double tc = r.points[i].contact_time_s;
       for (std::size_t k = 0; k < r.curve_samples; ++k) {
         o << i << ',' << g17(tc * static_cast<double>(k) / last) << ','
@@ -85,12 +95,24 @@ void write_sweep_pos(const std::filesystem::path& path, const SweepResult& r, co
     header(o, "//", meta, r);
     o << "// open with: gmsh " << path.filename().string() << "\n";
     const double fmax = max_force(r);
-    for (int view = 0; view < 2; ++view) {
-      o << "View \"" << (view == 0 ? "max_force_N" : "force_ratio") << "\" {\n";
+    auto sp = [&](const PointResult& p, double v) {
+      o << "SP(" << g17(p.point_m.x()) << "," << g17(p.point_m.y()) << "," << g17(p.point_m.z()) << "){" << g17(v)
+        << "};\n";
+    };
+    // The computed views hold the points off sharp features; those get a view of their own.
+    const char* names[] = {"max_force_N", "force_ratio", "contact_ellipse_axis_ratio"};
+    for (int view = 0; view < 3; ++view) {
+      o << "View \"" << names[view] << "\" {\n";
       for (const PointResult& p : r.points) {
-        o << "SP(" << g17(p.point_m.x()) << "," << g17(p.point_m.y()) << "," << g17(p.point_m.z()) << "){"
-          << g17(view == 0 ? p.max_force_N : p.max_force_N / fmax) << "};\n";
+        if (p.sharp_feature) continue;
+        sp(p, view == 0 ? p.max_force_N : view == 1 ? p.max_force_N / fmax : p.contact_ellipse_axis_ratio);
       }
+      o << "};\n";
+    }
+    if (r.sharp_count > 0) {
+      o << "View \"sharp_feature\" {\n";
+      for (const PointResult& p : r.points)
+        if (p.sharp_feature) sp(p, 1.0);
       o << "};\n";
     }
   });
@@ -120,7 +142,9 @@ void write_sweep_vtp(const std::filesystem::path& path, const SweepResult& r, co
     scalar("force_ratio", [&](const PointResult& p) { return p.max_force_N / fmax; });
     scalar("reduced_mass_kg", [](const PointResult& p) { return p.reduced_mass_kg; });
     scalar("effective_radius_m", [](const PointResult& p) { return p.effective_radius_m; });
-    scalar("target_radius_m", [](const PointResult& p) { return p.target_radius_m; });
+    scalar("target_radius_m", [](const PointResult& p) { return radius_out(p.target_radius_m); });
+    scalar("contact_ellipse_axis_ratio", [](const PointResult& p) { return p.contact_ellipse_axis_ratio; });
+    scalar("sharp_feature", [](const PointResult& p) { return p.sharp_feature ? 1.0 : 0.0; });
     o << "<DataArray type=\"Float64\" Name=\"normal\" NumberOfComponents=\"3\" format=\"ascii\">\n";
     for (const PointResult& p : r.points)
       o << g17(p.normal.x()) << ' ' << g17(p.normal.y()) << ' ' << g17(p.normal.z()) << '\n';
@@ -274,6 +298,18 @@ plot::Drawing force_map_drawing(const geometry::Shape& target, const Eigen::Vect
     for (std::size_t i : order) {
       const PointResult& p = r.points[i];
       if ((p.normal.dot(d) >= 0.0) != front) continue;
+      if (p.sharp_feature) {
+        // No force there: a small grey cross instead of a circle.
+        plot::Style x;
+        x.stroke = {0.45, 0.45, 0.45};
+        x.stroke_width = 1.0;
+        x.stroke_opacity = front ? 1.0 : 0.4;
+        const plot::Point2 c0 = screen(p.point_m);
+        const double h = 0.35 * rmax;
+        dr.line({c0.x - h, c0.y - h}, {c0.x + h, c0.y + h}, x);
+        dr.line({c0.x - h, c0.y + h}, {c0.x + h, c0.y - h}, x);
+        continue;
+      }
       plot::Style s;
       s.fill = plot::viridis(shade(p.max_force_N));
       s.fill_opacity = front ? 0.92 : 0.30;
@@ -313,6 +349,7 @@ plot::Drawing force_map_drawing(const geometry::Shape& target, const Eigen::Vect
       << plot::format_number(fmin * fu.factor, 4) << " " << fu.unit << " at " << coords(r.points[r.min_index].point_m)
       << ", max " << plot::format_number(fmax * fu.factor, 4) << " " << fu.unit << " at "
       << coords(r.points[r.max_index].point_m);
+  if (r.sharp_count > 0) sub << "; " << r.sharp_count << " on sharp edges/corners (grey x, left out)";
   dr.text({left, 48}, sub.str(), 12);
   dr.text({left, 66}, "circle radius \xE2\x88\x9D F_max, darker = lower force; faded: far side", 11,
           plot::Anchor::start, {0.35, 0.35, 0.35});

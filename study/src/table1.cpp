@@ -10,6 +10,8 @@
 #include "impactdeck/collision/eccentric.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/geometry/ellipsoid.hpp"
+#include "impactdeck/geometry/mass_properties.hpp"
+#include "impactdeck/geometry/mesh_shape.hpp"
 #include "impactdeck/study/cloud.hpp"
 
 namespace impactdeck::study {
@@ -64,7 +66,60 @@ double sphere_eq26_factor(const Eigen::Vector3d& u) {
   return sum / count;
 }
 
+// Axis-aligned bounding box of a mesh's vertices.
+void bounding_box(const geometry::TriangleMesh& m, Eigen::Vector3d& lo, Eigen::Vector3d& hi) {
+  lo = hi = m.vertices_m.front();
+  for (const auto& v : m.vertices_m) {
+    lo = lo.cwiseMin(v);
+    hi = hi.cwiseMax(v);
+  }
+}
+
+// The cloud of a scene-driven row: the paper grid on a mesh is the projected grid of its box.
+std::vector<geometry::SurfacePoint> scene_cloud(const geometry::Shape& t, const Table1Options& o) {
+  const auto* mesh = dynamic_cast<const geometry::MeshShape*>(&t);
+  if (!mesh || (o.cloud != CloudKind::paper_grid && o.cloud != CloudKind::both)) {
+    return make_cloud(t, o.cloud, o.grid_steps, o.uniform_count, o.seed);
+  }
+  Eigen::Vector3d lo, hi;
+  bounding_box(mesh->mesh(), lo, hi);
+  std::vector<geometry::SurfacePoint> cloud = projected_grid_cloud(t, lo, hi, o.grid_steps);
+  if (o.cloud == CloudKind::both) {
+    auto u = area_uniform_cloud(t, o.uniform_count, o.seed);
+    cloud.insert(cloud.end(), u.begin(), u.end());
+  }
+  return cloud;
+}
+
 }  // namespace
+
+std::shared_ptr<const geometry::Shape> stretched_target(const geometry::Shape& target, int axis, double g) {
+  if (axis < 0 || axis > 2) throw InputError("", "stretch axis", "must be 0 (x), 1 (y) or 2 (z)");
+  if (!(g > 0.0) || !std::isfinite(g)) throw InputError("", "geometric ratio", "must be positive and finite");
+  const int ref = (axis + 1) % 3;
+  if (const auto* e = dynamic_cast<const geometry::Ellipsoid*>(&target)) {
+    Eigen::Vector3d semi = e->semi_axes_m();
+    semi[axis] = g * semi[ref];
+    return std::make_shared<geometry::Ellipsoid>(semi.x(), semi.y(), semi.z());
+  }
+  if (const auto* m = dynamic_cast<const geometry::MeshShape*>(&target)) {
+    geometry::TriangleMesh mesh = m->mesh();
+    Eigen::Vector3d lo, hi;
+    bounding_box(mesh, lo, hi);
+    const Eigen::Vector3d half = 0.5 * (hi - lo);
+    if (!(half[axis] > 0.0) || !(half[ref] > 0.0)) {
+      throw InputError("", "stretch axis", "the part is flat along the stretch axis or the next axis");
+    }
+    // Affine stretch about the centroid (the body frame's origin stays where it was).
+    const double factor = g * half[ref] / half[axis];
+    const double c = m->volume_properties().centroid_m[axis];
+    for (auto& v : mesh.vertices_m) v[axis] = c + factor * (v[axis] - c);
+    const geometry::ShellLabels shells = geometry::label_shells(mesh);
+    const geometry::MeshMassProperties mass = geometry::compute_mass_properties(mesh, shells);
+    return std::make_shared<geometry::MeshShape>(std::move(mesh), mass, m->options());
+  }
+  throw InputError("", "target", "a " + target.kind() + " cannot be stretched (use an ellipsoid or a mesh)");
+}
 
 Table1Options table1_preset(const std::string& name) {
   if (name != "paper") {
@@ -113,6 +168,17 @@ Table1Result run_table1(const Table1Options& o) {
   if (!(o.size_ratio > 0.0) || !std::isfinite(o.size_ratio)) {
     throw InputError("", "size ratio", "must be positive and finite");
   }
+  if (o.scene) {
+    const Table1Scene& sc = *o.scene;
+    const double mi = sc.setup.impactor.mass_kg;
+    if (!(mi > 0.0) || !std::isfinite(mi)) {
+      throw InputError(sc.source, "impactor '" + sc.impactor + "'",
+                       "is fixed (infinite mass): the mass ratio target/impactor needs a finite impactor mass");
+    }
+    if (sc.stretch_axis < 0 || sc.stretch_axis > 2) {
+      throw InputError(sc.source, "stretch axis", "must be x, y or z");
+    }
+  }
   const auto t0 = std::chrono::steady_clock::now();
   Table1Result res;
   res.options = o;
@@ -127,55 +193,84 @@ Table1Result run_table1(const Table1Options& o) {
   const double m2 = kDensity_kg_m3 * sv.volume_m3;
 
   // Clouds first (the per-cell count is needed for the progress total).
-  std::vector<std::shared_ptr<geometry::Ellipsoid>> targets;
+  std::vector<std::shared_ptr<const geometry::Shape>> targets;
   std::vector<std::vector<geometry::SurfacePoint>> clouds;
   std::size_t total = 0;
   for (double g : o.geometric_ratios) {
-    const Eigen::Vector3d e = semi_axes(g, o.size_ratio);
-    auto target = std::make_shared<geometry::Ellipsoid>(e.x(), e.y(), e.z());
-    std::vector<geometry::SurfacePoint> cloud = make_cloud(*target, o.cloud, o.grid_steps, o.uniform_count, o.seed);
+    std::shared_ptr<const geometry::Shape> target;
+    std::vector<geometry::SurfacePoint> cloud;
+    if (o.scene) {
+      try {
+        target = stretched_target(*o.scene->setup.target.shape, o.scene->stretch_axis, g);
+        cloud = scene_cloud(*target, o);
+      } catch (const InputError& e) {
+        std::ostringstream place;
+        place << "target '" << o.scene->target << "' stretched to g = " << g;
+        throw InputError(o.scene->source, place.str(), (e.place().empty() ? "" : e.place() + ": ") + e.reason());
+      }
+    } else {
+      const Eigen::Vector3d e = semi_axes(g, o.size_ratio);
+      target = std::make_shared<geometry::Ellipsoid>(e.x(), e.y(), e.z());
+      cloud = make_cloud(*target, o.cloud, o.grid_steps, o.uniform_count, o.seed);
+    }
     total += cloud.size() * nm;
     targets.push_back(std::move(target));
     clouds.push_back(std::move(cloud));
   }
   res.points_per_cell = clouds.front().size();
+  res.sharp_points.assign(ng, 0);
 
   std::size_t done_before = 0;
   for (std::size_t gi = 0; gi < ng; ++gi) {
     const geometry::VolumeProperties tv = targets[gi]->volume_properties();
     for (std::size_t mi = 0; mi < nm; ++mi) {
       SweepSetup s;
-      const double m1 = o.mass_ratios[mi] * m2;
+      if (o.scene) {
+        s = o.scene->setup;  // impactor, materials, speed, radius rule
+      } else {
+        s.impactor.shape = sphere;
+        s.impactor.mass_kg = m2;
+        s.impactor.inertia_kg_m2 = sv.inertia_per_density_m5 * kDensity_kg_m3;
+        s.impactor.centroid_m = sv.centroid_m;
+        s.impactor.radius_rule = RadiusRule::mean;  // the sphere's own radius r, exactly
+        s.target.radius_rule = o.target_radius_rule;
+        s.effective_modulus_Pa = collision::effective_modulus_Pa(
+            {kYoungs_Pa, 0.3}, {kYoungs_Pa, 0.3}, collision::ModulusConvention::paper);
+        s.approach_speed_m_s = kSpeed_m_s;
+      }
+      // F_max does not depend on the restitution: none is evaluated (a scene's energy-flux model
+      // with range policy "error" would otherwise fail at extreme mass ratios for nothing).
+      s.restitution.from_energy_flux = false;
+      s.restitution.constant = 1.0;
+      const double m1 = o.mass_ratios[mi] * s.impactor.mass_kg;
       s.target.shape = targets[gi];
       s.target.mass_kg = m1;
       s.target.inertia_kg_m2 = tv.inertia_per_density_m5 * (m1 / tv.volume_m3);
       s.target.centroid_m = tv.centroid_m;
-      s.target.radius_rule = o.target_radius_rule;
-      s.impactor.shape = sphere;
-      s.impactor.mass_kg = m2;
-      s.impactor.inertia_kg_m2 = sv.inertia_per_density_m5 * kDensity_kg_m3;
-      s.impactor.centroid_m = sv.centroid_m;
-      s.impactor.radius_rule = RadiusRule::mean;  // the sphere's own radius r, exactly
-      s.effective_modulus_Pa = collision::effective_modulus_Pa(
-          {kYoungs_Pa, 0.3}, {kYoungs_Pa, 0.3}, collision::ModulusConvention::paper);
-      s.approach_speed_m_s = kSpeed_m_s;
-      s.restitution.from_energy_flux = false;
-      s.restitution.constant = 1.0;
       SweepOptions so;
       so.threads = o.threads;
       if (o.progress) {
         so.progress = [&](std::size_t done, std::size_t) { o.progress(done_before + done, total); };
       }
-      const SweepResult sr = run_sweep(s, clouds[gi], so);
+      SweepResult sr;
+      try {
+        sr = run_sweep(s, clouds[gi], so);
+      } catch (const InputError& e) {
+        if (!o.scene) throw;
+        std::ostringstream place;
+        place << "cell g = " << o.geometric_ratios[gi] << ", mu = " << o.mass_ratios[mi];
+        throw InputError(o.scene->source, place.str() + (e.place().empty() ? "" : ": " + e.place()), e.reason());
+      }
       done_before += clouds[gi].size();
       res.ratio[gi][mi] = sr.force_ratio;
       res.mass_only[gi][mi] = sr.mass_only_ratio;
+      res.sharp_points[gi] = sr.sharp_count;
     }
   }
 
   // Comparison with the paper, when the grid is the paper's.
   const PaperTable1& p = paper_table1();
-  if (same_grid(o.geometric_ratios, p.geometric_ratios) && same_grid(o.mass_ratios, p.mass_ratios)) {
+  if (!o.scene && same_grid(o.geometric_ratios, p.geometric_ratios) && same_grid(o.mass_ratios, p.mass_ratios)) {
     res.compared = true;
     res.paper = p.ratio;
     res.delta.assign(ng, std::vector<double>(nm));
@@ -201,9 +296,9 @@ Table1Result run_table1(const Table1Options& o) {
 
   // The sphere row, explained: Eq. 26 on a sphere.
   for (std::size_t gi = 0; gi < ng; ++gi) {
-    if (o.geometric_ratios[gi] != 1.0 || o.target_radius_rule != RadiusRule::paper) continue;
+    if (o.scene || o.geometric_ratios[gi] != 1.0 || o.target_radius_rule != RadiusRule::paper) continue;
     res.has_sphere_row = true;
-    const double R = targets[gi]->semi_axes_m().x();
+    const double R = static_cast<const geometry::Ellipsoid&>(*targets[gi]).semi_axes_m().x();
     double fmin = std::numeric_limits<double>::infinity(), fmax = 0.0;
     for (const auto& sp : clouds[gi]) {
       const double f = sphere_eq26_factor(sp.point_m / R);

@@ -45,15 +45,33 @@ bool excluded(const Table1Result& r, std::size_t gi, std::size_t mi) {
          r.options.mass_ratios[mi] == kExcludedMassRatio;
 }
 
+const char* kAxis[] = {"x", "y", "z"};
+
+std::size_t total_sharp(const Table1Result& r) {
+  std::size_t n = 0;
+  for (std::size_t k : r.sharp_points) n += k;
+  return n;
+}
+
 std::string settings_line(const Table1Result& r) {
+  const Table1Options& op = r.options;
   std::ostringstream s;
-  s << "cloud " << to_string(r.options.cloud);
-  if (r.options.cloud != CloudKind::area_uniform) s << " (step 1/" << r.options.grid_steps << ")";
-  if (r.options.cloud != CloudKind::paper_grid)
-    s << " (" << r.options.uniform_count << " uniform points, seed " << r.options.seed << ")";
-  s << ", " << r.points_per_cell << " points per cell; size ratio (smaller semi-axis / sphere radius) "
-    << plot::format_number(r.options.size_ratio, 6) << "; ellipsoid radius rule "
-    << to_string(r.options.target_radius_rule) << "; sphere radius exact";
+  s << "cloud " << to_string(op.cloud);
+  if (op.cloud == CloudKind::paper_grid || op.cloud == CloudKind::both) s << " (step 1/" << op.grid_steps << ")";
+  if (op.cloud == CloudKind::area_uniform || op.cloud == CloudKind::both)
+    s << " (" << op.uniform_count << " uniform points, seed " << op.seed << ")";
+  s << ", " << r.points_per_cell << " points per cell; ";
+  if (op.scene) {
+    const Table1Scene& sc = *op.scene;
+    const int ax = sc.stretch_axis, ref = (ax + 1) % 3;
+    s << "scene " << sc.source << ", impact '" << sc.impact << "': " << sc.impactor << " hits " << sc.target
+      << "; g = half-extent along " << kAxis[ax] << " / along " << kAxis[ref] << " (target stretched along "
+      << kAxis[ax] << "), mu = target mass / impactor mass; radius rule " << to_string(sc.setup.target.radius_rule);
+    if (const std::size_t k = total_sharp(r)) s << "; " << k << " points on sharp features left out (all rows)";
+    return s.str();
+  }
+  s << "size ratio (smaller semi-axis / sphere radius) " << plot::format_number(op.size_ratio, 6)
+    << "; ellipsoid radius rule " << to_string(op.target_radius_rule) << "; sphere radius exact";
   return s.str();
 }
 
@@ -98,6 +116,16 @@ std::string table1_markdown(const Table1Result& r) {
   };
   o << "## Collision force ratio (model)\n\n" << settings_line(r) << ".\n\n";
   table(r.ratio, 4, false);
+  if (r.options.scene) {
+    o << "**No comparison with the paper's Table 1:** this table is driven by a scene (the user's target, "
+      << "impactor and materials), not by the paper's setting; run without --scene for the comparison.\n\n";
+    if (total_sharp(r) > 0) {
+      o << "Points on sharp edges/corners per row (no local radius; left out of min/max):";
+      for (std::size_t gi = 0; gi < r.sharp_points.size(); ++gi)
+        o << (gi ? "," : "") << " g = " << decade(G[gi]) << ": " << r.sharp_points[gi];
+      o << ".\n\n";
+    }
+  }
   if (r.compared) {
     o << "## The paper's Table 1 (as printed)\n\n";
     table(r.paper, 3, false);
@@ -137,7 +165,10 @@ plot::Drawing table1_heatmap(const Table1Result& r) {
   const int panels = r.compared ? 3 : 1;
   const double pw = cw * M.size(), ph = ch * G.size();
   plot::Drawing d(left + panels * pw + (panels - 1) * gap + 30, top + ph + 118);
-  d.text({left, 26}, "Collision force ratio min/max F_max (paper Table 1)", 16, plot::Anchor::start, plot::kBlack, true);
+  d.text({left, 26},
+         r.options.scene ? "Collision force ratio min/max F_max (scene-driven; no paper comparison)"
+                         : "Collision force ratio min/max F_max (paper Table 1)",
+         16, plot::Anchor::start, plot::kBlack, true);
   d.text({left, 46}, settings_line(r), 11, plot::Anchor::start, {0.3, 0.3, 0.3});
   const double dmax = 0.005;  // the acceptance bound on |delta|: the colour scale of the difference
   for (int panel = 0; panel < panels; ++panel) {
@@ -180,7 +211,7 @@ plot::Drawing table1_heatmap(const Table1Result& r) {
     for (std::size_t mi = 0; mi < M.size(); ++mi) {
       d.text({x0 + cw * (mi + 0.5), top + ph + 16}, decade(M[mi]), 11, plot::Anchor::middle);
     }
-    d.text({x0 + pw / 2, top + ph + 36}, "mass ratio \xCE\xBC = m1/m2", 12, plot::Anchor::middle);
+    d.text({x0 + pw / 2, top + ph + 36}, r.options.scene ? "mass ratio \xCE\xBC = m_target/m_impactor" : "mass ratio \xCE\xBC = m1/m2", 12, plot::Anchor::middle);
     if (panel == 0) d.text({22, top + ph / 2}, "geometric ratio g = a/b", 12, plot::Anchor::middle, plot::kBlack, false, 90);
     // Colour scale under the panel.
     const double sy = top + ph + 52, sh = 12;
@@ -225,6 +256,21 @@ nlohmann::json table1_json(const Table1Result& r) {
                    {"points_per_cell", r.points_per_cell},
                    {"size_ratio", r.options.size_ratio},
                    {"radius_rule", to_string(r.options.target_radius_rule)}};
+  j["sharp_points"] = r.sharp_points;  // per row g
+  if (r.options.scene) {
+    const Table1Scene& sc = *r.options.scene;
+    j["settings"]["size_ratio"] = nullptr;  // sizes come from the scene
+    j["settings"]["radius_rule"] = to_string(sc.setup.target.radius_rule);
+    j["scene"] = {{"file", sc.source},
+                  {"impact", sc.impact},
+                  {"target", sc.target},
+                  {"impactor", sc.impactor},
+                  {"stretch_axis", kAxis[sc.stretch_axis]},
+                  {"reference_axis", kAxis[(sc.stretch_axis + 1) % 3]},
+                  {"impactor_mass_kg", sc.setup.impactor.mass_kg},
+                  {"approach_speed_m_s", sc.setup.approach_speed_m_s}};
+    j["paper_comparison"] = "none: the table is driven by a scene, not the paper's setting";
+  }
   if (r.compared) {
     j["paper_collision_force_ratio"] = r.paper;
     j["delta"] = r.delta;

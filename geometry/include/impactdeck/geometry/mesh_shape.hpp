@@ -45,6 +45,9 @@ class MeshShape final : public Shape {
   /// Principal curvatures by jet fitting at the closest surface point (see curvature_fit).
   Curvature curvature(const SurfacePoint& at) const override;
   CurvatureFit curvature_fit(const Eigen::Vector3d& point_m) const;
+  /// Within 1e-6 mean edge lengths of a sharp edge or of a vertex on one (the test curvature_fit
+  /// applies before fitting).
+  bool on_sharp_feature(const SurfacePoint& at) const override;
   /// Eq. 26 on the mesh: the three axis-normal planes through the point cut the surface; each
   /// section's radius at the point follows from the jet-fitted curvature tensor by Euler's and
   /// Meusnier's theorems (κ = κ_n(t)/|n×e|, t = n×e/|n×e|); tangent cuts (|n×e| ≤ 1e-3) are left
@@ -59,10 +62,12 @@ class MeshShape final : public Shape {
   const TriangleMesh& mesh() const { return mesh_; }
   const MeshMassProperties& mass_properties() const { return mass_; }
   std::size_t sharp_edge_count() const;
+  const MeshShapeOptions& options() const { return options_; }
   double mean_edge_length_m() const;
 
  private:
   struct Index;  // CGAL AABB tree and adjacency
+  bool near_sharp_feature(int face, const Eigen::Vector3d& p) const;
   TriangleMesh mesh_;
   MeshMassProperties mass_;
   MeshShapeOptions options_;

@@ -45,6 +45,9 @@ class Shape {
   virtual VolumeProperties volume_properties() const = 0;
   virtual SurfacePoint closest_point(const Eigen::Vector3d& query_m) const = 0;
   virtual Curvature curvature(const SurfacePoint& at) const = 0;
+  /// True when the point lies on a sharp edge or corner, where curvature() reports
+  /// sharp_feature and no local radius exists. Cheap (no curvature fit). Smooth shapes: false.
+  virtual bool on_sharp_feature(const SurfacePoint& /*at*/) const { return false; }
   /// The paper's local radius (Eq. 26): mean radius of the sections by the three axis-normal
   /// planes through the point, degenerate (tangent) sections left out.
   virtual double paper_radius_m(const SurfacePoint& at) const = 0;

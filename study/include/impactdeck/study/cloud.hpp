@@ -25,11 +25,24 @@ enum class CloudKind {
   paper_grid,    ///< paper_grid_cloud(steps); the target must be an analytic ellipsoid
   area_uniform,  ///< area_uniform_cloud(count, seed); any shape
   both,          ///< the grid followed by the uniform points
+  vertices,      ///< mesh_vertex_cloud; the target must be a mesh
 };
+
+/// The vertices of a mesh target, in mesh order, each with the normal closest_point gives there
+/// (on a corner of a sharp edge: the normal of one adjacent face; such points are flagged by the
+/// sweep). Throws InputError when the shape is not a mesh.
+std::vector<geometry::SurfacePoint> mesh_vertex_cloud(const geometry::Shape& target);
+
+/// The paper grid (paper_grid_cloud) of the ellipsoid inscribed in the shape's axis-aligned
+/// bounding box of `vertices`, each point moved to the closest point of the shape: on a mesh of an
+/// ellipsoid, the analytic grid's places. Used by `study table1 --scene` for mesh targets.
+std::vector<geometry::SurfacePoint> projected_grid_cloud(const geometry::Shape& target,
+                                                         const Eigen::Vector3d& box_min_m,
+                                                         const Eigen::Vector3d& box_max_m, int steps);
 const char* to_string(CloudKind k);
 
 /// The cloud of a kind. Throws InputError when the grid is asked of a shape that is not an
-/// analytic ellipsoid.
+/// analytic ellipsoid, or the vertices of a shape that is not a mesh.
 std::vector<geometry::SurfacePoint> make_cloud(const geometry::Shape& target, CloudKind kind,
                                                int grid_steps, std::size_t count, std::uint64_t seed);
 

@@ -8,6 +8,7 @@
 
 #include "impactdeck/scene/scene.hpp"
 #include "impactdeck/study/sweep.hpp"
+#include "impactdeck/study/table1.hpp"
 
 namespace impactdeck::study {
 
@@ -18,5 +19,9 @@ struct SceneSweep {
 
 /// `impact_name` empty: the scene's first impact. Throws InputError naming the scene file.
 SceneSweep sweep_from_scene(const scene::Scene& scene, const std::string& impact_name = "");
+
+/// The target and impactor of a scene's impact for `study table1 --scene` (Table1Scene), g
+/// stretching `stretch_axis` (0 x, 1 y, 2 z). Throws InputError as sweep_from_scene.
+Table1Scene table1_scene_from(const scene::Scene& scene, const std::string& impact_name = "", int stretch_axis = 0);
 
 }  // namespace impactdeck::study

@@ -62,6 +62,10 @@ struct SweepOptions {
 
 /// Everything computed at one point (SI).
 struct PointResult {
+  /// The target point lies on a sharp edge or corner (Shape::on_sharp_feature): no local radius
+  /// exists there, as `impactdeck run` refuses such a point. Nothing else of the point is computed
+  /// (every value below is 0, the axis ratio 1) and the reductions leave it out.
+  bool sharp_feature = false;
   Eigen::Vector3d point_m = Eigen::Vector3d::Zero();
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  ///< target's outward unit normal
   double target_radius_m = 0;       ///< local radius of the target by its rule (elliptical: 1/H)
@@ -88,10 +92,12 @@ struct SweepResult {
   /// point i is at time k / (curve_samples - 1) * points[i].contact_time_s.
   std::vector<double> curves_N;
   std::size_t curve_samples = 0;
-  std::size_t min_index = 0, max_index = 0;  ///< points with the smallest / largest F_max
+  /// Points with the smallest / largest F_max among those not on a sharp feature.
+  std::size_t min_index = 0, max_index = 0;
   double force_ratio = 0;                    ///< min F_max / max F_max (the paper's ratio)
   /// (min m_w / max m_w)^(n/(n+1)): the part of the ratio due to the reduced mass alone.
   double mass_only_ratio = 0;
+  std::size_t sharp_count = 0;               ///< points on sharp edges/corners, left out of the above
   std::size_t restitution_clamped_count = 0;
   unsigned threads_used = 0;
   double seconds = 0;                        ///< wall time of the point loop
@@ -104,7 +110,8 @@ void check_radius_rules(const SweepSetup& setup);
 /// One point (the sweep's kernel). Throws InputError naming the point when it cannot be solved.
 PointResult sweep_point(const SweepSetup& setup, const geometry::SurfacePoint& at);
 
-/// The whole cloud. Throws InputError (the first failing point's message) on bad input.
+/// The whole cloud. Throws InputError (the first failing point's message) on bad input, and when
+/// every point lies on a sharp feature.
 SweepResult run_sweep(const SweepSetup& setup, const std::vector<geometry::SurfacePoint>& cloud,
                       const SweepOptions& options = {});
 

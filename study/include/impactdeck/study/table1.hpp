@@ -9,6 +9,7 @@
 // the local-radius rule; the `paper` preset is the setting of MODEL.md that reproduces the table.
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,21 @@
 #include "impactdeck/study/sweep.hpp"
 
 namespace impactdeck::study {
+
+/// The user's own target and impactor (`study table1 --scene`), replacing the paper's ellipsoid and
+/// sphere. Row g: the target stretched along `stretch_axis` so that its half-extent there is g times
+/// its half-extent along the next axis (x -> y, y -> z, z -> x), the other axes unchanged (an
+/// ellipsoid: that semi-axis set to g times the next one; a mesh: an affine stretch about its
+/// centroid, with mass properties, curvature and cloud recomputed). Column mu: target mass / impactor
+/// mass (the paper's m1/m2), by scaling the target's density; the impactor keeps the scene's mass.
+/// Materials, approach speed and radius rule come from the scene (the restitution does not enter
+/// F_max and is not evaluated).
+struct Table1Scene {
+  SweepSetup setup;       ///< from sweep_from_scene
+  int stretch_axis = 0;   ///< 0 = x, 1 = y, 2 = z
+  std::string source;     ///< scene file
+  std::string impact, target, impactor;  ///< names, for the reports
+};
 
 struct Table1Options {
   std::vector<double> geometric_ratios;  ///< g = a/b, rows; each > 0
@@ -30,7 +46,13 @@ struct Table1Options {
   std::uint64_t seed = 1;
   unsigned threads = 0;            ///< 0: all cores
   ProgressFn progress;             ///< over all cells' points
+  /// Set: a scene-driven table (size_ratio and target_radius_rule unused; no paper comparison).
+  std::optional<Table1Scene> scene;
 };
+
+/// A scene target stretched for geometric ratio g (see Table1Scene). Throws InputError for a shape
+/// that is neither an analytic ellipsoid nor a mesh.
+std::shared_ptr<const geometry::Shape> stretched_target(const geometry::Shape& target, int axis, double g);
 
 /// Named presets. "paper": the 9 x 9 grid {1e-4 ... 1e4}^2, size ratio 20, Eq. 26 radius, the
 /// 390-point grid (MODEL.md "Table 1"). Throws InputError for an unknown name.
@@ -63,6 +85,8 @@ struct Table1Result {
   std::vector<std::vector<double>> ratio;      ///< [g][mu], min/max F_max
   std::vector<std::vector<double>> mass_only;  ///< [g][mu], reduced-mass part alone
   std::size_t points_per_cell = 0;
+  /// Per row g: points of the cloud on sharp edges/corners, left out of every cell of the row.
+  std::vector<std::size_t> sharp_points;
 
   bool compared = false;  ///< options' grid equals the paper's: the comparison below is set
   std::vector<std::vector<double>> paper;      ///< [g][mu]
