@@ -162,7 +162,9 @@ SurfacePoint Ellipsoid::closest_point(const Eigen::Vector3d& q) const {
   if (!q.allFinite()) throw InputError("", "point", "must be finite");
   // Sort the axes in decreasing order, fold the query into the first octant.
   std::array<int, 3> order{0, 1, 2};
-  std::stable_sort(order.begin(), order.end(), [&](int i, int j) { return e_[i] > e_[j]; });
+  // Equal axes keep their index order (std::sort with the index as tie-break, which is what
+  // stable_sort gave; stable_sort's temporary buffer trips ASan's alloc-dealloc check under clang).
+  std::sort(order.begin(), order.end(), [&](int i, int j) { return e_[i] > e_[j] || (e_[i] == e_[j] && i < j); });
   double e[3], y[3], x[3];
   for (int k = 0; k < 3; ++k) {
     e[k] = e_[order[k]];

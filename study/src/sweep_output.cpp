@@ -291,8 +291,12 @@ plot::Drawing force_map_drawing(const geometry::Shape& target, const Eigen::Vect
   for (std::size_t i = 0; i < r.points.size(); i += stride) order.push_back(i);
   for (std::size_t e : {r.min_index, r.max_index})
     if (e % stride != 0) order.push_back(e);
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    return r.points[a].point_m.dot(d) < r.points[b].point_m.dot(d);
+  // Ties (equal depth) drawn in point order: std::sort with the index as tie-break, not
+  // stable_sort, whose temporary buffer (operator new nothrow, freed with free) trips ASan's
+  // alloc-dealloc check under clang with libstdc++ 12.
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    const double da = r.points[a].point_m.dot(d), db = r.points[b].point_m.dot(d);
+    return da < db || (da == db && a < b);
   });
   auto draw_points = [&](bool front) {
     for (std::size_t i : order) {
