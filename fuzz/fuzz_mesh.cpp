@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -23,8 +24,11 @@ using namespace impactdeck::geometry;
 
 namespace {
 
-void require(bool ok) {
-  if (!ok) std::abort();
+// A failed check names itself on stderr before the abort, so a finding says what broke.
+void require(bool ok, const char* what) {
+  if (ok) return;
+  std::fprintf(stderr, "fuzz_mesh: check failed: %s\n", what);
+  std::abort();
 }
 
 bool finite(const Eigen::Vector3d& v) { return v.allFinite(); }
@@ -52,19 +56,21 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const Part part = load_part(file, opt);
     const MeshShape& s = *part.shape;
     const auto& vp = s.volume_properties();
-    require(std::isfinite(vp.volume_m3) && finite(vp.centroid_m) && vp.inertia_per_density_m5.allFinite());
-    require(std::isfinite(s.size_m()));
+    require(std::isfinite(vp.volume_m3) && finite(vp.centroid_m) && vp.inertia_per_density_m5.allFinite(),
+            "finite volume properties");
+    require(std::isfinite(s.size_m()), "finite size");
     const auto pts = s.sample_surface(3, size);
     for (const auto& p : pts) {
-      require(finite(p.point_m) && finite(p.normal));
+      require(finite(p.point_m) && finite(p.normal), "finite surface sample");
       const SurfacePoint c = s.closest_point(p.point_m + 0.1 * s.size_m() * p.normal);
-      require(finite(c.point_m) && finite(c.normal) && std::isfinite(c.distance_m));
+      require(finite(c.point_m) && finite(c.normal) && std::isfinite(c.distance_m), "finite closest point");
       try {
         const CurvatureFit f = s.curvature_fit(c.point_m);
-        require(std::isfinite(f.curvature.k1_per_m) && std::isfinite(f.curvature.k2_per_m));
+        require(std::isfinite(f.curvature.k1_per_m) && std::isfinite(f.curvature.k2_per_m), "finite curvatures");
         if (!f.curvature.sharp_feature) {
+          // A flat spot (a face of a box) has an infinite radius: a correct answer, not a NaN.
           const double r = s.paper_radius_m(c);
-          require(std::isfinite(r));
+          require(r > 0 && !std::isnan(r), "Eq. 26 radius > 0 (possibly infinite)");
         }
       } catch (const InputError&) {
         // too coarse, sharp, degenerate: a correct answer for this point
