@@ -38,26 +38,25 @@ struct JetSolver {
   using FT = double;
   using Vector = CGAL::Eigen_vector<FT>;
   using Matrix = CGAL::Eigen_matrix<FT>;
+  // Only the main fit's condition number is reported: the others skip the eigenvalues.
+  static thread_local bool want_condition_number;
   static FT solve(const Matrix& M, Vector& B) {
     const Eigen::MatrixXd& A = M.eigen_object();
     const Eigen::VectorXd x = A.householderQr().solve(Eigen::VectorXd(B.eigen_object()));
     B.eigen_object() = x;
+    if (!want_condition_number) return std::numeric_limits<double>::quiet_NaN();
     const Eigen::MatrixXd G = A.transpose() * A;
     const Eigen::VectorXd ev = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(G, Eigen::EigenvaluesOnly).eigenvalues();
     const double lo = std::max(ev.minCoeff(), 0.0), hi = ev.maxCoeff();
     return lo > 0 ? std::sqrt(hi / lo) : std::numeric_limits<double>::infinity();
   }
 };
+thread_local bool JetSolver::want_condition_number = true;
 using Monge = CGAL::Monge_via_jet_fitting<K, K, JetSolver>;
 
 CPoint cp(const Eigen::Vector3d& v) { return CPoint(v.x(), v.y(), v.z()); }
 Eigen::Vector3d ev(const CPoint& p) { return {p.x(), p.y(), p.z()}; }
 Eigen::Vector3d ev(const K::Vector_3& p) { return {p.x(), p.y(), p.z()}; }
-
-std::uint64_t edge_key(int a, int b) {
-  if (a > b) std::swap(a, b);
-  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) | static_cast<std::uint32_t>(b);
-}
 
 double point_segment_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   const Eigen::Vector3d ab = b - a;
@@ -118,21 +117,10 @@ MeshShape::MeshShape(TriangleMesh mesh, const MeshMassProperties& mass, const Me
   // Adjacency and sharp edges (dihedral angle between the two faces above the threshold; boundary
   // and non-manifold edges count as sharp: no smooth surface continues across them). One sorted
   // list of the 3F edge records gives every undirected edge's faces as a run.
-  struct EdgeRecord {
-    std::uint64_t key;
-    int face, k;
-    bool operator<(const EdgeRecord& o) const { return key < o.key || (key == o.key && face < o.face); }
-  };
-  std::vector<EdgeRecord> records;
-  records.reserve(nf * 3);
+  const EdgeTable records = build_edge_table(mesh_);
   double edge_sum = 0;
   for (std::size_t f = 0; f < nf; ++f)
-    for (int k = 0; k < 3; ++k) {
-      const int a = F[f][k], b = F[f][(k + 1) % 3];
-      edge_sum += (V[a] - V[b]).norm();
-      records.push_back({edge_key(a, b), int(f), k});
-    }
-  std::sort(records.begin(), records.end());
+    for (int k = 0; k < 3; ++k) edge_sum += (V[F[f][k]] - V[F[f][(k + 1) % 3]]).norm();
   ix.mean_edge = edge_sum / (3.0 * nf);
   const double cos_sharp = std::cos(options_.sharp_angle_deg * M_PI / 180.0);
   ix.vertex_sharp.assign(nv, 0);
@@ -140,19 +128,20 @@ MeshShape::MeshShape(TriangleMesh mesh, const MeshMassProperties& mass, const Me
   ix.face_edge_sharp.assign(nf, {0, 0, 0});
   for (std::size_t i = 0; i < records.size();) {
     std::size_t j = i;
-    while (j < records.size() && records[j].key == records[i].key) ++j;
-    const EdgeRecord& r0 = records[i];
+    const std::uint64_t key = records.key[i];
+    while (j < records.size() && records.key[j] == key) ++j;
+    const int f0 = records.face[i];
     bool sharp = j - i != 2;
-    if (!sharp) sharp = ix.face_normal[r0.face].dot(ix.face_normal[records[i + 1].face]) < cos_sharp;
+    if (!sharp) sharp = ix.face_normal[f0].dot(ix.face_normal[records.face[i + 1]]) < cos_sharp;
     if (sharp) {
       ++ix.sharp_edge_count;
-      ix.vertex_sharp[r0.key >> 32] = 1;
-      ix.vertex_sharp[r0.key & 0xffffffffu] = 1;
-      for (std::size_t q = i; q < j; ++q) ix.face_edge_sharp[records[q].face][records[q].k] = 1;
+      ix.vertex_sharp[EdgeTable::lo(key)] = 1;
+      ix.vertex_sharp[EdgeTable::hi(key)] = 1;
+      for (std::size_t q = i; q < j; ++q) ix.face_edge_sharp[records.face[q]][records.corner[q]] = 1;
     } else {
-      const EdgeRecord& r1 = records[i + 1];
-      ix.face_across[r0.face][r0.k] = r1.face;
-      ix.face_across[r1.face][r1.k] = r0.face;
+      const int f1 = records.face[i + 1];
+      ix.face_across[f0][records.corner[i]] = f1;
+      ix.face_across[f1][records.corner[i + 1]] = f0;
     }
     i = j;
   }
@@ -241,29 +230,34 @@ CurvatureFit MeshShape::curvature_fit(const Eigen::Vector3d& point) const {
   // face (about `rings` vertex rings around it), never crossing a sharp edge: a fit does not
   // straddle one. (Measured on the 3:2:1 ellipsoid at 20k triangles: 3 steps 0.87 % max error,
   // 5 steps 2.2 %, 7 steps 4 %: the cubic jet's model error grows faster than the noise drops.)
+  // Grown one ring at a time (BFS by levels; small sets, tens of entries: linear search in a
+  // vector beats hashing): the vertices of a smaller neighbourhood are a prefix of a larger one's,
+  // so the error estimate's wider neighbourhood costs only its extra ring. Scratch buffers are
+  // reused across queries (thread_local: queries on several threads stay independent).
+  thread_local std::vector<int> faces, pts;
+  faces.assign(1, f);
+  pts.assign(t.begin(), t.end());
+  std::size_t level_begin = 0, faces_done = 0;
+  int depth_done = 0;
   auto gather = [&](int rings) {
-    // Small sets (tens of entries): linear search in a vector beats hashing.
-    const int depth = 2 * rings - 1;
-    std::vector<int> faces{f};
-    std::size_t begin = 0;
-    for (int r = 0; r < depth; ++r) {
+    for (const int depth = 2 * rings - 1; depth_done < depth; ++depth_done) {
       const std::size_t end = faces.size();
-      for (std::size_t i = begin; i < end; ++i)
+      for (std::size_t i = level_begin; i < end; ++i)
         for (int g : ix.face_across[faces[i]])
           if (g >= 0 && std::find(faces.begin(), faces.end(), g) == faces.end()) faces.push_back(g);
-      begin = end;
+      level_begin = end;
     }
-    std::vector<int> pts(t.begin(), t.end());
-    for (int g : faces)
-      for (int v : mesh_.triangles[g])
+    for (; faces_done < faces.size(); ++faces_done)
+      for (int v : mesh_.triangles[faces[faces_done]])
         if (std::find(pts.begin(), pts.end(), v) == pts.end()) pts.push_back(v);
-    return pts;
+    return pts.size();
   };
   const int d = options_.jet_degree;
   const std::size_t needed = static_cast<std::size_t>((d + 1) * (d + 2) / 2);
   int rings = std::max(1, options_.curvature_rings);
-  std::vector<int> hood = gather(rings);
-  while (hood.size() < needed + needed / 2 && rings < options_.curvature_rings + 3) hood = gather(++rings);
+  std::size_t hood_size = gather(rings);
+  while (hood_size < needed + needed / 2 && rings < options_.curvature_rings + 3) hood_size = gather(++rings);
+  const std::vector<int> hood(pts.begin(), pts.begin() + static_cast<std::ptrdiff_t>(hood_size));
   int degree = d;
   while (degree > 2 && hood.size() < static_cast<std::size_t>((degree + 1) * (degree + 2) / 2) + 2) --degree;
   if (hood.size() < 6 + 1) {
@@ -285,12 +279,14 @@ CurvatureFit MeshShape::curvature_fit(const Eigen::Vector3d& point) const {
                          "too coarse there for a curvature fit");
   }
 
-  auto fit = [&](const Eigen::Vector3d& origin, const std::vector<int>& pts, int deg, Monge& m) {
-    std::vector<CPoint> in;
-    in.reserve(pts.size() + 1);
+  auto fit = [&](const Eigen::Vector3d& origin, const std::vector<int>& vertices, std::size_t count, int deg,
+                 Monge& m, bool want_condition) {
+    thread_local std::vector<CPoint> in;
+    in.clear();
     in.push_back(cp(origin));
-    for (int v : pts)
-      if (V[v] != origin) in.push_back(cp(V[v]));
+    for (std::size_t i = 0; i < count; ++i)
+      if (V[vertices[i]] != origin) in.push_back(cp(V[vertices[i]]));
+    JetSolver::want_condition_number = want_condition;
     auto form = m(in.begin(), in.end(), static_cast<std::size_t>(deg), 2);
     form.comply_wrt_given_normal(K::Vector_3(n.x(), n.y(), n.z()));
     return form;
@@ -301,7 +297,7 @@ CurvatureFit MeshShape::curvature_fit(const Eigen::Vector3d& point) const {
   for (int v : t)
     if ((V[v] - p).squaredNorm() < (V[nearest] - p).squaredNorm()) nearest = v;
   Monge m1;
-  auto f1 = fit(V[nearest], hood, degree, m1);
+  auto f1 = fit(V[nearest], hood, hood.size(), degree, m1, false);
   const Eigen::Vector3d o = ev(f1.origin()), e1 = ev(f1.maximal_principal_direction()),
                         e2 = ev(f1.minimal_principal_direction()), en = ev(f1.normal_direction());
   const double x = (p - o).dot(e1), y = (p - o).dot(e2);
@@ -310,10 +306,10 @@ CurvatureFit MeshShape::curvature_fit(const Eigen::Vector3d& point) const {
       0.5 * (f1.principal_curvatures(0) * x * x + f1.principal_curvatures(1) * y * y) * en;
   // Pass 2: the jet at the lifted point; pass 3: one ring more, for the error estimate.
   Monge m2;
-  auto f2 = fit(lifted, hood, degree, m2);
-  std::vector<int> wider = gather(rings + 1);
+  auto f2 = fit(lifted, hood, hood.size(), degree, m2, true);
+  const std::size_t wider_size = gather(rings + 1);
   Monge m3;
-  auto f3 = fit(lifted, wider, std::min(d, wider.size() >= needed + 2 ? d : degree), m3);
+  auto f3 = fit(lifted, pts, wider_size, std::min(d, wider_size >= needed + 2 ? d : degree), m3, false);
 
   // CGAL: k_max >= k_min with respect to the (outward) Monge normal; convex means the surface
   // bends away from the normal, i.e. negative there. Ours: positive convex, k1 >= k2.
