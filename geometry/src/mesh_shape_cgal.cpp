@@ -34,25 +34,98 @@ using Tree = CGAL::AABB_tree<CGAL::AABB_traits<K, Primitive>>;
 // system, and the singular values (for the condition number) come from the 10×10 Gram matrix.
 // The jet system is preconditioned by CGAL (condition numbers ~1e1–1e3 here), so squaring it in
 // the Gram matrix loses nothing that matters for a ratio of singular values.
+// The QR runs on a copy with the column count fixed at compile time (6, 10, 15: jet degree 2..4)
+// and at most kMaxRows rows on the stack: no heap allocation, unrolled column loops (the
+// dynamic-size QR was ~30 % of a curvature query under callgrind). Larger systems (very wide
+// neighbourhoods) take the dynamic path.
 struct JetSolver {
   using FT = double;
   using Vector = CGAL::Eigen_vector<FT>;
   using Matrix = CGAL::Eigen_matrix<FT>;
+  static constexpr int kMaxRows = 160;
   // Only the main fit's condition number is reported: the others skip the eigenvalues.
   static thread_local bool want_condition_number;
-  static FT solve(const Matrix& M, Vector& B) {
-    const Eigen::MatrixXd& A = M.eigen_object();
-    const Eigen::VectorXd x = A.householderQr().solve(Eigen::VectorXd(B.eigen_object()));
-    B.eigen_object() = x;
+
+  template <int C, class Mat>
+  static FT solve_with(const Mat& A, Vector& B) {
+    Eigen::HouseholderQR<Mat> qr(A);
+    B.eigen_object() = qr.solve(B.eigen_object()).eval();
     if (!want_condition_number) return std::numeric_limits<double>::quiet_NaN();
-    const Eigen::MatrixXd G = A.transpose() * A;
-    const Eigen::VectorXd ev = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(G, Eigen::EigenvaluesOnly).eigenvalues();
+    using Square = Eigen::Matrix<double, C, C, 0, C == Eigen::Dynamic ? Eigen::Dynamic : C,
+                                 C == Eigen::Dynamic ? Eigen::Dynamic : C>;
+    const Square G = A.transpose() * A;
+    const auto ev = Eigen::SelfAdjointEigenSolver<Square>(G, Eigen::EigenvaluesOnly).eigenvalues();
     const double lo = std::max(ev.minCoeff(), 0.0), hi = ev.maxCoeff();
     return lo > 0 ? std::sqrt(hi / lo) : std::numeric_limits<double>::infinity();
+  }
+  template <int C>
+  static FT solve_fixed(const Eigen::MatrixXd& A, Vector& B) {
+    using Mat = Eigen::Matrix<double, Eigen::Dynamic, C, Eigen::ColMajor, kMaxRows, C>;
+    return solve_with<C>(Mat(A), B);
+  }
+  static FT solve(const Matrix& M, Vector& B) {
+    const Eigen::MatrixXd& A = M.eigen_object();
+    if (A.rows() <= kMaxRows) {
+      switch (A.cols()) {
+        case 6: return solve_fixed<6>(A, B);
+        case 10: return solve_fixed<10>(A, B);
+        case 15: return solve_fixed<15>(A, B);
+        default: break;
+      }
+    }
+    return solve_with<Eigen::Dynamic>(A, B);
   }
 };
 thread_local bool JetSolver::want_condition_number = true;
 using Monge = CGAL::Monge_via_jet_fitting<K, K, JetSolver>;
+using PointIt = std::vector<CPoint>::iterator;
+}  // namespace
+}  // namespace impactdeck::geometry
+
+// The matrix fill of the jet fit, specialised for our instantiation (the fit itself, PCA, solve
+// and Monge basis stay CGAL's). CGAL's generic fill evaluates every monomial with three
+// std::pow calls (x^(k-i), y^i, precond^k): ~45 % of a curvature query under callgrind. Here the
+// points are taken to the fitting frame as R (q - p0) (R: the PCA basis, rows), scaled by the
+// preconditioning factor first, and the monomials u^a v^b / (a! b!) come from running products.
+// Same system (up to rounding): column k(k+1)/2 + i of a row holds x^(k-i) y^i / ((k-i)! i! h^k)
+// with (x, y) = h (u, v), the right-hand side the height z; solve_linear_system undoes h^k.
+template <>
+template <>
+void CGAL::Monge_via_jet_fitting<impactdeck::geometry::K, impactdeck::geometry::K, impactdeck::geometry::JetSolver>::
+    fill_matrix<impactdeck::geometry::PointIt>(impactdeck::geometry::PointIt begin, impactdeck::geometry::PointIt end,
+                                              std::size_t d, LAMatrix& M, LAVector& Z) {
+  const Point_3 p0 = *begin;
+  this->translate_p0 = Aff_transformation(CGAL::TRANSLATION, CGAL::ORIGIN - p0);
+  const Vector_3 r0 = m_pca_basis[0].second, r1 = m_pca_basis[1].second, r2 = m_pca_basis[2].second;
+  const std::size_t n = static_cast<std::size_t>(end - begin);
+  thread_local std::vector<std::array<double, 3>> local;
+  local.resize(n);
+  double h = 0;
+  for (std::size_t r = 0; r < n; ++r) {
+    const Vector_3 q = begin[static_cast<std::ptrdiff_t>(r)] - p0;
+    local[r] = {q * r0, q * r1, q * r2};
+    h += std::abs(local[r][0]) + std::abs(local[r][1]);
+  }
+  h /= 2.0 * static_cast<double>(n);
+  this->preconditionning = h;
+  constexpr double kFactorial[] = {1, 1, 2, 6, 24, 120};
+  double pu[6], pv[6];
+  for (std::size_t r = 0; r < n; ++r) {
+    const double u = local[r][0] / h, v = local[r][1] / h;
+    pu[0] = pv[0] = 1;
+    for (std::size_t k = 1; k <= d; ++k) {
+      pu[k] = pu[k - 1] * u;
+      pv[k] = pv[k - 1] * v;
+    }
+    Z.set(r, local[r][2]);
+    for (std::size_t k = 0; k <= d; ++k)
+      for (std::size_t i = 0; i <= k; ++i)
+        M.set(r, k * (k + 1) / 2 + i, pu[k - i] * pv[i] / (kFactorial[k - i] * kFactorial[i]));
+  }
+}
+
+namespace impactdeck::geometry {
+namespace {
 
 CPoint cp(const Eigen::Vector3d& v) { return CPoint(v.x(), v.y(), v.z()); }
 Eigen::Vector3d ev(const CPoint& p) { return {p.x(), p.y(), p.z()}; }
@@ -296,8 +369,8 @@ CurvatureFit MeshShape::curvature_fit(const Eigen::Vector3d& point) const {
   int nearest = t[0];
   for (int v : t)
     if ((V[v] - p).squaredNorm() < (V[nearest] - p).squaredNorm()) nearest = v;
-  Monge m1;
-  auto f1 = fit(V[nearest], hood, hood.size(), degree, m1, false);
+  thread_local Monge monge;  // reused: its PCA basis and transformations are heap-allocated
+  auto f1 = fit(V[nearest], hood, hood.size(), degree, monge, false);
   const Eigen::Vector3d o = ev(f1.origin()), e1 = ev(f1.maximal_principal_direction()),
                         e2 = ev(f1.minimal_principal_direction()), en = ev(f1.normal_direction());
   const double x = (p - o).dot(e1), y = (p - o).dot(e2);
@@ -305,11 +378,10 @@ CurvatureFit MeshShape::curvature_fit(const Eigen::Vector3d& point) const {
       o + x * e1 + y * e2 +
       0.5 * (f1.principal_curvatures(0) * x * x + f1.principal_curvatures(1) * y * y) * en;
   // Pass 2: the jet at the lifted point; pass 3: one ring more, for the error estimate.
-  Monge m2;
-  auto f2 = fit(lifted, hood, hood.size(), degree, m2, true);
+  auto f2 = fit(lifted, hood, hood.size(), degree, monge, true);
+  out.condition_number = monge.condition_number();
   const std::size_t wider_size = gather(rings + 1);
-  Monge m3;
-  auto f3 = fit(lifted, pts, wider_size, std::min(d, wider_size >= needed + 2 ? d : degree), m3, false);
+  auto f3 = fit(lifted, pts, wider_size, std::min(d, wider_size >= needed + 2 ? d : degree), monge, false);
 
   // CGAL: k_max >= k_min with respect to the (outward) Monge normal; convex means the surface
   // bends away from the normal, i.e. negative there. Ours: positive convex, k1 >= k2.
@@ -320,7 +392,6 @@ CurvatureFit MeshShape::curvature_fit(const Eigen::Vector3d& point) const {
   c.d2 = ev(f2.maximal_principal_direction());
   const double k1w = -f3.principal_curvatures(1), k2w = -f3.principal_curvatures(0);
   c.error_estimate_per_m = std::max(std::abs(k1w - c.k1_per_m), std::abs(k2w - c.k2_per_m));
-  out.condition_number = m2.condition_number();
   out.neighbourhood_points = static_cast<int>(hood.size());
   if (!std::isfinite(c.k1_per_m) || !std::isfinite(c.k2_per_m) || !std::isfinite(c.error_estimate_per_m)) {
     throw InputError("", "curvature", "the jet fit failed (degenerate neighbourhood)");
