@@ -30,50 +30,83 @@ using TriIt = std::vector<CTriangle>::const_iterator;
 using Primitive = CGAL::AABB_triangle_primitive<K, TriIt>;
 using Tree = CGAL::AABB_tree<CGAL::AABB_traits<K, Primitive>>;
 // Least-squares solver for the jet fit (CGAL's SvdTraits concept). CGAL's default, Eigen_svd, runs
-// a Jacobi SVD on the dynamic N×10 matrix (~60 µs per fit); Householder QR solves the same
-// system, and the singular values (for the condition number) come from the 10×10 Gram matrix.
-// The jet system is preconditioned by CGAL (condition numbers ~1e1–1e3 here), so squaring it in
-// the Gram matrix loses nothing that matters for a ratio of singular values.
-// The QR runs on a copy with the column count fixed at compile time (6, 10, 15: jet degree 2..4)
-// and at most kMaxRows rows on the stack: no heap allocation, unrolled column loops (the
-// dynamic-size QR was ~30 % of a curvature query under callgrind). Larger systems (very wide
-// neighbourhoods) take the dynamic path.
+// a Jacobi SVD on the dynamic N×10 matrix (~60 µs per fit); a Householder QR solves the same
+// system, and the singular values (for the condition number) come from the eigenvalues of RᵀR
+// (= AᵀA, 10×10). The jet system is preconditioned by CGAL (condition numbers ~1e1–1e3 here),
+// so squaring it loses nothing that matters for a ratio of singular values.
+// The QR is written out on a reused column-major buffer: Eigen's dynamic-size HouseholderQR
+// (allocations, blocked code paths for a 25×10 matrix) was ~30 % of a curvature query under
+// callgrind, and a fixed-column Eigen QR saved little.
 struct JetSolver {
   using FT = double;
   using Vector = CGAL::Eigen_vector<FT>;
   using Matrix = CGAL::Eigen_matrix<FT>;
-  static constexpr int kMaxRows = 160;
   // Only the main fit's condition number is reported: the others skip the eigenvalues.
   static thread_local bool want_condition_number;
 
-  template <int C, class Mat>
-  static FT solve_with(const Mat& A, Vector& B) {
-    Eigen::HouseholderQR<Mat> qr(A);
-    B.eigen_object() = qr.solve(B.eigen_object()).eval();
-    if (!want_condition_number) return std::numeric_limits<double>::quiet_NaN();
-    using Square = Eigen::Matrix<double, C, C, 0, C == Eigen::Dynamic ? Eigen::Dynamic : C,
-                                 C == Eigen::Dynamic ? Eigen::Dynamic : C>;
-    const Square G = A.transpose() * A;
+  template <class Square>
+  static FT condition_of(const Square& G) {
     const auto ev = Eigen::SelfAdjointEigenSolver<Square>(G, Eigen::EigenvaluesOnly).eigenvalues();
     const double lo = std::max(ev.minCoeff(), 0.0), hi = ev.maxCoeff();
     return lo > 0 ? std::sqrt(hi / lo) : std::numeric_limits<double>::infinity();
   }
   template <int C>
-  static FT solve_fixed(const Eigen::MatrixXd& A, Vector& B) {
-    using Mat = Eigen::Matrix<double, Eigen::Dynamic, C, Eigen::ColMajor, kMaxRows, C>;
-    return solve_with<C>(Mat(A), B);
+  static FT condition_fixed(const Eigen::MatrixXd& R) {
+    return condition_of(Eigen::Matrix<double, C, C>(R.transpose() * R));
   }
+
   static FT solve(const Matrix& M, Vector& B) {
-    const Eigen::MatrixXd& A = M.eigen_object();
-    if (A.rows() <= kMaxRows) {
-      switch (A.cols()) {
-        case 6: return solve_fixed<6>(A, B);
-        case 10: return solve_fixed<10>(A, B);
-        case 15: return solve_fixed<15>(A, B);
-        default: break;
+    const Eigen::MatrixXd& A0 = M.eigen_object();
+    const int n = static_cast<int>(A0.rows()), c = static_cast<int>(A0.cols());
+    thread_local std::vector<double> a, b, diag;
+    a.assign(A0.data(), A0.data() + static_cast<std::ptrdiff_t>(n) * c);  // column-major
+    b.assign(B.eigen_object().data(), B.eigen_object().data() + n);
+    diag.assign(static_cast<std::size_t>(c), 0.0);
+    // Column j: reflector H = I - 2 v vᵀ / (vᵀv) with v = x - α e_j, α = -sign(x_j) |x|, applied
+    // to the columns right of j and to b; v stays in the column below the diagonal.
+    for (int j = 0; j < c; ++j) {
+      double* x = a.data() + static_cast<std::ptrdiff_t>(j) * n;
+      double norm2 = 0;
+      for (int i = j; i < n; ++i) norm2 += x[i] * x[i];
+      const double alpha = x[j] >= 0 ? -std::sqrt(norm2) : std::sqrt(norm2);
+      diag[j] = alpha;
+      x[j] -= alpha;
+      double vnorm2 = 0;
+      for (int i = j; i < n; ++i) vnorm2 += x[i] * x[i];
+      if (!(vnorm2 > 0)) continue;
+      const double scale = 2.0 / vnorm2;
+      for (int k = j + 1; k < c; ++k) {
+        double* y = a.data() + static_cast<std::ptrdiff_t>(k) * n;
+        double dot = 0;
+        for (int i = j; i < n; ++i) dot += x[i] * y[i];
+        const double f = scale * dot;
+        for (int i = j; i < n; ++i) y[i] -= f * x[i];
       }
+      double dot = 0;
+      for (int i = j; i < n; ++i) dot += x[i] * b[i];
+      const double f = scale * dot;
+      for (int i = j; i < n; ++i) b[i] -= f * x[i];
     }
-    return solve_with<Eigen::Dynamic>(A, B);
+    // R: diag on the diagonal, a(j, k) above it (k > j). Back substitution R x = (Qᵀb)[0, c).
+    Eigen::VectorXd sol(c);
+    for (int j = c - 1; j >= 0; --j) {
+      double r = b[j];
+      for (int k = j + 1; k < c; ++k) r -= a[static_cast<std::size_t>(k) * n + j] * sol[k];
+      sol[j] = r / diag[j];
+    }
+    B.eigen_object() = sol;
+    if (!want_condition_number) return std::numeric_limits<double>::quiet_NaN();
+    Eigen::MatrixXd R = Eigen::MatrixXd::Zero(c, c);
+    for (int j = 0; j < c; ++j) {
+      R(j, j) = diag[j];
+      for (int k = j + 1; k < c; ++k) R(j, k) = a[static_cast<std::size_t>(k) * n + j];
+    }
+    switch (c) {
+      case 6: return condition_fixed<6>(R);
+      case 10: return condition_fixed<10>(R);
+      case 15: return condition_fixed<15>(R);
+      default: return condition_of(Eigen::MatrixXd(R.transpose() * R));
+    }
   }
 };
 thread_local bool JetSolver::want_condition_number = true;
@@ -310,14 +343,19 @@ CurvatureFit MeshShape::curvature_fit(const Eigen::Vector3d& point) const {
   thread_local std::vector<int> faces, pts;
   faces.assign(1, f);
   pts.assign(t.begin(), t.end());
-  std::size_t level_begin = 0, faces_done = 0;
+  // A neighbour of a face at BFS level L is at level L-1, L or L+1: the search for it starts
+  // at level L-1.
+  std::size_t previous_begin = 0, level_begin = 0, faces_done = 0;
   int depth_done = 0;
   auto gather = [&](int rings) {
     for (const int depth = 2 * rings - 1; depth_done < depth; ++depth_done) {
       const std::size_t end = faces.size();
       for (std::size_t i = level_begin; i < end; ++i)
-        for (int g : ix.face_across[faces[i]])
-          if (g >= 0 && std::find(faces.begin(), faces.end(), g) == faces.end()) faces.push_back(g);
+        for (int g : ix.face_across[faces[i]]) {
+          const auto from = faces.begin() + static_cast<std::ptrdiff_t>(previous_begin);
+          if (g >= 0 && std::find(from, faces.end(), g) == faces.end()) faces.push_back(g);
+        }
+      previous_begin = level_begin;
       level_begin = end;
     }
     for (; faces_done < faces.size(); ++faces_done)
