@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <exception>
 #include <random>
+#include <thread>
 #include <sstream>
 #include <unordered_map>
 #include <unordered_set>
@@ -50,10 +52,6 @@ struct JetSolver {
     const double lo = std::max(ev.minCoeff(), 0.0), hi = ev.maxCoeff();
     return lo > 0 ? std::sqrt(hi / lo) : std::numeric_limits<double>::infinity();
   }
-  template <int C>
-  static FT condition_fixed(const Eigen::MatrixXd& R) {
-    return condition_of(Eigen::Matrix<double, C, C>(R.transpose() * R));
-  }
 
   static FT solve(const Matrix& M, Vector& B) {
     const Eigen::MatrixXd& A0 = M.eigen_object();
@@ -87,26 +85,31 @@ struct JetSolver {
       const double f = scale * dot;
       for (int i = j; i < n; ++i) b[i] -= f * x[i];
     }
-    // R: diag on the diagonal, a(j, k) above it (k > j). Back substitution R x = (Qᵀb)[0, c).
-    Eigen::VectorXd sol(c);
+    // R: diag on the diagonal, a(j, k) above it (k > j). Back substitution R x = (Qᵀb)[0, c),
+    // into the first c entries of B (CGAL reads the c coefficients from there; no reallocation).
+    Eigen::VectorXd& sol = B.eigen_object();
     for (int j = c - 1; j >= 0; --j) {
       double r = b[j];
       for (int k = j + 1; k < c; ++k) r -= a[static_cast<std::size_t>(k) * n + j] * sol[k];
       sol[j] = r / diag[j];
     }
-    B.eigen_object() = sol;
     if (!want_condition_number) return std::numeric_limits<double>::quiet_NaN();
-    Eigen::MatrixXd R = Eigen::MatrixXd::Zero(c, c);
+    switch (c) {
+      case 6: return condition_of(r_transpose_r<6>(a, diag, n, c));
+      case 10: return condition_of(r_transpose_r<10>(a, diag, n, c));
+      case 15: return condition_of(r_transpose_r<15>(a, diag, n, c));
+      default: return condition_of(r_transpose_r<Eigen::Dynamic>(a, diag, n, c));
+    }
+  }
+  template <int C>
+  static Eigen::Matrix<double, C, C> r_transpose_r(const std::vector<double>& a, const std::vector<double>& diag,
+                                                   int n, int c) {
+    Eigen::Matrix<double, C, C> R = Eigen::Matrix<double, C, C>::Zero(c, c);
     for (int j = 0; j < c; ++j) {
       R(j, j) = diag[j];
       for (int k = j + 1; k < c; ++k) R(j, k) = a[static_cast<std::size_t>(k) * n + j];
     }
-    switch (c) {
-      case 6: return condition_fixed<6>(R);
-      case 10: return condition_fixed<10>(R);
-      case 15: return condition_fixed<15>(R);
-      default: return condition_of(Eigen::MatrixXd(R.transpose() * R));
-    }
+    return R.transpose() * R;
   }
 };
 thread_local bool JetSolver::want_condition_number = true;
@@ -202,10 +205,36 @@ MeshShape::MeshShape(TriangleMesh mesh, const MeshMassProperties& mass, const Me
   ix.face_area.resize(nf);
   ix.vertex_normal.assign(nv, Eigen::Vector3d::Zero());
   ix.cumulative_area.resize(nf);
+  for (const auto& t : F) ix.triangles.emplace_back(cp(V[t[0]]), cp(V[t[1]]), cp(V[t[2]]));
+  // The AABB tree and the kd-tree of its distance queries are built on a second thread while
+  // this one computes normals, areas and adjacency: disjoint data, so the results are the same
+  // as sequentially. Small meshes stay on one thread (a thread start costs more than it saves).
+  auto build_tree = [&ix] {
+    ix.tree.insert(ix.triangles.begin(), ix.triangles.end());
+    ix.tree.build();
+    ix.tree.accelerate_distance_queries();
+  };
+  std::exception_ptr tree_error;
+  std::thread tree_thread;
+  if (nf >= 20000) {
+    tree_thread = std::thread([&] {
+      try {
+        build_tree();
+      } catch (...) {
+        tree_error = std::current_exception();
+      }
+    });
+  }
+  struct Joiner {
+    std::thread& t;
+    ~Joiner() {
+      if (t.joinable()) t.join();
+    }
+  } joiner{tree_thread};
+
   double total = 0;
   for (std::size_t f = 0; f < nf; ++f) {
     const auto& t = F[f];
-    ix.triangles.emplace_back(cp(V[t[0]]), cp(V[t[1]]), cp(V[t[2]]));
     const Eigen::Vector3d c = (V[t[1]] - V[t[0]]).cross(V[t[2]] - V[t[0]]);
     const double n = c.norm();
     ix.face_area[f] = 0.5 * n;
@@ -216,9 +245,6 @@ MeshShape::MeshShape(TriangleMesh mesh, const MeshMassProperties& mass, const Me
   }
   for (auto& n : ix.vertex_normal)
     if (n.norm() > 0) n.normalize();
-  ix.tree.insert(ix.triangles.begin(), ix.triangles.end());
-  ix.tree.build();
-  ix.tree.accelerate_distance_queries();
 
   // Adjacency and sharp edges (dihedral angle between the two faces above the threshold; boundary
   // and non-manifold edges count as sharp: no smooth surface continues across them). One sorted
@@ -255,6 +281,12 @@ MeshShape::MeshShape(TriangleMesh mesh, const MeshMassProperties& mass, const Me
   for (const auto& v : V) {
     ix.lo = ix.lo.cwiseMin(v);
     ix.hi = ix.hi.cwiseMax(v);
+  }
+  if (tree_thread.joinable()) {
+    tree_thread.join();
+    if (tree_error) std::rethrow_exception(tree_error);
+  } else {
+    build_tree();
   }
 }
 
@@ -307,9 +339,13 @@ SurfacePoint MeshShape::closest_point(const Eigen::Vector3d& q) const {
   return sp;
 }
 
-Curvature MeshShape::curvature(const SurfacePoint& at) const { return curvature_fit(at.point_m).curvature; }
+// curvature() and paper_radius_m() skip the condition number: it is a diagnostic, and its 10×10
+// eigenvalue problem was ~12 % of a query.
+Curvature MeshShape::curvature(const SurfacePoint& at) const { return fit_curvature(at.point_m, false).curvature; }
 
-CurvatureFit MeshShape::curvature_fit(const Eigen::Vector3d& point) const {
+CurvatureFit MeshShape::curvature_fit(const Eigen::Vector3d& point) const { return fit_curvature(point, true); }
+
+CurvatureFit MeshShape::fit_curvature(const Eigen::Vector3d& point, bool with_condition) const {
   const Index& ix = *index_;
   const auto& V = mesh_.vertices_m;
   const auto hit = ix.tree.closest_point_and_primitive(cp(point));
@@ -368,16 +404,15 @@ CurvatureFit MeshShape::curvature_fit(const Eigen::Vector3d& point) const {
   int rings = std::max(1, options_.curvature_rings);
   std::size_t hood_size = gather(rings);
   while (hood_size < needed + needed / 2 && rings < options_.curvature_rings + 3) hood_size = gather(++rings);
-  const std::vector<int> hood(pts.begin(), pts.begin() + static_cast<std::ptrdiff_t>(hood_size));
   int degree = d;
-  while (degree > 2 && hood.size() < static_cast<std::size_t>((degree + 1) * (degree + 2) / 2) + 2) --degree;
-  if (hood.size() < 6 + 1) {
+  while (degree > 2 && hood_size < static_cast<std::size_t>((degree + 1) * (degree + 2) / 2) + 2) --degree;
+  if (hood_size < 6 + 1) {
     // Too few points for a quadric: exact zero when they are coplanar (a flat facet region).
     double dev = 0;
-    for (int v : hood) dev = std::max(dev, std::abs((V[v] - p).dot(ix.face_normal[f])));
+    for (std::size_t i = 0; i < hood_size; ++i) dev = std::max(dev, std::abs((V[pts[i]] - p).dot(ix.face_normal[f])));
     if (dev <= 1e-9 * std::max(size_m(), 1e-300)) {
       out.planar = true;
-      out.neighbourhood_points = static_cast<int>(hood.size());
+      out.neighbourhood_points = static_cast<int>(hood_size);
       out.curvature.k1_per_m = out.curvature.k2_per_m = 0;
       const Eigen::Vector3d d1 = (V[t[1]] - V[t[0]]).normalized();
       out.curvature.d1 = d1;
@@ -385,7 +420,7 @@ CurvatureFit MeshShape::curvature_fit(const Eigen::Vector3d& point) const {
       return out;
     }
     throw InputError("", "curvature",
-                     "only " + std::to_string(hood.size()) +
+                     "only " + std::to_string(hood_size) +
                          " vertices around the point (not separated by sharp edges): the mesh is "
                          "too coarse there for a curvature fit");
   }
@@ -408,7 +443,7 @@ CurvatureFit MeshShape::curvature_fit(const Eigen::Vector3d& point) const {
   for (int v : t)
     if ((V[v] - p).squaredNorm() < (V[nearest] - p).squaredNorm()) nearest = v;
   thread_local Monge monge;  // reused: its PCA basis and transformations are heap-allocated
-  auto f1 = fit(V[nearest], hood, hood.size(), degree, monge, false);
+  auto f1 = fit(V[nearest], pts, hood_size, degree, monge, false);
   const Eigen::Vector3d o = ev(f1.origin()), e1 = ev(f1.maximal_principal_direction()),
                         e2 = ev(f1.minimal_principal_direction()), en = ev(f1.normal_direction());
   const double x = (p - o).dot(e1), y = (p - o).dot(e2);
@@ -416,8 +451,8 @@ CurvatureFit MeshShape::curvature_fit(const Eigen::Vector3d& point) const {
       o + x * e1 + y * e2 +
       0.5 * (f1.principal_curvatures(0) * x * x + f1.principal_curvatures(1) * y * y) * en;
   // Pass 2: the jet at the lifted point; pass 3: one ring more, for the error estimate.
-  auto f2 = fit(lifted, hood, hood.size(), degree, monge, true);
-  out.condition_number = monge.condition_number();
+  auto f2 = fit(lifted, pts, hood_size, degree, monge, with_condition);
+  if (with_condition) out.condition_number = monge.condition_number();
   const std::size_t wider_size = gather(rings + 1);
   auto f3 = fit(lifted, pts, wider_size, std::min(d, wider_size >= needed + 2 ? d : degree), monge, false);
 
@@ -430,7 +465,7 @@ CurvatureFit MeshShape::curvature_fit(const Eigen::Vector3d& point) const {
   c.d2 = ev(f2.maximal_principal_direction());
   const double k1w = -f3.principal_curvatures(1), k2w = -f3.principal_curvatures(0);
   c.error_estimate_per_m = std::max(std::abs(k1w - c.k1_per_m), std::abs(k2w - c.k2_per_m));
-  out.neighbourhood_points = static_cast<int>(hood.size());
+  out.neighbourhood_points = static_cast<int>(hood_size);
   if (!std::isfinite(c.k1_per_m) || !std::isfinite(c.k2_per_m) || !std::isfinite(c.error_estimate_per_m)) {
     throw InputError("", "curvature", "the jet fit failed (degenerate neighbourhood)");
   }
@@ -446,7 +481,7 @@ double MeshShape::paper_radius_m(const SurfacePoint& at) const {
   // ellipsoid. (Fitting the facet polyline of each section directly was tried and rejected: the
   // facets' chordal error, h² k_max / 8, swamps the curvature of nearly straight sections; on the
   // 20k-triangle 3:2:1 ellipsoid it gave up to 32 % error against Eq. 26, this gives ≤ 2 %.)
-  const CurvatureFit fit = curvature_fit(at.point_m);
+  const CurvatureFit fit = fit_curvature(at.point_m, false);
   if (fit.curvature.sharp_feature) {
     throw InputError("", "point", "lies on a sharp edge or corner: the Eq. 26 radius is undefined there");
   }
