@@ -53,6 +53,17 @@ struct JetSolver {
     return lo > 0 ? std::sqrt(hi / lo) : std::numeric_limits<double>::infinity();
   }
 
+  // Σ x[i] y[i] over [j, n) with two partial sums (halves the add latency chain).
+  static double dot_from(const double* x, const double* y, int j, int n) {
+    double s0 = 0, s1 = 0;
+    int i = j;
+    for (; i + 1 < n; i += 2) {
+      s0 += x[i] * y[i];
+      s1 += x[i + 1] * y[i + 1];
+    }
+    if (i < n) s0 += x[i] * y[i];
+    return s0 + s1;
+  }
   static FT solve(const Matrix& M, Vector& B) {
     const Eigen::MatrixXd& A0 = M.eigen_object();
     const int n = static_cast<int>(A0.rows()), c = static_cast<int>(A0.cols());
@@ -64,25 +75,19 @@ struct JetSolver {
     // to the columns right of j and to b; v stays in the column below the diagonal.
     for (int j = 0; j < c; ++j) {
       double* x = a.data() + static_cast<std::ptrdiff_t>(j) * n;
-      double norm2 = 0;
-      for (int i = j; i < n; ++i) norm2 += x[i] * x[i];
+      const double norm2 = dot_from(x, x, j, n);
       const double alpha = x[j] >= 0 ? -std::sqrt(norm2) : std::sqrt(norm2);
       diag[j] = alpha;
       x[j] -= alpha;
-      double vnorm2 = 0;
-      for (int i = j; i < n; ++i) vnorm2 += x[i] * x[i];
+      const double vnorm2 = dot_from(x, x, j, n);
       if (!(vnorm2 > 0)) continue;
       const double scale = 2.0 / vnorm2;
       for (int k = j + 1; k < c; ++k) {
         double* y = a.data() + static_cast<std::ptrdiff_t>(k) * n;
-        double dot = 0;
-        for (int i = j; i < n; ++i) dot += x[i] * y[i];
-        const double f = scale * dot;
+        const double f = scale * dot_from(x, y, j, n);
         for (int i = j; i < n; ++i) y[i] -= f * x[i];
       }
-      double dot = 0;
-      for (int i = j; i < n; ++i) dot += x[i] * b[i];
-      const double f = scale * dot;
+      const double f = scale * dot_from(x, b.data(), j, n);
       for (int i = j; i < n; ++i) b[i] -= f * x[i];
     }
     // R: diag on the diagonal, a(j, k) above it (k > j). Back substitution R x = (Qᵀb)[0, c),
@@ -379,6 +384,16 @@ CurvatureFit MeshShape::fit_curvature(const Eigen::Vector3d& point, bool with_co
   thread_local std::vector<int> faces, pts;
   faces.assign(1, f);
   pts.assign(t.begin(), t.end());
+  // Vertex membership by stamp (one counter per query; 4 bytes per mesh vertex and thread)
+  // instead of a linear search through the list.
+  thread_local std::vector<std::uint32_t> vertex_stamp;
+  thread_local std::uint32_t stamp = 0;
+  if (vertex_stamp.size() < V.size()) vertex_stamp.resize(V.size(), 0);
+  if (++stamp == 0) {
+    std::fill(vertex_stamp.begin(), vertex_stamp.end(), 0);
+    stamp = 1;
+  }
+  for (int v : t) vertex_stamp[v] = stamp;
   // A neighbour of a face at BFS level L is at level L-1, L or L+1: the search for it starts
   // at level L-1.
   std::size_t previous_begin = 0, level_begin = 0, faces_done = 0;
@@ -396,7 +411,10 @@ CurvatureFit MeshShape::fit_curvature(const Eigen::Vector3d& point, bool with_co
     }
     for (; faces_done < faces.size(); ++faces_done)
       for (int v : mesh_.triangles[faces[faces_done]])
-        if (std::find(pts.begin(), pts.end(), v) == pts.end()) pts.push_back(v);
+        if (vertex_stamp[v] != stamp) {
+          vertex_stamp[v] = stamp;
+          pts.push_back(v);
+        }
     return pts.size();
   };
   const int d = options_.jet_degree;
