@@ -7,7 +7,6 @@
 #include <fstream>
 #include <iomanip>
 #include <sstream>
-#include <unordered_map>
 
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
@@ -21,20 +20,58 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct Vec3Hash {
-  std::size_t operator()(const Eigen::Vector3d& v) const {
-    std::size_t h = 1469598103934665603ull;
-    for (int i = 0; i < 3; ++i) {
-      double x = v[i] + 0.0;  // -0 and +0 are the same point
-      std::uint64_t bits;
-      std::memcpy(&bits, &x, sizeof bits);
-      h ^= bits + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2);
-    }
-    return h;
+// Exact-position vertex merge: a flat open-addressing table of vertex ids (linear probing, at
+// most half full), keyed by the bits of the coordinates: no node allocated per vertex and no
+// pointer chasing, unlike std::unordered_map. Ids are given in order of first use, as before.
+std::uint64_t position_hash(const Eigen::Vector3d& v) {
+  std::uint64_t h = 0x9e3779b97f4a7c15ull;
+  for (int i = 0; i < 3; ++i) {
+    const double x = v[i] + 0.0;  // -0 and +0 are the same point
+    std::uint64_t bits;
+    std::memcpy(&bits, &x, sizeof bits);
+    h = (h ^ bits) * 0xff51afd7ed558ccdull;
+    h ^= h >> 32;
   }
-};
-struct Vec3Eq {
-  bool operator()(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const { return a == b; }
+  h *= 0xc4ceb9fe1a85ec53ull;
+  return h ^ (h >> 29);
+}
+class VertexIndex {
+ public:
+  explicit VertexIndex(std::size_t expected) {
+    std::size_t cap = 16;
+    while (cap < 2 * expected) cap *= 2;
+    slots_.assign(cap, -1);
+    mask_ = cap - 1;
+  }
+  // Id of the vertex at x in `vertices`, appending it when new; `inserted` says which.
+  int find_or_add(const Eigen::Vector3d& x, std::vector<Eigen::Vector3d>& vertices, bool& inserted) {
+    if (2 * (vertices.size() + 1) > slots_.size()) grow(vertices);
+    std::size_t i = position_hash(x) & mask_;
+    while (slots_[i] >= 0) {
+      if (vertices[slots_[i]] == x) {
+        inserted = false;
+        return slots_[i];
+      }
+      i = (i + 1) & mask_;
+    }
+    slots_[i] = static_cast<int>(vertices.size());
+    vertices.push_back(x);
+    inserted = true;
+    return slots_[i];
+  }
+
+ private:
+  void grow(const std::vector<Eigen::Vector3d>& vertices) {
+    slots_.assign(2 * slots_.size(), -1);
+    mask_ = slots_.size() - 1;
+    for (std::size_t v = 0; v < vertices.size(); ++v) {
+      std::size_t i = position_hash(vertices[v]) & mask_;
+      while (slots_[i] >= 0) i = (i + 1) & mask_;
+      slots_[i] = static_cast<int>(v);
+    }
+  }
+  std::vector<int> slots_;
+  std::size_t mask_ = 0;
 };
 
 bool is_identity(const aiMatrix4x4& m) { return m.IsIdentity(); }
@@ -124,12 +161,14 @@ LoadedMesh load_mesh(const fs::path& file, LengthUnit unit) {
     }
   }
 
-  std::unordered_map<Eigen::Vector3d, int, Vec3Hash, Vec3Eq> index;
-  {
-    std::size_t total = 0;
-    for (unsigned m = 0; m < scene->mNumMeshes; ++m) total += scene->mMeshes[m]->mNumVertices;
-    index.reserve(total);  // no rehashing while merging (STL: 3 records per triangle)
+  std::size_t total_vertices = 0, total_faces = 0;
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+    total_vertices += scene->mMeshes[m]->mNumVertices;
+    total_faces += scene->mMeshes[m]->mNumFaces;
   }
+  // STL: 3 records per triangle, about 6 per distinct vertex; the table grows if needed.
+  VertexIndex index(total_vertices / 4 + 16);
+  out.mesh.triangles.reserve(total_faces);
   const double to_m = metres_per(unit);
   std::size_t face_counter = 0;  // faces in file order over all meshes (for messages)
 
@@ -176,11 +215,11 @@ LoadedMesh load_mesh(const fs::path& file, LengthUnit unit) {
                          "coordinate is not a finite number");
       }
       x *= to_m;
-      auto [found, inserted] = index.emplace(x, static_cast<int>(out.mesh.vertices_m.size()));
-      if (inserted) out.mesh.vertices_m.push_back(x);
-      else ++out.merged_vertices;
-      local[v] = found->second;
-      return found->second;
+      bool inserted = false;
+      const int id = index.find_or_add(x, out.mesh.vertices_m, inserted);
+      if (!inserted) ++out.merged_vertices;
+      local[v] = id;
+      return id;
     };
     for (unsigned f = 0; f < mesh->mNumFaces; ++f, ++face_counter) {
       const aiFace& face = mesh->mFaces[f];
@@ -203,20 +242,8 @@ LoadedMesh load_mesh(const fs::path& file, LengthUnit unit) {
       out.mesh.triangles.push_back(t);
     }
   }
-  // Vertices used only by skipped points/lines are dropped: keep only triangle corners.
-  {
-    std::vector<int> remap(out.mesh.vertices_m.size(), -1);
-    std::vector<Eigen::Vector3d> kept;
-    for (auto& t : out.mesh.triangles)
-      for (int& v : t) {
-        if (remap[v] < 0) {
-          remap[v] = static_cast<int>(kept.size());
-          kept.push_back(out.mesh.vertices_m[v]);
-        }
-        v = remap[v];
-      }
-    out.mesh.vertices_m.swap(kept);
-  }
+  // Vertices of skipped points/lines never get an id (vertex_id runs for triangle corners only),
+  // and ids are given in order of first use: every vertex is a triangle corner, no remap needed.
   if (out.lines_ignored + out.points_ignored > 0) {
     out.warnings.push_back(where + ": ignored " + std::to_string(out.lines_ignored) + " line(s) and " +
                            std::to_string(out.points_ignored) +

@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <exception>
 #include <random>
+#include <thread>
 #include <sstream>
 #include <unordered_map>
 #include <unordered_set>
@@ -30,34 +32,145 @@ using TriIt = std::vector<CTriangle>::const_iterator;
 using Primitive = CGAL::AABB_triangle_primitive<K, TriIt>;
 using Tree = CGAL::AABB_tree<CGAL::AABB_traits<K, Primitive>>;
 // Least-squares solver for the jet fit (CGAL's SvdTraits concept). CGAL's default, Eigen_svd, runs
-// a Jacobi SVD on the dynamic N×10 matrix (~60 µs per fit); Householder QR solves the same
-// system, and the singular values (for the condition number) come from the 10×10 Gram matrix.
-// The jet system is preconditioned by CGAL (condition numbers ~1e1–1e3 here), so squaring it in
-// the Gram matrix loses nothing that matters for a ratio of singular values.
+// a Jacobi SVD on the dynamic N×10 matrix (~60 µs per fit); a Householder QR solves the same
+// system, and the singular values (for the condition number) come from the eigenvalues of RᵀR
+// (= AᵀA, 10×10). The jet system is preconditioned by CGAL (condition numbers ~1e1–1e3 here),
+// so squaring it loses nothing that matters for a ratio of singular values.
+// The QR is written out on a reused column-major buffer: Eigen's dynamic-size HouseholderQR
+// (allocations, blocked code paths for a 25×10 matrix) was ~30 % of a curvature query under
+// callgrind, and a fixed-column Eigen QR saved little.
 struct JetSolver {
   using FT = double;
   using Vector = CGAL::Eigen_vector<FT>;
   using Matrix = CGAL::Eigen_matrix<FT>;
-  static FT solve(const Matrix& M, Vector& B) {
-    const Eigen::MatrixXd& A = M.eigen_object();
-    const Eigen::VectorXd x = A.householderQr().solve(Eigen::VectorXd(B.eigen_object()));
-    B.eigen_object() = x;
-    const Eigen::MatrixXd G = A.transpose() * A;
-    const Eigen::VectorXd ev = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(G, Eigen::EigenvaluesOnly).eigenvalues();
+  // Only the main fit's condition number is reported: the others skip the eigenvalues.
+  static thread_local bool want_condition_number;
+
+  template <class Square>
+  static FT condition_of(const Square& G) {
+    const auto ev = Eigen::SelfAdjointEigenSolver<Square>(G, Eigen::EigenvaluesOnly).eigenvalues();
     const double lo = std::max(ev.minCoeff(), 0.0), hi = ev.maxCoeff();
     return lo > 0 ? std::sqrt(hi / lo) : std::numeric_limits<double>::infinity();
   }
+
+  // Σ x[i] y[i] over [j, n) with two partial sums (halves the add latency chain).
+  static double dot_from(const double* x, const double* y, int j, int n) {
+    double s0 = 0, s1 = 0;
+    int i = j;
+    for (; i + 1 < n; i += 2) {
+      s0 += x[i] * y[i];
+      s1 += x[i + 1] * y[i + 1];
+    }
+    if (i < n) s0 += x[i] * y[i];
+    return s0 + s1;
+  }
+  static FT solve(const Matrix& M, Vector& B) {
+    const Eigen::MatrixXd& A0 = M.eigen_object();
+    const int n = static_cast<int>(A0.rows()), c = static_cast<int>(A0.cols());
+    thread_local std::vector<double> a, b, diag;
+    a.assign(A0.data(), A0.data() + static_cast<std::ptrdiff_t>(n) * c);  // column-major
+    b.assign(B.eigen_object().data(), B.eigen_object().data() + n);
+    diag.assign(static_cast<std::size_t>(c), 0.0);
+    // Column j: reflector H = I - 2 v vᵀ / (vᵀv) with v = x - α e_j, α = -sign(x_j) |x|, applied
+    // to the columns right of j and to b; v stays in the column below the diagonal.
+    for (int j = 0; j < c; ++j) {
+      double* x = a.data() + static_cast<std::ptrdiff_t>(j) * n;
+      const double norm2 = dot_from(x, x, j, n);
+      const double alpha = x[j] >= 0 ? -std::sqrt(norm2) : std::sqrt(norm2);
+      diag[j] = alpha;
+      x[j] -= alpha;
+      const double vnorm2 = dot_from(x, x, j, n);
+      if (!(vnorm2 > 0)) continue;
+      const double scale = 2.0 / vnorm2;
+      for (int k = j + 1; k < c; ++k) {
+        double* y = a.data() + static_cast<std::ptrdiff_t>(k) * n;
+        const double f = scale * dot_from(x, y, j, n);
+        for (int i = j; i < n; ++i) y[i] -= f * x[i];
+      }
+      const double f = scale * dot_from(x, b.data(), j, n);
+      for (int i = j; i < n; ++i) b[i] -= f * x[i];
+    }
+    // R: diag on the diagonal, a(j, k) above it (k > j). Back substitution R x = (Qᵀb)[0, c),
+    // into the first c entries of B (CGAL reads the c coefficients from there; no reallocation).
+    Eigen::VectorXd& sol = B.eigen_object();
+    for (int j = c - 1; j >= 0; --j) {
+      double r = b[j];
+      for (int k = j + 1; k < c; ++k) r -= a[static_cast<std::size_t>(k) * n + j] * sol[k];
+      sol[j] = r / diag[j];
+    }
+    if (!want_condition_number) return std::numeric_limits<double>::quiet_NaN();
+    switch (c) {
+      case 6: return condition_of(r_transpose_r<6>(a, diag, n, c));
+      case 10: return condition_of(r_transpose_r<10>(a, diag, n, c));
+      case 15: return condition_of(r_transpose_r<15>(a, diag, n, c));
+      default: return condition_of(r_transpose_r<Eigen::Dynamic>(a, diag, n, c));
+    }
+  }
+  template <int C>
+  static Eigen::Matrix<double, C, C> r_transpose_r(const std::vector<double>& a, const std::vector<double>& diag,
+                                                   int n, int c) {
+    Eigen::Matrix<double, C, C> R = Eigen::Matrix<double, C, C>::Zero(c, c);
+    for (int j = 0; j < c; ++j) {
+      R(j, j) = diag[j];
+      for (int k = j + 1; k < c; ++k) R(j, k) = a[static_cast<std::size_t>(k) * n + j];
+    }
+    return R.transpose() * R;
+  }
 };
+thread_local bool JetSolver::want_condition_number = true;
 using Monge = CGAL::Monge_via_jet_fitting<K, K, JetSolver>;
+using PointIt = std::vector<CPoint>::iterator;
+}  // namespace
+}  // namespace impactdeck::geometry
+
+// The matrix fill of the jet fit, specialised for our instantiation (the fit itself, PCA, solve
+// and Monge basis stay CGAL's). CGAL's generic fill evaluates every monomial with three
+// std::pow calls (x^(k-i), y^i, precond^k): ~45 % of a curvature query under callgrind. Here the
+// points are taken to the fitting frame as R (q - p0) (R: the PCA basis, rows), scaled by the
+// preconditioning factor first, and the monomials u^a v^b / (a! b!) come from running products.
+// Same system (up to rounding): column k(k+1)/2 + i of a row holds x^(k-i) y^i / ((k-i)! i! h^k)
+// with (x, y) = h (u, v), the right-hand side the height z; solve_linear_system undoes h^k.
+template <>
+template <>
+void CGAL::Monge_via_jet_fitting<impactdeck::geometry::K, impactdeck::geometry::K, impactdeck::geometry::JetSolver>::
+    fill_matrix<impactdeck::geometry::PointIt>(impactdeck::geometry::PointIt begin, impactdeck::geometry::PointIt end,
+                                              std::size_t d, LAMatrix& M, LAVector& Z) {
+  const Point_3 p0 = *begin;
+  this->translate_p0 = Aff_transformation(CGAL::TRANSLATION, CGAL::ORIGIN - p0);
+  const Vector_3 r0 = m_pca_basis[0].second, r1 = m_pca_basis[1].second, r2 = m_pca_basis[2].second;
+  const std::size_t n = static_cast<std::size_t>(end - begin);
+  thread_local std::vector<std::array<double, 3>> local;
+  local.resize(n);
+  double h = 0;
+  for (std::size_t r = 0; r < n; ++r) {
+    const Vector_3 q = begin[static_cast<std::ptrdiff_t>(r)] - p0;
+    local[r] = {q * r0, q * r1, q * r2};
+    h += std::abs(local[r][0]) + std::abs(local[r][1]);
+  }
+  h /= 2.0 * static_cast<double>(n);
+  this->preconditionning = h;
+  constexpr double kFactorial[] = {1, 1, 2, 6, 24, 120};
+  double pu[6], pv[6];
+  for (std::size_t r = 0; r < n; ++r) {
+    const double u = local[r][0] / h, v = local[r][1] / h;
+    pu[0] = pv[0] = 1;
+    for (std::size_t k = 1; k <= d; ++k) {
+      pu[k] = pu[k - 1] * u;
+      pv[k] = pv[k - 1] * v;
+    }
+    Z.set(r, local[r][2]);
+    for (std::size_t k = 0; k <= d; ++k)
+      for (std::size_t i = 0; i <= k; ++i)
+        M.set(r, k * (k + 1) / 2 + i, pu[k - i] * pv[i] / (kFactorial[k - i] * kFactorial[i]));
+  }
+}
+
+namespace impactdeck::geometry {
+namespace {
 
 CPoint cp(const Eigen::Vector3d& v) { return CPoint(v.x(), v.y(), v.z()); }
 Eigen::Vector3d ev(const CPoint& p) { return {p.x(), p.y(), p.z()}; }
 Eigen::Vector3d ev(const K::Vector_3& p) { return {p.x(), p.y(), p.z()}; }
-
-std::uint64_t edge_key(int a, int b) {
-  if (a > b) std::swap(a, b);
-  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) | static_cast<std::uint32_t>(b);
-}
 
 double point_segment_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   const Eigen::Vector3d ab = b - a;
@@ -97,10 +210,36 @@ MeshShape::MeshShape(TriangleMesh mesh, const MeshMassProperties& mass, const Me
   ix.face_area.resize(nf);
   ix.vertex_normal.assign(nv, Eigen::Vector3d::Zero());
   ix.cumulative_area.resize(nf);
+  for (const auto& t : F) ix.triangles.emplace_back(cp(V[t[0]]), cp(V[t[1]]), cp(V[t[2]]));
+  // The AABB tree and the kd-tree of its distance queries are built on a second thread while
+  // this one computes normals, areas and adjacency: disjoint data, so the results are the same
+  // as sequentially. Small meshes stay on one thread (a thread start costs more than it saves).
+  auto build_tree = [&ix] {
+    ix.tree.insert(ix.triangles.begin(), ix.triangles.end());
+    ix.tree.build();
+    ix.tree.accelerate_distance_queries();
+  };
+  std::exception_ptr tree_error;
+  std::thread tree_thread;
+  if (nf >= 20000) {
+    tree_thread = std::thread([&] {
+      try {
+        build_tree();
+      } catch (...) {
+        tree_error = std::current_exception();
+      }
+    });
+  }
+  struct Joiner {
+    std::thread& t;
+    ~Joiner() {
+      if (t.joinable()) t.join();
+    }
+  } joiner{tree_thread};
+
   double total = 0;
   for (std::size_t f = 0; f < nf; ++f) {
     const auto& t = F[f];
-    ix.triangles.emplace_back(cp(V[t[0]]), cp(V[t[1]]), cp(V[t[2]]));
     const Eigen::Vector3d c = (V[t[1]] - V[t[0]]).cross(V[t[2]] - V[t[0]]);
     const double n = c.norm();
     ix.face_area[f] = 0.5 * n;
@@ -111,28 +250,14 @@ MeshShape::MeshShape(TriangleMesh mesh, const MeshMassProperties& mass, const Me
   }
   for (auto& n : ix.vertex_normal)
     if (n.norm() > 0) n.normalize();
-  ix.tree.insert(ix.triangles.begin(), ix.triangles.end());
-  ix.tree.build();
-  ix.tree.accelerate_distance_queries();
 
   // Adjacency and sharp edges (dihedral angle between the two faces above the threshold; boundary
   // and non-manifold edges count as sharp: no smooth surface continues across them). One sorted
   // list of the 3F edge records gives every undirected edge's faces as a run.
-  struct EdgeRecord {
-    std::uint64_t key;
-    int face, k;
-    bool operator<(const EdgeRecord& o) const { return key < o.key || (key == o.key && face < o.face); }
-  };
-  std::vector<EdgeRecord> records;
-  records.reserve(nf * 3);
+  const EdgeTable records = build_edge_table(mesh_);
   double edge_sum = 0;
   for (std::size_t f = 0; f < nf; ++f)
-    for (int k = 0; k < 3; ++k) {
-      const int a = F[f][k], b = F[f][(k + 1) % 3];
-      edge_sum += (V[a] - V[b]).norm();
-      records.push_back({edge_key(a, b), int(f), k});
-    }
-  std::sort(records.begin(), records.end());
+    for (int k = 0; k < 3; ++k) edge_sum += (V[F[f][k]] - V[F[f][(k + 1) % 3]]).norm();
   ix.mean_edge = edge_sum / (3.0 * nf);
   const double cos_sharp = std::cos(options_.sharp_angle_deg * M_PI / 180.0);
   ix.vertex_sharp.assign(nv, 0);
@@ -140,19 +265,20 @@ MeshShape::MeshShape(TriangleMesh mesh, const MeshMassProperties& mass, const Me
   ix.face_edge_sharp.assign(nf, {0, 0, 0});
   for (std::size_t i = 0; i < records.size();) {
     std::size_t j = i;
-    while (j < records.size() && records[j].key == records[i].key) ++j;
-    const EdgeRecord& r0 = records[i];
+    const std::uint64_t key = records.key[i];
+    while (j < records.size() && records.key[j] == key) ++j;
+    const int f0 = records.face[i];
     bool sharp = j - i != 2;
-    if (!sharp) sharp = ix.face_normal[r0.face].dot(ix.face_normal[records[i + 1].face]) < cos_sharp;
+    if (!sharp) sharp = ix.face_normal[f0].dot(ix.face_normal[records.face[i + 1]]) < cos_sharp;
     if (sharp) {
       ++ix.sharp_edge_count;
-      ix.vertex_sharp[r0.key >> 32] = 1;
-      ix.vertex_sharp[r0.key & 0xffffffffu] = 1;
-      for (std::size_t q = i; q < j; ++q) ix.face_edge_sharp[records[q].face][records[q].k] = 1;
+      ix.vertex_sharp[EdgeTable::lo(key)] = 1;
+      ix.vertex_sharp[EdgeTable::hi(key)] = 1;
+      for (std::size_t q = i; q < j; ++q) ix.face_edge_sharp[records.face[q]][records.corner[q]] = 1;
     } else {
-      const EdgeRecord& r1 = records[i + 1];
-      ix.face_across[r0.face][r0.k] = r1.face;
-      ix.face_across[r1.face][r1.k] = r0.face;
+      const int f1 = records.face[i + 1];
+      ix.face_across[f0][records.corner[i]] = f1;
+      ix.face_across[f1][records.corner[i + 1]] = f0;
     }
     i = j;
   }
@@ -160,6 +286,12 @@ MeshShape::MeshShape(TriangleMesh mesh, const MeshMassProperties& mass, const Me
   for (const auto& v : V) {
     ix.lo = ix.lo.cwiseMin(v);
     ix.hi = ix.hi.cwiseMax(v);
+  }
+  if (tree_thread.joinable()) {
+    tree_thread.join();
+    if (tree_error) std::rethrow_exception(tree_error);
+  } else {
+    build_tree();
   }
 }
 
@@ -237,9 +369,13 @@ bool MeshShape::on_sharp_feature(const SurfacePoint& at) const {
   return near_sharp_feature(f, ev(hit.first));
 }
 
-Curvature MeshShape::curvature(const SurfacePoint& at) const { return curvature_fit(at.point_m).curvature; }
+// curvature() and paper_radius_m() skip the condition number: it is a diagnostic, and its 10×10
+// eigenvalue problem was ~12 % of a query.
+Curvature MeshShape::curvature(const SurfacePoint& at) const { return fit_curvature(at.point_m, false).curvature; }
 
-CurvatureFit MeshShape::curvature_fit(const Eigen::Vector3d& point) const {
+CurvatureFit MeshShape::curvature_fit(const Eigen::Vector3d& point) const { return fit_curvature(point, true); }
+
+CurvatureFit MeshShape::fit_curvature(const Eigen::Vector3d& point, bool with_condition) const {
   const Index& ix = *index_;
   const auto& V = mesh_.vertices_m;
   const auto hit = ix.tree.closest_point_and_primitive(cp(point));
@@ -260,38 +396,60 @@ CurvatureFit MeshShape::curvature_fit(const Eigen::Vector3d& point) const {
   // face (about `rings` vertex rings around it), never crossing a sharp edge: a fit does not
   // straddle one. (Measured on the 3:2:1 ellipsoid at 20k triangles: 3 steps 0.87 % max error,
   // 5 steps 2.2 %, 7 steps 4 %: the cubic jet's model error grows faster than the noise drops.)
+  // Grown one ring at a time (BFS by levels; small sets, tens of entries: linear search in a
+  // vector beats hashing): the vertices of a smaller neighbourhood are a prefix of a larger one's,
+  // so the error estimate's wider neighbourhood costs only its extra ring. Scratch buffers are
+  // reused across queries (thread_local: queries on several threads stay independent).
+  thread_local std::vector<int> faces, pts;
+  faces.assign(1, f);
+  pts.assign(t.begin(), t.end());
+  // Vertex membership by stamp (one counter per query; 4 bytes per mesh vertex and thread)
+  // instead of a linear search through the list.
+  thread_local std::vector<std::uint32_t> vertex_stamp;
+  thread_local std::uint32_t stamp = 0;
+  if (vertex_stamp.size() < V.size()) vertex_stamp.resize(V.size(), 0);
+  if (++stamp == 0) {
+    std::fill(vertex_stamp.begin(), vertex_stamp.end(), 0);
+    stamp = 1;
+  }
+  for (int v : t) vertex_stamp[v] = stamp;
+  // A neighbour of a face at BFS level L is at level L-1, L or L+1: the search for it starts
+  // at level L-1.
+  std::size_t previous_begin = 0, level_begin = 0, faces_done = 0;
+  int depth_done = 0;
   auto gather = [&](int rings) {
-    // Small sets (tens of entries): linear search in a vector beats hashing.
-    const int depth = 2 * rings - 1;
-    std::vector<int> faces{f};
-    std::size_t begin = 0;
-    for (int r = 0; r < depth; ++r) {
+    for (const int depth = 2 * rings - 1; depth_done < depth; ++depth_done) {
       const std::size_t end = faces.size();
-      for (std::size_t i = begin; i < end; ++i)
-        for (int g : ix.face_across[faces[i]])
-          if (g >= 0 && std::find(faces.begin(), faces.end(), g) == faces.end()) faces.push_back(g);
-      begin = end;
+      for (std::size_t i = level_begin; i < end; ++i)
+        for (int g : ix.face_across[faces[i]]) {
+          const auto from = faces.begin() + static_cast<std::ptrdiff_t>(previous_begin);
+          if (g >= 0 && std::find(from, faces.end(), g) == faces.end()) faces.push_back(g);
+        }
+      previous_begin = level_begin;
+      level_begin = end;
     }
-    std::vector<int> pts(t.begin(), t.end());
-    for (int g : faces)
-      for (int v : mesh_.triangles[g])
-        if (std::find(pts.begin(), pts.end(), v) == pts.end()) pts.push_back(v);
-    return pts;
+    for (; faces_done < faces.size(); ++faces_done)
+      for (int v : mesh_.triangles[faces[faces_done]])
+        if (vertex_stamp[v] != stamp) {
+          vertex_stamp[v] = stamp;
+          pts.push_back(v);
+        }
+    return pts.size();
   };
   const int d = options_.jet_degree;
   const std::size_t needed = static_cast<std::size_t>((d + 1) * (d + 2) / 2);
   int rings = std::max(1, options_.curvature_rings);
-  std::vector<int> hood = gather(rings);
-  while (hood.size() < needed + needed / 2 && rings < options_.curvature_rings + 3) hood = gather(++rings);
+  std::size_t hood_size = gather(rings);
+  while (hood_size < needed + needed / 2 && rings < options_.curvature_rings + 3) hood_size = gather(++rings);
   int degree = d;
-  while (degree > 2 && hood.size() < static_cast<std::size_t>((degree + 1) * (degree + 2) / 2) + 2) --degree;
-  if (hood.size() < 6 + 1) {
+  while (degree > 2 && hood_size < static_cast<std::size_t>((degree + 1) * (degree + 2) / 2) + 2) --degree;
+  if (hood_size < 6 + 1) {
     // Too few points for a quadric: exact zero when they are coplanar (a flat facet region).
     double dev = 0;
-    for (int v : hood) dev = std::max(dev, std::abs((V[v] - p).dot(ix.face_normal[f])));
+    for (std::size_t i = 0; i < hood_size; ++i) dev = std::max(dev, std::abs((V[pts[i]] - p).dot(ix.face_normal[f])));
     if (dev <= 1e-9 * std::max(size_m(), 1e-300)) {
       out.planar = true;
-      out.neighbourhood_points = static_cast<int>(hood.size());
+      out.neighbourhood_points = static_cast<int>(hood_size);
       out.curvature.k1_per_m = out.curvature.k2_per_m = 0;
       const Eigen::Vector3d d1 = (V[t[1]] - V[t[0]]).normalized();
       out.curvature.d1 = d1;
@@ -299,17 +457,19 @@ CurvatureFit MeshShape::curvature_fit(const Eigen::Vector3d& point) const {
       return out;
     }
     throw InputError("", "curvature",
-                     "only " + std::to_string(hood.size()) +
+                     "only " + std::to_string(hood_size) +
                          " vertices around the point (not separated by sharp edges): the mesh is "
                          "too coarse there for a curvature fit");
   }
 
-  auto fit = [&](const Eigen::Vector3d& origin, const std::vector<int>& pts, int deg, Monge& m) {
-    std::vector<CPoint> in;
-    in.reserve(pts.size() + 1);
+  auto fit = [&](const Eigen::Vector3d& origin, const std::vector<int>& vertices, std::size_t count, int deg,
+                 Monge& m, bool want_condition) {
+    thread_local std::vector<CPoint> in;
+    in.clear();
     in.push_back(cp(origin));
-    for (int v : pts)
-      if (V[v] != origin) in.push_back(cp(V[v]));
+    for (std::size_t i = 0; i < count; ++i)
+      if (V[vertices[i]] != origin) in.push_back(cp(V[vertices[i]]));
+    JetSolver::want_condition_number = want_condition;
     auto form = m(in.begin(), in.end(), static_cast<std::size_t>(deg), 2);
     form.comply_wrt_given_normal(K::Vector_3(n.x(), n.y(), n.z()));
     return form;
@@ -319,8 +479,8 @@ CurvatureFit MeshShape::curvature_fit(const Eigen::Vector3d& point) const {
   int nearest = t[0];
   for (int v : t)
     if ((V[v] - p).squaredNorm() < (V[nearest] - p).squaredNorm()) nearest = v;
-  Monge m1;
-  auto f1 = fit(V[nearest], hood, degree, m1);
+  thread_local Monge monge;  // reused: its PCA basis and transformations are heap-allocated
+  auto f1 = fit(V[nearest], pts, hood_size, degree, monge, false);
   const Eigen::Vector3d o = ev(f1.origin()), e1 = ev(f1.maximal_principal_direction()),
                         e2 = ev(f1.minimal_principal_direction()), en = ev(f1.normal_direction());
   const double x = (p - o).dot(e1), y = (p - o).dot(e2);
@@ -328,11 +488,10 @@ CurvatureFit MeshShape::curvature_fit(const Eigen::Vector3d& point) const {
       o + x * e1 + y * e2 +
       0.5 * (f1.principal_curvatures(0) * x * x + f1.principal_curvatures(1) * y * y) * en;
   // Pass 2: the jet at the lifted point; pass 3: one ring more, for the error estimate.
-  Monge m2;
-  auto f2 = fit(lifted, hood, degree, m2);
-  std::vector<int> wider = gather(rings + 1);
-  Monge m3;
-  auto f3 = fit(lifted, wider, std::min(d, wider.size() >= needed + 2 ? d : degree), m3);
+  auto f2 = fit(lifted, pts, hood_size, degree, monge, with_condition);
+  if (with_condition) out.condition_number = monge.condition_number();
+  const std::size_t wider_size = gather(rings + 1);
+  auto f3 = fit(lifted, pts, wider_size, std::min(d, wider_size >= needed + 2 ? d : degree), monge, false);
 
   // CGAL: k_max >= k_min with respect to the (outward) Monge normal; convex means the surface
   // bends away from the normal, i.e. negative there. Ours: positive convex, k1 >= k2.
@@ -343,8 +502,7 @@ CurvatureFit MeshShape::curvature_fit(const Eigen::Vector3d& point) const {
   c.d2 = ev(f2.maximal_principal_direction());
   const double k1w = -f3.principal_curvatures(1), k2w = -f3.principal_curvatures(0);
   c.error_estimate_per_m = std::max(std::abs(k1w - c.k1_per_m), std::abs(k2w - c.k2_per_m));
-  out.condition_number = m2.condition_number();
-  out.neighbourhood_points = static_cast<int>(hood.size());
+  out.neighbourhood_points = static_cast<int>(hood_size);
   if (!std::isfinite(c.k1_per_m) || !std::isfinite(c.k2_per_m) || !std::isfinite(c.error_estimate_per_m)) {
     throw InputError("", "curvature", "the jet fit failed (degenerate neighbourhood)");
   }
@@ -360,7 +518,7 @@ double MeshShape::paper_radius_m(const SurfacePoint& at) const {
   // ellipsoid. (Fitting the facet polyline of each section directly was tried and rejected: the
   // facets' chordal error, h² k_max / 8, swamps the curvature of nearly straight sections; on the
   // 20k-triangle 3:2:1 ellipsoid it gave up to 32 % error against Eq. 26, this gives ≤ 2 %.)
-  const CurvatureFit fit = curvature_fit(at.point_m);
+  const CurvatureFit fit = fit_curvature(at.point_m, false);
   if (fit.curvature.sharp_feature) {
     throw InputError("", "point", "lies on a sharp edge or corner: the Eq. 26 radius is undefined there");
   }

@@ -36,11 +36,6 @@ bool is_degenerate(const TriangleMesh& m, const std::array<int, 3>& t) {
                          to_point(m.vertices_m[t[2]]));
 }
 
-std::uint64_t edge_key(int a, int b) {
-  if (a > b) std::swap(a, b);
-  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) | static_cast<std::uint32_t>(b);
-}
-
 int find_root(std::vector<int>& parent, int i) {
   while (parent[i] != i) i = parent[i] = parent[parent[i]];
   return i;
@@ -85,23 +80,10 @@ ValidationReport validate_mesh(const TriangleMesh& m, const ValidationOptions& o
   r.vertices = m.vertices_m.size();
   for (const auto& t : m.triangles) r.degenerate_triangles += is_degenerate(m, t) ? 1 : 0;
 
-  // Edge incidences from one sorted list of the 3F edge records (faster and leaner than hash
-  // maps at a million triangles). Per undirected edge: count, and net direction (+1 for a->b
-  // with a<b, -1 otherwise) — a manifold edge is consistently oriented when net = 0.
-  struct EdgeRecord {
-    std::uint64_t key;
-    int face;
-    int k;  // the edge runs from corner k to corner k+1 of `face`
-    bool operator<(const EdgeRecord& o) const { return key < o.key || (key == o.key && face < o.face); }
-  };
-  std::vector<EdgeRecord> records;
-  records.reserve(m.triangles.size() * 3);
-  for (std::size_t f = 0; f < m.triangles.size(); ++f)
-    for (int k = 0; k < 3; ++k) {
-      const int a = m.triangles[f][k], b = m.triangles[f][(k + 1) % 3];
-      if (a != b) records.push_back({edge_key(a, b), static_cast<int>(f), k});
-    }
-  std::sort(records.begin(), records.end());
+  // Edge incidences from the edge table (3F records sorted by undirected edge, then face; O(F)).
+  // Per undirected edge: count, and net direction (+1 for a->b with a<b, -1 otherwise) — a
+  // manifold edge is consistently oriented when net = 0. Edges of a repeated corner are skipped.
+  const EdgeTable records = build_edge_table(m);
   // Non-manifold vertices: the triangles around a vertex must form one fan. Corners (f, k) at the
   // same vertex are joined when their triangles share an edge through that vertex.
   const int nc = static_cast<int>(m.triangles.size() * 3);
@@ -114,21 +96,25 @@ ValidationReport validate_mesh(const TriangleMesh& m, const ValidationOptions& o
   for (std::size_t i = 0; i < records.size();) {
     std::size_t j = i;
     int net = 0;
-    while (j < records.size() && records[j].key == records[i].key) {
-      const auto& r = records[j];
-      const int a = m.triangles[r.face][r.k], b = m.triangles[r.face][(r.k + 1) % 3];
-      net += a < b ? 1 : -1;
+    const std::uint64_t key = records.key[i];
+    const int va = EdgeTable::lo(key), vb = EdgeTable::hi(key);
+    while (j < records.size() && records.key[j] == key) {
+      const int f = records.face[j], k = records.corner[j];
+      net += m.triangles[f][k] < m.triangles[f][(k + 1) % 3] ? 1 : -1;
       ++j;
+    }
+    if (va == vb) {
+      i = j;
+      continue;
     }
     const std::size_t count = j - i;
     if (count == 1) ++r.boundary_edges;
     else if (count > 2) ++r.non_manifold_edges;
     else if (net != 0) ++r.orientation_conflicts;
-    const int va = static_cast<int>(records[i].key >> 32), vb = static_cast<int>(records[i].key & 0xffffffffu);
     for (std::size_t q = i + 1; q < j; ++q)
       for (int v : {va, vb}) {
-        const int ra = find_root(parent, corner_of(records[q].face, v));
-        const int rb = find_root(parent, corner_of(records[i].face, v));
+        const int ra = find_root(parent, corner_of(records.face[q], v));
+        const int rb = find_root(parent, corner_of(records.face[i], v));
         if (ra != rb) parent[ra] = rb;
       }
     i = j;
@@ -150,7 +136,7 @@ ValidationReport validate_mesh(const TriangleMesh& m, const ValidationOptions& o
   }
 
   // Shells, their signed volumes and nesting (winding number of one vertex w.r.t. the others).
-  const ShellLabels shells = label_shells(m);
+  const ShellLabels shells = label_shells(m, records);
   r.shells = shells.shell_count;
   const MeshMassProperties mp = compute_mass_properties(m, shells);
   r.shell_nesting_depth.assign(shells.shell_count, 0);

@@ -44,27 +44,60 @@ int find_root(std::vector<int>& parent, int i) {
 }
 }  // namespace
 
-ShellLabels label_shells(const TriangleMesh& mesh) {
-  // Faces sharing an undirected edge are joined: sort the 3F edge records by key (faster and
-  // leaner than a hash map at a million triangles), then union each run.
+EdgeTable build_edge_table(const TriangleMesh& mesh) {
+  const std::size_t nf = mesh.triangles.size(), nv = mesh.vertices_m.size();
+  // Bucket the records by their smaller vertex (stable: faces ascending within a bucket), then
+  // order each small bucket (a vertex's edges: ~6 records) by the larger vertex, stably.
+  std::vector<std::uint32_t> start(nv + 1, 0);
+  for (const auto& t : mesh.triangles)
+    for (int k = 0; k < 3; ++k) ++start[std::min(t[k], t[(k + 1) % 3]) + 1];
+  for (std::size_t v = 0; v < nv; ++v) start[v + 1] += start[v];
+  EdgeTable e;
+  e.key.resize(3 * nf);
+  e.face.resize(3 * nf);
+  e.corner.resize(3 * nf);
+  {
+    std::vector<std::uint32_t> next(start.begin(), start.end() - 1);
+    for (std::size_t f = 0; f < nf; ++f) {
+      const auto& t = mesh.triangles[f];
+      for (int k = 0; k < 3; ++k) {
+        std::uint64_t a = static_cast<std::uint32_t>(t[k]), b = static_cast<std::uint32_t>(t[(k + 1) % 3]);
+        if (a > b) std::swap(a, b);
+        const std::uint32_t i = next[a]++;
+        e.key[i] = (a << 32) | b;
+        e.face[i] = static_cast<int>(f);
+        e.corner[i] = static_cast<std::uint8_t>(k);
+      }
+    }
+  }
+  for (std::size_t v = 0; v < nv; ++v)
+    for (std::uint32_t i = start[v] + 1; i < start[v + 1]; ++i) {
+      const std::uint64_t key = e.key[i];
+      const int face = e.face[i];
+      const std::uint8_t corner = e.corner[i];
+      std::uint32_t j = i;
+      for (; j > start[v] && e.key[j - 1] > key; --j) {
+        e.key[j] = e.key[j - 1];
+        e.face[j] = e.face[j - 1];
+        e.corner[j] = e.corner[j - 1];
+      }
+      e.key[j] = key;
+      e.face[j] = face;
+      e.corner[j] = corner;
+    }
+  return e;
+}
+
+ShellLabels label_shells(const TriangleMesh& mesh) { return label_shells(mesh, build_edge_table(mesh)); }
+
+ShellLabels label_shells(const TriangleMesh& mesh, const EdgeTable& edges) {
+  // Faces sharing an undirected edge (a != b) are joined: one run of the edge table per edge.
   const int nf = static_cast<int>(mesh.triangles.size());
   std::vector<int> parent(nf);
   std::iota(parent.begin(), parent.end(), 0);
-  std::vector<std::pair<std::uint64_t, int>> edges;
-  edges.reserve(static_cast<std::size_t>(nf) * 3);
-  for (int f = 0; f < nf; ++f) {
-    const auto& t = mesh.triangles[f];
-    for (int k = 0; k < 3; ++k) {
-      std::uint64_t a = static_cast<std::uint32_t>(t[k]), b = static_cast<std::uint32_t>(t[(k + 1) % 3]);
-      if (a == b) continue;
-      if (a > b) std::swap(a, b);
-      edges.emplace_back((a << 32) | b, f);
-    }
-  }
-  std::sort(edges.begin(), edges.end());
   for (std::size_t i = 1; i < edges.size(); ++i) {
-    if (edges[i].first != edges[i - 1].first) continue;
-    const int ra = find_root(parent, edges[i].second), rb = find_root(parent, edges[i - 1].second);
+    if (edges.key[i] != edges.key[i - 1] || EdgeTable::lo(edges.key[i]) == EdgeTable::hi(edges.key[i])) continue;
+    const int ra = find_root(parent, edges.face[i]), rb = find_root(parent, edges.face[i - 1]);
     if (ra != rb) parent[ra] = rb;
   }
   ShellLabels s;

@@ -23,7 +23,7 @@ struct MeshShapeOptions {
 /// Curvature with the details of its fit.
 struct CurvatureFit {
   Curvature curvature;             ///< k1 >= k2, positive convex; error estimate included
-  double condition_number = 0;     ///< of the jet least-squares system (CGAL)
+  double condition_number = 0;     ///< of the jet least-squares system (CGAL; curvature_fit only)
   int neighbourhood_points = 0;    ///< points in the main fit
   bool planar = false;             ///< neighbourhood too small but coplanar: k = 0 exactly
 };
@@ -66,6 +66,7 @@ class MeshShape final : public Shape {
   double mean_edge_length_m() const;
 
  private:
+  CurvatureFit fit_curvature(const Eigen::Vector3d& point_m, bool with_condition_number) const;
   struct Index;  // CGAL AABB tree and adjacency
   bool near_sharp_feature(int face, const Eigen::Vector3d& p) const;
   TriangleMesh mesh_;

@@ -22,6 +22,20 @@ struct TriangleMesh {
   double mean_edge_length_m() const;
 };
 
+/// The 3F directed edges of the triangles (edge k of face f runs from corner k to corner k+1),
+/// sorted by undirected edge key (min vertex << 32 | max vertex), then by face: the faces of an
+/// undirected edge are one run. Built in O(F) by a counting sort on the smaller vertex (the same
+/// order std::sort on (key, face) gives). Edges of a repeated corner (a == b) are included.
+struct EdgeTable {
+  std::vector<std::uint64_t> key;
+  std::vector<int> face;
+  std::vector<std::uint8_t> corner;  ///< k
+  std::size_t size() const { return key.size(); }
+  static int lo(std::uint64_t key) { return static_cast<int>(key >> 32); }
+  static int hi(std::uint64_t key) { return static_cast<int>(key & 0xffffffffu); }
+};
+EdgeTable build_edge_table(const TriangleMesh& mesh);
+
 /// Connected components through shared edges ("shells"): shell index of every triangle, and the
 /// number of shells.
 struct ShellLabels {
@@ -29,6 +43,8 @@ struct ShellLabels {
   int shell_count = 0;
 };
 ShellLabels label_shells(const TriangleMesh& mesh);
+/// The same, on the mesh's edge table (build_edge_table) when the caller has it already.
+ShellLabels label_shells(const TriangleMesh& mesh, const EdgeTable& edges);
 
 /// Winding number of the closed surface made of the triangles with `shell_of_triangle == shell`
 /// around point `q` (±1 inside, 0 outside; van Oosterom–Strackee solid angles).
