@@ -138,6 +138,33 @@ TEST(Scene, AnalyticSceneRunsOnlyWhatItNeeds) {
   }
 }
 
+// Non-ASCII text reaches toml++ as ASCII (scene/src/toml_ascii.hpp: toml++ 3.3.0 has undefined
+// behaviour on most non-ASCII code points where it tests for whitespace). The values must be the
+// ones TOML gives: names in basic, literal and multi-line strings, comments, keys.
+TEST(SceneText, NonAsciiStringsKeepTheirValue) {
+  std::string t = kBase;
+  t = replace(t, "name = \"target\"", "name = \"pi\u00e8ce \xc3\xa9\xce\xbc\xf0\x9f\x94\xa9 \\\\ \\\"q\\\"\"  # \xce\xbc = 0.3, r\xc3\xa9sum\xc3\xa9");
+  t = replace(t, "name = \"ball\"", "name = 'bille \\ \"\xc3\xa9\"'");
+  t = replace(t, "target = \"target\"", "target = \"\"\"pi\u00E8ce \\\n   \xc3\xa9\xce\xbc\xf0\x9f\x94\xa9 \\\\ \\\"q\\\"\"\"\"");
+  t = replace(t, "impactor = \"ball\"", "impactor = \'\'\'bille \\ \"\xc3\xa9\"\'\'\'");
+  t = "\xef\xbb\xbf# sc\xc3\xa8ne d'essai \xe2\x80\x94 \xce\xbc\n" + t;
+  const Scene s = parse_scene(t, "utf8.toml");
+  EXPECT_EQ(s.bodies[0].name, "pi\xc3\xa8" "ce \xc3\xa9\xce\xbc\xf0\x9f\x94\xa9 \\ \"q\"");
+  EXPECT_EQ(s.bodies[1].name, "bille \\ \"\xc3\xa9\"");
+  // The multi-line basic string's line-ending backslash trims the newline and the indentation.
+  EXPECT_EQ(s.impacts[0].target, s.bodies[0].name);
+  EXPECT_EQ(s.impacts[0].impactor, s.bodies[1].name);
+}
+
+TEST(SceneText, NonAsciiOutsideStringsIsASyntaxErrorWithItsPlace) {
+  expect_error(kBase + "vitesse_\xc3\xa9 = 3\n", R"(line 21, column 9: TOML syntax error: a non-ASCII character outside a string or comment)");
+  expect_error("\xef\xbb\x9d" + kBase, R"(line 1, column 1: TOML syntax error: a non-ASCII character)");
+  // fuzz_scene's second finding: a line-ending backslash followed by a non-ASCII character.
+  expect_error("#\n\"\"\"\\\\\\\xef\xbb\xbb\r", R"(line 2, column 7: TOML syntax error: invalid escape sequence)");
+  expect_error(kBase + "x = 'caf\xc3\xa9\n", R"(line 21, column 5: TOML syntax error: unterminated literal string)");
+  expect_error(kBase + "x = \"caf\xc3\n", R"(line 21, column 9: TOML syntax error: Encountered invalid utf-8 sequence)");
+}
+
 TEST(SceneErrors, NameFileLineKeyAndReason) {
   expect_error(replace(kBase, "youngs_modulus_Pa = 2.05e11", "youngs_modulus_Pa = -2e11"),
                R"(line 3, key 'materials\.steel\.youngs_modulus_Pa': must be > 0)");

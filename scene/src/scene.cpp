@@ -8,6 +8,7 @@
 #include <toml++/toml.h>
 
 #include "impactdeck/common/error.hpp"
+#include "toml_ascii.hpp"
 
 namespace impactdeck::scene {
 namespace fs = std::filesystem;
@@ -463,74 +464,12 @@ Scene build(const toml::table& root, const std::string& file, const fs::path& ba
   return sc;
 }
 
-// TOML allows non-ASCII characters only inside strings and comments. Refuse one anywhere else
-// before toml++ sees it: toml++ 3.3.0 (Debian 12) reaches __builtin_unreachable() in
-// is_non_ascii_horizontal_whitespace for most non-ASCII code points where it expects whitespace
-// (found by fuzz_scene: a scene starting with U+FEDD), which is undefined behaviour.
-void reject_bare_non_ascii(const std::string& text, const std::string& name) {
-  enum class In { code, comment, basic, literal, ml_basic, ml_literal } in = In::code;
-  std::size_t line = 1, column = 1;
-  std::size_t i = text.compare(0, 3, "\xEF\xBB\xBF") == 0 ? 3 : 0;  // a UTF-8 byte order mark
-  auto starts = [&](const char* t) { return text.compare(i, std::char_traits<char>::length(t), t) == 0; };
-  // Length of the well-formed UTF-8 sequence at i, 0 if malformed (toml++ reports those itself).
-  auto utf8_length = [&](std::size_t at) -> std::size_t {
-    const auto b = static_cast<unsigned char>(text[at]);
-    const std::size_t n = b >= 0xC2 && b <= 0xDF ? 2 : b >= 0xE0 && b <= 0xEF ? 3 : b >= 0xF0 && b <= 0xF4 ? 4 : 0;
-    if (n == 0 || at + n > text.size()) return 0;
-    for (std::size_t k = 1; k < n; ++k)
-      if ((static_cast<unsigned char>(text[at + k]) & 0xC0) != 0x80) return 0;
-    return n;
-  };
-  while (i < text.size()) {
-    const char c = text[i];
-    std::size_t step = 1;
-    if (static_cast<unsigned char>(c) >= 0x80) {
-      step = utf8_length(i);
-      if (step == 0) return;  // malformed UTF-8: toml++'s error, at this place or before it
-    }
-    switch (in) {
-      case In::code:
-        if (static_cast<unsigned char>(c) >= 0x80)
-          throw InputError(name, "line " + std::to_string(line) + ", column " + std::to_string(column),
-                           "TOML syntax error: a non-ASCII character outside a string or comment");
-        if (c == '#') in = In::comment;
-        else if (starts("\"\"\"")) in = In::ml_basic, step = 3;
-        else if (starts("'''")) in = In::ml_literal, step = 3;
-        else if (c == '"') in = In::basic;
-        else if (c == '\'') in = In::literal;
-        break;
-      case In::comment:
-        if (c == '\n') in = In::code;
-        break;
-      case In::basic:
-        if (c == '\\' && i + 1 < text.size() && text[i + 1] != '\n') step = 2;
-        else if (c == '"' || c == '\n') in = In::code;  // an unterminated string is toml++'s error
-        break;
-      case In::literal:
-        if (c == '\'' || c == '\n') in = In::code;
-        break;
-      case In::ml_basic:
-        if (c == '\\' && i + 1 < text.size() && text[i + 1] != '\n') step = 2;
-        else if (starts("\"\"\"")) in = In::code, step = 3;
-        break;
-      case In::ml_literal:
-        if (starts("'''")) in = In::code, step = 3;
-        break;
-    }
-    for (std::size_t k = 0; k < step && i < text.size(); ++k, ++i) {
-      if (text[i] == '\n') line += 1, column = 1;
-      else if ((static_cast<unsigned char>(text[i]) & 0xC0) != 0x80) column += 1;
-    }
-  }
-}
-
 }  // namespace
 
 Scene parse_scene(const std::string& text, const std::string& name, const fs::path& base_dir) {
-  reject_bare_non_ascii(text, name);
   toml::table root;
   try {
-    root = toml::parse(text, name);
+    root = toml::parse(detail::toml_ascii(text, name), name);  // why ASCII: toml_ascii.hpp
   } catch (const toml::parse_error& e) {
     std::ostringstream place;
     place << "line " << e.source().begin.line << ", column " << e.source().begin.column;
