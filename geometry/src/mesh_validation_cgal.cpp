@@ -204,7 +204,10 @@ RepairLog repair_mesh(TriangleMesh& m) {
   PMP::polygon_soup_to_polygon_mesh(points, polygons, sm);
   const std::size_t stitched = PMP::stitch_borders(sm);
   if (stitched > 0) log.actions.push_back("stitched " + std::to_string(stitched) + " pairs of border edges");
-  if (CGAL::is_closed(sm)) {
+  if (sm.number_of_faces() == 0) {
+    // Nothing left to orient (every triangle was degenerate or a duplicate); load_part says so.
+    // CGAL's orient_to_bound_a_volume reads an empty bit vector on an empty mesh (fuzz_mesh).
+  } else if (CGAL::is_closed(sm)) {
     PMP::orient_to_bound_a_volume(sm);
     log.actions.push_back("oriented every shell to bound a volume (outer shells outward, cavities inward)");
   } else {
