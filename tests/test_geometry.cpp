@@ -392,6 +392,31 @@ TEST(Files, PolygonsArePlyAndOffCubesAreExact) {
   }
 }
 
+// A flat face of a CAD-like part: the jet fit's heights are exact to rounding, and its curvatures
+// came out as +-1e-28 1/m; a "-3e-28" made the contact model refuse the point as concave and gave
+// an Eq. 26 radius of -4e28 m. Below the fit's rounding level they are exactly 0 (flat, an
+// infinite radius). Every vertex of the box that is not on a sharp edge lies inside a face.
+TEST(Curvature, FlatFacesOfABoxAreExactlyFlat) {
+  PartOptions opt;
+  opt.length_unit = LengthUnit::mm;
+  const Part p = load_part(data("box_200x100x60mm.stl"), opt);
+  const MeshShape& s = *p.shape;
+  EXPECT_EQ(s.sharp_edge_count() > 0, true);
+  std::size_t flat = 0;
+  for (const auto& v : s.mesh().vertices_m) {
+    const SurfacePoint at = s.closest_point(v);
+    const CurvatureFit f = s.curvature_fit(at.point_m);
+    if (f.curvature.sharp_feature) continue;
+    ++flat;
+    EXPECT_EQ(f.curvature.k1_per_m, 0.0) << v.transpose();
+    EXPECT_EQ(f.curvature.k2_per_m, 0.0) << v.transpose();
+    const double r = s.paper_radius_m(at);
+    EXPECT_TRUE(std::isinf(r) && r > 0) << v.transpose() << ": " << r;
+  }
+  EXPECT_GT(flat, 20u);
+  RecordProperty("flat_points", static_cast<int>(flat));
+}
+
 TEST(FileErrors, OpenInvertedNonManifoldPointsEmpty) {
   PartOptions opt;
   opt.length_unit = LengthUnit::mm;

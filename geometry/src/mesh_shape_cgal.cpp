@@ -517,6 +517,15 @@ CurvatureFit MeshShape::fit_curvature(const Eigen::Vector3d& point, bool with_co
   c.d2 = ev(f2.maximal_principal_direction());
   const double k1w = -f3.principal_curvatures(1), k2w = -f3.principal_curvatures(0);
   c.error_estimate_per_m = std::max(std::abs(k1w - c.k1_per_m), std::abs(k2w - c.k2_per_m));
+  // Rounding floor: a fit whose heights are exact to rounding (a flat face: heights ~1e-17 m)
+  // returns curvatures of either sign around 1e-28 1/m, and a "-3e-28" would read as concave
+  // (the contact model refuses it) and give a negative Eq. 26 radius of -4e28 m. Curvatures below
+  // the rounding level of the fit, 64 eps |p| / h^2 (position rounding over the squared spacing),
+  // are exactly 0: flat, an infinite radius.
+  const double floor = 64.0 * std::numeric_limits<double>::epsilon() * (p.norm() + ix.mean_edge) /
+                       (ix.mean_edge * ix.mean_edge);
+  for (double* k : {&c.k1_per_m, &c.k2_per_m})
+    if (std::abs(*k) <= floor) *k = 0.0;
   out.neighbourhood_points = static_cast<int>(hood_size);
   if (!std::isfinite(c.k1_per_m) || !std::isfinite(c.k2_per_m) || !std::isfinite(c.error_estimate_per_m)) {
     throw InputError("", "curvature", "the jet fit failed (degenerate neighbourhood)");
