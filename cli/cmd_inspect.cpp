@@ -236,7 +236,8 @@ void register_inspect(CLI::App& app, Context& /*ctx*/) {
         o << "    SHARP EDGE OR CORNER: curvature undefined, the local radius is your call\n";
       } else {
         o << "    principal curvatures " << q["principal_curvatures_1_per_m"].dump() << " 1/m (error estimate "
-          << q["curvature_error_estimate_1_per_m"].dump() << "), Eq. 26 radius " << q["paper_radius_m"].dump() << " m\n";
+          << q["curvature_error_estimate_1_per_m"].dump() << "), Eq. 26 radius "
+          << (q["paper_radius_m"].is_null() ? std::string("infinite (flat)") : q["paper_radius_m"].dump() + " m") << "\n";
       }
     }
     for (const auto& w : warnings) o << "  warning: " << w << "\n";

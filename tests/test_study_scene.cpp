@@ -133,7 +133,7 @@ TEST(SweepSharp, BoxCornersAndEdgesAreFlaggedAndLeftOut) {
   std::size_t circles = 0;
   for (std::size_t k = 0; (k = svg.find("<circle", k)) != std::string::npos; ++k) ++circles;
   EXPECT_EQ(circles, cloud.size() - 20 + 2);  // sharp points are crosses; two rings at the extremes
-  EXPECT_NE(svg.find("20 on sharp edges/corners"), std::string::npos);
+  EXPECT_NE(svg.find("20 points on sharp edges/corners"), std::string::npos);
 
   // Every point sharp: an error, not a ratio.
   std::vector<geometry::SurfacePoint> corners(cloud.begin(), cloud.begin() + 8);

@@ -353,10 +353,12 @@ plot::Drawing force_map_drawing(const geometry::Shape& target, const Eigen::Vect
       << plot::format_number(fmin * fu.factor, 4) << " " << fu.unit << " at " << coords(r.points[r.min_index].point_m)
       << ", max " << plot::format_number(fmax * fu.factor, 4) << " " << fu.unit << " at "
       << coords(r.points[r.max_index].point_m);
-  if (r.sharp_count > 0) sub << "; " << r.sharp_count << " on sharp edges/corners (grey x, left out)";
   dr.text({left, 48}, sub.str(), 12);
-  dr.text({left, 66}, "circle radius \xE2\x88\x9D F_max, darker = lower force; faded: far side", 11,
-          plot::Anchor::start, {0.35, 0.35, 0.35});
+  // The sharp-point count goes on the legend line: on the subtitle it ran past the picture's edge.
+  std::string legend = "circle radius \xE2\x88\x9D F_max, darker = lower force; faded: far side";
+  if (r.sharp_count > 0)
+    legend += "; " + std::to_string(r.sharp_count) + " points on sharp edges/corners (grey x, left out)";
+  dr.text({left, 66}, legend, 11, plot::Anchor::start, {0.35, 0.35, 0.35});
 
   // Colour bar.
   const double bx = o.width_px - 112, by0 = top + 20, by1 = bottom - 20, bwid = 20;
