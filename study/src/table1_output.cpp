@@ -1,9 +1,12 @@
 #include "impactdeck/study/table1_output.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "impactdeck/common/atomic_file.hpp"
 #include "impactdeck/common/error.hpp"
@@ -161,15 +164,33 @@ std::string table1_markdown(const Table1Result& r) {
 plot::Drawing table1_heatmap(const Table1Result& r) {
   const auto& G = r.options.geometric_ratios;
   const auto& M = r.options.mass_ratios;
-  const double cw = 52, ch = 28, left = 86, top = 74, gap = 78;
+  const std::string title = r.options.scene
+                                ? "Collision force ratio min/max F_max (scene-driven; no paper comparison)"
+                                : "Collision force ratio min/max F_max (paper Table 1)";
+  // The settings line is wrapped at its "; " separators (a scene path makes it long), and the
+  // picture is at least as wide as its text: one panel is narrower than its title. DejaVu Sans
+  // averages about 0.62 em per character in bold, 0.56 em in regular.
+  std::vector<std::string> settings{""};
+  {
+    const std::string all = settings_line(r);
+    std::size_t at = 0;
+    while (at < all.size()) {
+      std::size_t next = all.find("; ", at);
+      const std::string part = all.substr(at, next == std::string::npos ? std::string::npos : next + 2 - at);
+      if (!settings.back().empty() && settings.back().size() + part.size() > 95) settings.emplace_back();
+      settings.back() += part;
+      at = next == std::string::npos ? all.size() : next + 2;
+    }
+  }
+  double text_width = 0.62 * 16 * title.size();
+  for (const auto& line : settings) text_width = std::max(text_width, 0.56 * 11 * line.size());
+  const double cw = 52, ch = 28, left = 86, top = 74 + 15.0 * (settings.size() - 1), gap = 78;
   const int panels = r.compared ? 3 : 1;
   const double pw = cw * M.size(), ph = ch * G.size();
-  plot::Drawing d(left + panels * pw + (panels - 1) * gap + 30, top + ph + 118);
-  d.text({left, 26},
-         r.options.scene ? "Collision force ratio min/max F_max (scene-driven; no paper comparison)"
-                         : "Collision force ratio min/max F_max (paper Table 1)",
-         16, plot::Anchor::start, plot::kBlack, true);
-  d.text({left, 46}, settings_line(r), 11, plot::Anchor::start, {0.3, 0.3, 0.3});
+  plot::Drawing d(std::max(left + panels * pw + (panels - 1) * gap + 30, left + text_width + 20), top + ph + 118);
+  d.text({left, 26}, title, 16, plot::Anchor::start, plot::kBlack, true);
+  for (std::size_t i = 0; i < settings.size(); ++i)
+    d.text({left, 46 + 15.0 * i}, settings[i], 11, plot::Anchor::start, {0.3, 0.3, 0.3});
   const double dmax = 0.005;  // the acceptance bound on |delta|: the colour scale of the difference
   for (int panel = 0; panel < panels; ++panel) {
     const double x0 = left + panel * (pw + gap);
