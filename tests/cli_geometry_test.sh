@@ -3,12 +3,7 @@
 # keys of docs/geometry.md, one-line errors.  usage: cli_geometry_test.sh IMPACTDECK SOURCE_DIR
 set -u
 bin=$1; src=$2
-tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
-fails=0; passes=0
-check() {  # check NAME CONDITION...
-  local name=$1; shift
-  if "$@"; then passes=$((passes+1)); else echo "FAILED: $name"; fails=$((fails+1)); fi
-}
+. "$(dirname "$0")/check_lib.sh"
 
 "$bin" mesh-ellipsoid 30 20 10 --subdivisions 5 -o "$tmp/e.stl" >/dev/null
 check "mesh-ellipsoid exit 0" test $? -eq 0
@@ -66,5 +61,4 @@ check "sharp edge reported" python3 -c "import json,sys; p=json.load(open('$tmp/
 "$bin" inspect "$tmp/e.stl" --length-unit mm --density-kg-m3 1 --mass-kg 1 >/dev/null 2>&1; check "density xor mass exit 2" test $? -eq 2
 "$bin" mesh-ellipsoid 1 -1 1 -o "$tmp/x.stl" 2>/dev/null >/dev/null; check "negative axis exit 3" test $? -eq 3
 
-echo "cli_geometry_test: $passes passed, $fails failed"
-test $fails -eq 0
+finish cli_geometry_test

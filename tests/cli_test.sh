@@ -3,12 +3,7 @@
 # usage: cli_test.sh IMPACTDECK SOURCE_DIR
 set -u
 bin=$1; src=$2
-tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
-fails=0; passes=0
-check() {  # check NAME CONDITION...
-  local name=$1; shift
-  if "$@"; then passes=$((passes+1)); else echo "FAILED: $name"; fails=$((fails+1)); fi
-}
+. "$(dirname "$0")/check_lib.sh"
 
 # 1. The paper sample: exit 0, JSON with the contract keys, CSV written into --out.
 "$bin" run "$src/samples/paper_table2.toml" --json --out "$tmp/out" >"$tmp/p.json" 2>"$tmp/p.err"
@@ -145,5 +140,4 @@ passes=$((passes+1))
 check "sweep with every point on a corner exit 3" test $? -eq 3
 check "sweep names the sharp points" grep -q "all 8 points of the cloud lie on sharp edges or corners" "$tmp/sh2.err"
 
-echo "cli_end_to_end: $passes passed, $fails failed"
-test $fails -eq 0
+finish cli_end_to_end

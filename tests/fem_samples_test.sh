@@ -4,12 +4,7 @@
 # usage: fem_samples_test.sh IMPACTDECK SOURCE_DIR
 set -u
 bin=$1; src=$2
-tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
-fails=0; passes=0
-check() {  # check NAME CONDITION...
-  local name=$1; shift
-  if "$@"; then passes=$((passes+1)); else echo "FAILED: $name"; fails=$((fails+1)); fi
-}
+. "$(dirname "$0")/check_lib.sh"
 
 # 1. The paper's Table 2 case, coarse and short: linear momentum <= 0.1 % (central hit).
 "$bin" run "$src/samples/paper_table2_fem.toml" --json --out "$tmp/paper" >"$tmp/paper.json" 2>"$tmp/paper.err"
@@ -105,5 +100,4 @@ check "probe outside -> exit 3" test $? -eq 3
 check "probe outside message" grep -q "probe.toml: line [0-9]*, key 'outputs.fem': impact 'table2': FEM deck .*fem_table2/mesh.geo: PROBE1: probe point is not inside the ellipsoid" "$tmp/probe.err"
 check "no deck after a failure" test ! -e "$tmp/probe/fem_table2"
 
-echo "fem_samples_test: $passes passed, $fails failed"
-[ "$fails" -eq 0 ]
+finish fem_samples_test
