@@ -9,17 +9,12 @@
 #include "impactdeck/common/atomic_file.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/common/version.hpp"
+#include "number_text.hpp"
 
 namespace impactdeck::study {
 namespace {
 
-// 17 significant digits, never NaN/Inf, never "-0".
-std::string g17(double v) {
-  if (!std::isfinite(v)) throw Error(ExitCode::internal_error, "sweep output: non-finite value");
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", v + 0.0);
-  return buf;
-}
+std::string g17(double v) { return detail::g17(v, "sweep output"); }
 
 void header(std::ostream& o, const char* comment, const SweepMeta& m, const SweepResult& r) {
   o << comment << " impactdeck " << kVersion << " sweep: maximal Hertz contact force over the surface\n";

@@ -11,16 +11,12 @@
 #include "impactdeck/common/atomic_file.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/common/version.hpp"
+#include "number_text.hpp"
 
 namespace impactdeck::study {
 namespace {
 
-std::string g17(double v) {
-  if (!std::isfinite(v)) throw Error(ExitCode::internal_error, "table1 output: non-finite value");
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", v + 0.0);
-  return buf;
-}
+std::string g17(double v) { return detail::g17(v, "table1 output"); }
 
 std::string fixed(double v, int decimals, bool sign = false) {
   char buf[40];
