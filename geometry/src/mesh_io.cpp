@@ -140,8 +140,7 @@ void check_ply_header(const fs::path& file, const std::string& where, std::uintm
   int line_no = 0;
   bool binary = false;
   long double minimal = 0, element_count = 0, element_size = 0;
-  const std::string place_prefix = "line ";
-  auto fail = [&](const std::string& reason) { throw InputError(where, place_prefix + std::to_string(line_no), reason); };
+  auto fail = [&](const std::string& reason) { throw InputError(where, "line " + std::to_string(line_no), reason); };
   auto close_element = [&] { minimal += element_count * element_size; };
   std::uintmax_t header_bytes = 0;
   while (std::getline(in, line)) {
