@@ -79,3 +79,24 @@ TEST(Elliptical, RejectsNonConvex) {
   EXPECT_THROW(elliptical_contact({0.0, 1.0}), impactdeck::InputError);
   EXPECT_THROW(elliptical_contact({2.0, 1.0}), impactdeck::InputError);
 }
+
+// Contact ellipse semi-axes: the sphere-on-sphere closed form a = (3 P R* / (4 E*))^(1/3) (Hertz;
+// Johnson, Contact Mechanics, Eq. 4.22), the P^(1/3) growth, and the long axis along the direction
+// of the smaller relative curvature.
+TEST(Elliptical, ContactEllipseSemiAxes) {
+  const double R1 = 0.05, R2 = 0.02, E = 1.1e11, P = 1234.0;
+  const Eigen::Vector3d n(0, 0, 1), x(1, 0, 0), y(0, 1, 0);
+  const RelativeCurvatures rc = relative_curvatures(1 / R1, 1 / R1, x, y, 1 / R2, 1 / R2, x, y, n);
+  const ContactEllipse ce = contact_ellipse(rc, elliptical_contact(rc), E, P);
+  const double Rstar = R1 * R2 / (R1 + R2);
+  const double a = std::cbrt(3.0 * P * Rstar / (4.0 * E));
+  EXPECT_NEAR(ce.a_m / a, 1.0, 1e-12);
+  EXPECT_NEAR(ce.b_m / a, 1.0, 1e-12);
+  const ContactEllipse ce8 = contact_ellipse(rc, elliptical_contact(rc), E, 8.0 * P);
+  EXPECT_NEAR(ce8.a_m / ce.a_m, 2.0, 1e-12);
+  // A cylinder-like target (k = 10 along x, 0 along y) against a sphere: A lies along y.
+  const RelativeCurvatures cyl = relative_curvatures(10.0, 0.0, x, y, 1 / R2, 1 / R2, x, y, n);
+  EXPECT_NEAR(std::abs(cyl.direction_A.dot(y)), 1.0, 1e-12);
+  const ContactEllipse ec = contact_ellipse(cyl, elliptical_contact(cyl), E, P);
+  EXPECT_GT(ec.a_m, ec.b_m);
+}

@@ -78,7 +78,8 @@ RelativeCurvatures relative_curvatures(double k1a, double k2a, const Eigen::Vect
   // Gap h = 1/2 x^T (C_a + C_b) x = A x^2 + B y^2 in the principal frame of the sum.
   const Eigen::Matrix2d sum = 0.5 * (tensor(k1a, k2a, d1a, d2a) + tensor(k1b, k2b, d1b, d2b));
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(0.5 * (sum + sum.transpose()));
-  return {es.eigenvalues()[0], es.eigenvalues()[1]};
+  const Eigen::Vector2d ev = es.eigenvectors().col(0);
+  return {es.eigenvalues()[0], es.eigenvalues()[1], (T * ev).normalized()};
 }
 
 EllipticalContact elliptical_contact(const RelativeCurvatures& c) {
@@ -109,6 +110,12 @@ EllipticalContact elliptical_contact(const RelativeCurvatures& c) {
   r.m = std::cbrt((2.0 / M_PI) * (1.0 + target) * s.s1);
   r.n = r.m * std::sqrt(1.0 - m);
   return r;
+}
+
+ContactEllipse contact_ellipse(const RelativeCurvatures& c, const EllipticalContact& e,
+                               double effective_modulus_Pa, double force_N) {
+  const double q = std::cbrt(3.0 * force_N / (4.0 * effective_modulus_Pa * (c.A_per_m + c.B_per_m)));
+  return {e.m * q, e.n * q};
 }
 
 }  // namespace impactdeck::collision

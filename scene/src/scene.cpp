@@ -185,7 +185,7 @@ class Reader {
 // All keys a reader may see are declared by reading them; sub-tables are read by their own reader.
 Material read_material(const std::string& name, const toml::table& t, const std::string& file) {
   Reader r(t, "materials." + name, file);
-  r.allow({"youngs_modulus_Pa", "poisson_ratio", "density_kg_m3"});
+  r.allow({"youngs_modulus_Pa", "poisson_ratio", "density_kg_m3", "yield_strength_Pa"});
   Material m;
   m.name = name;
   m.place = r.self();
@@ -195,6 +195,7 @@ Material read_material(const std::string& name, const toml::table& t, const std:
     r.fail("poisson_ratio", "must lie in (-1, 0.5), got " + Reader::fmt(m.elastic.poisson_ratio));
   }
   if (r.has("density_kg_m3")) m.density_kg_m3 = r.positive("density_kg_m3");
+  if (r.has("yield_strength_Pa")) m.yield_strength_Pa = r.positive("yield_strength_Pa");
   r.reject_unknown();
   return m;
 }

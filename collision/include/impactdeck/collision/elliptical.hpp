@@ -17,6 +17,9 @@ namespace impactdeck::collision {
 struct RelativeCurvatures {
   double A_per_m = 0;  ///< smaller, > 0
   double B_per_m = 0;  ///< larger
+  /// Unit tangent direction of A (the contact ellipse's long semi-axis a lies along it); the short
+  /// semi-axis b lies along normal x direction_A.
+  Eigen::Vector3d direction_A = Eigen::Vector3d::UnitX();
 };
 
 /// A, B from each surface's principal curvatures (1/m, convex positive) and directions (unit,
@@ -39,5 +42,14 @@ struct EllipticalContact {
 
 /// Solves for the contact ellipse. Throws InputError unless 0 < A <= B (finite).
 EllipticalContact elliptical_contact(const RelativeCurvatures& c);
+
+/// Semi-axes of the contact ellipse under the normal force P (a >= b, m):
+/// a = m [3P/(4E*(A+B))]^(1/3), b = n [...]^(1/3) (Timoshenko & Goodier, Sect. 140). They grow as
+/// P^(1/3); the peak pressure is p0 = 3P/(2 pi a b).
+struct ContactEllipse {
+  double a_m = 0, b_m = 0;
+};
+ContactEllipse contact_ellipse(const RelativeCurvatures& c, const EllipticalContact& e,
+                               double effective_modulus_Pa, double force_N);
 
 }  // namespace impactdeck::collision

@@ -27,6 +27,9 @@ struct Material {
   std::string name;
   collision::ElasticMaterial elastic;
   std::optional<double> density_kg_m3;
+  /// Optional yield strength sigma_y (Pa): the validity report compares the peak Hertz pressure
+  /// with the onset of yield, and the FEM verdict compares stresses with it.
+  std::optional<double> yield_strength_Pa;
   Place place;
 };
 
