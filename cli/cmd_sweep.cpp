@@ -131,7 +131,7 @@ void register_sweep(CLI::App& app, Context& ctx) {
     study::write_sweep_vtp(with(".vtp"), r, meta);
     study::ForceMapOptions fo;
     fo.title = "Maximal collision force: " + imp.impactor + " hits " + imp.target + " (impact '" + imp.name + "')";
-    const plot::Drawing pic = study::force_map_drawing(*ss.setup.target.shape, ss.setup.target.centroid_m, r, fo);
+    const plot::Drawing pic = study::force_map_drawing(*ss.setup.target.shape, ss.setup.target.volume.centroid_m, r, fo);
     plot::write_svg(with(".svg"), pic);
     if (!a->no_png) plot::write_png(with(".png"), pic, 1.5);
 
@@ -151,6 +151,12 @@ void register_sweep(CLI::App& app, Context& ctx) {
       j["approach_speed_m_s"] = ss.setup.approach_speed_m_s;
       j["restitution_clamped_points"] = r.restitution_clamped_count;
       j["sharp_points"] = r.sharp_count;
+      j["flagged_points"] = r.flagged_count;
+      nlohmann::json flags = nlohmann::json::object();
+      for (int f = 1; f < collision::kContactFlagCount; ++f) {
+        flags[collision::flag_word(static_cast<collision::ContactFlag>(f))] = r.flag_counts[f];
+      }
+      j["flag_counts"] = flags;
       j["threads"] = r.threads_used;
       j["seconds"] = r.seconds;
       nlohmann::json fl = nlohmann::json::array();
@@ -175,9 +181,15 @@ void register_sweep(CLI::App& app, Context& ctx) {
                 << ")\n"
                 << "  time                  " << r.seconds << " s on " << r.threads_used << " threads ("
                 << std::setprecision(3) << rate << " points/s)\n";
-      if (r.sharp_count > 0) {
-        std::cout << "  sharp points          " << r.sharp_count
-                  << " on sharp edges or corners (no local radius; left out of min/max, flagged in the files)\n";
+      if (r.flagged_count > 0) {
+        std::cout << "  flagged points        " << r.flagged_count << " (";
+        bool any = false;
+        for (int f = 1; f < collision::kContactFlagCount; ++f) {
+          if (r.flag_counts[f] == 0) continue;
+          std::cout << (any ? ", " : "") << r.flag_counts[f] << " " << collision::flag_word(static_cast<collision::ContactFlag>(f));
+          any = true;
+        }
+        std::cout << "): the model does not apply there; left out of min/max, `flag` column in the files\n";
       }
       if (r.restitution_clamped_count > 0) {
         std::cout << "  warning: ln(Phi) clamped into Eq. 30's range at " << r.restitution_clamped_count

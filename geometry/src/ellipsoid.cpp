@@ -202,6 +202,9 @@ Curvature Ellipsoid::curvature(const SurfacePoint& at) const {
 }
 
 double Ellipsoid::paper_radius_m(const SurfacePoint& at) const {
+  // A sphere's radius is its radius wherever it is hit: Eq. 26's axis-normal sections are not
+  // normal sections (Meusnier), so off the axes they would give less than r (MODEL.md).
+  if (is_sphere()) return e_.x();
   const Eigen::Vector3d& p = at.point_m;
   double sum = 0.0;
   int count = 0;
@@ -267,6 +270,20 @@ double ellipsoid_gaussian_curvature(const Eigen::Vector3d& e, const Eigen::Vecto
   const double abc2 = std::pow(e.prod(), 2);
   const double h2 = p.cwiseQuotient(e.cwiseProduct(e)).squaredNorm();
   return 1.0 / (abc2 * h2 * h2);
+}
+
+}  // namespace impactdeck::geometry
+
+namespace impactdeck::geometry {
+
+std::optional<SurfacePoint> Ellipsoid::support_point(const Eigen::Vector3d& d) const {
+  const Eigen::Vector3d Md = e_.cwiseProduct(e_).cwiseProduct(d);
+  const double q = d.dot(Md);
+  if (!(q > 0.0) || !std::isfinite(q)) return std::nullopt;
+  SurfacePoint s;
+  s.point_m = Md / std::sqrt(q);
+  s.normal = d.normalized();
+  return s;
 }
 
 }  // namespace impactdeck::geometry

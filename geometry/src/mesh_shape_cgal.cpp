@@ -611,3 +611,30 @@ std::vector<SurfacePoint> MeshShape::sample_surface(std::size_t count, std::uint
 }
 
 }  // namespace impactdeck::geometry
+
+// Temporary (the `contact` branch brings the full first-contact geometry): extreme vertex and a
+// winding-number inside test.
+namespace impactdeck::geometry {
+
+std::optional<SurfacePoint> MeshShape::support_point(const Eigen::Vector3d& d) const {
+  if (mesh_.vertices_m.empty() || !(d.norm() > 0.0)) return std::nullopt;
+  std::size_t best = 0;
+  double h = -std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < mesh_.vertices_m.size(); ++i) {
+    const double v = d.dot(mesh_.vertices_m[i]);
+    if (v > h) { h = v; best = i; }
+  }
+  SurfacePoint sp = closest_point(mesh_.vertices_m[best]);
+  sp.point_m = mesh_.vertices_m[best];
+  sp.distance_m = 0;
+  return sp;
+}
+
+bool MeshShape::contains(const Eigen::Vector3d& p) const {
+  const ShellLabels shells = label_shells(mesh_);
+  double w = 0;
+  for (int s = 0; s < shells.shell_count; ++s) w += winding_number(mesh_, shells, s, p);
+  return w > 0.5;
+}
+
+}  // namespace impactdeck::geometry

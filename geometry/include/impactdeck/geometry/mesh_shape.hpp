@@ -58,6 +58,9 @@ class MeshShape final : public Shape {
   double size_m() const override;
   /// Area-uniform over the triangles (cumulative areas, deterministic mt19937_64).
   std::vector<SurfacePoint> sample_surface(std::size_t count, std::uint64_t seed) const override;
+  /// The extreme vertex (an exact support of the polytope), with closest_point's normal there.
+  std::optional<SurfacePoint> support_point(const Eigen::Vector3d& direction) const override;
+  bool contains(const Eigen::Vector3d& p) const override;
 
   const TriangleMesh& mesh() const { return mesh_; }
   const MeshMassProperties& mass_properties() const { return mass_; }
