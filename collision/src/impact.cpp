@@ -54,6 +54,9 @@ std::string explain_flag(const KernelInput& in, const KernelResult& r, const std
     case ContactFlag::restitution_invalid:
       s << "restitution: " << describe_restitution(*in.restitution, r.restitution, r.approach_velocity_m_s);
       break;
+    case ContactFlag::no_curvature:
+      s << "the curvature of a surface cannot be estimated at the contact point (a mesh too coarse there)";
+      break;
     case ContactFlag::degenerate:
       s << "the impact cannot be computed in double precision (an input or result under- or overflows: reduced "
            "mass "
@@ -84,7 +87,9 @@ ImpactResult solve_impact(const ImpactInput& in) {
   if (in.restitution.kind == RestitutionModel::Kind::table) validate_restitution_table(in.restitution.table);
 
   Contact c = in.contact;
-  c.normal /= nn;
+  // A unit normal is used as given (bit for bit what the kernel sees in a sweep); others are
+  // normalised.
+  if (std::abs(nn - 1.0) > 1e-12) c.normal /= nn;
   KernelInput k;
   k.target = kernel_body(in.target);
   k.impactor = kernel_body(in.impactor);

@@ -30,6 +30,7 @@ const char* flag_word(ContactFlag f) {
     case ContactFlag::restitution_range: return "restitution-range";
     case ContactFlag::restitution_invalid: return "restitution-invalid";
     case ContactFlag::degenerate: return "degenerate";
+    case ContactFlag::no_curvature: return "no-curvature";
   }
   return "?";
 }

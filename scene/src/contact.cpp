@@ -80,9 +80,17 @@ collision::ContactCurvature ContactModel::surface(const PreparedBody& b, const g
 
 ContactEvaluation ContactModel::evaluate(ContactEvaluation e, const Eigen::Vector3d& impactor_centroid_world,
                                         std::optional<double> approach_speed_m_s) const {
-  e.target_curvature = target_.shape->curvature(e.target_point);
-  e.impactor_curvature = impactor_.shape->curvature(e.impactor_point);
   collision::KernelInput& in = e.input;
+  try {
+    e.target_curvature = target_.shape->curvature(e.target_point);
+    e.impactor_curvature = impactor_.shape->curvature(e.impactor_point);
+  } catch (const InputError& err) {
+    // A curvature fit that cannot be made (too few vertices around the point): flagged, so that a
+    // sweep goes on and `run` names the reason.
+    e.curvature_problem = (err.place().empty() ? "" : err.place() + ": ") + err.reason();
+    e.result.flag = collision::ContactFlag::no_curvature;
+    return e;
+  }
   in.target = target_body_;
   in.impactor = impactor_body_;
   in.target.lever_arm_m = e.point_m - target_.centroid_world_m();

@@ -294,7 +294,8 @@ RunReport run_scene(const Scene& scene, const RunOptions& opt) {
       const Place place{s.place.line, s.place.key + (s.first_contact ? ".point" : ".point")};
       throw InputError(where(scene), place.describe(),
                        "impact '" + s.name + "': at " + text(ir.contact.point_m) + " m (normal " +
-                           text(ir.contact.normal) + "): " + collision::explain_flag(ir.contact.input, ir.contact.result, "'" + s.target + "'", "'" + s.impactor + "'"));
+                           text(ir.contact.normal) + "): " + collision::explain_flag(ir.contact.input, ir.contact.result, "'" + s.target + "'", "'" + s.impactor + "'") +
+                           (ir.contact.curvature_problem.empty() ? "" : " (" + ir.contact.curvature_problem + ")"));
     }
     if (s.contact_radius == ContactRadiusRule::paper) {
       for (const PreparedBody* b : {&target, &impactor}) {

@@ -29,6 +29,8 @@ PointResult sweep_point(const scene::ContactModel& model, double speed, const ge
   r.flag = k.flag;
   r.sharp_feature = k.flag == collision::ContactFlag::sharp;
   if (r.flagged()) return r;
+  r.target_k1_per_m = e.input.target.curvature.k1_per_m;
+  r.target_k2_per_m = e.input.target.curvature.k2_per_m;
   r.target_radius_m = rule_radius(e.input.target.curvature, model.rule());
   r.impactor_radius_m = rule_radius(e.input.impactor.curvature, model.rule());
   r.effective_radius_m = k.effective_radius_m;

@@ -82,12 +82,13 @@ enum class ContactFlag : std::uint8_t {
   restitution_range,    ///< outside the restitution model's range under policy "error"
   restitution_invalid,  ///< R outside [0, 1]
   degenerate,           ///< input or result not finite (under- or overflow)
+  no_curvature,         ///< the surface's curvature cannot be estimated there (mesh too coarse)
 };
 /// "" for none, else "sharp", "no-fit", "saddle", "line", "flat", "no-approach",
-/// "restitution-range", "restitution-invalid", "degenerate".
+/// "restitution-range", "restitution-invalid", "degenerate", "no-curvature".
 const char* flag_word(ContactFlag f);
 /// Number of flags (for counting them).
-inline constexpr int kContactFlagCount = 10;
+inline constexpr int kContactFlagCount = 11;
 
 struct KernelResult {
   ContactFlag flag = ContactFlag::none;

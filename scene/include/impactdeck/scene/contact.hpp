@@ -58,6 +58,8 @@ struct ContactEvaluation {
   double travel_m = 0;                    ///< first contact: distance travelled
   geometry::Curvature target_curvature;   ///< own frames, as fitted (error estimates kept)
   geometry::Curvature impactor_curvature;
+  /// Why a curvature could not be estimated (result.flag no_curvature), e.g. a coarse mesh.
+  std::string curvature_problem;
   collision::KernelInput input;
   collision::KernelResult result;
 };

@@ -61,6 +61,7 @@ struct PointResult {
   /// sweep overlays the part and its FEM deck whatever the target's placement.
   Eigen::Vector3d point_m = Eigen::Vector3d::Zero();
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  ///< target's outward unit normal
+  double target_k1_per_m = 0, target_k2_per_m = 0;  ///< target's principal curvatures (concave < 0)
   double target_radius_m = 0;       ///< local radius of the target by the rule (1/H unless "paper")
   double impactor_radius_m = 0;     ///< the same for the impactor at its contact point
   double effective_radius_m = 0;    ///< R* by the rule (R_eq for "elliptical")
