@@ -379,6 +379,10 @@ class OpaqueShape final : public geometry::Shape {
   std::vector<geometry::SurfacePoint> sample_surface(std::size_t n, std::uint64_t seed) const override {
     return e_.sample_surface(n, seed);
   }
+  std::optional<geometry::SurfacePoint> support_point(const Eigen::Vector3d& d) const override {
+    return e_.support_point(d);
+  }
+  bool contains(const Eigen::Vector3d& p) const override { return e_.contains(p); }
 
  private:
   geometry::Ellipsoid e_;
