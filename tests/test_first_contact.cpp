@@ -756,6 +756,28 @@ TEST(FirstContact, BadPlacementsAreOneLineErrors) {
   expect_message(input_error_of([] { Plane({0, 0, 0}); }), "^normal: must be a non-zero finite vector$");
   expect_message(input_error_of([] { Pose::from_axis_angle({0, 0, 0}, {0, 0, 0}, 0.5); }),
                  "^orientation_axis: must be a non-zero finite vector$");
+  // A shape kind the search does not know (here a sphere seen only through the Shape interface).
+  struct Unknown final : Shape {
+    Ellipsoid e = Ellipsoid::sphere(0.3);
+    std::string kind() const override { return "unknown"; }
+    VolumeProperties volume_properties() const override { return e.volume_properties(); }
+    SurfacePoint closest_point(const Vector3d& q) const override { return e.closest_point(q); }
+    Curvature curvature(const SurfacePoint& at) const override { return e.curvature(at); }
+    double paper_radius_m(const SurfacePoint& at) const override { return e.paper_radius_m(at); }
+    std::optional<SurfacePoint> ray_exit(const Vector3d& o, const Vector3d& dir) const override {
+      return e.ray_exit(o, dir);
+    }
+    double size_m() const override { return e.size_m(); }
+    std::vector<SurfacePoint> sample_surface(std::size_t n, std::uint64_t seed) const override {
+      return e.sample_surface(n, seed);
+    }
+    std::optional<SurfacePoint> support_point(const Vector3d& dir) const override { return e.support_point(dir); }
+    bool contains(const Vector3d& p) const override { return e.contains(p); }
+  } unknown;
+  expect_message(input_error_of([&] { first_contact({&a, origin}, {&unknown, above}, {0, 0, -1}); }),
+                 "^no first-contact method for the shape kinds 'unknown' \\(moving\\) and 'ellipsoid'$");
+  // Through its support point it still lands on a floor.
+  EXPECT_NEAR(first_contact({&floor, origin}, {&unknown, above}, {0, 0, -1}).travel_m, 2.7, 1e-15);
   // Touching at travel 0 (within the 1e-9 allowance) is a contact, not an overlap.
   Pose resting;
   resting.position_m = {0, 0, 0.3 - 1e-12};

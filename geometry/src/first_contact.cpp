@@ -550,8 +550,8 @@ FirstContact first_contact(const PlacedShape& target_in, const PlacedShape& move
   } else if (target.mesh && mover.mesh) {
     h = mesh_pair(target, mover, d, tol);
   } else {
-    throw InputError("", "", "no first-contact method for a " + mover.shape->kind() + " moving onto a " +
-                                 target.shape->kind());
+    throw InputError("", "", "no first-contact method for the shape kinds '" + mover.shape->kind() + "' (moving) and '" +
+                                 target.shape->kind() + "'");
   }
   return dress(target, mover, d, h);
 }
