@@ -638,7 +638,7 @@ TEST(FirstContact, SphereOntoAMeshAgainstCgalClosestPoints) {
 
 // ---------------------------------------------------------------------------------------------
 TEST(FirstContact, TwoMeshPartsAgainstBruteForce) {
-  // Two copies of a concave CGAL demo part (u.off, 168 triangles) in random placements: every
+  // Two copies of a concave CGAL demo part (u.off, 168 triangles) in 8 random placements: every
   // vertex-face and edge-edge pair in the world frame, against the tree-pruned search.
   const TriangleMesh u = load_mesh(data("u.off"), LengthUnit::m).mesh;
   const auto target = mesh_shape(u), mover = mesh_shape(u);
@@ -647,7 +647,7 @@ TEST(FirstContact, TwoMeshPartsAgainstBruteForce) {
   int hits = 0, misses = 0;
   std::map<std::string, int> kinds;
   double worst = 0;
-  for (int trial = 0; trial < 16; ++trial) {
+  for (int trial = 0; trial < 8; ++trial) {
     Pose pt, pm;
     pt.rotation = random_rotation(rng);
     pm.rotation = random_rotation(rng);
@@ -676,7 +676,7 @@ TEST(FirstContact, TwoMeshPartsAgainstBruteForce) {
   std::printf("u.off pairs: %d hits (", hits);
   for (const auto& [k, c] : kinds) std::printf(" %s %d", k.c_str(), c);
   std::printf(" ), %d misses; worst |travel or point error| %.1e m\n", misses, worst);
-  EXPECT_GE(hits, 8);
+  EXPECT_GE(hits, 5);
   EXPECT_GE(kinds.size(), 2u);
 }
 
