@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <random>
 #include <sstream>
@@ -260,6 +261,23 @@ std::vector<SurfacePoint> Ellipsoid::sample_surface(std::size_t count, std::uint
   return out;
 }
 
+std::optional<SurfacePoint> Ellipsoid::support_point(const Eigen::Vector3d& direction) const {
+  const double len = direction.norm();
+  if (!(len > 0.0) || !std::isfinite(len)) throw InputError("", "direction", "must be a non-zero finite vector");
+  // Scaled first (u = direction / |direction|): |M u| stays finite for any finite direction.
+  const Eigen::Vector3d u = direction / len;
+  const Eigen::Vector3d mu = e_.cwiseProduct(e_).cwiseProduct(u);
+  SurfacePoint sp;
+  sp.point_m = mu / std::sqrt(u.dot(mu));
+  sp.normal = u;
+  sp.distance_m = 0.0;
+  return sp;
+}
+
+bool Ellipsoid::contains(const Eigen::Vector3d& p) const {
+  return p.cwiseQuotient(e_).squaredNorm() <= 1.0 + 16.0 * std::numeric_limits<double>::epsilon();
+}
+
 double ellipsoid_mean_curvature(const Eigen::Vector3d& e, const Eigen::Vector3d& p) {
   const double abc2 = std::pow(e.prod(), 2);
   const double h2 = p.cwiseQuotient(e.cwiseProduct(e)).squaredNorm();
@@ -270,20 +288,6 @@ double ellipsoid_gaussian_curvature(const Eigen::Vector3d& e, const Eigen::Vecto
   const double abc2 = std::pow(e.prod(), 2);
   const double h2 = p.cwiseQuotient(e.cwiseProduct(e)).squaredNorm();
   return 1.0 / (abc2 * h2 * h2);
-}
-
-}  // namespace impactdeck::geometry
-
-namespace impactdeck::geometry {
-
-std::optional<SurfacePoint> Ellipsoid::support_point(const Eigen::Vector3d& d) const {
-  const Eigen::Vector3d Md = e_.cwiseProduct(e_).cwiseProduct(d);
-  const double q = d.dot(Md);
-  if (!(q > 0.0) || !std::isfinite(q)) return std::nullopt;
-  SurfacePoint s;
-  s.point_m = Md / std::sqrt(q);
-  s.normal = d.normalized();
-  return s;
 }
 
 }  // namespace impactdeck::geometry

@@ -4,80 +4,78 @@
 #include <limits>
 
 #include "impactdeck/common/error.hpp"
-#include "impactdeck/geometry/pose.hpp"
 
 namespace impactdeck::geometry {
 
-Pose Pose::from_axis_angle(const Eigen::Vector3d& p, const Eigen::Vector3d& axis, double angle) {
-  const double len = axis.norm();
-  if (!(len > 0.0) || !std::isfinite(len) || !std::isfinite(angle)) {
-    throw InputError("", "orientation_axis", "must have a non-zero finite length");
-  }
-  Pose pose;
-  pose.rotation = Eigen::AngleAxisd(angle, axis / len).toRotationMatrix();
-  pose.position_m = p;
-  return pose;
+namespace {
+constexpr double kEps = std::numeric_limits<double>::epsilon();
 }
 
-SurfacePoint to_world(const Pose& pose, const SurfacePoint& own) {
-  SurfacePoint w = own;
-  w.point_m = pose.to_world(own.point_m);
-  w.normal = pose.direction_to_world(own.normal);
-  return w;
-}
-
-Curvature to_world(const Pose& pose, const Curvature& own) {
-  Curvature w = own;
-  w.d1 = pose.direction_to_world(own.d1);
-  w.d2 = pose.direction_to_world(own.d2);
-  return w;
-}
-
-Plane::Plane(const Eigen::Vector3d& n) {
-  const double len = n.norm();
-  if (!(len > 0.0) || !std::isfinite(len)) throw InputError("", "normal", "must be a non-zero finite vector");
-  n_ = n / len;
+Plane::Plane(const Eigen::Vector3d& normal) {
+  const double largest = normal.cwiseAbs().maxCoeff();
+  if (!normal.allFinite() || !(largest > 0.0)) throw InputError("", "normal", "must be a non-zero finite vector");
+  n_ = (normal / largest).normalized();
+  // Tangent pair: the coordinate axis least aligned with n, made orthogonal.
+  Eigen::Index k = 0;
+  n_.cwiseAbs().minCoeff(&k);
+  t1_ = (Eigen::Vector3d::Unit(k) - n_[k] * n_).normalized();
+  t2_ = n_.cross(t1_);
 }
 
 SurfacePoint Plane::closest_point(const Eigen::Vector3d& q) const {
-  SurfacePoint s;
-  const double d = n_.dot(q);
-  s.point_m = q - d * n_;
-  s.normal = n_;
-  s.distance_m = std::abs(d);
-  return s;
+  if (!q.allFinite()) throw InputError("", "point", "must be finite");
+  SurfacePoint sp;
+  const double h = n_.dot(q);
+  sp.point_m = q - h * n_;
+  sp.normal = n_;
+  sp.distance_m = std::abs(h);
+  return sp;
 }
 
-Curvature Plane::curvature(const SurfacePoint&) const {
+Curvature Plane::curvature(const SurfacePoint& /*at*/) const {
   Curvature c;
-  const Eigen::Vector3d helper = std::abs(n_.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
-  c.d1 = n_.cross(helper).normalized();
-  c.d2 = n_.cross(c.d1);
+  c.k1_per_m = c.k2_per_m = 0.0;
+  c.d1 = t1_;
+  c.d2 = t2_;
+  c.error_estimate_per_m = 0.0;
+  c.sharp_feature = false;
   return c;
 }
 
-double Plane::paper_radius_m(const SurfacePoint&) const { return std::numeric_limits<double>::infinity(); }
+double Plane::paper_radius_m(const SurfacePoint& /*at*/) const { return std::numeric_limits<double>::infinity(); }
 
-std::optional<SurfacePoint> Plane::ray_exit(const Eigen::Vector3d& o, const Eigen::Vector3d& d) const {
-  const double dn = n_.dot(d);
-  if (!(dn > 0.0)) return std::nullopt;
-  SurfacePoint s;
-  s.point_m = o - (n_.dot(o) / dn) * d;
-  s.normal = n_;
-  return s;
+std::optional<SurfacePoint> Plane::ray_exit(const Eigen::Vector3d& o, const Eigen::Vector3d& dir) const {
+  if (!o.allFinite() || !dir.allFinite()) return std::nullopt;
+  const double h = n_.dot(o), rate = n_.dot(dir);
+  if (h > 0.0 || !(rate > 0.0)) return std::nullopt;
+  SurfacePoint sp;
+  sp.point_m = o + (-h / rate) * dir;
+  sp.point_m -= n_.dot(sp.point_m) * n_;  // onto the plane to rounding
+  sp.normal = n_;
+  sp.distance_m = 0.0;
+  return sp;
 }
 
-std::vector<SurfacePoint> Plane::sample_surface(std::size_t, std::uint64_t) const {
-  throw InputError("", "plane", "a plane has no finite surface to sample");
+std::vector<SurfacePoint> Plane::sample_surface(std::size_t /*count*/, std::uint64_t /*seed*/) const {
+  throw InputError("", "plane", "an unbounded plane has no finite surface to sample");
 }
 
-std::optional<SurfacePoint> Plane::support_point(const Eigen::Vector3d& d) const {
-  // Bounded only along the outward normal itself: the support set is the whole plane; the origin
-  // stands for it.
-  if (d.cross(n_).norm() > 1e-12 * d.norm() || !(d.dot(n_) > 0.0)) return std::nullopt;
-  SurfacePoint s;
-  s.normal = n_;
-  return s;
+std::optional<SurfacePoint> Plane::support_point(const Eigen::Vector3d& direction) const {
+  const double largest = direction.cwiseAbs().maxCoeff();
+  if (!direction.allFinite() || !(largest > 0.0)) {
+    throw InputError("", "direction", "must be a non-zero finite vector");
+  }
+  const Eigen::Vector3d u = (direction / largest).normalized();
+  // |u - n| is the angle between them (to first order): 64 ulps allow for a normal that went
+  // through a rotation and back.
+  if (!((u - n_).norm() <= 64.0 * kEps)) return std::nullopt;
+  SurfacePoint sp;
+  sp.point_m.setZero();
+  sp.normal = n_;
+  sp.distance_m = 0.0;
+  return sp;
 }
+
+bool Plane::contains(const Eigen::Vector3d& p) const { return n_.dot(p) <= 16.0 * kEps * p.norm(); }
 
 }  // namespace impactdeck::geometry
