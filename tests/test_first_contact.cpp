@@ -558,7 +558,9 @@ TEST(FirstContact, MeshedEllipsoidConvergesToTheAnalyticContact) {
     const double size = analytic.size_m();
     const FirstContact drop = first_contact({&floor, floor_pose}, {mesh.get(), pose}, d_drop);
     const FirstContact hit = first_contact({mesh.get(), pose}, {&ball, ball_pose}, d_ball);
-    EXPECT_EQ(drop.kind, "vertex-smooth");
+    // Refined onto the smoothed surface (MeshShape::smooth_support_point) from 320 triangles on; the
+    // 80-triangle mesh's normals bracket no face near the vertex and keep the vertex.
+    EXPECT_EQ(drop.kind, n == 1 ? "vertex-smooth" : "face-smooth");
     EXPECT_EQ(hit.kind.substr(0, 7), "smooth-");
     EXPECT_LE(drop.gap_residual_m, 1e-12 * 100);
     EXPECT_LE(hit.gap_residual_m, 1e-12 * 100);
@@ -583,11 +585,11 @@ TEST(FirstContact, MeshedEllipsoidConvergesToTheAnalyticContact) {
   RecordProperty("order_ball_travel", sci(o_bt));
   RecordProperty("order_ball_normal", sci(o_bn));
   // Inscribed polyhedron: the gap to the true surface is O(h^2) (travel), the contact point and
-  // the face normal O(h).
+  // the face normal O(h); the drop's point, on the smoothed surface, is O(h^2) (measured 2.05).
   EXPECT_GE(o_dt, 2.0 - test::kContactRateSlack);
   EXPECT_GE(o_bt, 2.0 - test::kContactRateSlack);
   EXPECT_GE(o_bn, 1.0 - test::kContactRateSlack);
-  EXPECT_GE(o_dp, 1.0 - test::kContactRateSlack);
+  EXPECT_GE(o_dp, 2.0 - test::kContactRateSlack);
   EXPECT_GE(o_bp, 1.0 - test::kContactRateSlack);
   EXPECT_LE(drop_travel.back(), 1e-4);
   EXPECT_LE(ball_travel.back(), 1e-4);

@@ -815,3 +815,52 @@ bool MeshShape::contains(const Eigen::Vector3d& q) const {
 }
 
 }  // namespace impactdeck::geometry
+
+namespace impactdeck::geometry {
+
+std::optional<SurfacePoint> MeshShape::smooth_support_point(const Eigen::Vector3d& direction) const {
+  const auto vertex = support_point(direction);
+  if (!vertex || on_sharp_feature(*vertex)) return std::nullopt;
+  const Index& ix = *index_;
+  const Eigen::Vector3d d = direction.normalized();
+  // Faces within three rings of the face closest_point found at the vertex.
+  const auto hit = ix.tree.closest_point_and_primitive(cp(vertex->point_m));
+  std::vector<int> faces{static_cast<int>(hit.second - ix.triangles.begin())};
+  for (std::size_t ring = 0, begin = 0; ring < 3; ++ring) {
+    const std::size_t end = faces.size();
+    for (std::size_t k = begin; k < end; ++k) {
+      for (int g : ix.face_across[faces[k]]) {
+        if (g >= 0 && std::find(faces.begin(), faces.end(), g) == faces.end()) faces.push_back(g);
+      }
+    }
+    begin = end;
+  }
+  std::optional<SurfacePoint> best;
+  double best_h = -std::numeric_limits<double>::infinity();
+  for (int f : faces) {
+    const auto& t = mesh_.triangles[f];
+    if (ix.vertex_sharp[t[0]] || ix.vertex_sharp[t[1]] || ix.vertex_sharp[t[2]]) continue;
+    // sum b_i N_i = lambda d with sum b_i = 1: four linear equations in (b, lambda).
+    Eigen::Matrix4d A = Eigen::Matrix4d::Zero();
+    for (int i = 0; i < 3; ++i) {
+      A.block<3, 1>(0, i) = ix.vertex_normal[t[i]];
+      A(3, i) = 1.0;
+    }
+    A.block<3, 1>(0, 3) = -d;
+    const Eigen::Vector4d x = A.fullPivLu().solve(Eigen::Vector4d(0, 0, 0, 1));
+    if (!x.allFinite() || !(x[3] > 0.0) || x.head<3>().minCoeff() < -1e-12) continue;
+    const Eigen::Vector3d b = x.head<3>().cwiseMax(0.0) / x.head<3>().cwiseMax(0.0).sum();
+    const Eigen::Vector3d p = b[0] * mesh_.vertices_m[t[0]] + b[1] * mesh_.vertices_m[t[1]] + b[2] * mesh_.vertices_m[t[2]];
+    const double h = d.dot(p);
+    if (h > best_h) {
+      best_h = h;
+      SurfacePoint sp;
+      sp.point_m = p;
+      sp.normal = d;
+      best = sp;
+    }
+  }
+  return best;
+}
+
+}  // namespace impactdeck::geometry

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/geometry/mesh_shape.hpp"
 
 namespace impactdeck::scene {
 
@@ -117,7 +118,15 @@ ContactEvaluation ContactModel::at_surface_point(const geometry::SurfacePoint& a
   const Eigen::Vector3d down_own = impactor_.pose.direction_to_own(-e.normal);
   const Eigen::Vector3d placed_centroid = impactor_.centroid_world_m();
   Eigen::Vector3d touch_world;
-  if (auto sp = impactor_.shape->bounded() ? impactor_.shape->support_point(down_own) : std::nullopt) {
+  std::optional<geometry::SurfacePoint> support;
+  if (impactor_.shape->bounded()) {
+    // A mesh touches with its smoothed surface where that is smooth (see first_contact).
+    if (const auto* mesh = dynamic_cast<const geometry::MeshShape*>(impactor_.shape.get())) {
+      support = mesh->smooth_support_point(down_own);
+    }
+    if (!support) support = impactor_.shape->support_point(down_own);
+  }
+  if (const auto& sp = support) {
     e.impactor_point = *sp;
     touch_world = impactor_.pose.to_world(sp->point_m);
   } else {

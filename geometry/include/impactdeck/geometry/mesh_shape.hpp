@@ -63,6 +63,12 @@ class MeshShape final : public Shape {
   /// equal dot products the lowest vertex index), with the surface normal there (as
   /// closest_point gives it).
   std::optional<SurfacePoint> support_point(const Eigen::Vector3d& direction) const override;
+  /// The support point of the smoothed surface (the blended vertex normals that closest_point
+  /// reports): the point near the extreme vertex where that normal is `direction`, found on the
+  /// faces within three rings of it. Smooth parts of a mesh converge to the true support point at
+  /// second order this way, where the extreme vertex is first order. nullopt on a sharp feature or
+  /// where no face brackets the direction.
+  std::optional<SurfacePoint> smooth_support_point(const Eigen::Vector3d& direction) const;
   /// On the surface (within 1e-12 of the part's size) or inside: the orientation of the first
   /// face a ray meets (outward: inside), retried along other rays when the hit is within 1e-9
   /// of an edge or grazing; after 16 ambiguous rays, the sign of the winding number.
