@@ -38,7 +38,7 @@ static ImpactInput sample_input() {
   in.contact.normal = Eigen::Vector3d(0.375, 5.28, 0).normalized();
   in.impactor.center_of_mass_m = in.contact.point_m + 0.05 * in.contact.normal;
   in.impactor.velocity_m_s = -400 * in.contact.normal;
-  in.effective_radius_m = 0.045;
+  in.target_curvature = ContactCurvature::sphere(0.045);  // R* = 0.045 m against a flat impactor
   in.effective_modulus_Pa = 1.025e11;
   return in;
 }

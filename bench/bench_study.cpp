@@ -20,14 +20,12 @@ study::SweepSetup setup() {
   study::SweepSetup s;
   auto target = std::make_shared<geometry::Ellipsoid>(2.0, 0.5, 0.5);
   auto ball = std::make_shared<geometry::Ellipsoid>(geometry::Ellipsoid::sphere(0.05));
-  const auto tv = target->volume_properties(), bv = ball->volume_properties();
-  s.target = {target, 7850 * tv.volume_m3, tv.inertia_per_density_m5 * 7850, tv.centroid_m,
-              study::RadiusRule::paper};
-  s.impactor = {ball, 7850 * bv.volume_m3, bv.inertia_per_density_m5 * 7850, bv.centroid_m,
-                study::RadiusRule::paper};
+  s.target = scene::body_of_mass("target", target, 7850 * target->volume_properties().volume_m3);
+  s.impactor = scene::body_of_mass("ball", ball, 7850 * ball->volume_properties().volume_m3);
+  s.rule = collision::ContactRule::paper;
   s.effective_modulus_Pa = 1.025e11;
   s.approach_speed_m_s = 1.0;
-  s.restitution.from_energy_flux = true;
+  s.restitution.kind = collision::RestitutionModel::Kind::energy_flux;
   return s;
 }
 

@@ -60,7 +60,7 @@ void register_study(CLI::App& app, Context& ctx) {
   cmd->add_option("--geometric-ratios", a->g, "Comma-separated g = a/b values (rows)");
   cmd->add_option("--mass-ratios", a->mu, "Comma-separated m1/m2 values (columns)");
   cmd->add_option("--size-ratio", a->size_ratio, "Smaller semi-axis / sphere radius (paper preset: 20)");
-  cmd->add_option("--radius-rule", a->rule, "Ellipsoid's local radius: paper (Eq. 26) | mean (curvature)");
+  cmd->add_option("--radius-rule", a->rule, "Local radius rule: paper (Eq. 26, the sphere's radius) | mean (mean curvature) | elliptical (both curvature tensors)");
   cmd->add_option("--scene", a->scene,
                   "Scene file (TOML) giving the target, impactor, materials and speed instead of the paper's "
                   "ellipsoid and sphere (docs/study.md)");
@@ -93,9 +93,10 @@ void register_study(CLI::App& app, Context& ctx) {
     }
     if (a->size_ratio != 0) o.size_ratio = a->size_ratio;
     if (!a->rule.empty()) {
-      if (a->rule == "paper") o.target_radius_rule = study::RadiusRule::paper;
-      else if (a->rule == "mean") o.target_radius_rule = study::RadiusRule::mean;
-      else throw UsageError("--radius-rule: expected paper or mean, got \"" + a->rule + "\"");
+      if (a->rule == "paper") o.rule = collision::ContactRule::paper;
+      else if (a->rule == "mean") o.rule = collision::ContactRule::mean;
+      else if (a->rule == "elliptical") o.rule = collision::ContactRule::elliptical;
+      else throw UsageError("--radius-rule: expected paper, mean or elliptical, got \"" + a->rule + "\"");
     }
     if (!a->cloud.empty()) {
       if (a->cloud == "grid") o.cloud = study::CloudKind::paper_grid;

@@ -39,7 +39,7 @@ nlohmann::json point_json(std::size_t index, const study::PointResult& p) {
 
 void register_sweep(CLI::App& app, Context& ctx) {
   struct Args {
-    std::string scene, impact, cloud = "auto", out = ".", prefix, azimuth, elevation;
+    std::string scene, impact, cloud = "auto", out = ".", prefix, azimuth, elevation, points;
     int grid_steps = 8;
     std::size_t count = 2000;
     std::uint64_t seed = 1;
@@ -55,6 +55,9 @@ void register_sweep(CLI::App& app, Context& ctx) {
   cmd->add_option("--cloud", a->cloud,
                   "grid (the paper's, analytic ellipsoid only) | uniform (area-uniform, any shape) | both | "
                   "vertices (the mesh's vertices, mesh only) | auto (grid for an ellipsoid, else uniform)");
+  cmd->add_option("--points", a->points,
+                  "CSV of impact points x,y,z (scene length unit, the target's own frame), each projected onto the "
+                  "surface as `run` projects an impact point; replaces --cloud");
   cmd->add_option("--grid-steps", a->grid_steps, "Paper grid step 1/N on (y/b, z/c) (default 8: 390 points)");
   cmd->add_option("--count", a->count, "Points of the area-uniform cloud (default 2000)");
   cmd->add_option("--seed", a->seed, "Seed of the area-uniform cloud (default 1)");
@@ -80,10 +83,16 @@ void register_sweep(CLI::App& app, Context& ctx) {
     else if (a->cloud == "vertices") kind = study::CloudKind::vertices;
     else throw UsageError("--cloud: expected grid, uniform, both, vertices or auto, got \"" + a->cloud + "\"");
     std::vector<geometry::SurfacePoint> cloud;
-    try {
-      cloud = study::make_cloud(*ss.setup.target.shape, kind, a->grid_steps, a->count, a->seed);
-    } catch (const InputError& e) {
-      throw InputError(sc.file.string(), e.place(), "target '" + imp.target + "': " + e.reason());
+    if (!a->points.empty()) {
+      // Projected as `run` projects an impact point, with the same distance limit.
+      const double tol = imp.max_projection_distance_m.value_or(0.01 * ss.setup.target.shape->size_m());
+      cloud = study::csv_point_cloud(*ss.setup.target.shape, a->points, metres_per(sc.length_unit), tol);
+    } else {
+      try {
+        cloud = study::make_cloud(*ss.setup.target.shape, kind, a->grid_steps, a->count, a->seed);
+      } catch (const InputError& e) {
+        throw InputError(sc.file.string(), e.place(), "target '" + imp.target + "': " + e.reason());
+      }
     }
 
     std::error_code ec;
@@ -110,10 +119,10 @@ void register_sweep(CLI::App& app, Context& ctx) {
     meta.impact = imp.name;
     meta.target = imp.target;
     meta.impactor = imp.impactor;
-    meta.cloud = study::to_string(kind);
-    if (kind == study::CloudKind::paper_grid || kind == study::CloudKind::both)
+    meta.cloud = a->points.empty() ? study::to_string(kind) : "points of " + a->points;
+    if (a->points.empty() && (kind == study::CloudKind::paper_grid || kind == study::CloudKind::both))
       meta.cloud += ", grid step 1/" + std::to_string(a->grid_steps);
-    if (kind == study::CloudKind::area_uniform || kind == study::CloudKind::both)
+    if (a->points.empty() && (kind == study::CloudKind::area_uniform || kind == study::CloudKind::both))
       meta.cloud += ", " + std::to_string(a->count) + " area-uniform (seed " + std::to_string(a->seed) + ")";
 
     const std::string prefix = a->prefix.empty() ? "sweep_" + imp.name : a->prefix;
@@ -131,7 +140,7 @@ void register_sweep(CLI::App& app, Context& ctx) {
     study::write_sweep_vtp(with(".vtp"), r, meta);
     study::ForceMapOptions fo;
     fo.title = "Maximal collision force: " + imp.impactor + " hits " + imp.target + " (impact '" + imp.name + "')";
-    const plot::Drawing pic = study::force_map_drawing(*ss.setup.target.shape, ss.setup.target.centroid_m, r, fo);
+    const plot::Drawing pic = study::force_map_drawing(*ss.setup.target.shape, ss.setup.target.volume.centroid_m, r, fo);
     plot::write_svg(with(".svg"), pic);
     if (!a->no_png) plot::write_png(with(".png"), pic, 1.5);
 
@@ -151,6 +160,12 @@ void register_sweep(CLI::App& app, Context& ctx) {
       j["approach_speed_m_s"] = ss.setup.approach_speed_m_s;
       j["restitution_clamped_points"] = r.restitution_clamped_count;
       j["sharp_points"] = r.sharp_count;
+      j["flagged_points"] = r.flagged_count;
+      nlohmann::json flags = nlohmann::json::object();
+      for (int f = 1; f < collision::kContactFlagCount; ++f) {
+        flags[collision::flag_word(static_cast<collision::ContactFlag>(f))] = r.flag_counts[f];
+      }
+      j["flag_counts"] = flags;
       j["threads"] = r.threads_used;
       j["seconds"] = r.seconds;
       nlohmann::json fl = nlohmann::json::array();
@@ -175,9 +190,15 @@ void register_sweep(CLI::App& app, Context& ctx) {
                 << ")\n"
                 << "  time                  " << r.seconds << " s on " << r.threads_used << " threads ("
                 << std::setprecision(3) << rate << " points/s)\n";
-      if (r.sharp_count > 0) {
-        std::cout << "  sharp points          " << r.sharp_count
-                  << " on sharp edges or corners (no local radius; left out of min/max, flagged in the files)\n";
+      if (r.flagged_count > 0) {
+        std::cout << "  flagged points        " << r.flagged_count << " (";
+        bool any = false;
+        for (int f = 1; f < collision::kContactFlagCount; ++f) {
+          if (r.flag_counts[f] == 0) continue;
+          std::cout << (any ? ", " : "") << r.flag_counts[f] << " " << collision::flag_word(static_cast<collision::ContactFlag>(f));
+          any = true;
+        }
+        std::cout << "): the model does not apply there; left out of min/max, `flag` column in the files\n";
       }
       if (r.restitution_clamped_count > 0) {
         std::cout << "  warning: ln(Phi) clamped into Eq. 30's range at " << r.restitution_clamped_count

@@ -131,13 +131,14 @@ d = json.load(open(sys.argv[1]))
 assert d["sharp_points"] == 0 and d["points"] == 100
 rows = [l for l in open(sys.argv[2]) if not l.startswith("#")]
 head = rows[0].strip().split(",")
-assert head[-2:] == ["contact_ellipse_axis_ratio", "sharp_feature"], head[-2:]
-assert all(l.strip().endswith(",0") for l in rows[1:])
+assert head[-3:] == ["contact_ellipse_axis_ratio", "sharp_feature", "flag"], head[-3:]
+assert all(l.rstrip("\n").endswith(",0,") for l in rows[1:])
+assert d["flagged_points"] == 0 and d["flag_counts"]["sharp"] == 0
 PY
 passes=$((passes+1))
 "$bin" sweep "$src/tests/data/bad/scenes/mesh_sharp_edge.toml" --cloud vertices --quiet --no-png --out "$tmp/sh2" \
   >/dev/null 2>"$tmp/sh2.err"
 check "sweep with every point on a corner exit 3" test $? -eq 3
-check "sweep names the sharp points" grep -q "all 8 points of the cloud lie on sharp edges or corners" "$tmp/sh2.err"
+check "sweep names the sharp points" grep -q "all 8 points of the cloud are flagged (8 sharp)" "$tmp/sh2.err"
 
 finish cli_end_to_end

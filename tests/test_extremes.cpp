@@ -29,10 +29,10 @@ TEST_P(ExtremeGrid, FiniteOutputsAndPassingChecks) {
                                 : Eigen::Vector3d(0, 1, 0);
   in.impactor.center_of_mass_m = in.contact.point_m + 0.05 * in.contact.normal;
   in.impactor.velocity_m_s = -velocity * in.contact.normal;
-  in.effective_radius_m = 0.04;
+  in.target_curvature = ContactCurvature::sphere(0.04);  // R* = 0.04 m against a flat impactor
   const ElasticMaterial mat{modulus, 0.3};
   in.effective_modulus_Pa = effective_modulus_Pa(mat, mat, ModulusConvention::hertz);
-  in.restitution.from_energy_flux = true;  // warn policy: clamps outside (-5, 6)
+  in.restitution.kind = RestitutionModel::Kind::energy_flux;  // warn policy: clamps outside (-5, 6)
   const ImpactResult r = solve_impact(in);
   const auto& c = r.history.compression;
   EXPECT_TRUE(is_finite_all(r.reduced_mass_kg, r.hertz_constant, r.restitution.coefficient,

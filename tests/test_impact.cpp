@@ -24,9 +24,9 @@ ImpactInput eccentric_case(double R) {
   in.contact.normal = Eigen::Vector3d(1.5 / 4.0, 0.33 / 0.25, 0).normalized();
   in.impactor.center_of_mass_m = in.contact.point_m + 0.05 * in.contact.normal;
   in.impactor.velocity_m_s = -10.0 * in.contact.normal;
-  in.effective_radius_m = 0.04;
+  in.target_curvature = ContactCurvature::sphere(0.04);  // R* = 0.04 m against a flat impactor
   in.effective_modulus_Pa = 1.1e11;
-  in.restitution.from_energy_flux = false;
+  in.restitution.kind = RestitutionModel::Kind::constant;
   in.restitution.constant = R;
   return in;
 }
@@ -55,7 +55,7 @@ TEST(Impact, SelfChecksPassTightlyAndPhysicsHolds) {
 
 TEST(Impact, EnergyFluxRestitutionWithPolicies) {
   ImpactInput in = eccentric_case(0);
-  in.restitution.from_energy_flux = true;
+  in.restitution.kind = RestitutionModel::Kind::energy_flux;
   in.restitution.flux_unit = EnergyFluxUnit::J_per_cm3;
   in.restitution.range_policy = RangePolicy::warn;
   const ImpactResult r = solve_impact(in);
@@ -94,9 +94,9 @@ TEST(Impact, WallImpactBouncesBack) {
   in.impactor.center_of_mass_m = {0, 0, 0.1};
   in.impactor.velocity_m_s = {0, 0, -1.5};
   in.contact.normal = {0, 0, 1};
-  in.effective_radius_m = 0.1;
+  in.target_curvature = ContactCurvature::sphere(0.1);  // R* = 0.1 m against a flat impactor
   in.effective_modulus_Pa = 1e11;
-  in.restitution.from_energy_flux = false;
+  in.restitution.kind = RestitutionModel::Kind::constant;
   in.restitution.constant = 0.8;
   const ImpactResult r = solve_impact(in);
   EXPECT_DOUBLE_EQ(r.reduced_mass_kg, 2.0);

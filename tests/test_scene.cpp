@@ -219,7 +219,7 @@ TEST(Scene, EllipticalContactRadius) {
   // Ellipsoid 2000/500/500 mm at (0, b, 0), ball r = 50 mm: target curvatures b/a^2 (along x) and
   // 1/b (along z); the ball's 1/r both ways. A = (b/a^2 + 1/r)/2, B = (1/b + 1/r)/2.
   const RunReport e = run_scene(parse_scene(kBase + "contact_radius = \"elliptical\"\n", "e.toml"));
-  const auto& g = e.impacts[0].contact;
+  const auto& g = e.impacts[0].result.kernel;
   EXPECT_NEAR(g.relative_curvature_A_per_m, 0.5 * (0.5 / 4.0 + 20.0), 1e-12);
   EXPECT_NEAR(g.relative_curvature_B_per_m, 0.5 * (2.0 + 20.0), 1e-12);
   const auto ec = impactdeck::collision::elliptical_contact({0.5 * (0.125 + 20.0), 11.0});

@@ -136,7 +136,7 @@ struct SweepFiles : ::testing::Test {
     write_sweep_curves_csv(*dir / "s_curves.csv", *result, meta);
     write_sweep_pos(*dir / "s.pos", *result, meta);
     write_sweep_vtp(*dir / "s.vtp", *result, meta);
-    const plot::Drawing d = force_map_drawing(*ss->setup.target.shape, ss->setup.target.centroid_m, *result);
+    const plot::Drawing d = force_map_drawing(*ss->setup.target.shape, ss->setup.target.volume.centroid_m, *result);
     plot::write_svg(*dir / "s.svg", d);
     plot::write_png(*dir / "s.png", d, 1.0);
   }
@@ -172,7 +172,7 @@ TEST_F(SweepFiles, CsvHasOneRowPerPoint) {
     EXPECT_EQ(line.find("inf"), std::string::npos);
     ++rows;
   }
-  EXPECT_EQ(header_cols, 27u);  // ... target_dwz_rad_s, contact_ellipse_axis_ratio, sharp_feature
+  EXPECT_EQ(header_cols, 28u);  // ... target_dwz_rad_s, contact_ellipse_axis_ratio, sharp_feature, flag
   EXPECT_EQ(rows, result->points.size());
   EXPECT_EQ(result->points.size(), 690u);  // 390 grid + 300 uniform
 
@@ -227,7 +227,7 @@ TEST_F(SweepFiles, VtpIsWellFormedPolyData) {
     }
     ++arrays;
   }
-  EXPECT_EQ(arrays, 11u);  // 7 scalars + normals + points + connectivity + offsets
+  EXPECT_EQ(arrays, 12u);  // 8 scalars (flag included) + normals + points + connectivity + offsets
 }
 
 TEST_F(SweepFiles, ForceMapSvgAndPng) {
@@ -264,7 +264,7 @@ TEST_F(SweepFiles, LargeCloudPictureIsThinned) {
   const SweepResult big = run_sweep(ss->setup, cloud);
   ForceMapOptions fo;
   fo.max_points = 5000;  // stride 3: points 0, 3, 6, ... (4000) plus the extremes if off-stride
-  const std::string svg = plot::to_svg(force_map_drawing(*ss->setup.target.shape, ss->setup.target.centroid_m, big, fo));
+  const std::string svg = plot::to_svg(force_map_drawing(*ss->setup.target.shape, ss->setup.target.volume.centroid_m, big, fo));
   std::size_t circles = 0;
   for (std::size_t k = svg.find("<circle"); k != std::string::npos; k = svg.find("<circle", k + 1)) ++circles;
   const std::size_t extra = (big.min_index % 3 != 0) + (big.max_index % 3 != 0);

@@ -30,13 +30,13 @@ constexpr double kMeshRatioRel = 2e-3;
 SweepSetup setup(std::shared_ptr<const geometry::Shape> target) {
   SweepSetup s;
   auto ball = std::make_shared<geometry::Ellipsoid>(geometry::Ellipsoid::sphere(0.05));
-  const auto tv = target->volume_properties(), bv = ball->volume_properties();
-  const double m2 = 7850 * bv.volume_m3, m1 = 0.3 * m2;  // light target: mass and curvature both vary
-  s.target = {target, m1, tv.inertia_per_density_m5 * (m1 / tv.volume_m3), tv.centroid_m, RadiusRule::mean};
-  s.impactor = {ball, m2, bv.inertia_per_density_m5 * 7850, bv.centroid_m, RadiusRule::mean};
+  const double m2 = 7850 * ball->volume_properties().volume_m3, m1 = 0.3 * m2;  // light target: mass and curvature both vary
+  s.target = scene::body_of_mass("target", target, m1);
+  s.impactor = scene::body_of_mass("ball", ball, m2);
+  s.rule = collision::ContactRule::mean;
   s.effective_modulus_Pa = 1.0e11;
   s.approach_speed_m_s = 1.0;
-  s.restitution.from_energy_flux = false;
+  s.restitution.kind = collision::RestitutionModel::Kind::constant;
   s.restitution.constant = 0.8;
   return s;
 }

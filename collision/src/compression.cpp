@@ -176,17 +176,7 @@ double CompressionPhase::force_N(double t_s) const {
   return max_force_N * compression_force_fraction(t_s / compression_time_s);
 }
 
-CompressionPhase solve_compression(double m_w, double v_w, double k_h) {
-  auto require_positive = [](double value, const char* name, const char* unit) {
-    if (!(value > 0.0) || !std::isfinite(value)) {
-      std::ostringstream s;
-      s << "must be a positive finite number, got " << value << " " << unit;
-      throw InputError("", name, s.str());
-    }
-  };
-  require_positive(m_w, "reduced mass", "kg");
-  require_positive(v_w, "approach velocity", "m/s");
-  require_positive(k_h, "Hertz constant", "N/m^1.5");
+CompressionPhase compression_phase(double m_w, double v_w, double k_h) noexcept {
   CompressionPhase c;
   c.reduced_mass_kg = m_w;
   c.approach_velocity_m_s = v_w;
@@ -199,6 +189,20 @@ CompressionPhase solve_compression(double m_w, double v_w, double k_h) {
   c.compression_time_s = compression_time_factor() * std::exp(log_xmax - std::log(v_w));
   c.impulse_Ns = m_w * v_w;
   return c;
+}
+
+CompressionPhase solve_compression(double m_w, double v_w, double k_h) {
+  auto require_positive = [](double value, const char* name, const char* unit) {
+    if (!(value > 0.0) || !std::isfinite(value)) {
+      std::ostringstream s;
+      s << "must be a positive finite number, got " << value << " " << unit;
+      throw InputError("", name, s.str());
+    }
+  };
+  require_positive(m_w, "reduced mass", "kg");
+  require_positive(v_w, "approach velocity", "m/s");
+  require_positive(k_h, "Hertz constant", "N/m^1.5");
+  return compression_phase(m_w, v_w, k_h);
 }
 
 }  // namespace impactdeck::collision

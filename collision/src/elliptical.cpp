@@ -71,6 +71,8 @@ RelativeCurvatures relative_curvatures(double k1a, double k2a, const Eigen::Vect
   Eigen::Matrix<double, 3, 2> T;
   T << t1, t2;
   auto tensor = [&](double k1, double k2, const Eigen::Vector3d& d1, const Eigen::Vector3d& d2) {
+    // An umbilic (sphere, plane) has no principal directions: k times the tangent identity.
+    if (k1 == k2) return Eigen::Matrix2d(k1 * Eigen::Matrix2d::Identity());
     const Eigen::Matrix3d C = k1 * d1.normalized() * d1.normalized().transpose() +
                               k2 * d2.normalized() * d2.normalized().transpose();
     return Eigen::Matrix2d(T.transpose() * C * T);

@@ -3,84 +3,160 @@
 #include <cmath>
 #include <sstream>
 
-#include "impactdeck/collision/hertz.hpp"
 #include "impactdeck/common/error.hpp"
 
 namespace impactdeck::collision {
 
+namespace {
+
+std::string curvature_text(const ContactCurvature& c) {
+  std::ostringstream s;
+  s << "k1 = " << c.k1_per_m << ", k2 = " << c.k2_per_m << " 1/m";
+  return s.str();
+}
+
+}  // namespace
+
+std::string explain_flag(const KernelInput& in, const KernelResult& r, const std::string& target_name,
+                         const std::string& impactor_name) {
+  std::ostringstream s;
+  const std::string curv = target_name + " " + curvature_text(in.target.curvature) + ", " + impactor_name + " " +
+                           curvature_text(in.impactor.curvature);
+  switch (r.flag) {
+    case ContactFlag::none:
+      return "";
+    case ContactFlag::sharp:
+      s << "the contact point lies on a sharp edge or corner of "
+        << (in.target.curvature.sharp ? target_name : impactor_name)
+        << ", where no local radius exists (not a Hertz contact)";
+      break;
+    case ContactFlag::no_fit:
+      s << impactor_name << " does not fit: a concave surface is tighter than the other body (" << curv
+        << "; relative curvatures A = " << r.relative_curvature_A_per_m << ", B = " << r.relative_curvature_B_per_m
+        << " 1/m: both must be > 0 for a point contact)";
+      break;
+    case ContactFlag::saddle:
+      s << "a saddle point not outweighed by the other body's curvature (" << curv << "; relative curvatures A = "
+        << r.relative_curvature_A_per_m << ", B = " << r.relative_curvature_B_per_m << " 1/m: both must be > 0)";
+      break;
+    case ContactFlag::line:
+      s << "a line contact, not Hertzian (" << curv << "; relative curvature A = " << r.relative_curvature_A_per_m
+        << " 1/m)";
+      break;
+    case ContactFlag::flat:
+      s << "both surfaces are flat at the contact point: a flat contact, not Hertzian (" << curv << ")";
+      break;
+    case ContactFlag::no_approach:
+      s << "no impact: the bodies do not approach at the contact point (approach velocity "
+        << r.approach_velocity_m_s + 0.0 << " m/s along the inward normal)";
+      break;
+    case ContactFlag::restitution_range:
+    case ContactFlag::restitution_invalid:
+      s << "restitution: " << describe_restitution(*in.restitution, r.restitution, r.approach_velocity_m_s);
+      break;
+    case ContactFlag::no_curvature:
+      s << "the curvature of a surface cannot be estimated at the contact point (a mesh too coarse there)";
+      break;
+    case ContactFlag::degenerate:
+      s << "the impact cannot be computed in double precision (an input or result under- or overflows: reduced "
+           "mass "
+        << r.reduced_mass_kg << " kg, approach velocity " << r.approach_velocity_m_s << " m/s, effective radius "
+        << r.effective_radius_m << " m, E* " << in.effective_modulus_Pa << " Pa, F_max " << r.max_force_N << " N)";
+      break;
+  }
+  return s.str();
+}
+
 ImpactResult solve_impact(const ImpactInput& in) {
-  ImpactResult r;
-  Contact c = in.contact;
-  const double nn = c.normal.norm();
+  const double nn = in.contact.normal.norm();
   if (!(nn > 0.0) || !std::isfinite(nn)) {
     throw InputError("", "contact normal", "must be a non-zero finite vector");
   }
-  c.normal /= nn;
-
-  r.reduced_mass_kg = reduced_mass_kg(in.target, in.impactor, c);
-  r.approach_velocity_m_s = approach_velocity_m_s(in.target, in.impactor, c);
-  if (!(r.approach_velocity_m_s > 0.0)) {
-    std::ostringstream s;
-    s << "no impact: the bodies do not approach at the contact point (approach velocity "
-      << r.approach_velocity_m_s + 0.0 << " m/s along the inward normal)";
-    throw InputError("", "velocity", s.str());
-  }
-  if (!(in.effective_radius_m > 0.0) || !std::isfinite(in.effective_radius_m)) {
-    throw InputError("", "effective radius", "must be positive and finite");
+  if (in.target.fixed() && in.impactor.fixed()) {
+    throw InputError("", "bodies", "both bodies are fixed (infinite mass): nothing can move");
   }
   if (!(in.effective_modulus_Pa > 0.0) || !std::isfinite(in.effective_modulus_Pa)) {
     throw InputError("", "effective modulus", "must be positive and finite");
   }
-  r.effective_radius_m = in.effective_radius_m;
-  r.effective_modulus_Pa = in.effective_modulus_Pa;
-  r.hertz_constant = hertz_constant(in.effective_modulus_Pa, in.effective_radius_m);
-
-  r.restitution_from_energy_flux = in.restitution.from_energy_flux;
-  if (in.restitution.from_energy_flux) {
-    r.restitution = restitution_from_energy_flux(r.reduced_mass_kg, r.approach_velocity_m_s,
-                                                 r.effective_radius_m, in.restitution.flux_unit,
-                                                 in.restitution.range_policy);
-    if (!r.restitution.warning.empty()) r.warnings.push_back(r.restitution.warning);
-  } else {
-    const double R = in.restitution.constant;
-    if (!(R >= 0.0 && R <= 1.0)) {
-      std::ostringstream s;
-      s << "must lie in [0, 1], got " << R;
-      throw InputError("", "restitution", s.str());
-    }
-    r.restitution.coefficient = R;
+  if (in.restitution.kind == RestitutionModel::Kind::constant &&
+      !(in.restitution.constant >= 0.0 && in.restitution.constant <= 1.0)) {
+    std::ostringstream s;
+    s << "must lie in [0, 1], got " << in.restitution.constant;
+    throw InputError("", "restitution", s.str());
   }
+  if (in.restitution.kind == RestitutionModel::Kind::table) validate_restitution_table(in.restitution.table);
 
-  r.history.compression =
-      solve_compression(r.reduced_mass_kg, r.approach_velocity_m_s, r.hertz_constant);
-  r.history.restitution = r.restitution.coefficient;
+  Contact c = in.contact;
+  // A unit normal is used as given (bit for bit what the kernel sees in a sweep); others are
+  // normalised.
+  if (std::abs(nn - 1.0) > 1e-12) c.normal /= nn;
+  KernelInput k;
+  k.target = kernel_body(in.target);
+  k.impactor = kernel_body(in.impactor);
+  k.target.lever_arm_m = c.point_m - in.target.center_of_mass_m;
+  k.impactor.lever_arm_m = c.point_m - in.impactor.center_of_mass_m;
+  k.target.curvature = in.target_curvature;
+  k.impactor.curvature = in.impactor_curvature;
+  k.normal = c.normal;
+  k.rule = in.rule;
+  k.effective_modulus_Pa = in.effective_modulus_Pa;
+  k.restitution = &in.restitution;
+
+  ImpactResult r;
+  r.kernel = solve_kernel(k);
+  const KernelResult& kr = r.kernel;
+  if (kr.flag != ContactFlag::none) {
+    const char* place = kr.flag == ContactFlag::no_approach ? "velocity"
+                        : (kr.flag == ContactFlag::restitution_range || kr.flag == ContactFlag::restitution_invalid)
+                            ? "restitution"
+                            : "contact";
+    throw InputError("", place, explain_flag(k, kr));
+  }
+  r.reduced_mass_kg = kr.reduced_mass_kg;
+  r.approach_velocity_m_s = kr.approach_velocity_m_s;
+  r.effective_radius_m = kr.effective_radius_m;
+  r.effective_modulus_Pa = in.effective_modulus_Pa;
+  r.hertz_constant = kr.hertz_constant;
+  r.restitution_kind = in.restitution.kind;
+  r.restitution.coefficient = kr.restitution.coefficient;
+  r.restitution.energy_flux_density_J_m3 = kr.restitution.energy_flux_density_J_m3;
+  r.restitution.ln_energy_flux = kr.restitution.ln_energy_flux;
+  r.restitution.energy_flux_density = std::exp(kr.restitution.ln_energy_flux);
+  r.restitution.clamped = kr.restitution.clamped;
+  if (kr.restitution.outside_range) {
+    r.restitution.warning = describe_restitution(in.restitution, kr.restitution, kr.approach_velocity_m_s);
+    r.warnings.push_back(r.restitution.warning);
+  }
+  r.target_jump = kr.target_jump;
+  r.impactor_jump = kr.impactor_jump;
+
+  r.history.compression = compression_phase(kr.reduced_mass_kg, kr.approach_velocity_m_s, kr.hertz_constant);
+  r.history.restitution = kr.restitution.coefficient;
 
   // Self-check 1 (Eq. 31): compression impulse by quadrature of the curve vs m_w v_w.
-  ImpactChecks& k = r.checks;
-  k.thresholds = in.thresholds;
+  ImpactChecks& ch = r.checks;
+  ch.thresholds = in.thresholds;
   const double tm = r.history.compression.compression_time_s;
-  k.impulse_compression_numerical_Ns = integrate_force_Ns(r.history, 0.0, tm);
-  k.impulse_total_numerical_Ns =
-      k.impulse_compression_numerical_Ns + integrate_force_Ns(r.history, tm, r.history.contact_time_s());
+  ch.impulse_compression_numerical_Ns = integrate_force_Ns(r.history, 0.0, tm);
+  ch.impulse_total_numerical_Ns =
+      ch.impulse_compression_numerical_Ns + integrate_force_Ns(r.history, tm, r.history.contact_time_s());
   const double pi1 = r.history.compression.impulse_Ns;
-  k.impulse_relative_error = std::abs(k.impulse_compression_numerical_Ns - pi1) / pi1;
+  ch.impulse_relative_error = std::abs(ch.impulse_compression_numerical_Ns - pi1) / pi1;
 
-  // Velocity jumps from the numerically integrated total impulse (Eq. 22-23).
-  velocity_jumps(in.target, in.impactor, c, k.impulse_total_numerical_Ns, r.target_jump,
-                 r.impactor_jump);
-
-  // Self-check 2 (Eq. 32): Carnot loss vs kinetic energy lost according to those jumps.
-  const double R = r.restitution.coefficient;
-  k.carnot_loss_J = carnot_energy_loss_J(r.reduced_mass_kg, r.approach_velocity_m_s, R);
-  k.kinetic_energy_loss_J =
-      kinetic_energy_loss_J(in.target, r.target_jump) + kinetic_energy_loss_J(in.impactor, r.impactor_jump);
-  const double scale = k.carnot_loss_J > 0.0
-                           ? k.carnot_loss_J
-                           : 0.5 * r.reduced_mass_kg * r.approach_velocity_m_s * r.approach_velocity_m_s;
-  k.energy_relative_error = std::abs(k.kinetic_energy_loss_J - k.carnot_loss_J) / scale;
-  k.passed = std::isfinite(k.impulse_relative_error) && std::isfinite(k.energy_relative_error) &&
-             k.impulse_relative_error <= k.thresholds.impulse_relative &&
-             k.energy_relative_error <= k.thresholds.energy_relative;
+  // Self-check 2 (Eq. 32): Carnot loss vs the kinetic energy lost through the jumps that the
+  // numerically integrated total impulse gives (Eq. 22-23), independent of the closed form.
+  VelocityJump tj, ij;
+  velocity_jumps(in.target, in.impactor, c, ch.impulse_total_numerical_Ns, tj, ij);
+  const double R = kr.restitution.coefficient;
+  ch.carnot_loss_J = carnot_energy_loss_J(kr.reduced_mass_kg, kr.approach_velocity_m_s, R);
+  ch.kinetic_energy_loss_J = kinetic_energy_loss_J(in.target, tj) + kinetic_energy_loss_J(in.impactor, ij);
+  const double scale = ch.carnot_loss_J > 0.0
+                           ? ch.carnot_loss_J
+                           : 0.5 * kr.reduced_mass_kg * kr.approach_velocity_m_s * kr.approach_velocity_m_s;
+  ch.energy_relative_error = std::abs(ch.kinetic_energy_loss_J - ch.carnot_loss_J) / scale;
+  ch.passed = std::isfinite(ch.impulse_relative_error) && std::isfinite(ch.energy_relative_error) &&
+              ch.impulse_relative_error <= ch.thresholds.impulse_relative &&
+              ch.energy_relative_error <= ch.thresholds.energy_relative;
   return r;
 }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <random>
 #include <sstream>
@@ -202,6 +203,9 @@ Curvature Ellipsoid::curvature(const SurfacePoint& at) const {
 }
 
 double Ellipsoid::paper_radius_m(const SurfacePoint& at) const {
+  // A sphere's radius is its radius wherever it is hit: Eq. 26's axis-normal sections are not
+  // normal sections (Meusnier), so off the axes they would give less than r (MODEL.md).
+  if (is_sphere()) return e_.x();
   const Eigen::Vector3d& p = at.point_m;
   double sum = 0.0;
   int count = 0;
@@ -255,6 +259,23 @@ std::vector<SurfacePoint> Ellipsoid::sample_surface(std::size_t count, std::uint
     out.push_back(sp);
   }
   return out;
+}
+
+std::optional<SurfacePoint> Ellipsoid::support_point(const Eigen::Vector3d& direction) const {
+  const double len = direction.norm();
+  if (!(len > 0.0) || !std::isfinite(len)) throw InputError("", "direction", "must be a non-zero finite vector");
+  // Scaled first (u = direction / |direction|): |M u| stays finite for any finite direction.
+  const Eigen::Vector3d u = direction / len;
+  const Eigen::Vector3d mu = e_.cwiseProduct(e_).cwiseProduct(u);
+  SurfacePoint sp;
+  sp.point_m = mu / std::sqrt(u.dot(mu));
+  sp.normal = u;
+  sp.distance_m = 0.0;
+  return sp;
+}
+
+bool Ellipsoid::contains(const Eigen::Vector3d& p) const {
+  return p.cwiseQuotient(e_).squaredNorm() <= 1.0 + 16.0 * std::numeric_limits<double>::epsilon();
 }
 
 double ellipsoid_mean_curvature(const Eigen::Vector3d& e, const Eigen::Vector3d& p) {

@@ -3,6 +3,7 @@
 #include "impactdeck/geometry/mesh_shape.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <exception>
@@ -11,6 +12,7 @@
 #include <sstream>
 #include <unordered_map>
 #include <unordered_set>
+#include <utility>
 
 #include <CGAL/AABB_traits.h>
 #include <CGAL/AABB_tree.h>
@@ -191,6 +193,7 @@ struct MeshShape::Index {
   std::size_t sharp_edge_count = 0;
   std::vector<char> vertex_sharp;
   std::vector<double> cumulative_area;
+  std::vector<int> surface_vertices;  // corners of some triangle, ascending
   double mean_edge = 0;
   Eigen::Vector3d lo, hi;
 };
@@ -301,6 +304,13 @@ MeshShape::MeshShape(TriangleMesh mesh, const MeshMassProperties& mass, const Me
   for (const auto& v : V) {
     ix.lo = ix.lo.cwiseMin(v);
     ix.hi = ix.hi.cwiseMax(v);
+  }
+  {
+    std::vector<char> used(nv, 0);
+    for (const auto& t : F)
+      for (int v : t) used[v] = 1;
+    for (std::size_t v = 0; v < nv; ++v)
+      if (used[v]) ix.surface_vertices.push_back(static_cast<int>(v));
   }
   if (tree_thread.joinable()) {
     tree_thread.join();
@@ -608,6 +618,249 @@ std::vector<SurfacePoint> MeshShape::sample_surface(std::size_t count, std::uint
     out.push_back(sp);
   }
   return out;
+}
+
+std::optional<SurfacePoint> MeshShape::support_point(const Eigen::Vector3d& direction) const {
+  const double largest = direction.cwiseAbs().maxCoeff();
+  if (!direction.allFinite() || !(largest > 0.0)) {
+    throw InputError("", "direction", "must be a non-zero finite vector");
+  }
+  const Eigen::Vector3d u = direction / largest;
+  const auto& V = mesh_.vertices_m;
+  int best = -1;
+  double best_dot = -std::numeric_limits<double>::infinity();
+  for (int v : index_->surface_vertices) {  // ascending: the first of equal dot products stays
+    const double h = u.dot(V[v]);
+    if (h > best_dot) {
+      best_dot = h;
+      best = v;
+    }
+  }
+  return closest_point(V[best]);
+}
+
+namespace {
+
+/// The interval of s for which the box [lo, hi] + s * dir meets the box [fixed_lo, fixed_hi]
+/// (closed boxes). Empty when first > second. Axes with dir = 0 give all or nothing.
+std::pair<double, double> swept_box_interval(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                                             const Eigen::Vector3d& dir, const Eigen::Vector3d& fixed_lo,
+                                             const Eigen::Vector3d& fixed_hi) {
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  double s0 = -inf, s1 = inf;
+  for (int i = 0; i < 3; ++i) {
+    // Overlap on axis i: lo_i + s d_i <= fixed_hi_i and hi_i + s d_i >= fixed_lo_i.
+    const double a = fixed_hi[i] - lo[i], b = fixed_lo[i] - hi[i];
+    if (dir[i] > 0) {
+      s0 = std::max(s0, b / dir[i]);
+      s1 = std::min(s1, a / dir[i]);
+    } else if (dir[i] < 0) {
+      s0 = std::max(s0, a / dir[i]);
+      s1 = std::min(s1, b / dir[i]);
+    } else if (a < 0 || b > 0) {
+      return {inf, -inf};
+    }
+  }
+  return {s0, s1};
+}
+
+// Traversal of the AABB tree by the swept box: children whose box the moving box enters earlier
+// are visited first; a node whose entry time is past the current s_max is skipped.
+struct SweepTraits {
+  using Priority = double;
+  Eigen::Vector3d lo, hi, dir;
+  double s_min, s_max;
+  const std::vector<CTriangle>* triangles;
+  const std::function<double(int, double)>* visit;
+
+  std::pair<double, double> interval(const CGAL::Bbox_3& b) const {
+    return swept_box_interval(lo, hi, dir, Eigen::Vector3d(b.xmin(), b.ymin(), b.zmin()),
+                              Eigen::Vector3d(b.xmax(), b.ymax(), b.zmax()));
+  }
+  bool admits(const std::pair<double, double>& in) const {
+    return in.first <= in.second && in.first <= s_max && in.second >= s_min;
+  }
+  bool go_further() const { return s_min <= s_max; }
+  template <class Query, class Primitive>
+  void intersection(const Query&, const Primitive& p) {
+    const int face = static_cast<int>(p.id() - triangles->begin());
+    if (admits(interval((*triangles)[face].bbox()))) s_max = (*visit)(face, s_max);
+  }
+  template <class Query, class Node>
+  bool do_intersect(const Query&, const Node& n) const {
+    return admits(interval(n.bbox()));
+  }
+  template <class Query, class Node>
+  std::pair<bool, Priority> do_intersect_with_priority(const Query&, const Node& n) const {
+    const auto in = interval(n.bbox());
+    return {admits(in), -in.first};
+  }
+};
+
+}  // namespace
+
+double MeshShape::sweep_faces(const Eigen::AlignedBox3d& moving, const Eigen::Vector3d& direction, double s_min,
+                              double s_max, const std::function<double(int, double)>& visit) const {
+  if (moving.isEmpty() || !(s_min <= s_max)) return s_max;
+  SweepTraits traits{moving.min(), moving.max(), direction, s_min, s_max, &index_->triangles, &visit};
+  const int query = 0;  // the traits carry the query
+  index_->tree.traversal_with_priority(query, traits);
+  return traits.s_max;
+}
+
+namespace {
+
+// A subtree of an AABB tree as CGAL lays it out: a node over `count` >= 2 primitives (its
+// children: two primitives for 2, a primitive and a node of 2 for 3, nodes of count/2 and the
+// rest otherwise), or one primitive (count 1), named by its face.
+using Node = CGAL::AABB_node<CGAL::AABB_traits<K, Primitive>>;
+struct Subtree {
+  const Node* node = nullptr;
+  int face = -1;
+  std::size_t count = 0;
+};
+
+Subtree root_of(const Tree& tree) {
+  if (tree.size() == 1) return {nullptr, 0, 1};
+  return {tree.root_node(), -1, tree.size()};
+}
+
+std::array<Subtree, 2> children_of(const Subtree& s, const std::vector<CTriangle>& triangles) {
+  auto face = [&](const Primitive& p) { return static_cast<int>(p.id() - triangles.begin()); };
+  if (s.count == 2) return {Subtree{nullptr, face(s.node->left_data()), 1}, Subtree{nullptr, face(s.node->right_data()), 1}};
+  if (s.count == 3) return {Subtree{nullptr, face(s.node->left_data()), 1}, Subtree{&s.node->right_child(), -1, 2}};
+  return {Subtree{&s.node->left_child(), -1, s.count / 2}, Subtree{&s.node->right_child(), -1, s.count - s.count / 2}};
+}
+
+CGAL::Bbox_3 box_of(const Subtree& s, const std::vector<CTriangle>& triangles) {
+  return s.node ? s.node->bbox() : triangles[s.face].bbox();
+}
+
+}  // namespace
+
+double MeshShape::sweep_face_pairs(const MeshShape& mover, const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
+                                   const Eigen::Vector3d& direction, double pad, double s_min, double s_max,
+                                   const std::function<double(int, int, double)>& visit) const {
+  const auto& own_triangles = index_->triangles;
+  const auto& mover_triangles = mover.index_->triangles;
+  const Eigen::Matrix3d abs_r = R.cwiseAbs();
+  // When the pair's boxes can meet: the mover's box, rotated into this frame (centre R c + t,
+  // half extents |R| h), padded, translating along the direction.
+  auto interval = [&](const Subtree& own, const Subtree& mv) {
+    const CGAL::Bbox_3 a = box_of(own, own_triangles), b = box_of(mv, mover_triangles);
+    const Eigen::Vector3d lo(b.xmin(), b.ymin(), b.zmin()), hi(b.xmax(), b.ymax(), b.zmax());
+    const Eigen::Vector3d c = R * (0.5 * (lo + hi)) + t;
+    const Eigen::Vector3d h = abs_r * (0.5 * (hi - lo)) + Eigen::Vector3d::Constant(pad);
+    return swept_box_interval(c - h, c + h, direction, Eigen::Vector3d(a.xmin(), a.ymin(), a.zmin()),
+                              Eigen::Vector3d(a.xmax(), a.ymax(), a.zmax()));
+  };
+  struct Pair {
+    double entry;
+    Subtree own, mv;
+  };
+  // Best first: the pair whose boxes meet earliest (a binary heap; the order is deterministic).
+  auto later = [](const Pair& x, const Pair& y) { return x.entry > y.entry; };
+  std::vector<Pair> heap;
+  auto offer = [&](const Subtree& own, const Subtree& mv) {
+    const auto in = interval(own, mv);
+    if (in.first <= in.second && in.second >= s_min && in.first <= s_max) {
+      heap.push_back({std::max(in.first, s_min), own, mv});
+      std::push_heap(heap.begin(), heap.end(), later);
+    }
+  };
+  offer(root_of(index_->tree), root_of(mover.index_->tree));
+  while (!heap.empty() && heap.front().entry <= s_max) {
+    std::pop_heap(heap.begin(), heap.end(), later);
+    const Pair p = heap.back();
+    heap.pop_back();
+    if (p.own.count == 1 && p.mv.count == 1) {
+      s_max = visit(p.own.face, p.mv.face, s_max);
+    } else if (p.mv.count == 1 || (p.own.count > 1 && p.own.count >= p.mv.count)) {
+      for (const Subtree& c : children_of(p.own, own_triangles)) offer(c, p.mv);
+    } else {
+      for (const Subtree& c : children_of(p.mv, mover_triangles)) offer(p.own, c);
+    }
+  }
+  return s_max;
+}
+
+bool MeshShape::contains(const Eigen::Vector3d& q) const {
+  if (!q.allFinite()) return false;
+  const Index& ix = *index_;
+  const double tol = 1e-12 * std::max(size_m(), q.norm());
+  if (((ix.lo - q).array() > tol).any() || ((q - ix.hi).array() > tol).any()) return false;
+  if (closest_point(q).distance_m <= tol) return true;
+  // Rays in 16 fixed directions, spread over the sphere (golden-angle spiral) and offset from the
+  // coordinate axes so that axis-aligned parts do not hit edges on purpose.
+  const auto& V = mesh_.vertices_m;
+  for (int k = 0; k < 16; ++k) {
+    const double z = 1.0 - (2.0 * k + 1.0) / 16.0, r = std::sqrt(1.0 - z * z);
+    const double phi = 0.3 + 2.399963229728653 * k;
+    const Eigen::Vector3d dir(r * std::cos(phi), r * std::sin(phi), z);
+    const auto hit = ix.tree.first_intersection(K::Ray_3(cp(q), K::Vector_3(dir.x(), dir.y(), dir.z())));
+    if (!hit) return false;  // nothing around the point in that direction: outside
+    const CPoint* pt = boost::get<CPoint>(&hit->first);
+    if (!pt) continue;  // the ray runs in a face's plane
+    const int f = static_cast<int>(hit->second - ix.triangles.begin());
+    const auto& t = mesh_.triangles[f];
+    const Eigen::Vector3d bc = barycentric(ev(*pt), V[t[0]], V[t[1]], V[t[2]]);
+    const double along = ix.face_normal[f].dot(dir);
+    if (bc.minCoeff() < 1e-9 || std::abs(along) < 1e-6) continue;  // an edge, a corner or grazing
+    return along > 0.0;
+  }
+  ShellLabels one;
+  one.shell_of_triangle.assign(mesh_.triangles.size(), 0);
+  one.shell_count = 1;
+  return std::abs(winding_number(mesh_, one, 0, q)) > 0.5;
+}
+
+}  // namespace impactdeck::geometry
+
+namespace impactdeck::geometry {
+
+std::optional<SurfacePoint> MeshShape::smooth_support_point(const Eigen::Vector3d& direction) const {
+  const auto vertex = support_point(direction);
+  if (!vertex || on_sharp_feature(*vertex)) return std::nullopt;
+  const Index& ix = *index_;
+  const Eigen::Vector3d d = direction.normalized();
+  // Faces within three rings of the face closest_point found at the vertex.
+  const auto hit = ix.tree.closest_point_and_primitive(cp(vertex->point_m));
+  std::vector<int> faces{static_cast<int>(hit.second - ix.triangles.begin())};
+  for (std::size_t ring = 0, begin = 0; ring < 3; ++ring) {
+    const std::size_t end = faces.size();
+    for (std::size_t k = begin; k < end; ++k) {
+      for (int g : ix.face_across[faces[k]]) {
+        if (g >= 0 && std::find(faces.begin(), faces.end(), g) == faces.end()) faces.push_back(g);
+      }
+    }
+    begin = end;
+  }
+  std::optional<SurfacePoint> best;
+  double best_h = -std::numeric_limits<double>::infinity();
+  for (int f : faces) {
+    const auto& t = mesh_.triangles[f];
+    if (ix.vertex_sharp[t[0]] || ix.vertex_sharp[t[1]] || ix.vertex_sharp[t[2]]) continue;
+    // sum b_i N_i = lambda d with sum b_i = 1: four linear equations in (b, lambda).
+    Eigen::Matrix4d A = Eigen::Matrix4d::Zero();
+    for (int i = 0; i < 3; ++i) {
+      A.block<3, 1>(0, i) = ix.vertex_normal[t[i]];
+      A(3, i) = 1.0;
+    }
+    A.block<3, 1>(0, 3) = -d;
+    const Eigen::Vector4d x = A.fullPivLu().solve(Eigen::Vector4d(0, 0, 0, 1));
+    if (!x.allFinite() || !(x[3] > 0.0) || x.head<3>().minCoeff() < -1e-12) continue;
+    const Eigen::Vector3d b = x.head<3>().cwiseMax(0.0) / x.head<3>().cwiseMax(0.0).sum();
+    const Eigen::Vector3d p = b[0] * mesh_.vertices_m[t[0]] + b[1] * mesh_.vertices_m[t[1]] + b[2] * mesh_.vertices_m[t[2]];
+    const double h = d.dot(p);
+    if (h > best_h) {
+      best_h = h;
+      SurfacePoint sp;
+      sp.point_m = p;
+      sp.normal = d;
+      best = sp;
+    }
+  }
+  return best;
 }
 
 }  // namespace impactdeck::geometry

@@ -12,6 +12,7 @@
 #include "impactdeck/fem_export/force_table.hpp"
 #include "impactdeck/geometry/ellipsoid.hpp"
 #include "impactdeck/geometry/part.hpp"
+#include "impactdeck/geometry/plane.hpp"
 #include "impactdeck/plot/force_plot.hpp"
 
 namespace impactdeck::scene {
@@ -73,6 +74,8 @@ std::shared_ptr<const geometry::Shape> make_shape(const BodySpec& b, const Scene
       case ShapeKind::ellipsoid:
         return std::make_shared<geometry::Ellipsoid>(b.semi_axes_m.x(), b.semi_axes_m.y(),
                                                      b.semi_axes_m.z());
+      case ShapeKind::plane:
+        return std::make_shared<geometry::Plane>(b.plane_normal);
       case ShapeKind::mesh: {
         geometry::PartOptions opt;
         opt.length_unit = scene.length_unit;  // the scene's unit applies to the part file too
@@ -104,11 +107,17 @@ std::shared_ptr<const geometry::Shape> make_shape(const BodySpec& b, const Scene
 
 PreparedBody prepare_body(const BodySpec& b, const Scene& scene, RunReport* report) {
   PreparedBody p;
+  p.name = b.name;
   p.spec = &b;
   p.shape = make_shape(b, scene, report);
+  p.pose.rotation = b.rotation;
+  p.pose.position_m = b.position_m;
+  p.velocity_m_s = b.velocity_m_s;
+  p.angular_velocity_rad_s = b.angular_velocity_rad_s;
   p.volume = p.shape->volume_properties();
   const Material& m = scene.materials.at(b.material);
   p.material = m.elastic;
+  p.yield_strength_Pa = m.yield_strength_Pa;
   if (b.fixed) {
     p.mass_kg = std::numeric_limits<double>::infinity();
     p.inertia_kg_m2 = Eigen::Matrix3d::Identity() * std::numeric_limits<double>::infinity();
@@ -137,73 +146,55 @@ auto in_impact(const Scene& scene, const ImpactSpec& s, F&& f) {
   }
 }
 
-// The curvature (1/m) a rule assigns to one body at its contact point; for the elliptical rule
-// this is only reported (the radius comes from both bodies' curvature tensors).
-double rule_curvature(const geometry::Shape& shape, const geometry::SurfacePoint& sp,
-                      const geometry::Curvature& k, ContactRadiusRule rule) {
-  if (rule == ContactRadiusRule::paper) return 1.0 / shape.paper_radius_m(sp);
-  return k.mean_per_m();
+std::string text(const Eigen::Vector3d& v) {
+  std::ostringstream s;
+  s << "(" << v.x() + 0.0 << ", " << v.y() + 0.0 << ", " << v.z() + 0.0 << ")";
+  return s.str();
 }
 
-ContactGeometry contact_geometry(const Scene& scene, const ImpactSpec& s, const PreparedBody& target,
-                                 const PreparedBody& impactor) {
-  ContactGeometry g;
-  const std::string place = s.place.describe();
-  g.target_point = target.shape->closest_point(s.point_m);
-  const double tol = s.max_projection_distance_m.value_or(0.01 * target.shape->size_m());
-  if (g.target_point.distance_m > tol) {
+// Where the bodies of an impact touch: the projected point (point mode) or the first contact.
+ContactEvaluation locate_contact(const Scene& scene, const ImpactSpec& s, const ContactModel& model) {
+  const PreparedBody& target = model.target();
+  if (s.first_contact) {
+    try {
+      return model.at_first_contact();
+    } catch (const InputError& e) {
+      if (!e.where().empty()) throw;
+      throw InputError(where(scene), Place{s.place.line, s.place.key + ".point"}.describe(),
+                       "impact '" + s.name + "': first contact of '" + s.impactor + "' with '" + s.target +
+                           "': " + e.reason());
+    }
+  }
+  const geometry::SurfacePoint sp = target.shape->closest_point(s.point_m);
+  const double size = target.shape->bounded() ? target.shape->size_m() : model.impactor().shape->size_m();
+  const double tol = s.max_projection_distance_m.value_or(0.01 * size);
+  if (sp.distance_m > tol) {
     std::ostringstream m;
-    m << "impact '" << s.name << "': point is " << g.target_point.distance_m
-      << " m from the surface of '" << s.target << "' (allowed: " << tol
-      << " m; set max_projection_distance to accept it)";
+    m << "impact '" << s.name << "': point is " << sp.distance_m << " m from the surface of '" << s.target
+      << "' (allowed: " << tol << " m; set max_projection_distance to accept it)";
     throw InputError(where(scene), Place{s.place.line, s.place.key + ".point"}.describe(), m.str());
   }
-  g.target_curvature = target.shape->curvature(g.target_point);
-  if (g.target_curvature.sharp_feature) {
-    throw InputError(where(scene), Place{s.place.line, s.place.key + ".point"}.describe(),
-                     "impact '" + s.name + "': the point lies on a sharp edge or corner of '" +
-                         s.target + "', where the local radius is undefined");
-  }
-  // The impactor's centroid lies on the impact line; it touches the target where the ray from its
-  // centroid towards the target (-n) leaves its surface. Its axes are parallel to the target's.
-  const Eigen::Vector3d n = g.target_point.normal;
-  auto exit = impactor.shape->ray_exit(impactor.volume.centroid_m, -n);
-  if (!exit) {
-    throw InputError(where(scene), place, "impact '" + s.name + "': cannot find the contact point "
-                                          "on impactor '" + s.impactor + "' (centroid outside it)");
-  }
-  g.impactor_point = *exit;
-  g.impactor_offset_m = g.target_point.point_m - g.impactor_point.point_m;
-  g.impactor_curvature = impactor.shape->curvature(g.impactor_point);
-  g.target_curvature_per_m = rule_curvature(*target.shape, g.target_point, g.target_curvature, s.contact_radius);
-  g.impactor_curvature_per_m =
-      rule_curvature(*impactor.shape, g.impactor_point, g.impactor_curvature, s.contact_radius);
-  g.effective_radius_m = in_impact(scene, s, [&] {
-    if (s.contact_radius != ContactRadiusRule::elliptical) {
-      return collision::effective_radius_m(g.target_curvature_per_m, g.impactor_curvature_per_m);
-    }
-    const geometry::Curvature& a = g.target_curvature;
-    const geometry::Curvature& b = g.impactor_curvature;
-    const collision::RelativeCurvatures rc = collision::relative_curvatures(
-        a.k1_per_m, a.k2_per_m, a.d1, a.d2, b.k1_per_m, b.k2_per_m, b.d1, b.d2, n);
-    const collision::EllipticalContact ec = collision::elliptical_contact(rc);
-    g.relative_curvature_A_per_m = rc.A_per_m;
-    g.relative_curvature_B_per_m = rc.B_per_m;
-    g.contact_ellipse_axis_ratio = ec.axis_ratio;
-    return ec.equivalent_radius_m;
-  });
-  return g;
+  return model.at_surface_point(sp, s.approach_speed_m_s);
 }
 
-collision::RigidBody rigid(const PreparedBody& b, const Eigen::Vector3d& offset,
-                           const Eigen::Vector3d& velocity) {
-  collision::RigidBody r;
-  r.mass_kg = b.mass_kg;
-  r.inertia_kg_m2 = b.spec->fixed ? Eigen::Matrix3d::Identity() : b.inertia_kg_m2;
-  r.center_of_mass_m = b.volume.centroid_m + offset;
-  r.velocity_m_s = velocity;
-  r.angular_velocity_rad_s = b.spec->angular_velocity_rad_s;
-  return r;
+// The impact solved by `run` from the located contact: the kernel's input as rigid bodies, so that
+// solve_impact adds the force curve and the paper's checks.
+collision::ImpactInput impact_input(const Scene& scene, const ImpactSpec& s, const ContactModel& model,
+                                    const ContactEvaluation& e) {
+  collision::ImpactInput in;
+  in.target = model.target().rigid_body();
+  in.impactor = model.impactor().rigid_body();
+  in.impactor.center_of_mass_m += e.impactor_translation_m;
+  in.impactor.velocity_m_s = e.input.impactor.velocity_m_s;  // -speed n with approach_speed_m_s
+  in.contact.point_m = e.point_m;
+  in.contact.normal = e.normal;
+  in.target_curvature = e.input.target.curvature;
+  in.impactor_curvature = e.input.impactor.curvature;
+  in.rule = s.contact_radius;
+  in.effective_modulus_Pa = e.input.effective_modulus_Pa;
+  in.restitution = s.restitution;
+  in.thresholds = scene.thresholds;
+  return in;
 }
 
 void add_stage(RunReport& r, const std::string& name, double seconds) {
@@ -230,6 +221,8 @@ fem_export::DeckRequest fem_request(const Scene& scene, const ImpactReport& ir, 
       break;
     case ShapeKind::ellipsoid:
       r.body.semi_axes_m = b.semi_axes_m;
+      break;
+    case ShapeKind::plane:  // fixed, refused above
       break;
     case ShapeKind::mesh:
       r.body.kind = fem_export::BodyKind::stl;
@@ -291,26 +284,36 @@ RunReport run_scene(const Scene& scene, const RunOptions& opt) {
     ir.spec = &s;
     const PreparedBody& target = bodies.at(s.target);
     const PreparedBody& impactor = bodies.at(s.impactor);
-    ir.contact = clock.run("contact_geometry", [&] { return in_impact(scene, s, [&] {
-      return contact_geometry(scene, s, target, impactor); }); });
-
-    ir.result = clock.run("impact", [&] {
-      return in_impact(scene, s, [&] {
-        collision::ImpactInput in;
-        in.target = rigid(target, Eigen::Vector3d::Zero(), target.spec->velocity_m_s);
-        Eigen::Vector3d v2 = impactor.spec->velocity_m_s;
-        if (s.approach_speed_m_s) v2 = -*s.approach_speed_m_s * ir.contact.target_point.normal;
-        in.impactor = rigid(impactor, ir.contact.impactor_offset_m, v2);
-        in.contact.point_m = ir.contact.target_point.point_m;
-        in.contact.normal = ir.contact.target_point.normal;
-        in.effective_radius_m = ir.contact.effective_radius_m;
-        in.effective_modulus_Pa =
-            collision::effective_modulus_Pa(target.material, impactor.material, scene.modulus_convention);
-        in.restitution = s.restitution;
-        in.thresholds = scene.thresholds;
-        return collision::solve_impact(in);
-      });
+    const ContactModel model = in_impact(scene, s, [&] {
+      return ContactModel(target, impactor, s.contact_radius,
+                          collision::effective_modulus_Pa(target.material, impactor.material, scene.modulus_convention),
+                          s.restitution);
     });
+    ir.contact = clock.run("contact_geometry", [&] { return locate_contact(scene, s, model); });
+    if (ir.contact.result.flag != collision::ContactFlag::none) {
+      const Place place{s.place.line, s.place.key + (s.first_contact ? ".point" : ".point")};
+      throw InputError(where(scene), place.describe(),
+                       "impact '" + s.name + "': at " + text(ir.contact.point_m) + " m (normal " +
+                           text(ir.contact.normal) + "): " + collision::explain_flag(ir.contact.input, ir.contact.result, "'" + s.target + "'", "'" + s.impactor + "'") +
+                           (ir.contact.curvature_problem.empty() ? "" : " (" + ir.contact.curvature_problem + ")"));
+    }
+    if (s.contact_radius == ContactRadiusRule::paper) {
+      for (const PreparedBody* b : {&target, &impactor}) {
+        if (b->spec && b->spec->shape == ShapeKind::mesh) {
+          report.warnings.push_back("impact '" + s.name + "': contact_radius = \"paper\" on mesh body '" + b->name +
+                                    "': Eq. 26 cuts the part with planes normal to its file's axes, so the radius "
+                                    "depends on the part's coordinate frame; \"elliptical\" does not");
+        }
+      }
+    }
+    ir.result = clock.run("impact", [&] {
+      return in_impact(scene, s, [&] { return collision::solve_impact(impact_input(scene, s, model, ir.contact)); });
+    });
+    ir.validity = collision::assess_validity(ir.contact.input, ir.result.kernel, target.yield_strength_Pa,
+                                             impactor.yield_strength_Pa, scene.validity);
+    for (const auto& w : ir.validity.warnings) {
+      report.warnings.push_back("impact '" + s.name + "': validity of the Hertz model: " + w);
+    }
     for (const auto& w : ir.result.warnings) report.warnings.push_back("impact '" + s.name + "': " + w);
     report.impacts.push_back(std::move(ir));
   }
@@ -381,7 +384,7 @@ RunReport run_scene(const Scene& scene, const RunOptions& opt) {
             fem_export::ForceTableHeader h;
             h.source = scene.file.string();
             h.impact = ir.spec->name;
-            h.direction = -ir.contact.target_point.normal;  // force on the target: along -n
+            h.direction = -ir.contact.normal;  // force on the target: along -n (world)
             files.add(full, [&](std::ostream& out) { fem_export::write_force_table_csv(out, *ir.table, h); });
             ir.table_path = full;
           }

@@ -20,10 +20,35 @@ std::string text(const Eigen::Vector3d& v) {
 // Never NaN or Inf in an output: a non-finite value becomes null.
 nlohmann::json num(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
 
-nlohmann::json body_json(const std::string& name, const collision::VelocityJump& j) {
+nlohmann::json body_json(const std::string& name, const collision::VelocityJump& j, const collision::KernelBody& k) {
   return {{"name", name},
           {"delta_velocity_m_s", vec(j.delta_velocity_m_s)},
-          {"delta_angular_velocity_rad_s", vec(j.delta_angular_velocity_rad_s)}};
+          {"delta_angular_velocity_rad_s", vec(j.delta_angular_velocity_rad_s)},
+          {"lever_arm_m", vec(k.lever_arm_m)},
+          {"principal_curvatures_1_per_m", {num(k.curvature.k1_per_m), num(k.curvature.k2_per_m)}}};
+}
+
+// The 1/R a rule assigns to one body (reported; the elliptical rule uses both tensors).
+double rule_curvature(const collision::ContactCurvature& c, collision::ContactRule rule) {
+  return rule == collision::ContactRule::paper ? c.paper_curvature_per_m : 0.5 * (c.k1_per_m + c.k2_per_m);
+}
+
+nlohmann::json validity_json(const collision::ValidityReport& v) {
+  nlohmann::json j = {{"indentation_over_radius", num(v.indentation_over_radius)},
+                      {"max_indentation_over_radius", v.limits.max_indentation_over_radius},
+                      {"contact_semi_axis_a_m", num(v.contact_semi_axis_a_m)},
+                      {"contact_semi_axis_b_m", num(v.contact_semi_axis_b_m)},
+                      {"smallest_curvature_radius_m", num(v.smallest_curvature_radius_m)},
+                      {"contact_size_over_radius", num(v.contact_size_over_radius)},
+                      {"max_contact_size_over_radius", v.limits.max_contact_size_over_radius},
+                      {"peak_pressure_Pa", num(v.peak_pressure_Pa)},
+                      {"ok", v.ok},
+                      {"warnings", v.warnings}};
+  j["yield_onset_pressure_Pa"] = v.yield_onset_pressure_Pa ? num(*v.yield_onset_pressure_Pa) : nlohmann::json(nullptr);
+  j["peak_pressure_over_yield_onset"] =
+      v.peak_pressure_over_yield_onset ? num(*v.peak_pressure_over_yield_onset) : nlohmann::json(nullptr);
+  if (!v.yielding_body.empty()) j["yield_checked_body"] = v.yielding_body;
+  return j;
 }
 
 }  // namespace
@@ -41,36 +66,37 @@ nlohmann::json to_json(const Scene& scene, const RunReport& rep) {
     const auto& c = r.history.compression;
     nlohmann::json i;
     i["name"] = ir.spec->name;
-    i["target"] = body_json(ir.spec->target, r.target_jump);
-    i["impactor"] = body_json(ir.spec->impactor, r.impactor_jump);
-    i["contact_point_m"] = vec(ir.contact.target_point.point_m);
-    i["contact_normal"] = vec(ir.contact.target_point.normal);
+    const collision::KernelInput& kin = ir.contact.input;
+    const collision::KernelResult& kr = r.kernel;
+    i["target"] = body_json(ir.spec->target, r.target_jump, kin.target);
+    i["impactor"] = body_json(ir.spec->impactor, r.impactor_jump, kin.impactor);
+    i["contact_mode"] = ir.spec->first_contact ? "first-contact" : "point";
+    i["contact_point_m"] = vec(ir.contact.point_m);
+    i["contact_normal"] = vec(ir.contact.normal);
+    i["travel_m"] = num(ir.contact.travel_m);
     i["projection_distance_m"] = num(ir.contact.target_point.distance_m);
     i["contact_radius_rule"] = to_string(ir.spec->contact_radius);
-    i["target_principal_curvatures_1_per_m"] = {ir.contact.target_curvature.k1_per_m,
-                                                ir.contact.target_curvature.k2_per_m};
-    i["target_contact_curvature_1_per_m"] = num(ir.contact.target_curvature_per_m);
-    i["impactor_contact_curvature_1_per_m"] = num(ir.contact.impactor_curvature_per_m);
-    if (ir.spec->contact_radius == ContactRadiusRule::elliptical) {
-      i["relative_curvatures_1_per_m"] = {ir.contact.relative_curvature_A_per_m,
-                                          ir.contact.relative_curvature_B_per_m};
-      i["contact_ellipse_axis_ratio"] = num(ir.contact.contact_ellipse_axis_ratio);
-    }
+    i["target_principal_curvatures_1_per_m"] = {num(kin.target.curvature.k1_per_m), num(kin.target.curvature.k2_per_m)};
+    i["target_contact_curvature_1_per_m"] = num(rule_curvature(kin.target.curvature, ir.spec->contact_radius));
+    i["impactor_contact_curvature_1_per_m"] = num(rule_curvature(kin.impactor.curvature, ir.spec->contact_radius));
+    i["relative_curvatures_1_per_m"] = {num(kr.relative_curvature_A_per_m), num(kr.relative_curvature_B_per_m)};
+    i["contact_ellipse_axis_ratio"] = num(kr.contact_ellipse_axis_ratio);
+    i["validity"] = validity_json(ir.validity);
     i["reduced_mass_kg"] = num(r.reduced_mass_kg);
     i["effective_radius_m"] = num(r.effective_radius_m);
     i["effective_modulus_Pa"] = num(r.effective_modulus_Pa);
     i["hertz_constant_N_per_m1_5"] = num(r.hertz_constant);
     i["approach_velocity_m_s"] = num(r.approach_velocity_m_s);
-    if (r.restitution_from_energy_flux) {
-      i["restitution_model"] = "energy-flux";
+    i["restitution_model"] = collision::to_string(r.restitution_kind);
+    if (r.restitution_kind == collision::RestitutionModel::Kind::energy_flux) {
       i["energy_flux_density"] = num(r.restitution.energy_flux_density);
       i["energy_flux_density_unit"] = collision::to_string(ir.spec->restitution.flux_unit);
       i["energy_flux_density_J_m3"] = num(r.restitution.energy_flux_density_J_m3);
       i["ln_energy_flux_density"] = num(r.restitution.ln_energy_flux);
       i["restitution_clamped"] = r.restitution.clamped;
     } else {
-      i["restitution_model"] = "constant";
       i["energy_flux_density"] = nullptr;
+      if (r.restitution_kind == collision::RestitutionModel::Kind::table) i["restitution_clamped"] = r.restitution.clamped;
     }
     i["restitution"] = num(r.restitution.coefficient);
     i["max_indentation_m"] = num(c.max_indentation_m);
@@ -135,16 +161,20 @@ std::string format_summary(const Scene& scene, const RunReport& rep) {
   for (const auto& ir : rep.impacts) {
     const auto& r = ir.result;
     const auto& c = r.history.compression;
-    const auto& p = ir.contact.target_point;
     o << "\nimpact '" << ir.spec->name << "': " << ir.spec->impactor << " hits " << ir.spec->target
-      << " at " << text(p.point_m) << " m, normal " << text(p.normal) << "\n";
+      << " at " << text(ir.contact.point_m) << " m, normal " << text(ir.contact.normal) << "\n";
+    if (ir.spec->first_contact) {
+      o << "  first contact         after " << ir.contact.travel_m << " m of travel; lever arms target "
+        << text(ir.contact.input.target.lever_arm_m) << " m, impactor " << text(ir.contact.input.impactor.lever_arm_m)
+        << " m\n";
+    }
     o << "  reduced mass          " << r.reduced_mass_kg << " kg\n";
     o << "  approach velocity     " << r.approach_velocity_m_s << " m/s\n";
     o << "  effective radius      " << r.effective_radius_m << " m (" << to_string(ir.spec->contact_radius)
       << " rule)\n";
     o << "  effective modulus     " << r.effective_modulus_Pa << " Pa\n";
     o << "  Hertz constant        " << r.hertz_constant << " N/m^1.5\n";
-    if (r.restitution_from_energy_flux) {
+    if (r.restitution_kind == collision::RestitutionModel::Kind::energy_flux) {
       o << "  energy flux density   " << r.restitution.energy_flux_density << " "
         << collision::to_string(ir.spec->restitution.flux_unit) << " (ln = " << r.restitution.ln_energy_flux
         << (r.restitution.clamped ? ", clamped" : "") << ")\n";
@@ -156,6 +186,12 @@ std::string format_summary(const Scene& scene, const RunReport& rep) {
     o << "  contact time          " << r.history.contact_time_s() << " s\n";
     o << "  impulse               " << r.history.impulse_total_Ns() << " N s (compression "
       << r.history.impulse_compression_Ns() << ")\n";
+    const auto& v = ir.validity;
+    o << "  validity              x_max/R* " << v.indentation_over_radius << ", contact a = "
+      << v.contact_semi_axis_a_m << " m, b = " << v.contact_semi_axis_b_m << " m, a/R_min "
+      << v.contact_size_over_radius << ", p0 " << v.peak_pressure_Pa << " Pa";
+    if (v.peak_pressure_over_yield_onset) o << " (" << *v.peak_pressure_over_yield_onset << " x onset of yield)";
+    o << (v.ok ? " -> within Hertz's assumptions" : " -> OUTSIDE Hertz's assumptions (see warnings)") << "\n";
     o << "  target   dv = " << text(r.target_jump.delta_velocity_m_s) << " m/s, dw = "
       << text(r.target_jump.delta_angular_velocity_rad_s) << " rad/s\n";
     o << "  impactor dv = " << text(r.impactor_jump.delta_velocity_m_s) << " m/s, dw = "

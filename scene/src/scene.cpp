@@ -25,15 +25,7 @@ const char* to_string(ShapeKind k) {
     case ShapeKind::sphere: return "sphere";
     case ShapeKind::ellipsoid: return "ellipsoid";
     case ShapeKind::mesh: return "mesh";
-  }
-  return "?";
-}
-
-const char* to_string(ContactRadiusRule r) {
-  switch (r) {
-    case ContactRadiusRule::paper: return "paper";
-    case ContactRadiusRule::mean: return "mean";
-    case ContactRadiusRule::elliptical: return "elliptical";
+    case ShapeKind::plane: return "plane";
   }
   return "?";
 }
@@ -203,14 +195,15 @@ Material read_material(const std::string& name, const toml::table& t, const std:
 BodySpec read_body(std::size_t index, const toml::table& t, const std::string& file,
                    double to_m, const fs::path& base_dir) {
   Reader r(t, "bodies[" + std::to_string(index) + "]", file);
-  r.allow({"name", "shape", "radius", "semi_axes", "mesh", "material", "mass_kg", "fixed",
-           "velocity_m_s", "angular_velocity_rad_s"});
+  r.allow({"name", "shape", "radius", "semi_axes", "mesh", "normal", "material", "mass_kg", "fixed",
+           "velocity_m_s", "angular_velocity_rad_s", "position", "orientation_axis", "orientation_angle_deg"});
   BodySpec b;
   b.place = r.self();
   b.name = r.required_string("name");
   b.shape = r.choice<ShapeKind>("shape", {{"sphere", ShapeKind::sphere},
                                           {"ellipsoid", ShapeKind::ellipsoid},
-                                          {"mesh", ShapeKind::mesh}}, std::nullopt);
+                                          {"mesh", ShapeKind::mesh},
+                                          {"plane", ShapeKind::plane}}, std::nullopt);
   switch (b.shape) {
     case ShapeKind::sphere:
       b.radius_m = r.positive("radius") * to_m;
@@ -230,15 +223,77 @@ BodySpec read_body(std::size_t index, const toml::table& t, const std::string& f
       b.mesh_self_intersection_check = r.boolean("self_intersection_check").value_or(true);
       break;
     }
+    case ShapeKind::plane: {
+      auto n = r.vec3("normal");
+      if (!n) r.missing("normal");
+      const double len = n->norm();
+      if (!(len > 0.0) || !std::isfinite(len)) r.fail("normal", "must be a non-zero vector (the plane's outward normal)");
+      b.plane_normal = *n / len;
+      break;
+    }
   }
   b.material = r.required_string("material");
   if (r.has("mass_kg")) b.mass_kg = r.positive("mass_kg");
-  b.fixed = r.boolean("fixed").value_or(false);
+  const std::optional<bool> fixed = r.boolean("fixed");
+  b.fixed = fixed.value_or(false);
   if (b.fixed && b.mass_kg) r.fail("mass_kg", "a fixed body has infinite mass; remove mass_kg or fixed");
   b.velocity_m_s = r.vec3("velocity_m_s").value_or(Eigen::Vector3d::Zero());
   b.angular_velocity_rad_s = r.vec3("angular_velocity_rad_s").value_or(Eigen::Vector3d::Zero());
+  if (b.shape == ShapeKind::plane) {
+    // A half-space: infinite mass, at rest (the other body carries the relative velocity).
+    if (fixed && !*fixed) r.fail("fixed", "a plane is always fixed (infinite mass)");
+    if (b.mass_kg) r.fail("mass_kg", "a plane has infinite mass; remove mass_kg");
+    if (!b.velocity_m_s.isZero(0.0)) r.fail("velocity_m_s", "a plane is fixed: give the other body the relative velocity");
+    if (!b.angular_velocity_rad_s.isZero(0.0)) r.fail("angular_velocity_rad_s", "a plane is fixed: it cannot spin");
+    b.fixed = true;
+  }
+  if (auto p = r.vec3("position")) {
+    b.position_m = *p * to_m;
+    b.placed = true;
+  }
+  const std::optional<Eigen::Vector3d> axis = r.vec3("orientation_axis");
+  const std::optional<double> angle = r.number("orientation_angle_deg");
+  if (axis.has_value() != angle.has_value()) {
+    r.fail(axis ? "orientation_axis" : "orientation_angle_deg",
+           "orientation_axis and orientation_angle_deg go together: give both or neither");
+  }
+  if (axis) {
+    const double len = axis->norm();
+    if (!(len > 0.0) || !std::isfinite(len)) r.fail("orientation_axis", "must have a non-zero length");
+    b.rotation = Eigen::AngleAxisd(*angle * M_PI / 180.0, *axis / len).toRotationMatrix();
+    b.placed = true;
+  }
   r.reject_unknown();
   return b;
+}
+
+// `restitution = { approach_speed_m_s = [...], value = [...] }`
+collision::RestitutionTable read_restitution_table(Reader& parent, const toml::table& t, const std::string& file) {
+  Reader r(t, parent.key_path("restitution"), file);
+  collision::RestitutionTable tab;
+  auto list = [&](const char* k, std::vector<double>& out) {
+    const toml::node* n = r.get(k);
+    if (!n) r.missing(k);
+    const toml::array* a = n->as_array();
+    if (!a) r.fail(k, "must be an array of numbers");
+    if (a->size() > 100000) r.fail(k, "at most 100000 points");
+    for (std::size_t i = 0; i < a->size(); ++i) {
+      const toml::node* e = a->get(i);
+      if (!e->is_number()) r.fail(k, "element " + std::to_string(i) + " must be a number");
+      const double v = e->value<double>().value();
+      if (!std::isfinite(v)) r.fail(k, "element " + std::to_string(i) + " must be finite");
+      out.push_back(v);
+    }
+  };
+  list("approach_speed_m_s", tab.approach_speed_m_s);
+  list("value", tab.value);
+  try {
+    collision::validate_restitution_table(tab);
+  } catch (const InputError& e) {
+    throw InputError(file, r.self().describe(), e.reason());
+  }
+  r.reject_unknown();
+  return tab;
 }
 
 ImpactSpec read_impact(std::size_t index, const toml::table& t, const std::string& file,
@@ -252,32 +307,52 @@ ImpactSpec read_impact(std::size_t index, const toml::table& t, const std::strin
   s.target = r.required_string("target");
   s.impactor = r.required_string("impactor");
   if (s.target == s.impactor) r.fail("impactor", "a body cannot hit itself");
-  auto p = r.vec3("point");
-  if (!p) r.missing("point");
-  s.point_m = *p * to_m;
+  if (const toml::node* n = r.get("point")) {
+    if (n->is_string()) {
+      if (n->value<std::string>().value() != "first-contact") {
+        r.fail("point", "must be [x, y, z] or \"first-contact\"");
+      }
+      s.first_contact = true;
+    } else {
+      s.point_m = *r.vec3("point") * to_m;
+    }
+  } else {
+    r.missing("point");
+  }
   s.restitution = defaults;
   if (const toml::node* n = r.get("restitution")) {
     if (n->is_string()) {
       if (n->value<std::string>().value() != "energy-flux") {
-        r.fail("restitution", "must be \"energy-flux\" or a number in [0, 1]");
+        r.fail("restitution", "must be \"energy-flux\", a number in [0, 1] or a table "
+                              "{ approach_speed_m_s = [...], value = [...] }");
       }
-      s.restitution.from_energy_flux = true;
+      s.restitution.kind = collision::RestitutionModel::Kind::energy_flux;
     } else if (n->is_number()) {
       const double R = n->value<double>().value();
       if (!(R >= 0.0 && R <= 1.0)) r.fail("restitution", "must lie in [0, 1], got " + Reader::fmt(R));
-      s.restitution.from_energy_flux = false;
+      s.restitution.kind = collision::RestitutionModel::Kind::constant;
       s.restitution.constant = R;
+    } else if (n->is_table()) {
+      s.restitution.kind = collision::RestitutionModel::Kind::table;
+      s.restitution.table = read_restitution_table(r, *n->as_table(), file);
     } else {
-      r.fail("restitution", "must be \"energy-flux\" or a number in [0, 1]");
+      r.fail("restitution", "must be \"energy-flux\", a number in [0, 1] or a table "
+                            "{ approach_speed_m_s = [...], value = [...] }");
     }
   }
   s.contact_radius = r.choice<ContactRadiusRule>(
       "contact_radius",
-      {{"paper", ContactRadiusRule::paper},
+      {{"elliptical", ContactRadiusRule::elliptical},
        {"mean", ContactRadiusRule::mean},
-       {"elliptical", ContactRadiusRule::elliptical}},
-      ContactRadiusRule::paper);
-  if (r.has("approach_speed_m_s")) s.approach_speed_m_s = r.positive("approach_speed_m_s");
+       {"paper", ContactRadiusRule::paper}},
+      ContactRadiusRule::elliptical);
+  if (r.has("approach_speed_m_s")) {
+    s.approach_speed_m_s = r.positive("approach_speed_m_s");
+    if (s.first_contact) {
+      r.fail("approach_speed_m_s", "point = \"first-contact\" takes the bodies' own velocities; "
+                                   "remove approach_speed_m_s");
+    }
+  }
   if (r.has("max_projection_distance")) {
     const double d = r.required_number("max_projection_distance");
     if (!(d >= 0.0)) r.fail("max_projection_distance", "must be >= 0");
@@ -372,7 +447,7 @@ Scene build(const toml::table& root, const std::string& file, const fs::path& ba
   sc.file = file;
   Reader r(root, "", file);
   r.allow({"length_unit", "modulus_convention", "energy_flux_unit", "restitution_range_policy",
-           "checks", "materials", "bodies", "impacts", "outputs"});
+           "checks", "validity", "materials", "bodies", "impacts", "outputs"});
   const std::string unit_text = r.required_string("length_unit");
   auto unit = parse_length_unit(unit_text);
   if (!unit) r.fail("length_unit", "unknown unit \"" + unit_text + "\" (expected m, cm, mm or in)");
@@ -402,6 +477,18 @@ Scene build(const toml::table& root, const std::string& file, const fs::path& ba
     c.allow({"impulse_relative", "energy_relative"});
     if (c.has("impulse_relative")) sc.thresholds.impulse_relative = c.positive("impulse_relative");
     if (c.has("energy_relative")) sc.thresholds.energy_relative = c.positive("energy_relative");
+    c.reject_unknown();
+  }
+
+  if (const toml::node* n = r.get("validity")) {
+    Reader c(sub_table(n, "validity", file), "validity", file);
+    c.allow({"max_indentation_over_radius", "max_contact_size_over_radius"});
+    if (c.has("max_indentation_over_radius")) {
+      sc.validity.max_indentation_over_radius = c.positive("max_indentation_over_radius");
+    }
+    if (c.has("max_contact_size_over_radius")) {
+      sc.validity.max_contact_size_over_radius = c.positive("max_contact_size_over_radius");
+    }
     c.reject_unknown();
   }
 
@@ -448,6 +535,14 @@ Scene build(const toml::table& root, const std::string& file, const fs::path& ba
         const char* key = who == &s.target ? "target" : "impactor";
         throw InputError(file, Place{s.place.line, "impacts[" + std::to_string(i) + "]." + key}.describe(),
                          "no body named '" + *who + "'");
+      }
+    }
+    if (!s.first_contact) {
+      const BodySpec& imp = sc.body(s.impactor);
+      if (imp.placed && imp.position_m != Eigen::Vector3d::Zero()) {
+        throw InputError(file, Place{s.place.line, "impacts[" + std::to_string(i) + "].point"}.describe(),
+                         "impactor '" + s.impactor + "' has a position, but with point = [x, y, z] it is placed "
+                         "to touch the target there; use point = \"first-contact\" to keep both placements");
       }
     }
     for (const auto& other : sc.impacts) {

@@ -1,6 +1,9 @@
 #include "impactdeck/study/cloud.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <fstream>
+#include <sstream>
 
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/geometry/mesh_shape.hpp"
@@ -93,6 +96,56 @@ std::vector<geometry::SurfacePoint> make_cloud(const geometry::Shape& target, Cl
     cloud.insert(cloud.end(), u.begin(), u.end());
   }
   return cloud;
+}
+
+}  // namespace impactdeck::study
+
+namespace impactdeck::study {
+
+std::vector<geometry::SurfacePoint> csv_point_cloud(const geometry::Shape& target, const std::filesystem::path& csv,
+                                                    double metres_per_unit, double max_distance_m,
+                                                    std::size_t max_points) {
+  std::ifstream in(csv);
+  if (!in) throw InputError(csv.string(), "file", "cannot be opened (missing or unreadable)");
+  std::vector<geometry::SurfacePoint> out;
+  std::string line;
+  std::size_t n = 0;
+  bool first = true;
+  while (std::getline(in, line)) {
+    ++n;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    const std::size_t start = line.find_first_not_of(" \t");
+    if (start == std::string::npos || line[start] == '#') continue;
+    std::replace(line.begin(), line.end(), ',', ' ');
+    std::istringstream fields(line);
+    double v[3];
+    std::string extra;
+    const bool ok = static_cast<bool>(fields >> v[0] >> v[1] >> v[2]) && !(fields >> extra);
+    if (!ok) {
+      if (first) {  // a header line
+        first = false;
+        continue;
+      }
+      throw InputError(csv.string(), "line " + std::to_string(n), "expected three numbers x, y, z");
+    }
+    first = false;
+    Eigen::Vector3d p(v[0], v[1], v[2]);
+    p *= metres_per_unit;
+    if (!p.allFinite()) throw InputError(csv.string(), "line " + std::to_string(n), "coordinates must be finite");
+    if (out.size() >= max_points) {
+      throw InputError(csv.string(), "line " + std::to_string(n),
+                       "more than " + std::to_string(max_points) + " points");
+    }
+    const geometry::SurfacePoint sp = target.closest_point(p);
+    if (sp.distance_m > max_distance_m) {
+      std::ostringstream m;
+      m << "the point is " << sp.distance_m << " m from the target's surface (allowed: " << max_distance_m << " m)";
+      throw InputError(csv.string(), "line " + std::to_string(n), m.str());
+    }
+    out.push_back(sp);
+  }
+  if (out.empty()) throw InputError(csv.string(), "file", "holds no point");
+  return out;
 }
 
 }  // namespace impactdeck::study

@@ -23,35 +23,23 @@ SceneSweep sweep_from_scene(const scene::Scene& sc, const std::string& name) {
     throw InputError(file, "--impact", "no impact named '" + name + "' (the scene has " + list + ")");
   }
   const scene::ImpactSpec& s = *out.impact;
-  const scene::PreparedBody t = scene::prepare_body(sc.body(s.target), sc);
-  const scene::PreparedBody i = scene::prepare_body(sc.body(s.impactor), sc);
-  // Every scene rule is mapped explicitly: a rule added to the scene format must be taught to the
-  // sweep (the compiler warns about the switch; at run time the sweep refuses it by name).
-  std::optional<RadiusRule> mapped;
-  switch (s.contact_radius) {
-    case scene::ContactRadiusRule::paper: mapped = RadiusRule::paper; break;
-    case scene::ContactRadiusRule::mean: mapped = RadiusRule::mean; break;
-    case scene::ContactRadiusRule::elliptical: mapped = RadiusRule::elliptical; break;
-  }
-  if (!mapped) {
-    throw InputError(file, scene::Place{s.place.line, s.place.key + ".contact_radius"}.describe(),
-                     std::string("impact '") + s.name + "': the sweep does not support contact_radius = \"" +
-                         scene::to_string(s.contact_radius) + "\" (use \"paper\", \"mean\" or \"elliptical\")");
-  }
-  const RadiusRule rule = *mapped;
-  auto body = [&](const scene::PreparedBody& p) {
-    SweepBody b;
-    b.shape = p.shape;
-    b.mass_kg = p.mass_kg;
-    b.inertia_kg_m2 = p.inertia_kg_m2;
-    b.centroid_m = p.volume.centroid_m;
-    b.radius_rule = rule;
+  // The sweep's setting: the target at rest, the impactor translating along the inward normal.
+  auto at_rest = [](scene::PreparedBody b) {
+    b.velocity_m_s.setZero();
+    b.angular_velocity_rad_s.setZero();
     return b;
   };
-  out.setup.target = body(t);
-  out.setup.impactor = body(i);
+  out.setup.target = at_rest(scene::prepare_body(sc.body(s.target), sc));
+  out.setup.impactor = at_rest(scene::prepare_body(sc.body(s.impactor), sc));
+  if (!out.setup.target.shape->bounded()) {
+    throw InputError(file, scene::Place{s.place.line, s.place.key + ".target"}.describe(),
+                     "impact '" + s.name + "': a sweep covers the target's surface; target '" + s.target +
+                         "' is a plane (swap target and impactor)");
+  }
+  out.setup.rule = s.contact_radius;
   try {
-    out.setup.effective_modulus_Pa = collision::effective_modulus_Pa(t.material, i.material, sc.modulus_convention);
+    out.setup.effective_modulus_Pa = collision::effective_modulus_Pa(out.setup.target.material,
+                                                                     out.setup.impactor.material, sc.modulus_convention);
   } catch (const InputError& e) {
     throw InputError(file, s.place.describe(), "impact '" + s.name + "': " + e.reason());
   }

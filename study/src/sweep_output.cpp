@@ -25,8 +25,12 @@ void header(std::ostream& o, const char* comment, const SweepMeta& m, const Swee
   o << comment << " units: SI (m, kg, N, s); coordinates in the target's frame\n";
   o << comment << " force ratio min/max = " << g17(r.force_ratio) << " (min at point " << r.min_index
     << ", max at point " << r.max_index << ")\n";
-  o << comment << " sharp points: " << r.sharp_count
-    << " (on sharp edges or corners: no local radius, left out of min/max; flagged sharp_feature = 1)\n";
+  o << comment << " flagged points: " << r.flagged_count << " (the contact model does not apply there: left out of "
+    << "min/max; column flag names why";
+  for (int f = 1; f < collision::kContactFlagCount; ++f) {
+    if (r.flag_counts[f] > 0) o << "; " << collision::flag_word(static_cast<collision::ContactFlag>(f)) << " " << r.flag_counts[f];
+  }
+  o << ")\n";
 }
 
 double max_force(const SweepResult& r) { return r.points[r.max_index].max_force_N; }
@@ -44,7 +48,7 @@ void write_sweep_csv(const std::filesystem::path& path, const SweepResult& r, co
          "reduced_mass_kg,hertz_constant_N_per_m1_5,max_indentation_m,max_force_N,force_ratio,"
          "compression_time_s,restitution,contact_time_s,impulse_total_Ns,"
          "target_dvx_m_s,target_dvy_m_s,target_dvz_m_s,target_dwx_rad_s,target_dwy_rad_s,target_dwz_rad_s,"
-         "contact_ellipse_axis_ratio,sharp_feature\n";
+         "contact_ellipse_axis_ratio,sharp_feature,flag\n";
     const double fmax = max_force(r);
     for (std::size_t i = 0; i < r.points.size(); ++i) {
       const PointResult& p = r.points[i];
@@ -60,7 +64,7 @@ void write_sweep_csv(const std::filesystem::path& path, const SweepResult& r, co
                        p.contact_ellipse_axis_ratio}) {
         o << ',' << g17(v);
       }
-      o << ',' << (p.sharp_feature ? 1 : 0) << '\n';
+      o << ',' << (p.sharp_feature ? 1 : 0) << ',' << collision::flag_word(p.flag) << '\n';
     }
   });
 }
@@ -75,7 +79,7 @@ void write_sweep_curves_csv(const std::filesystem::path& path, const SweepResult
     o << "point,time_s,force_N\n";
     const double last = static_cast<double>(r.curve_samples - 1);
     for (std::size_t i = 0; i < r.points.size(); ++i) {
-      if (r.points[i].sharp_feature) continue;  // no curve: no local radius there
+      if (r.points[i].flagged()) continue;  // no curve where the model does not apply
       const double tc = r.points[i].contact_time_s;
       for (std::size_t k = 0; k < r.curve_samples; ++k) {
         o << i << ',' << g17(tc * static_cast<double>(k) / last) << ','
@@ -94,12 +98,13 @@ void write_sweep_pos(const std::filesystem::path& path, const SweepResult& r, co
       o << "SP(" << g17(p.point_m.x()) << "," << g17(p.point_m.y()) << "," << g17(p.point_m.z()) << "){" << g17(v)
         << "};\n";
     };
-    // The computed views hold the points off sharp features; those get a view of their own.
+    // The computed views hold the points not flagged; sharp points and the other flagged points get
+    // views of their own (value: the flag's number, collision::ContactFlag).
     const char* names[] = {"max_force_N", "force_ratio", "contact_ellipse_axis_ratio"};
     for (int view = 0; view < 3; ++view) {
       o << "View \"" << names[view] << "\" {\n";
       for (const PointResult& p : r.points) {
-        if (p.sharp_feature) continue;
+        if (p.flagged()) continue;
         sp(p, view == 0 ? p.max_force_N : view == 1 ? p.max_force_N / fmax : p.contact_ellipse_axis_ratio);
       }
       o << "};\n";
@@ -108,6 +113,12 @@ void write_sweep_pos(const std::filesystem::path& path, const SweepResult& r, co
       o << "View \"sharp_feature\" {\n";
       for (const PointResult& p : r.points)
         if (p.sharp_feature) sp(p, 1.0);
+      o << "};\n";
+    }
+    if (r.flagged_count > r.sharp_count) {
+      o << "View \"flag\" {\n";
+      for (const PointResult& p : r.points)
+        if (p.flagged() && !p.sharp_feature) sp(p, static_cast<double>(p.flag));
       o << "};\n";
     }
   });
@@ -140,6 +151,7 @@ void write_sweep_vtp(const std::filesystem::path& path, const SweepResult& r, co
     scalar("target_radius_m", [](const PointResult& p) { return radius_out(p.target_radius_m); });
     scalar("contact_ellipse_axis_ratio", [](const PointResult& p) { return p.contact_ellipse_axis_ratio; });
     scalar("sharp_feature", [](const PointResult& p) { return p.sharp_feature ? 1.0 : 0.0; });
+    scalar("flag", [](const PointResult& p) { return static_cast<double>(p.flag); });  // collision::ContactFlag
     o << "<DataArray type=\"Float64\" Name=\"normal\" NumberOfComponents=\"3\" format=\"ascii\">\n";
     for (const PointResult& p : r.points)
       o << g17(p.normal.x()) << ' ' << g17(p.normal.y()) << ' ' << g17(p.normal.z()) << '\n';
@@ -297,8 +309,8 @@ plot::Drawing force_map_drawing(const geometry::Shape& target, const Eigen::Vect
     for (std::size_t i : order) {
       const PointResult& p = r.points[i];
       if ((p.normal.dot(d) >= 0.0) != front) continue;
-      if (p.sharp_feature) {
-        // No force there: a small grey cross instead of a circle.
+      if (p.flagged()) {
+        // No force there (sharp, no-fit, ...): a small grey cross instead of a circle.
         plot::Style x;
         x.stroke = {0.45, 0.45, 0.45};
         x.stroke_width = 1.0;
@@ -351,8 +363,17 @@ plot::Drawing force_map_drawing(const geometry::Shape& target, const Eigen::Vect
   dr.text({left, 48}, sub.str(), 12);
   // The sharp-point count goes on the legend line: on the subtitle it ran past the picture's edge.
   std::string legend = "circle radius \xE2\x88\x9D F_max, darker = lower force; faded: far side";
-  if (r.sharp_count > 0)
-    legend += "; " + std::to_string(r.sharp_count) + " points on sharp edges/corners (grey x, left out)";
+  if (r.flagged_count > 0) {
+    legend += "; " + std::to_string(r.flagged_count) + " flagged points (grey x, left out: ";
+    bool any = false;
+    for (int f = 1; f < collision::kContactFlagCount; ++f) {
+      if (r.flag_counts[f] == 0) continue;
+      legend += std::string(any ? ", " : "") + std::to_string(r.flag_counts[f]) + " " +
+                collision::flag_word(static_cast<collision::ContactFlag>(f));
+      any = true;
+    }
+    legend += ")";
+  }
   dr.text({left, 66}, legend, 11, plot::Anchor::start, {0.35, 0.35, 0.35});
 
   // Colour bar.

@@ -52,20 +52,6 @@ Eigen::Vector3d semi_axes(double g, double size_ratio) {
   return {s, s / g, s / g};
 }
 
-// Eq. 26 factor on a unit sphere at a unit vector u: mean of sqrt(1 - u_i^2) over the sections
-// that are not tangent (written out independently of geometry::Ellipsoid, as a check).
-double sphere_eq26_factor(const Eigen::Vector3d& u) {
-  double sum = 0.0;
-  int count = 0;
-  for (int i = 0; i < 3; ++i) {
-    const double s2 = 1.0 - u[i] * u[i];
-    if (!(s2 > 1e-12)) continue;
-    sum += std::sqrt(s2);
-    ++count;
-  }
-  return sum / count;
-}
-
 // Axis-aligned bounding box of a mesh's vertices.
 void bounding_box(const geometry::TriangleMesh& m, Eigen::Vector3d& lo, Eigen::Vector3d& hi) {
   lo = hi = m.vertices_m.front();
@@ -129,7 +115,7 @@ Table1Options table1_preset(const std::string& name) {
   o.geometric_ratios = kDecades;
   o.mass_ratios = kDecades;
   o.size_ratio = 20.0;
-  o.target_radius_rule = RadiusRule::paper;
+  o.rule = collision::ContactRule::paper;
   o.cloud = CloudKind::paper_grid;
   o.grid_steps = 8;
   return o;
@@ -219,34 +205,29 @@ Table1Result run_table1(const Table1Options& o) {
   }
   res.points_per_cell = clouds.front().size();
   res.sharp_points.assign(ng, 0);
+  res.flagged_points.assign(ng, 0);
 
   std::size_t done_before = 0;
   for (std::size_t gi = 0; gi < ng; ++gi) {
-    const geometry::VolumeProperties tv = targets[gi]->volume_properties();
     for (std::size_t mi = 0; mi < nm; ++mi) {
       SweepSetup s;
       if (o.scene) {
-        s = o.scene->setup;  // impactor, materials, speed, radius rule
+        s = o.scene->setup;  // impactor, materials, speed, contact rule
       } else {
-        s.impactor.shape = sphere;
-        s.impactor.mass_kg = m2;
-        s.impactor.inertia_kg_m2 = sv.inertia_per_density_m5 * kDensity_kg_m3;
-        s.impactor.centroid_m = sv.centroid_m;
-        s.impactor.radius_rule = RadiusRule::mean;  // the sphere's own radius r, exactly
-        s.target.radius_rule = o.target_radius_rule;
+        s.impactor = scene::body_of_mass("sphere", sphere, m2);
+        s.rule = o.rule;  // "paper": Eq. 26 on the ellipsoid, the sphere's own radius r exactly
         s.effective_modulus_Pa = collision::effective_modulus_Pa(
             {kYoungs_Pa, 0.3}, {kYoungs_Pa, 0.3}, collision::ModulusConvention::paper);
         s.approach_speed_m_s = kSpeed_m_s;
       }
       // F_max does not depend on the restitution: none is evaluated (a scene's energy-flux model
       // with range policy "error" would otherwise fail at extreme mass ratios for nothing).
-      s.restitution.from_energy_flux = false;
+      s.restitution = collision::RestitutionModel{};
+      s.restitution.kind = collision::RestitutionModel::Kind::constant;
       s.restitution.constant = 1.0;
       const double m1 = o.mass_ratios[mi] * s.impactor.mass_kg;
-      s.target.shape = targets[gi];
-      s.target.mass_kg = m1;
-      s.target.inertia_kg_m2 = tv.inertia_per_density_m5 * (m1 / tv.volume_m3);
-      s.target.centroid_m = tv.centroid_m;
+      const std::string name = o.scene ? s.target.name : std::string("ellipsoid");
+      s.target = scene::body_of_mass(name, targets[gi], m1, s.target.material);
       SweepOptions so;
       so.threads = o.threads;
       if (o.progress) {
@@ -265,6 +246,7 @@ Table1Result run_table1(const Table1Options& o) {
       res.ratio[gi][mi] = sr.force_ratio;
       res.mass_only[gi][mi] = sr.mass_only_ratio;
       res.sharp_points[gi] = sr.sharp_count;
+      res.flagged_points[gi] = sr.flagged_count;
     }
   }
 
@@ -292,22 +274,6 @@ Table1Result run_table1(const Table1Options& o) {
       }
     }
     res.mean_abs_delta = sum / static_cast<double>(res.cells_compared);
-  }
-
-  // The sphere row, explained: Eq. 26 on a sphere.
-  for (std::size_t gi = 0; gi < ng; ++gi) {
-    if (o.scene || o.geometric_ratios[gi] != 1.0 || o.target_radius_rule != RadiusRule::paper) continue;
-    res.has_sphere_row = true;
-    const double R = static_cast<const geometry::Ellipsoid&>(*targets[gi]).semi_axes_m().x();
-    double fmin = std::numeric_limits<double>::infinity(), fmax = 0.0;
-    for (const auto& sp : clouds[gi]) {
-      const double f = sphere_eq26_factor(sp.point_m / R);
-      fmin = std::min(fmin, f);
-      fmax = std::max(fmax, f);
-    }
-    auto rstar = [&](double f) { return 1.0 / (1.0 / (f * R) + 1.0 / r); };
-    res.sphere_min_radius_factor = fmin;
-    res.sphere_row_prediction = std::pow(rstar(fmin) / rstar(fmax), 0.2);
   }
 
   // Analytic limit (Eq. 39-41): the paper's Case 2 through the core, and Eq. 40 itself.

@@ -46,9 +46,9 @@ bool excluded(const Table1Result& r, std::size_t gi, std::size_t mi) {
 
 const char* kAxis[] = {"x", "y", "z"};
 
-std::size_t total_sharp(const Table1Result& r) {
+std::size_t total_flagged(const Table1Result& r) {
   std::size_t n = 0;
-  for (std::size_t k : r.sharp_points) n += k;
+  for (std::size_t k : r.flagged_points) n += k;
   return n;
 }
 
@@ -65,12 +65,12 @@ std::string settings_line(const Table1Result& r) {
     const int ax = sc.stretch_axis, ref = (ax + 1) % 3;
     s << "scene " << sc.source << ", impact '" << sc.impact << "': " << sc.impactor << " hits " << sc.target
       << "; g = half-extent along " << kAxis[ax] << " / along " << kAxis[ref] << " (target stretched along "
-      << kAxis[ax] << "), mu = target mass / impactor mass; radius rule " << to_string(sc.setup.target.radius_rule);
-    if (const std::size_t k = total_sharp(r)) s << "; " << k << " points on sharp features left out (all rows)";
+      << kAxis[ax] << "), mu = target mass / impactor mass; contact rule " << to_string(sc.setup.rule);
+    if (const std::size_t k = total_flagged(r)) s << "; " << k << " flagged points left out (all rows)";
     return s.str();
   }
   s << "size ratio (smaller semi-axis / sphere radius) " << plot::format_number(op.size_ratio, 6)
-    << "; ellipsoid radius rule " << to_string(op.target_radius_rule) << "; sphere radius exact";
+    << "; contact rule " << to_string(op.rule) << " (a sphere's radius is exact under every rule)";
   return s.str();
 }
 
@@ -118,10 +118,11 @@ std::string table1_markdown(const Table1Result& r) {
   if (r.options.scene) {
     o << "**No comparison with the paper's Table 1:** this table is driven by a scene (the user's target, "
       << "impactor and materials), not by the paper's setting; run without --scene for the comparison.\n\n";
-    if (total_sharp(r) > 0) {
-      o << "Points on sharp edges/corners per row (no local radius; left out of min/max):";
-      for (std::size_t gi = 0; gi < r.sharp_points.size(); ++gi)
-        o << (gi ? "," : "") << " g = " << decade(G[gi]) << ": " << r.sharp_points[gi];
+    if (total_flagged(r) > 0) {
+      o << "Flagged points per row (sharp edges/corners, no-fit, saddles, ...; left out of min/max):";
+      for (std::size_t gi = 0; gi < r.flagged_points.size(); ++gi)
+        o << (gi ? "," : "") << " g = " << decade(G[gi]) << ": " << r.flagged_points[gi] << " (" << r.sharp_points[gi]
+          << " sharp)";
       o << ".\n\n";
     }
   }
@@ -134,13 +135,6 @@ std::string table1_markdown(const Table1Result& r) {
       << "marked *): mean |delta| = " << fixed(r.mean_abs_delta, 5) << ", max |delta| = "
       << fixed(r.max_abs_delta, 5) << ". Left-out cell: model " << fixed(r.excluded_cell_model, 4)
       << ", paper " << fixed(r.excluded_cell_paper, 3) << ".\n\n";
-  }
-  if (r.has_sphere_row) {
-    o << "**Sphere row (g = 1).** Eq. 26 on a sphere of radius R gives R times the mean of sqrt(1 - p_i^2/R^2)"
-      << " over the non-tangent sections, not R; on this cloud the factor falls to "
-      << fixed(r.sphere_min_radius_factor, 4) << ", which predicts the ratio "
-      << fixed(r.sphere_row_prediction, 5) << " at every mass ratio (the reduced mass is the same at every"
-      << " point of a sphere). The paper prints 1.\n\n";
   }
   o << "## Analytic limit (Eq. 39-40)\n\n"
     << "Eq. 40: [(1 + mu)/(6 + mu)]^(3/5), Eq. 39 as mu -> 0 (= " << fixed(std::pow(1.0 / 6.0, 0.6), 4)
@@ -272,12 +266,13 @@ nlohmann::json table1_json(const Table1Result& r) {
                    {"seed", r.options.seed},
                    {"points_per_cell", r.points_per_cell},
                    {"size_ratio", r.options.size_ratio},
-                   {"radius_rule", to_string(r.options.target_radius_rule)}};
-  j["sharp_points"] = r.sharp_points;  // per row g
+                   {"radius_rule", to_string(r.options.rule)}};
+  j["sharp_points"] = r.sharp_points;      // per row g
+  j["flagged_points"] = r.flagged_points;  // per row g, any flag
   if (r.options.scene) {
     const Table1Scene& sc = *r.options.scene;
     j["settings"]["size_ratio"] = nullptr;  // sizes come from the scene
-    j["settings"]["radius_rule"] = to_string(sc.setup.target.radius_rule);
+    j["settings"]["radius_rule"] = to_string(sc.setup.rule);
     j["scene"] = {{"file", sc.source},
                   {"impact", sc.impact},
                   {"target", sc.target},
@@ -298,10 +293,6 @@ nlohmann::json table1_json(const Table1Result& r) {
                                          {"mass_ratio", kExcludedMassRatio},
                                          {"model", r.excluded_cell_model},
                                          {"paper", r.excluded_cell_paper}}}};
-  }
-  if (r.has_sphere_row) {
-    j["sphere_row"] = {{"min_eq26_radius_factor", r.sphere_min_radius_factor},
-                       {"predicted_ratio", r.sphere_row_prediction}};
   }
   json lim = json::array();
   for (const auto& l : r.limit_check) {

@@ -52,6 +52,11 @@ struct CompressionPhase {
   void force_curve(const double* t_s, double* force_N, std::size_t n) const;
 };
 
+/// Closed-form compression phase without input checks (noexcept; the physics kernel checks the
+/// result for finiteness).
+CompressionPhase compression_phase(double reduced_mass_kg, double approach_velocity_m_s,
+                                   double hertz_constant) noexcept;
+
 /// Closed-form compression phase. Throws InputError unless m_w > 0, v_w > 0, k_H > 0 (finite).
 CompressionPhase solve_compression(double reduced_mass_kg, double approach_velocity_m_s,
                                    double hertz_constant);

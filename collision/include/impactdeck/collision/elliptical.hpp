@@ -23,8 +23,9 @@ struct RelativeCurvatures {
 };
 
 /// A, B from each surface's principal curvatures (1/m, convex positive) and directions (unit,
-/// any frame), projected onto the tangent plane normal to `normal`. Equivalent to the classical
-/// formula with the angle between the principal directions.
+/// any frame), projected onto the tangent plane normal to `normal`; an umbilic surface (k1 = k2:
+/// sphere, plane) needs no directions. Equivalent to the classical formula with the angle between
+/// the principal directions.
 RelativeCurvatures relative_curvatures(double k1a, double k2a, const Eigen::Vector3d& d1a,
                                        const Eigen::Vector3d& d2a, double k1b, double k2b,
                                        const Eigen::Vector3d& d1b, const Eigen::Vector3d& d2b,

@@ -6,17 +6,10 @@
 
 #include "impactdeck/collision/eccentric.hpp"
 #include "impactdeck/collision/force_history.hpp"
+#include "impactdeck/collision/kernel.hpp"
 #include "impactdeck/collision/restitution.hpp"
 
 namespace impactdeck::collision {
-
-/// How R is obtained.
-struct RestitutionModel {
-  bool from_energy_flux = true;  ///< Eq. 14 + 30; otherwise `constant`
-  double constant = 1.0;         ///< R in [0, 1] when !from_energy_flux
-  EnergyFluxUnit flux_unit = EnergyFluxUnit::J_per_cm3;
-  RangePolicy range_policy = RangePolicy::warn;
-};
 
 /// The paper's thresholds (Sect. 2.3): 3 % on the compression impulse, 1 % on the energy loss.
 struct CheckThresholds {
@@ -24,11 +17,14 @@ struct CheckThresholds {
   double energy_relative = 0.01;
 };
 
+/// One impact as `run` solves it. Everything in one (world) frame.
 struct ImpactInput {
   RigidBody target;
   RigidBody impactor;
-  Contact contact;                  ///< point and the target's outward normal
-  double effective_radius_m = 0;    ///< R* (Eq. 29)
+  Contact contact;  ///< point and the target's outward normal
+  ContactCurvature target_curvature = ContactCurvature::flat();
+  ContactCurvature impactor_curvature = ContactCurvature::flat();
+  ContactRule rule = ContactRule::elliptical;
   double effective_modulus_Pa = 0;  ///< E* (Eq. 28 or Hertz)
   RestitutionModel restitution;
   CheckThresholds thresholds;
@@ -48,22 +44,31 @@ struct ImpactChecks {
 };
 
 struct ImpactResult {
+  KernelResult kernel;  ///< the physics kernel's result (valid: flag none)
   double reduced_mass_kg = 0;
   double effective_radius_m = 0;
   double effective_modulus_Pa = 0;
   double hertz_constant = 0;
   double approach_velocity_m_s = 0;
-  bool restitution_from_energy_flux = false;
+  RestitutionModel::Kind restitution_kind = RestitutionModel::Kind::energy_flux;
   RestitutionResult restitution;  ///< coefficient always set; flux fields when from the flux
   ForceHistory history;
-  VelocityJump target_jump;
+  VelocityJump target_jump;    ///< from the exact impulse (the kernel's)
   VelocityJump impactor_jump;
   ImpactChecks checks;
   std::vector<std::string> warnings;
 };
 
-/// Solves the impact. Throws InputError for invalid input or when the bodies do not approach at
-/// the contact point (no impact). Check failures do not throw: see `checks.passed`.
+/// Solves the impact through the physics kernel (solve_kernel), then builds the force history and
+/// runs the paper's self-checks on it. Throws InputError for invalid input and where the kernel
+/// flags the point (no impact, not a Hertz contact, restitution refused), naming the reason and
+/// the curvatures. Check failures do not throw: see `checks.passed`.
 ImpactResult solve_impact(const ImpactInput& input);
+
+/// One line explaining a kernel flag at a point (the curvatures of both surfaces, the approach
+/// velocity or the restitution), for errors and reports; the names are used as given (e.g. "'cube'").
+std::string explain_flag(const KernelInput& input, const KernelResult& result,
+                         const std::string& target_name = "the target",
+                         const std::string& impactor_name = "the impactor");
 
 }  // namespace impactdeck::collision

@@ -26,6 +26,12 @@ class Ellipsoid final : public Shape {
   /// Area-uniform: uniform directions on the unit sphere mapped by diag(a, b, c), accepted with
   /// probability proportional to the area stretch abc |diag(1/a, 1/b, 1/c) u|.
   std::vector<SurfacePoint> sample_surface(std::size_t count, std::uint64_t seed) const override;
+  /// Closed form p = M u / sqrt(u^T M u), M = diag(a^2, b^2, c^2), u = direction; the outward
+  /// normal there is u / |u| exactly.
+  std::optional<SurfacePoint> support_point(const Eigen::Vector3d& direction) const override;
+  /// x^2/a^2 + y^2/b^2 + z^2/c^2 <= 1 (+ 16 ulps: points computed on the surface count).
+  bool contains(const Eigen::Vector3d& own_point_m) const override;
+  bool is_convex() const override { return true; }
 
   /// Outward unit normal at a surface point (Eq. 25).
   Eigen::Vector3d normal_at(const Eigen::Vector3d& p_m) const;

@@ -2,6 +2,7 @@
 // A triangulated part as a Shape: surface queries on a closed, outward-oriented mesh. Built once
 // (AABB tree, adjacency, vertex normals, sharp edges), then every query is cheap.
 // CGAL stays in the .cpp (pimpl); this header uses Eigen and the standard library only.
+#include <functional>
 #include <memory>
 
 #include "impactdeck/geometry/mass_properties.hpp"
@@ -58,6 +59,35 @@ class MeshShape final : public Shape {
   double size_m() const override;
   /// Area-uniform over the triangles (cumulative areas, deterministic mt19937_64).
   std::vector<SurfacePoint> sample_surface(std::size_t count, std::uint64_t seed) const override;
+  /// The extreme vertex along the direction (an exact support point of the polytope; among
+  /// equal dot products the lowest vertex index), with the surface normal there (as
+  /// closest_point gives it).
+  std::optional<SurfacePoint> support_point(const Eigen::Vector3d& direction) const override;
+  /// The support point of the smoothed surface (the blended vertex normals that closest_point
+  /// reports): the point near the extreme vertex where that normal is `direction`, found on the
+  /// faces within three rings of it. Smooth parts of a mesh converge to the true support point at
+  /// second order this way, where the extreme vertex is first order. nullopt on a sharp feature or
+  /// where no face brackets the direction.
+  std::optional<SurfacePoint> smooth_support_point(const Eigen::Vector3d& direction) const;
+  /// On the surface (within 1e-12 of the part's size) or inside: the orientation of the first
+  /// face a ray meets (outward: inside), retried along other rays when the hit is within 1e-9
+  /// of an edge or grazing; after 16 ambiguous rays, the sign of the winding number.
+  bool contains(const Eigen::Vector3d& own_point_m) const override;
+
+  /// Broad phase of continuous collision on the AABB tree: visits every face whose bounding box
+  /// the box `moving` (own frame) meets while it translates by s * direction, s in
+  /// [s_min, s_max], boxes entered earlier first. `visit(face, s_max)` returns the new s_max:
+  /// lowering it prunes the rest of the search. Returns the final s_max.
+  double sweep_faces(const Eigen::AlignedBox3d& moving, const Eigen::Vector3d& direction, double s_min,
+                     double s_max, const std::function<double(int face, double s_max)>& visit) const;
+  /// The same between two meshes (both AABB trees, best first over pairs of boxes): `mover`'s
+  /// frame maps into this one by x -> rotation x + translation, and it translates by
+  /// s * direction (this frame); its boxes are taken in this frame (the box of a rotated box)
+  /// and padded by `pad_m`. Visits the pairs (own face, mover face) whose boxes meet for some s
+  /// in [s_min, s_max]; `visit(own_face, mover_face, s_max)` returns the new s_max.
+  double sweep_face_pairs(const MeshShape& mover, const Eigen::Matrix3d& rotation, const Eigen::Vector3d& translation,
+                          const Eigen::Vector3d& direction, double pad_m, double s_min, double s_max,
+                          const std::function<double(int own_face, int mover_face, double s_max)>& visit) const;
 
   const TriangleMesh& mesh() const { return mesh_; }
   const MeshMassProperties& mass_properties() const { return mass_; }

@@ -49,7 +49,8 @@ class Shape {
   /// sharp_feature and no local radius exists. Cheap (no curvature fit). Smooth shapes: false.
   virtual bool on_sharp_feature(const SurfacePoint& /*at*/) const { return false; }
   /// The paper's local radius (Eq. 26): mean radius of the sections by the three axis-normal
-  /// planes through the point, degenerate (tangent) sections left out.
+  /// planes through the point, degenerate (tangent) sections left out; a sphere's radius on a
+  /// sphere (MODEL.md: axis-normal sections are not normal sections), infinity on a plane.
   virtual double paper_radius_m(const SurfacePoint& at) const = 0;
   /// Where the ray from `origin_m` (inside the solid) along `direction` leaves the surface.
   virtual std::optional<SurfacePoint> ray_exit(const Eigen::Vector3d& origin_m,
@@ -59,6 +60,20 @@ class Shape {
   /// `count` points distributed uniformly by area over the surface, with outward normals;
   /// deterministic for a given seed.
   virtual std::vector<SurfacePoint> sample_surface(std::size_t count, std::uint64_t seed) const = 0;
+
+  // Queries for the first contact of placed bodies (first_contact.hpp). All in the own frame.
+
+  /// The surface point farthest along `direction` (any length; InputError when zero or not
+  /// finite) and the outward normal there; nullopt where the shape is unbounded along it (a
+  /// plane, except along its normal). Analytic shapes: exact; a mesh: its extreme vertex.
+  virtual std::optional<SurfacePoint> support_point(const Eigen::Vector3d& direction) const = 0;
+  /// True when the point is inside the solid or on its surface (to rounding).
+  virtual bool contains(const Eigen::Vector3d& own_point_m) const = 0;
+  /// True when the solid is known to be convex (ellipsoid, sphere, plane); false when it is
+  /// not, or not known to be (a mesh).
+  virtual bool is_convex() const { return false; }
+  /// False for an unbounded solid (a plane's half-space).
+  virtual bool bounded() const { return true; }
 };
 
 }  // namespace impactdeck::geometry

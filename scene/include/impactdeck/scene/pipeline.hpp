@@ -12,39 +12,16 @@
 #include "impactdeck/fem_export/check.hpp"
 #include "impactdeck/fem_export/decks.hpp"
 #include "impactdeck/geometry/shape.hpp"
+#include "impactdeck/scene/contact.hpp"
 #include "impactdeck/scene/scene.hpp"
 
 namespace impactdeck::scene {
 
-/// A body made ready for impacts: its shape and rigid-body state in its own frame.
-struct PreparedBody {
-  const BodySpec* spec = nullptr;
-  std::shared_ptr<const geometry::Shape> shape;
-  geometry::VolumeProperties volume;
-  double mass_kg = 0;  ///< +infinity when fixed
-  Eigen::Matrix3d inertia_kg_m2 = Eigen::Matrix3d::Zero();
-  collision::ElasticMaterial material;
-};
-
-/// Contact geometry of one impact, in the target's frame.
-struct ContactGeometry {
-  geometry::SurfacePoint target_point;    ///< projected point and outward normal
-  geometry::SurfacePoint impactor_point;  ///< in the impactor's own frame
-  Eigen::Vector3d impactor_offset_m = Eigen::Vector3d::Zero();  ///< impactor frame -> target frame
-  double target_curvature_per_m = 0;      ///< 1/R used for the target (rule-dependent)
-  double impactor_curvature_per_m = 0;
-  geometry::Curvature target_curvature;   ///< principal curvatures at the contact point
-  geometry::Curvature impactor_curvature;
-  double effective_radius_m = 0;          ///< R* (Eq. 29), or R_eq of the elliptical contact
-  /// Elliptical rule only: relative curvatures A <= B and the contact ellipse's axis ratio a/b.
-  double relative_curvature_A_per_m = 0, relative_curvature_B_per_m = 0;
-  double contact_ellipse_axis_ratio = 1;
-};
-
 struct ImpactReport {
   const ImpactSpec* spec = nullptr;
-  ContactGeometry contact;
+  ContactEvaluation contact;         ///< where the bodies touch, both surfaces, the kernel's input
   collision::ImpactResult result;
+  collision::ValidityReport validity;  ///< of the Hertz model at this impact
   std::optional<collision::ForceTable> table;
   std::optional<std::filesystem::path> table_path;  ///< where the CSV was written
   std::optional<std::filesystem::path> plot_path;   ///< where the F(t) SVG was written
@@ -77,7 +54,7 @@ struct RunOptions {
 std::shared_ptr<const geometry::Shape> make_shape(const BodySpec& body, const Scene& scene,
                                                   RunReport* report = nullptr);
 
-/// Mass, inertia and material of a body from its spec.
+/// Mass, inertia, material and placement of a body from its spec.
 PreparedBody prepare_body(const BodySpec& body, const Scene& scene, RunReport* report = nullptr);
 
 /// Runs everything the scene asks for. Throws InputError on bad input; a failed self-check is

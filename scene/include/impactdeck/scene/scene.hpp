@@ -12,6 +12,7 @@
 #include "impactdeck/collision/hertz.hpp"
 #include "impactdeck/collision/force_history.hpp"
 #include "impactdeck/collision/impact.hpp"
+#include "impactdeck/collision/validity.hpp"
 #include "impactdeck/common/units.hpp"
 
 namespace impactdeck::scene {
@@ -33,7 +34,7 @@ struct Material {
   Place place;
 };
 
-enum class ShapeKind { sphere, ellipsoid, mesh };
+enum class ShapeKind { sphere, ellipsoid, mesh, plane };
 
 struct BodySpec {
   std::string name;
@@ -41,30 +42,37 @@ struct BodySpec {
   double radius_m = 0;                                     ///< sphere
   Eigen::Vector3d semi_axes_m = Eigen::Vector3d::Zero();   ///< ellipsoid
   std::filesystem::path mesh_path;                         ///< mesh, resolved against the scene
+  Eigen::Vector3d plane_normal = Eigen::Vector3d::UnitZ();  ///< plane: outward unit normal (own frame)
   bool mesh_repair = false;                  ///< mesh: `repair = true` (stitch, merge, orient outward)
   bool mesh_approximate_mass = false;        ///< mesh: `approximate_mass_properties = true`
   bool mesh_self_intersection_check = true;  ///< mesh: `self_intersection_check = false` skips it
   std::string material;
   std::optional<double> mass_kg;  ///< overrides density x volume; inertia scales with it
-  bool fixed = false;             ///< infinite mass
-  Eigen::Vector3d velocity_m_s = Eigen::Vector3d::Zero();
-  Eigen::Vector3d angular_velocity_rad_s = Eigen::Vector3d::Zero();
+  bool fixed = false;             ///< infinite mass (always for a plane)
+  /// Placement: world position of the body's own origin (`position`, length unit) and the rotation
+  /// from its own frame into the world (`orientation_axis`, `orientation_angle_deg`, right hand).
+  Eigen::Vector3d position_m = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  bool placed = false;  ///< position or orientation given
+  Eigen::Vector3d velocity_m_s = Eigen::Vector3d::Zero();            ///< world frame
+  Eigen::Vector3d angular_velocity_rad_s = Eigen::Vector3d::Zero();  ///< world frame
   Place place;
 };
 
-enum class ContactRadiusRule {
-  paper,  ///< Eq. 26: average radius of the three axis-normal sections
-  mean,   ///< 1 / mean curvature, from the principal curvatures
-  elliptical,  ///< full elliptical Hertz contact from both bodies' principal curvatures
-};
+/// Which local radius the Hertz constant uses (the physics kernel's rule).
+using ContactRadiusRule = collision::ContactRule;
 
 struct ImpactSpec {
   std::string name;
   std::string target;
   std::string impactor;
-  Eigen::Vector3d point_m = Eigen::Vector3d::Zero();  ///< target frame; projected on its surface
+  /// `point = [x, y, z]`: the target's own frame, projected on its surface; the impactor is placed
+  /// to touch there. `point = "first-contact"`: both bodies as placed, the impactor moving along
+  /// the relative velocity until they touch.
+  bool first_contact = false;
+  Eigen::Vector3d point_m = Eigen::Vector3d::Zero();
   collision::RestitutionModel restitution;            ///< unit and policy from the scene top level
-  ContactRadiusRule contact_radius = ContactRadiusRule::paper;
+  ContactRadiusRule contact_radius = ContactRadiusRule::elliptical;
   std::optional<double> approach_speed_m_s;  ///< if set: impactor velocity = -speed * n
   std::optional<double> max_projection_distance_m;  ///< default: 1 % of the target's size
   Place place;
@@ -95,6 +103,7 @@ struct Scene {
   LengthUnit length_unit = LengthUnit::m;
   collision::ModulusConvention modulus_convention = collision::ModulusConvention::hertz;
   collision::CheckThresholds thresholds;
+  collision::ValidityLimits validity;  ///< `[validity]`
   std::map<std::string, Material> materials;
   std::vector<BodySpec> bodies;
   std::vector<ImpactSpec> impacts;
@@ -111,6 +120,5 @@ Scene parse_scene(const std::string& text, const std::string& name,
                   const std::filesystem::path& base_dir = ".");
 
 const char* to_string(ShapeKind k);
-const char* to_string(ContactRadiusRule r);
 
 }  // namespace impactdeck::scene

@@ -3,6 +3,7 @@
 // cloud of points on its surface"). Each point carries its outward unit normal.
 #include <cstddef>
 #include <cstdint>
+#include <filesystem>
 #include <vector>
 
 #include "impactdeck/geometry/ellipsoid.hpp"
@@ -40,6 +41,15 @@ std::vector<geometry::SurfacePoint> projected_grid_cloud(const geometry::Shape& 
                                                          const Eigen::Vector3d& box_min_m,
                                                          const Eigen::Vector3d& box_max_m, int steps);
 const char* to_string(CloudKind k);
+
+/// Points read from a CSV file (three numbers x, y, z per line in `metres_per_unit` metres, the
+/// target's own frame; lines starting with '#' and a first line that is not numeric are skipped),
+/// each moved to the closest point of the target exactly as `impactdeck run` projects an impact
+/// point. Throws InputError naming the file and line for an unreadable file, a malformed line, more
+/// than `max_points` points, or a point farther than `max_distance_m` from the surface.
+std::vector<geometry::SurfacePoint> csv_point_cloud(const geometry::Shape& target,
+                                                    const std::filesystem::path& csv, double metres_per_unit,
+                                                    double max_distance_m, std::size_t max_points = 100000000);
 
 /// The cloud of a kind. Throws InputError when the grid is asked of a shape that is not an
 /// analytic ellipsoid, or the vertices of a shape that is not a mesh.

@@ -8,6 +8,7 @@
 // Speed and determinism: points are independent, so they run on all cores (std::thread, chunks
 // handed out by an atomic counter). Each point writes only its own slot of preallocated arrays:
 // no allocation per point, and the result is bit for bit the same whatever the thread count.
+#include <array>
 #include <cstddef>
 #include <functional>
 #include <memory>
@@ -18,35 +19,21 @@
 #include "impactdeck/collision/hertz.hpp"
 #include "impactdeck/collision/impact.hpp"
 #include "impactdeck/geometry/shape.hpp"
+#include "impactdeck/scene/contact.hpp"
 
 namespace impactdeck::study {
 
-/// Which local radius a body gets at the contact point.
-enum class RadiusRule {
-  paper,  ///< Eq. 26: average radius of the axis-normal sections (Shape::paper_radius_m)
-  mean,   ///< 1 / mean curvature from the principal curvatures (exact on a sphere)
-  /// Full elliptical Hertz contact (collision/elliptical.hpp) from both bodies' curvature tensors,
-  /// as `impactdeck run` with contact_radius = "elliptical". A rule of the pair: both bodies of a
-  /// sweep must have it (the sweep refuses a mix).
-  elliptical,
-};
-const char* to_string(RadiusRule r);
-
-/// One body of a sweep, in its own frame (SI).
-struct SweepBody {
-  std::shared_ptr<const geometry::Shape> shape;
-  double mass_kg = 0;                                       ///< > 0, or +infinity (fixed)
-  Eigen::Matrix3d inertia_kg_m2 = Eigen::Matrix3d::Identity();  ///< about the centroid
-  Eigen::Vector3d centroid_m = Eigen::Vector3d::Zero();
-  RadiusRule radius_rule = RadiusRule::paper;
-};
-
+/// One sweep: both bodies (scene::PreparedBody: shape, placement, mass, inertia, material), the
+/// contact rule, E* and the restitution model. The sweep takes the target at rest and moves the
+/// impactor along the inward normal at `approach_speed_m_s` at every point (the paper's setting);
+/// the bodies' own velocities are not used.
 struct SweepSetup {
-  SweepBody target;
-  SweepBody impactor;
+  scene::PreparedBody target;
+  scene::PreparedBody impactor;
+  collision::ContactRule rule = collision::ContactRule::elliptical;
   double effective_modulus_Pa = 0;   ///< E* (Eq. 28 or Hertz convention)
   double approach_speed_m_s = 1.0;   ///< impactor velocity = -speed * n at every point
-  collision::RestitutionModel restitution;  ///< used for the curve (R, contact time, impulse)
+  collision::RestitutionModel restitution;  ///< R, contact time and impulse at every point
 };
 
 /// Called from the calling thread about ten times a second with (points done, total).
@@ -60,17 +47,24 @@ struct SweepOptions {
   ProgressFn progress;              ///< optional
 };
 
-/// Everything computed at one point (SI).
+/// Everything computed at one point (SI), from the physics kernel (collision::solve_kernel) through
+/// scene::ContactModel, as `impactdeck run` computes it.
 struct PointResult {
-  /// The target point lies on a sharp edge or corner (Shape::on_sharp_feature): no local radius
-  /// exists there, as `impactdeck run` refuses such a point. Nothing else of the point is computed
-  /// (every value below is 0, the axis ratio 1) and the reductions leave it out.
+  /// Why the model does not apply here (collision::flag_word gives the CSV word): a sharp edge or
+  /// corner, an impactor that does not fit a concave region, a saddle, no approach, ... Nothing
+  /// else of a flagged point is used (the reductions leave it out).
+  collision::ContactFlag flag = collision::ContactFlag::none;
+  bool flagged() const { return flag != collision::ContactFlag::none; }
+  /// The target point lies on a sharp edge or corner (flag sharp): no local radius exists there.
   bool sharp_feature = false;
+  /// Every vector of a point is in the target's own frame (the part file's coordinates), so that a
+  /// sweep overlays the part and its FEM deck whatever the target's placement.
   Eigen::Vector3d point_m = Eigen::Vector3d::Zero();
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  ///< target's outward unit normal
-  double target_radius_m = 0;       ///< local radius of the target by its rule (elliptical: 1/H)
-  double impactor_radius_m = 0;     ///< local radius of the impactor at its contact point
-  double effective_radius_m = 0;    ///< R* (Eq. 29), or R_eq of the elliptical rule
+  double target_k1_per_m = 0, target_k2_per_m = 0;  ///< target's principal curvatures (concave < 0)
+  double target_radius_m = 0;       ///< local radius of the target by the rule (1/H unless "paper")
+  double impactor_radius_m = 0;     ///< the same for the impactor at its contact point
+  double effective_radius_m = 0;    ///< R* by the rule (R_eq for "elliptical")
   double contact_ellipse_axis_ratio = 1;  ///< a/b of the contact ellipse (1 unless elliptical)
   double reduced_mass_kg = 0;       ///< m_w at the point (tensor form of Eq. 21)
   double hertz_constant = 0;        ///< k_H, N/m^1.5
@@ -78,7 +72,7 @@ struct PointResult {
   double max_force_N = 0;
   double compression_time_s = 0;
   double restitution = 0;           ///< R
-  bool restitution_clamped = false; ///< ln Phi clamped into Eq. 30's range (policy "warn")
+  bool restitution_clamped = false; ///< outside the restitution model's range, clamped (policy "warn")
   double contact_time_s = 0;        ///< (1 + R) t_m
   double impulse_total_Ns = 0;      ///< (1 + R) m_w v_w
   /// Velocity jumps of the target (Eq. 22-23) for that impulse; zero for a fixed target.
@@ -92,26 +86,26 @@ struct SweepResult {
   /// point i is at time k / (curve_samples - 1) * points[i].contact_time_s.
   std::vector<double> curves_N;
   std::size_t curve_samples = 0;
-  /// Points with the smallest / largest F_max among those not on a sharp feature.
+  /// Points with the smallest / largest F_max among the points not flagged.
   std::size_t min_index = 0, max_index = 0;
   double force_ratio = 0;                    ///< min F_max / max F_max (the paper's ratio)
   /// (min m_w / max m_w)^(n/(n+1)): the part of the ratio due to the reduced mass alone.
   double mass_only_ratio = 0;
-  std::size_t sharp_count = 0;               ///< points on sharp edges/corners, left out of the above
+  std::size_t sharp_count = 0;               ///< points on sharp edges/corners (flag sharp)
+  std::size_t flagged_count = 0;             ///< points with any flag, left out of the above
+  /// Points per flag, indexed by collision::ContactFlag (index 0, none: the valid points).
+  std::array<std::size_t, collision::kContactFlagCount> flag_counts{};
   std::size_t restitution_clamped_count = 0;
   unsigned threads_used = 0;
   double seconds = 0;                        ///< wall time of the point loop
 };
 
-/// Throws InputError when one body has the elliptical rule and the other not (run_sweep checks it;
-/// call it before sweep_point on a setup built by hand).
-void check_radius_rules(const SweepSetup& setup);
+/// One point (the sweep's kernel): the target is hit at `at` (its own frame). Never throws: a point
+/// where the model does not apply comes back flagged.
+PointResult sweep_point(const scene::ContactModel& model, double approach_speed_m_s,
+                        const geometry::SurfacePoint& at);
 
-/// One point (the sweep's kernel). Throws InputError naming the point when it cannot be solved.
-PointResult sweep_point(const SweepSetup& setup, const geometry::SurfacePoint& at);
-
-/// The whole cloud. Throws InputError (the first failing point's message) on bad input, and when
-/// every point lies on a sharp feature.
+/// The whole cloud. Throws InputError on bad input (bodies, speed), and when every point is flagged.
 SweepResult run_sweep(const SweepSetup& setup, const std::vector<geometry::SurfacePoint>& cloud,
                       const SweepOptions& options = {});
 

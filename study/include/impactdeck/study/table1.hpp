@@ -24,7 +24,7 @@ namespace impactdeck::study {
 /// ellipsoid: that semi-axis set to g times the next one; a mesh: an affine stretch about its
 /// centroid, with mass properties, curvature and cloud recomputed). Column mu: target mass / impactor
 /// mass (the paper's m1/m2), by scaling the target's density; the impactor keeps the scene's mass.
-/// Materials, approach speed and radius rule come from the scene (the restitution does not enter
+/// Materials, approach speed and contact rule come from the scene (the restitution does not enter
 /// F_max and is not evaluated).
 struct Table1Scene {
   SweepSetup setup;       ///< from sweep_from_scene
@@ -39,14 +39,15 @@ struct Table1Options {
   /// Smaller semi-axis of the ellipsoid / sphere radius (g >= 1: b = c = s r, a = g b;
   /// g < 1: a = s r, b = c = a/g).
   double size_ratio = 20.0;
-  RadiusRule target_radius_rule = RadiusRule::paper;  ///< local radius of the ellipsoid
+  /// Local radius rule: "paper" (Eq. 26 on the ellipsoid, the sphere's radius r) reproduces the table.
+  collision::ContactRule rule = collision::ContactRule::paper;
   CloudKind cloud = CloudKind::paper_grid;
   int grid_steps = 8;              ///< paper grid step 1/steps
   std::size_t uniform_count = 2000;
   std::uint64_t seed = 1;
   unsigned threads = 0;            ///< 0: all cores
   ProgressFn progress;             ///< over all cells' points
-  /// Set: a scene-driven table (size_ratio and target_radius_rule unused; no paper comparison).
+  /// Set: a scene-driven table (size_ratio and rule unused: the scene has its own; no paper comparison).
   std::optional<Table1Scene> scene;
 };
 
@@ -87,6 +88,8 @@ struct Table1Result {
   std::size_t points_per_cell = 0;
   /// Per row g: points of the cloud on sharp edges/corners, left out of every cell of the row.
   std::vector<std::size_t> sharp_points;
+  /// Per row g: points flagged for any reason (sharp, no-fit, saddle, ...), left out of the row.
+  std::vector<std::size_t> flagged_points;
 
   bool compared = false;  ///< options' grid equals the paper's: the comparison below is set
   std::vector<std::vector<double>> paper;      ///< [g][mu]
@@ -97,13 +100,6 @@ struct Table1Result {
   double mean_abs_delta = 0;
   double max_abs_delta = 0;
   double excluded_cell_model = 0, excluded_cell_paper = 0;
-
-  /// Sphere row (g = 1), when present: Eq. 26 on a sphere of radius R gives R times the mean of
-  /// sqrt(1 - p_i^2/R^2) over the non-degenerate sections, not R. Smallest such factor on the
-  /// cloud, and the ratio it predicts, (R*(f_min) / R*(1))^(1/5) with R* = (1/(fR) + 1/r)^-1.
-  bool has_sphere_row = false;
-  double sphere_min_radius_factor = 0;
-  double sphere_row_prediction = 0;
 
   std::vector<LimitCheckRow> limit_check;  ///< one per mass ratio
   double limit_row_geometric_ratio = 0;    ///< g_max used for cloud_* in the limit check

@@ -1,0 +1,219 @@
+#include "impactdeck/collision/kernel.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include "impactdeck/collision/compression.hpp"
+#include "impactdeck/collision/hertz.hpp"
+#include "impactdeck/common/error.hpp"
+
+namespace impactdeck::collision {
+
+const char* to_string(ContactRule r) {
+  switch (r) {
+    case ContactRule::elliptical: return "elliptical";
+    case ContactRule::mean: return "mean";
+    case ContactRule::paper: return "paper";
+  }
+  return "?";
+}
+
+const char* flag_word(ContactFlag f) {
+  switch (f) {
+    case ContactFlag::none: return "";
+    case ContactFlag::sharp: return "sharp";
+    case ContactFlag::no_fit: return "no-fit";
+    case ContactFlag::saddle: return "saddle";
+    case ContactFlag::line: return "line";
+    case ContactFlag::flat: return "flat";
+    case ContactFlag::no_approach: return "no-approach";
+    case ContactFlag::restitution_range: return "restitution-range";
+    case ContactFlag::restitution_invalid: return "restitution-invalid";
+    case ContactFlag::degenerate: return "degenerate";
+    case ContactFlag::no_curvature: return "no-curvature";
+  }
+  return "?";
+}
+
+ContactCurvature ContactCurvature::sphere(double radius_m) {
+  ContactCurvature c;
+  c.k1_per_m = c.k2_per_m = c.paper_curvature_per_m = 1.0 / radius_m;
+  return c;
+}
+
+ContactCurvature ContactCurvature::flat() { return ContactCurvature{}; }
+
+KernelBody kernel_body(const RigidBody& b) {
+  KernelBody k;
+  k.velocity_m_s = b.velocity_m_s;
+  k.angular_velocity_rad_s = b.angular_velocity_rad_s;
+  if (b.fixed()) return k;  // 0 inverse mass and inertia
+  if (!(b.mass_kg > 0.0) || !std::isfinite(b.mass_kg)) {
+    std::ostringstream s;
+    s << "must be positive and finite, got " << b.mass_kg << " kg";
+    throw InputError("", "mass", s.str());
+  }
+  const Eigen::Matrix3d& I = b.inertia_kg_m2;
+  const double scale = I.cwiseAbs().maxCoeff();
+  if (!(scale > 0.0) || !I.allFinite() || (I - I.transpose()).cwiseAbs().maxCoeff() > 1e-9 * scale) {
+    throw InputError("", "inertia tensor", "must be finite, symmetric and non-zero");
+  }
+  Eigen::LLT<Eigen::Matrix3d> llt(I / scale);
+  if (llt.info() != Eigen::Success) throw InputError("", "inertia tensor", "is not positive definite");
+  k.inverse_mass_per_kg = 1.0 / b.mass_kg;
+  Eigen::Matrix3d inv = llt.solve(Eigen::Matrix3d::Identity()) / scale;
+  k.inverse_inertia_world = 0.5 * (inv + inv.transpose());
+  if (!std::isfinite(k.inverse_mass_per_kg) || !k.inverse_inertia_world.allFinite()) {
+    throw InputError("", "inertia tensor", "its inverse is not finite (mass or inertia too small)");
+  }
+  return k;
+}
+
+RelativeCurvatures kernel_relative_curvatures(const KernelInput& in) noexcept {
+  const ContactCurvature& a = in.target.curvature;
+  const ContactCurvature& b = in.impactor.curvature;
+  return relative_curvatures(a.k1_per_m, a.k2_per_m, a.d1, a.d2, b.k1_per_m, b.k2_per_m, b.d1, b.d2,
+                             in.normal);
+}
+
+namespace {
+
+bool finite_positive(double x) { return x > 0.0 && std::isfinite(x); }
+
+// Why the relative curvature tensor is not positive definite (A <= 0), from each body's shape.
+ContactFlag classify_non_hertzian(const ContactCurvature& a, const ContactCurvature& b, double B) {
+  auto saddle = [](const ContactCurvature& c) {
+    return std::max(c.k1_per_m, c.k2_per_m) > 0.0 && std::min(c.k1_per_m, c.k2_per_m) < 0.0;
+  };
+  auto concave = [](const ContactCurvature& c) { return std::min(c.k1_per_m, c.k2_per_m) < 0.0; };
+  if (saddle(a) || saddle(b)) return ContactFlag::saddle;
+  if (concave(a) || concave(b)) return ContactFlag::no_fit;
+  return B > 0.0 ? ContactFlag::line : ContactFlag::flat;
+}
+
+}  // namespace
+
+KernelResult solve_kernel(const KernelInput& in) noexcept {
+  KernelResult r;
+  const KernelBody& t = in.target;
+  const KernelBody& i = in.impactor;
+  const Eigen::Vector3d& n = in.normal;
+  if (!n.allFinite() || !(std::abs(n.norm() - 1.0) < 1e-9) || !finite_positive(in.effective_modulus_Pa) ||
+      in.restitution == nullptr || !t.lever_arm_m.allFinite() || !i.lever_arm_m.allFinite()) {
+    r.flag = ContactFlag::degenerate;
+    return r;
+  }
+  // Reduced mass at the contact point (tensor form of Eq. 21), both bodies eccentric.
+  const Eigen::Vector3d rt = t.lever_arm_m.cross(n), ri = i.lever_arm_m.cross(n);
+  const double inv_m = t.inverse_mass_per_kg + rt.dot(t.inverse_inertia_world * rt) +
+                       i.inverse_mass_per_kg + ri.dot(i.inverse_inertia_world * ri);
+  r.reduced_mass_kg = 1.0 / inv_m;
+  // Approach velocity: both bodies' v + w x r at the point.
+  const Eigen::Vector3d u = (i.velocity_m_s + i.angular_velocity_rad_s.cross(i.lever_arm_m)) -
+                            (t.velocity_m_s + t.angular_velocity_rad_s.cross(t.lever_arm_m));
+  r.approach_velocity_m_s = -n.dot(u);
+  if (!finite_positive(r.reduced_mass_kg) || !std::isfinite(r.approach_velocity_m_s)) {
+    r.flag = ContactFlag::degenerate;
+    return r;
+  }
+
+  // Contact curvature.
+  if (t.curvature.sharp || i.curvature.sharp) {
+    r.flag = ContactFlag::sharp;
+    return r;
+  }
+  const RelativeCurvatures rc = kernel_relative_curvatures(in);
+  r.relative_curvature_A_per_m = rc.A_per_m;
+  r.relative_curvature_B_per_m = rc.B_per_m;
+  r.direction_A = rc.direction_A;
+  if (!std::isfinite(rc.A_per_m) || !std::isfinite(rc.B_per_m)) {
+    r.flag = ContactFlag::degenerate;
+    return r;
+  }
+  if (!(rc.A_per_m > 0.0)) {
+    r.flag = classify_non_hertzian(t.curvature, i.curvature, rc.B_per_m);
+    return r;
+  }
+  EllipticalContact ec;  // circular unless the rule is elliptical
+  switch (in.rule) {
+    case ContactRule::elliptical:
+      ec = elliptical_contact(rc);  // does not throw: 0 < A <= B, finite
+      r.effective_radius_m = ec.equivalent_radius_m;
+      r.contact_ellipse_axis_ratio = ec.axis_ratio;
+      break;
+    case ContactRule::mean:
+      r.effective_radius_m = 1.0 / (0.5 * (t.curvature.k1_per_m + t.curvature.k2_per_m) +
+                                    0.5 * (i.curvature.k1_per_m + i.curvature.k2_per_m));
+      break;
+    case ContactRule::paper: {
+      const double k = t.curvature.paper_curvature_per_m + i.curvature.paper_curvature_per_m;
+      if (!(k > 0.0)) {
+        r.flag = std::isfinite(k) ? ContactFlag::no_fit : ContactFlag::degenerate;
+        return r;
+      }
+      r.effective_radius_m = 1.0 / k;
+      break;
+    }
+  }
+  if (!finite_positive(r.effective_radius_m)) {
+    r.flag = ContactFlag::degenerate;
+    return r;
+  }
+  if (!(r.approach_velocity_m_s > 0.0)) {
+    r.flag = ContactFlag::no_approach;
+    return r;
+  }
+
+  // Hertz: k_H, x_max, F_max, t_m (closed forms, Eq. 1-12, 27).
+  r.hertz_constant = hertz_constant(in.effective_modulus_Pa, r.effective_radius_m);
+  const CompressionPhase c = compression_phase(r.reduced_mass_kg, r.approach_velocity_m_s, r.hertz_constant);
+  r.max_indentation_m = c.max_indentation_m;
+  r.max_force_N = c.max_force_N;
+  r.compression_time_s = c.compression_time_s;
+  r.impulse_compression_Ns = c.impulse_Ns;
+  if (!finite_positive(r.hertz_constant) || !finite_positive(r.max_indentation_m) ||
+      !finite_positive(r.max_force_N) || !finite_positive(r.compression_time_s) ||
+      !finite_positive(r.impulse_compression_Ns)) {
+    r.flag = ContactFlag::degenerate;
+    return r;
+  }
+
+  // Contact ellipse at F_max and the peak pressure.
+  if (in.rule == ContactRule::elliptical) {
+    const ContactEllipse e = contact_ellipse(rc, ec, in.effective_modulus_Pa, r.max_force_N);
+    r.contact_semi_axis_a_m = e.a_m;
+    r.contact_semi_axis_b_m = e.b_m;
+  } else {
+    r.contact_semi_axis_a_m = r.contact_semi_axis_b_m =
+        std::cbrt(3.0 * r.max_force_N * r.effective_radius_m / (4.0 * in.effective_modulus_Pa));
+  }
+  r.peak_pressure_Pa = 3.0 * r.max_force_N / (2.0 * M_PI * r.contact_semi_axis_a_m * r.contact_semi_axis_b_m);
+
+  // Restitution and the total impulse (Eq. 13-15, 30).
+  r.restitution = evaluate_restitution(*in.restitution, r.reduced_mass_kg, r.approach_velocity_m_s,
+                                       r.effective_radius_m);
+  if (r.restitution.refused) {
+    r.flag = ContactFlag::restitution_range;
+    return r;
+  }
+  if (r.restitution.invalid) {
+    r.flag = ContactFlag::restitution_invalid;
+    return r;
+  }
+  r.impulse_total_Ns = (1.0 + r.restitution.coefficient) * r.impulse_compression_Ns;
+
+  // Velocity jumps (Eq. 22-23): the impactor is pushed along +n, the target along -n.
+  const Eigen::Vector3d P = r.impulse_total_Ns * n;
+  r.target_jump.delta_velocity_m_s = -t.inverse_mass_per_kg * P;
+  r.target_jump.delta_angular_velocity_rad_s = t.inverse_inertia_world * t.lever_arm_m.cross(-P);
+  r.impactor_jump.delta_velocity_m_s = i.inverse_mass_per_kg * P;
+  r.impactor_jump.delta_angular_velocity_rad_s = i.inverse_inertia_world * i.lever_arm_m.cross(P);
+  if (!r.target_jump.delta_velocity_m_s.allFinite() || !r.target_jump.delta_angular_velocity_rad_s.allFinite() ||
+      !r.impactor_jump.delta_velocity_m_s.allFinite() || !r.impactor_jump.delta_angular_velocity_rad_s.allFinite() ||
+      !std::isfinite(r.peak_pressure_Pa)) {
+    r.flag = ContactFlag::degenerate;
+  }
+  return r;
+}
+
+}  // namespace impactdeck::collision

@@ -1,0 +1,107 @@
+#pragma once
+// The geometric half of an impact: placed bodies, where they touch, and the physics kernel's
+// input built from both surfaces there. `run`, `sweep` and `study` all go through ContactModel, so
+// that one contact point gives bit for bit the same numbers whatever command asks for it.
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "impactdeck/collision/hertz.hpp"
+#include "impactdeck/collision/kernel.hpp"
+#include "impactdeck/geometry/first_contact.hpp"
+#include "impactdeck/geometry/pose.hpp"
+#include "impactdeck/geometry/shape.hpp"
+
+namespace impactdeck::scene {
+
+struct BodySpec;
+
+/// A body made ready for impacts: its shape in its own frame, its placement and its rigid-body
+/// state (velocities in the world frame).
+struct PreparedBody {
+  std::string name;
+  const BodySpec* spec = nullptr;  ///< null for bodies made without a scene (study presets)
+  std::shared_ptr<const geometry::Shape> shape;
+  geometry::Pose pose;             ///< own frame -> world
+  geometry::VolumeProperties volume;  ///< own frame, unit density
+  double mass_kg = 0;              ///< +infinity when fixed
+  Eigen::Matrix3d inertia_kg_m2 = Eigen::Matrix3d::Zero();  ///< own frame, about the centroid
+  collision::ElasticMaterial material;
+  std::optional<double> yield_strength_Pa;
+  Eigen::Vector3d velocity_m_s = Eigen::Vector3d::Zero();            ///< world
+  Eigen::Vector3d angular_velocity_rad_s = Eigen::Vector3d::Zero();  ///< world
+
+  bool fixed() const;
+  Eigen::Vector3d centroid_world_m() const { return pose.to_world(volume.centroid_m); }
+  /// R I R^T (identity for a fixed body: never used, its inverse mass is 0).
+  Eigen::Matrix3d inertia_world_kg_m2() const;
+  /// The rigid-body state in the world frame (collision::RigidBody).
+  collision::RigidBody rigid_body() const;
+};
+
+/// A free body made without a scene: `shape` at rest at the origin of the world, with total mass
+/// `mass_kg` (+infinity: fixed) spread uniformly (inertia scaled from the shape's unit-density
+/// inertia). Throws InputError when the shape has no volume and the mass is finite.
+PreparedBody body_of_mass(std::string name, std::shared_ptr<const geometry::Shape> shape, double mass_kg,
+                          const collision::ElasticMaterial& material = {});
+
+/// Everything about one contact point: where it is on both bodies, both surfaces' curvature there,
+/// the kernel's input and its result.
+struct ContactEvaluation {
+  geometry::SurfacePoint target_point;    ///< target's own frame (point, outward normal)
+  geometry::SurfacePoint impactor_point;  ///< impactor's own frame
+  Eigen::Vector3d point_m = Eigen::Vector3d::Zero();  ///< world
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  ///< world, target's outward unit normal
+  /// World translation of the impactor from its scene placement to the contact (point mode: the
+  /// placement that makes it touch; first contact: travel along the relative velocity).
+  Eigen::Vector3d impactor_translation_m = Eigen::Vector3d::Zero();
+  double travel_m = 0;                    ///< first contact: distance travelled
+  geometry::Curvature target_curvature;   ///< own frames, as fitted (error estimates kept)
+  geometry::Curvature impactor_curvature;
+  /// Why a curvature could not be estimated (result.flag no_curvature), e.g. a coarse mesh.
+  std::string curvature_problem;
+  collision::KernelInput input;
+  collision::KernelResult result;
+};
+
+/// One impact's invariants: both bodies, the rule, E*, the restitution model and the kernel bodies
+/// (inverse mass, world inverse inertia: computed once). Keeps references: the bodies and the
+/// restitution model must outlive it.
+class ContactModel {
+ public:
+  /// Throws InputError (place "") for invalid masses or inertias.
+  ContactModel(const PreparedBody& target, const PreparedBody& impactor, collision::ContactRule rule,
+               double effective_modulus_Pa, const collision::RestitutionModel& restitution);
+
+  /// Point mode (and sweeps): the target is hit at its surface point `at` (own frame, with its
+  /// outward normal). The impactor keeps its orientation and is translated so that its support
+  /// point along -n touches there. With `approach_speed_m_s`, the impactor's velocity is replaced
+  /// by -speed n and the target taken at rest (the paper's sweep setting). Never throws: a point
+  /// where the model does not apply comes back flagged (result.flag).
+  ContactEvaluation at_surface_point(const geometry::SurfacePoint& at,
+                                     std::optional<double> approach_speed_m_s = std::nullopt) const;
+
+  /// First-contact mode: the impactor, as placed, translates along the relative velocity of the
+  /// bodies until they touch (geometry::first_contact). Throws InputError (place "") when they
+  /// never touch, already overlap, or do not move relative to each other.
+  ContactEvaluation at_first_contact() const;
+
+  const PreparedBody& target() const { return target_; }
+  const PreparedBody& impactor() const { return impactor_; }
+  collision::ContactRule rule() const { return rule_; }
+
+ private:
+  ContactEvaluation evaluate(ContactEvaluation e, const Eigen::Vector3d& impactor_centroid_world_m,
+                             std::optional<double> approach_speed_m_s) const;
+  collision::ContactCurvature surface(const PreparedBody& b, const geometry::SurfacePoint& own,
+                                      const geometry::Curvature& k) const;
+
+  const PreparedBody& target_;
+  const PreparedBody& impactor_;
+  collision::ContactRule rule_;
+  double effective_modulus_Pa_;
+  const collision::RestitutionModel& restitution_;
+  collision::KernelBody target_body_, impactor_body_;
+};
+
+}  // namespace impactdeck::scene
