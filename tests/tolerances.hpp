@@ -48,3 +48,9 @@ inline constexpr double kPaperRadius20kRel = 2e-2;
 /// Coordinates that went through float32 (STL) on both sides: identical meshes give identical sums.
 inline constexpr double kSameFileRel = 1e-12;
 }  // namespace impactdeck::test
+
+namespace impactdeck::test {
+/// CAD parts: exact B-rep integrals (OpenCASCADE) and evaluations from the face parametrisation
+/// against closed forms, parts 1e3 sizes from the origin: the acceptance figure (1e-9).
+inline constexpr double kCadExactRel = 1e-9;
+}  // namespace impactdeck::test

@@ -59,6 +59,9 @@ class MeshShape final : public Shape {
   /// Area-uniform over the triangles (cumulative areas, deterministic mt19937_64).
   std::vector<SurfacePoint> sample_surface(std::size_t count, std::uint64_t seed) const override;
 
+  /// Index of the triangle holding the closest surface point (AABB tree).
+  int closest_triangle(const Eigen::Vector3d& query_m) const;
+
   const TriangleMesh& mesh() const { return mesh_; }
   const MeshMassProperties& mass_properties() const { return mass_; }
   std::size_t sharp_edge_count() const;
