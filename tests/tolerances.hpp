@@ -54,3 +54,9 @@ namespace impactdeck::test {
 /// against closed forms, parts 1e3 sizes from the origin: the acceptance figure (1e-9).
 inline constexpr double kCadExactRel = 1e-9;
 }  // namespace impactdeck::test
+
+namespace impactdeck::test {
+/// A real STEP part (screw.step) against a Gmsh STL of it at 0.5 mm (~19k triangles): the facets
+/// are inscribed, so volume and inertia fall short by O(h^2). Measured 1.1e-3 (volume).
+inline constexpr double kCadMeshRel = 2e-3;
+}  // namespace impactdeck::test
