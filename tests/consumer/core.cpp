@@ -23,6 +23,7 @@ int main() {
   in.effective_radius_m = r / 2;
   ElasticMaterial steel{2.05e11, 0.3};
   in.effective_modulus_Pa = effective_modulus_Pa(steel, steel, ModulusConvention::hertz);
+  in.restitution.from_energy_flux = false;
   in.restitution.constant = 1.0;
   const ImpactResult res = solve_impact(in);
   const double kH = 4.0 / 3.0 * in.effective_modulus_Pa * std::sqrt(r / 2);
@@ -30,5 +31,7 @@ int main() {
   const double fmax = kH * std::pow(xmax, 1.5);
   const double got = res.history.compression.max_force_N;
   std::printf("max_force_N %.10g (closed form %.10g)\n", got, fmax);
-  return std::abs(got - fmax) <= 1e-9 * fmax && res.checks.passed ? 0 : 1;
+  const double impulse = res.history.impulse_total_Ns();  // R = 1: twice m_w v
+  std::printf("impulse_Ns %.10g (closed form %.10g)\n", impulse, 2 * (m / 2) * v);
+  return std::abs(got - fmax) <= 1e-9 * fmax && std::abs(impulse - m * v) <= 1e-9 * m * v && res.checks.passed ? 0 : 1;
 }
