@@ -10,6 +10,7 @@
 
 #include "impactdeck/common/atomic_file.hpp"
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/common/guarded_step.hpp"
 #include "impactdeck/common/version.hpp"
 #include "impactdeck/fem_export/mesh.hpp"
 #include "gmsh_plugin.hpp"
@@ -64,22 +65,7 @@ class GmshSession {
 // Runs a Gmsh step; whatever Gmsh throws becomes an InputError naming the step and Gmsh's message.
 template <class F>
 void gmsh_step(const std::string& where, const std::string& step, F&& f) {
-  std::string what;
-  try {
-    f();
-    return;
-  } catch (const Error&) {
-    throw;
-  } catch (const std::exception& e) {
-    what = e.what();
-  } catch (const std::string& e) {
-    what = e;
-  } catch (...) {
-    what = "unknown Gmsh error";
-  }
-  const std::string last = GmshSession::last_error();
-  if (!last.empty() && last != what) what += " (" + last + ")";
-  throw InputError(where, "gmsh " + step, what);
+  run_as_input_error(where, "gmsh " + step, std::forward<F>(f), &GmshSession::last_error);
 }
 
 std::string fmt(double v) {
@@ -269,6 +255,27 @@ void write_msh(const fs::path& folder, const std::string& name, MeshResult& r) {
   gmsh::write(r.msh22.string());
 }
 
+// After meshing a body whose load point and probes are geometry points (ellipsoid and CAD routes):
+// extract the tetrahedra, name LOAD and PROBEk, check the quality, write the .msh files.
+void finish_point_mesh(const std::string& where, const MeshOptions& o, const fs::path& folder,
+                       const std::string& name, int load_tag, const std::vector<int>& probe_tags,
+                       const Eigen::Vector3d& p_mm, MeshResult& r) {
+  gmsh_step(where, "mesh", [&] {
+    const std::map<std::size_t, int> index = extract(r.mesh, where);
+    const int ln = node_of_point_entity(load_tag, index, where, "LOAD");
+    r.mesh.node_groups.emplace_back("LOAD", ln);
+    r.quality.load_node_distance_m = (r.mesh.nodes_m[ln] * kMmPerM - p_mm).norm() / kMmPerM;
+    for (std::size_t i = 0; i < probe_tags.size(); ++i) {
+      const int pn = node_of_point_entity(probe_tags[i], index, where, probe_name(i));
+      r.mesh.node_groups.emplace_back(probe_name(i), pn);
+      r.quality.probe_node_distance_m.push_back((r.mesh.nodes_m[pn] - o.probes_m[i]).norm());
+    }
+  });
+  fill_quality(r.mesh, r.quality);
+  check_mesh(r, where);
+  gmsh_step(where, "write", [&] { write_msh(folder, name, r); });
+}
+
 
 std::string geo_header(const std::string& what) {
   return "// impactdeck " + std::string(kVersion) + ": " + what +
@@ -338,21 +345,7 @@ MeshResult mesh_ellipsoid_with_gmsh(const Eigen::Vector3d& semi_axes_m, const Ei
     add_probe_groups(probe_tags);
   });
   generate_tets(where, o, p_mm, h0, h);
-  std::map<std::size_t, int> index;
-  gmsh_step(where, "mesh", [&] {
-    index = extract(r.mesh, where);
-    const int ln = node_of_point_entity(load_tag, index, where, "LOAD");
-    r.mesh.node_groups.emplace_back("LOAD", ln);
-    r.quality.load_node_distance_m = (r.mesh.nodes_m[ln] * kMmPerM - p_mm).norm() / kMmPerM;
-    for (std::size_t i = 0; i < probe_tags.size(); ++i) {
-      const int pn = node_of_point_entity(probe_tags[i], index, where, probe_name(i));
-      r.mesh.node_groups.emplace_back(probe_name(i), pn);
-      r.quality.probe_node_distance_m.push_back((r.mesh.nodes_m[pn] - o.probes_m[i]).norm());
-    }
-  });
-  fill_quality(r.mesh, r.quality);
-  check_mesh(r, where);
-  gmsh_step(where, "write", [&] { write_msh(folder, name, r); });
+  finish_point_mesh(where, o, folder, name, load_tag, probe_tags, p_mm, r);
 
   std::ostringstream g;
   g << geo_header("ellipsoid " + fmt(ax.x()) + " x " + fmt(ax.y()) + " x " + fmt(ax.z()) +
@@ -578,20 +571,7 @@ MeshResult mesh_cad_with_gmsh(const fs::path& cad, double cad_unit_m, const Eige
     add_probe_groups(probe_tags);
   });
   generate_tets(where, o, p_mm, h0, h);
-  gmsh_step(where, "mesh", [&] {
-    const std::map<std::size_t, int> index = extract(r.mesh, where);
-    const int ln = node_of_point_entity(load_tag, index, where, "LOAD");
-    r.mesh.node_groups.emplace_back("LOAD", ln);
-    r.quality.load_node_distance_m = (r.mesh.nodes_m[ln] * kMmPerM - p_mm).norm() / kMmPerM;
-    for (std::size_t i = 0; i < probe_tags.size(); ++i) {
-      const int pn = node_of_point_entity(probe_tags[i], index, where, probe_name(i));
-      r.mesh.node_groups.emplace_back(probe_name(i), pn);
-      r.quality.probe_node_distance_m.push_back((r.mesh.nodes_m[pn] - o.probes_m[i]).norm());
-    }
-  });
-  fill_quality(r.mesh, r.quality);
-  check_mesh(r, where);
-  gmsh_step(where, "write", [&] { write_msh(folder, name, r); });
+  finish_point_mesh(where, o, folder, name, load_tag, probe_tags, p_mm, r);
   fs::copy_file(cad, copy, fs::copy_options::overwrite_existing);
 
   std::ostringstream g;

@@ -14,6 +14,7 @@
 
 #include "cad_plugin.hpp"
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/common/guarded_step.hpp"
 #include "impactdeck/common/version.hpp"
 
 namespace impactdeck::geometry {
@@ -45,22 +46,7 @@ std::string last_gmsh_error() {
 // Runs a Gmsh step; whatever Gmsh throws becomes an InputError naming the file and step.
 template <class F>
 void gmsh_step(const fs::path& file, const std::string& step, F&& f) {
-  std::string what;
-  try {
-    f();
-    return;
-  } catch (const Error&) {
-    throw;
-  } catch (const std::exception& e) {
-    what = e.what();
-  } catch (const std::string& e) {
-    what = e;
-  } catch (...) {
-    what = "unknown Gmsh error";
-  }
-  const std::string last = last_gmsh_error();
-  if (!last.empty() && last != what) what += " (" + last + ")";
-  throw InputError(file.string(), step, what);
+  run_as_input_error(file.string(), step, std::forward<F>(f), &last_gmsh_error);
 }
 
 void ensure_initialized() {
