@@ -18,7 +18,10 @@
 #include "impactdeck/geometry/section_radius.hpp"
 #include "impactdeck/scene/pipeline.hpp"
 #include "impactdeck/scene/scene.hpp"
+#include "impactdeck/study/cloud.hpp"
+#include "impactdeck/study/scene_sweep.hpp"
 #include "impactdeck/common/numeric.hpp"
+#include "expect_error.hpp"
 #include "tolerances.hpp"
 
 namespace fs = std::filesystem;
@@ -71,16 +74,7 @@ Eigen::Vector3d placed(const Eigen::Vector3d& local_mm) { return (R() * local_mm
 
 double rel_matrix(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) { return (a - b).norm() / b.norm(); }
 
-template <class F>
-void expect_input_error(F&& f, const std::string& re) {
-  try {
-    f();
-    ADD_FAILURE() << "no InputError, expected /" << re << "/";
-  } catch (const InputError& e) {
-    EXPECT_TRUE(std::regex_search(std::string(e.what()), std::regex(re))) << e.what() << "\n  expected /" << re << "/";
-    EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << "message must be one line";
-  }
-}
+using impactdeck::test::expect_input_error;
 
 struct Solids {
   fs::path cylinder, sphere, torus;
@@ -388,4 +382,60 @@ TEST(Cad, SceneWithAStepTargetMatchesTheAnalyticSphereAndMeshesFromTheBrep) {
   EXPECT_LE(deck.quality.load_node_distance_m, 1e-9);
   EXPECT_LE(std::abs(deck.quality.part_volume_m3 - 4.0 / 3.0 * kPi * 0.125e-3) / (0.125e-3), test::kCadExactRel);
   EXPECT_LE(std::abs(deck.quality.volume_relative_difference), 0.1);
+}
+
+namespace {
+bool gmsh_loaded() {
+  std::ifstream maps("/proc/self/maps");
+  std::string line;
+  while (std::getline(maps, line)) {
+    if (line.find("libgmsh") != std::string::npos) return true;
+  }
+  return false;
+}
+}  // namespace
+
+TEST(Cad, GmshIsLoadedOnlyWithTheFirstCadPart) {
+  // (Each test runs in its own process under ctest.) A mesh part does not load Gmsh; a CAD part does.
+  PartOptions po;
+  po.length_unit = LengthUnit::m;
+  const Part cube = load_part(data("cube.off"), po);
+  EXPECT_GT(cube.shape->volume_properties().volume_m3, 0);
+  EXPECT_FALSE(gmsh_loaded());
+  const auto cad = CadShape::load(data("cad/screw.step"), LengthUnit::mm);
+  EXPECT_TRUE(gmsh_loaded());
+}
+
+TEST(Cad, SweepOverACadTargetOnTwoThreads) {
+  // sweep's kernel on a CAD cylinder from several threads (queries serialised by the Gmsh lock):
+  // the same numbers as on one thread; points on the rims are flagged, the rest hit the exact
+  // surface (mean rule: R = 2 r on the lateral face, flat on the caps).
+  const fs::path step = gmsh_cad("sweep_cylinder.step", "Cylinder(1) = {0, 0, 0, 0, 0, 60, 20};\n");
+  const std::string scene_text = two_body_scene(
+      "[[bodies]]\nname = \"target\"\nshape = \"mesh\"\nmesh = \"" + step.string() + "\"\nmaterial = \"steel\"\n");
+  std::string mean = scene_text;
+  mean.replace(mean.find("\"elliptical\""), 12, "\"mean\"");
+  mean.replace(mean.find("[30, 20, 35.70714214271425]"), 27, "[20, 0, 30]");
+  const scene::Scene sc = scene::parse_scene(mean, "sweep");
+  const study::SceneSweep ss = study::sweep_from_scene(sc);
+  const auto cloud = study::make_cloud(*ss.setup.target.shape, study::CloudKind::area_uniform, 8, 120, 5);
+  study::SweepOptions one, two;
+  one.threads = 1;
+  two.threads = 2;
+  two.chunk = 7;
+  const study::SweepResult a = study::run_sweep(ss.setup, cloud, one);
+  const study::SweepResult b = study::run_sweep(ss.setup, cloud, two);
+  ASSERT_EQ(a.points.size(), 120u);
+  for (std::size_t i = 0; i < a.points.size(); ++i) {
+    EXPECT_EQ(a.points[i].max_force_N, b.points[i].max_force_N) << i;
+    const auto& p = a.points[i];
+    if (p.sharp_feature) continue;
+    const Eigen::Vector3d x = p.point_m;
+    const bool cap = std::abs(x.z()) < 1e-12 || std::abs(x.z() - 0.06) < 1e-12;
+    if (!cap) {
+      EXPECT_LE(std::abs(std::hypot(x.x(), x.y()) - 0.02) / 0.02, test::kCadExactRel) << i;
+      EXPECT_LE(std::abs(p.target_radius_m - 0.04) / 0.04, test::kCadExactRel) << i;  // 1 / mean curvature
+    }
+  }
+  EXPECT_GT(a.force_ratio, 0);
 }
