@@ -5,8 +5,8 @@
 # a collision-core-only build (IMPACTDECK_CORE_ONLY=ON) of the sources.
 #   consumer_test.sh BUILD_DIR SOURCE_DIR
 set -u
-build=$1
-src=$2
+build=$(cd "$1" && pwd)
+src=$(cd "$2" && pwd)
 . "$src/tests/check_lib.sh"
 
 export CCACHE_BASEDIR=$src

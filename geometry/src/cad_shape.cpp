@@ -65,6 +65,7 @@ struct CadShape::Impl {
     Box box;
   };
   std::vector<SharpEdge> sharp;
+  std::vector<Box> edge_box;  // per loaded.edges entry: its polyline's box, padded by the chord sag
   double load_seconds = 0;
 
   ~Impl() {
@@ -118,7 +119,9 @@ struct CadShape::Impl {
       }
     }
     // Closest point on an edge of a candidate face: nearer than any face foot, or no foot at all.
-    for (const auto& e : loaded.edges) {
+    for (std::size_t k = 0; k < loaded.edges.size(); ++k) {
+      const auto& e = loaded.edges[k];
+      if (edge_box[k].distance(q) > best_d) continue;  // cannot be nearer than the best foot
       bool near = false;
       for (int f : e.faces) near = near || std::find(candidates.begin(), candidates.end(), f) != candidates.end();
       if (!near) continue;
@@ -267,16 +270,18 @@ std::shared_ptr<const CadShape> CadShape::load(const fs::path& file, LengthUnit 
     b.hi.array() += impl->margin;
   }
   for (const auto& e : L.edges) {
-    if (!(e.dihedral_deg > o.sharp_angle_deg)) continue;
-    Impl::SharpEdge s{e.tag, {}};
+    // The polyline's box, padded by half its longest chord (the arc between two samples stays
+    // within that of the chord).
+    Box box;
     double seg = 0;
     for (std::size_t i = 0; i < e.polyline_m.size(); ++i) {
-      s.box.add(e.polyline_m[i]);
+      box.add(e.polyline_m[i]);
       if (i) seg = std::max(seg, (e.polyline_m[i] - e.polyline_m[i - 1]).norm());
     }
-    s.box.lo.array() -= 0.5 * seg + 1e-9 * impl->size;
-    s.box.hi.array() += 0.5 * seg + 1e-9 * impl->size;
-    impl->sharp.push_back(s);
+    box.lo.array() -= 0.5 * seg + 1e-9 * impl->size;
+    box.hi.array() += 0.5 * seg + 1e-9 * impl->size;
+    impl->edge_box.push_back(box);
+    if (e.dihedral_deg > o.sharp_angle_deg) impl->sharp.push_back(Impl::SharpEdge{e.tag, box});
   }
   impl->load_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return std::shared_ptr<const CadShape>(new CadShape(std::move(impl)));
