@@ -52,6 +52,8 @@ inline constexpr double kSameFileRel = 1e-12;
 namespace impactdeck::test {
 /// CAD parts: exact B-rep integrals (OpenCASCADE) and evaluations from the face parametrisation
 /// against closed forms, parts 1e3 sizes from the origin: the acceptance figure (1e-9).
+/// Measured: volume <= 3.4e-11, inertia <= 3.1e-10 (cylinder; the moments about the origin lose
+/// ~6 digits when moved to the centre of mass), curvatures and normals ~1e-13.
 inline constexpr double kCadExactRel = 1e-9;
 }  // namespace impactdeck::test
 
