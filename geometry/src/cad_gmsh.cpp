@@ -120,17 +120,31 @@ Eigen::Vector3d normal_at(int face, double u, double v) {
   return v3(n).normalized();
 }
 
+void release(int model);
+CadLoaded load_model(const fs::path& file, double unit_m, double mesh_size_relative, int model);
+
+// Reads a part into a new model; a failure drops the model again.
 CadLoaded load(const fs::path& file, double unit_m, double mesh_size_relative) {
   static int next = 0;
-  ModelState st{file, unit_m, "impactdeck_cad_" + std::to_string(++next)};
+  const int model = ++next;
+  try {
+    return load_model(file, unit_m, mesh_size_relative, model);
+  } catch (...) {
+    release(model);
+    throw;
+  }
+}
+
+CadLoaded load_model(const fs::path& file, double unit_m, double mesh_size_relative, int model) {
+  ModelState st{file, unit_m, "impactdeck_cad_" + std::to_string(model)};
   CadLoaded out;
-  out.model = next;
+  out.model = model;
   const std::string where = file.string();
+  models()[out.model] = st;
   gmsh_step(file, "read", [&] {
     ensure_initialized();
     import_into(st);
   });
-  models()[out.model] = st;
   gmsh::vectorpair vols, faces, edges;
   double x0 = 0, y0 = 0, z0 = 0, size = 0;
   gmsh_step(file, "mass properties", [&] {
