@@ -15,6 +15,12 @@ impactdeck_require(Eigen3_FOUND "Eigen 3" libeigen3-dev)
 find_package(GSL QUIET)
 impactdeck_require(GSL_FOUND "GSL" libgsl-dev)
 
+find_package(Threads REQUIRED)
+
+if(IMPACTDECK_CORE_ONLY)
+  return()  # common + collision need Eigen and GSL only
+endif()
+
 # toml++ is used header-only: Debian's package config declares a compiled library it does not ship.
 find_path(IMPACTDECK_TOMLPP_INCLUDE toml++/toml.h)
 impactdeck_require(IMPACTDECK_TOMLPP_INCLUDE "toml++" libtomlplusplus-dev)
@@ -29,8 +35,6 @@ impactdeck_require(nlohmann_json_FOUND "nlohmann-json" nlohmann-json3-dev)
 
 find_package(CLI11 QUIET)
 impactdeck_require(CLI11_FOUND "CLI11" libcli11-dev)
-
-find_package(Threads REQUIRED)
 
 # cairo renders the pictures (SVG is written by our own code, PNG by cairo's image surface).
 find_package(PkgConfig QUIET)

@@ -15,6 +15,7 @@
 #include "impactdeck/geometry/mesh_shape.hpp"
 #include "impactdeck/geometry/mesh_validation.hpp"
 #include "impactdeck/geometry/part.hpp"
+#include "expect_error.hpp"
 #include "tolerances.hpp"
 
 namespace fs = std::filesystem;
@@ -39,17 +40,7 @@ Eigen::Matrix3d rotation() {
 
 MeshMassProperties mass_of(const TriangleMesh& m) { return compute_mass_properties(m, label_shells(m)); }
 
-// Expects an InputError whose one-line message matches `re`.
-template <class F>
-void expect_input_error(F&& f, const std::string& re) {
-  try {
-    f();
-    ADD_FAILURE() << "no InputError, expected /" << re << "/";
-  } catch (const InputError& e) {
-    EXPECT_TRUE(std::regex_search(std::string(e.what()), std::regex(re))) << e.what() << "\n  expected /" << re << "/";
-    EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << "message must be one line";
-  }
-}
+using impactdeck::test::expect_input_error;
 
 std::shared_ptr<MeshShape> shape_of(const TriangleMesh& m, MeshShapeOptions o = {}) {
   return std::make_shared<MeshShape>(m, mass_of(m), o);

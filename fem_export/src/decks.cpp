@@ -264,11 +264,14 @@ DeckResult write_decks(const DeckRequest& r, const fs::path& folder) {
     const auto t_mesh = std::chrono::steady_clock::now();
     MeshResult mr = r.body.kind == BodyKind::ellipsoid
                         ? mesh_ellipsoid(r.body.semi_axes_m, r.load_point_m, r.options.mesh, stage, "mesh")
+                    : r.body.kind == BodyKind::cad
+                        ? mesh_cad(r.body.stl, r.body.stl_unit_m, r.load_point_m, r.options.mesh, stage, "mesh")
                         : mesh_stl(r.body.stl, r.body.stl_unit_m, r.load_point_m, r.options.mesh, stage, "mesh");
     out.mesh_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_mesh).count();
     const TetMesh& m = mr.mesh;
     std::vector<std::string> names = {"mesh.geo", "mesh.msh", "mesh_v22.msh"};
     if (r.body.kind == BodyKind::stl) names.push_back("mesh_part.stl");
+    if (r.body.kind == BodyKind::cad) names.push_back("mesh_part" + r.body.stl.extension().string());
     if (r.options.calculix) {
       write_file_atomically(stage / "mesh.inp", calculix_mesh_inp(m));
       write_file_atomically(stage / (std::string(kJobName) + ".inp"), calculix_inp(r, m));

@@ -10,6 +10,7 @@
 
 #include "impactdeck/common/atomic_file.hpp"
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/common/guarded_step.hpp"
 #include "impactdeck/common/version.hpp"
 #include "impactdeck/fem_export/mesh.hpp"
 #include "gmsh_plugin.hpp"
@@ -64,22 +65,7 @@ class GmshSession {
 // Runs a Gmsh step; whatever Gmsh throws becomes an InputError naming the step and Gmsh's message.
 template <class F>
 void gmsh_step(const std::string& where, const std::string& step, F&& f) {
-  std::string what;
-  try {
-    f();
-    return;
-  } catch (const Error&) {
-    throw;
-  } catch (const std::exception& e) {
-    what = e.what();
-  } catch (const std::string& e) {
-    what = e;
-  } catch (...) {
-    what = "unknown Gmsh error";
-  }
-  const std::string last = GmshSession::last_error();
-  if (!last.empty() && last != what) what += " (" + last + ")";
-  throw InputError(where, "gmsh " + step, what);
+  run_as_input_error(where, "gmsh " + step, std::forward<F>(f), &GmshSession::last_error);
 }
 
 std::string fmt(double v) {
@@ -269,6 +255,27 @@ void write_msh(const fs::path& folder, const std::string& name, MeshResult& r) {
   gmsh::write(r.msh22.string());
 }
 
+// After meshing a body whose load point and probes are geometry points (ellipsoid and CAD routes):
+// extract the tetrahedra, name LOAD and PROBEk, check the quality, write the .msh files.
+void finish_point_mesh(const std::string& where, const MeshOptions& o, const fs::path& folder,
+                       const std::string& name, int load_tag, const std::vector<int>& probe_tags,
+                       const Eigen::Vector3d& p_mm, MeshResult& r) {
+  gmsh_step(where, "mesh", [&] {
+    const std::map<std::size_t, int> index = extract(r.mesh, where);
+    const int ln = node_of_point_entity(load_tag, index, where, "LOAD");
+    r.mesh.node_groups.emplace_back("LOAD", ln);
+    r.quality.load_node_distance_m = (r.mesh.nodes_m[ln] * kMmPerM - p_mm).norm() / kMmPerM;
+    for (std::size_t i = 0; i < probe_tags.size(); ++i) {
+      const int pn = node_of_point_entity(probe_tags[i], index, where, probe_name(i));
+      r.mesh.node_groups.emplace_back(probe_name(i), pn);
+      r.quality.probe_node_distance_m.push_back((r.mesh.nodes_m[pn] - o.probes_m[i]).norm());
+    }
+  });
+  fill_quality(r.mesh, r.quality);
+  check_mesh(r, where);
+  gmsh_step(where, "write", [&] { write_msh(folder, name, r); });
+}
+
 
 std::string geo_header(const std::string& what) {
   return "// impactdeck " + std::string(kVersion) + ": " + what +
@@ -338,21 +345,7 @@ MeshResult mesh_ellipsoid_with_gmsh(const Eigen::Vector3d& semi_axes_m, const Ei
     add_probe_groups(probe_tags);
   });
   generate_tets(where, o, p_mm, h0, h);
-  std::map<std::size_t, int> index;
-  gmsh_step(where, "mesh", [&] {
-    index = extract(r.mesh, where);
-    const int ln = node_of_point_entity(load_tag, index, where, "LOAD");
-    r.mesh.node_groups.emplace_back("LOAD", ln);
-    r.quality.load_node_distance_m = (r.mesh.nodes_m[ln] * kMmPerM - p_mm).norm() / kMmPerM;
-    for (std::size_t i = 0; i < probe_tags.size(); ++i) {
-      const int pn = node_of_point_entity(probe_tags[i], index, where, probe_name(i));
-      r.mesh.node_groups.emplace_back(probe_name(i), pn);
-      r.quality.probe_node_distance_m.push_back((r.mesh.nodes_m[pn] - o.probes_m[i]).norm());
-    }
-  });
-  fill_quality(r.mesh, r.quality);
-  check_mesh(r, where);
-  gmsh_step(where, "write", [&] { write_msh(folder, name, r); });
+  finish_point_mesh(where, o, folder, name, load_tag, probe_tags, p_mm, r);
 
   std::ostringstream g;
   g << geo_header("ellipsoid " + fmt(ax.x()) + " x " + fmt(ax.y()) + " x " + fmt(ax.z()) +
@@ -504,13 +497,111 @@ MeshResult mesh_stl_with_gmsh(const fs::path& stl, double stl_unit_m, const Eige
   return r;
 }
 
+MeshResult mesh_cad_with_gmsh(const fs::path& cad, double cad_unit_m, const Eigen::Vector3d& load_point_m,
+                              const MeshOptions& o, const fs::path& folder, const std::string& name) {
+  const std::string where = cad.string();
+  check_options(o, where);
+  if (!fs::is_regular_file(cad)) throw InputError(where, "file", "cannot be opened (missing or unreadable)");
+  if (!(cad_unit_m > 0)) throw InputError(where, "unit", "must be > 0");
+  // STEP and IGES come in mm (OpenCASCADE converts from the file's own unit); a BREP has no unit:
+  // its coordinates are in cad_unit_m metres and are scaled to mm.
+  const double scale = cad_unit_m * kMmPerM;
+  const bool scaled = std::abs(scale - 1.0) > 1e-15;
+  const double h = o.mesh_size_m * kMmPerM, h0 = load_size(o) * kMmPerM;
+  const Eigen::Vector3d p_mm = load_point_m * kMmPerM;
+  const fs::path copy = folder / (name + "_part" + cad.extension().string());
+
+  MeshResult r;
+  GmshSession session(name);
+  std::vector<int> volumes, probe_tags;
+  int load_tag = -1, load_face = -1;
+  gmsh_step(where, "read CAD", [&] {
+    gmsh::option::setString("Geometry.OCCTargetUnit", "MM");
+    gmsh::vectorpair out;
+    gmsh::model::occ::importShapes(cad.string(), out, true);
+    gmsh::vectorpair vols;
+    gmsh::model::occ::getEntities(vols, 3);
+    if (vols.empty()) throw InputError(where, "solids", "the file holds no solid");
+    if (scaled) gmsh::model::occ::dilate(vols, 0, 0, 0, scale, scale, scale);
+    gmsh::model::occ::synchronize();
+    gmsh::model::getEntities(vols, 3);
+    r.quality.part_volume_m3 = 0;
+    for (const auto& [d, t] : vols) {
+      double m = 0;
+      gmsh::model::occ::getMass(3, t, m);
+      r.quality.part_volume_m3 += m / std::pow(kMmPerM, 3);
+      volumes.push_back(t);
+    }
+    // LOAD: a point embedded in the face nearest to the load point (a node exactly there).
+    gmsh::vectorpair faces;
+    gmsh::model::getEntities(faces, 2);
+    double best = 1e300;
+    Eigen::Vector3d foot = p_mm;
+    for (const auto& [d, t] : faces) {
+      std::vector<double> cp, uv, uv2;
+      try {
+        gmsh::model::getClosestPoint(2, t, {p_mm.x(), p_mm.y(), p_mm.z()}, cp, uv);
+        gmsh::model::getParametrization(2, t, cp, uv2);
+        if (!gmsh::model::isInside(2, t, uv2)) continue;
+      } catch (...) {
+        continue;  // the projection left the face: another face is nearer
+      }
+      const Eigen::Vector3d c(cp[0], cp[1], cp[2]);
+      if ((c - p_mm).norm() < best) best = (c - p_mm).norm(), load_face = t, foot = c;
+    }
+    double size_mm = 0;
+    {
+      double x0, y0, z0, x1, y1, z1;
+      gmsh::model::getBoundingBox(-1, -1, x0, y0, z0, x1, y1, z1);
+      size_mm = std::max({x1 - x0, y1 - y0, z1 - z0});
+    }
+    if (load_face < 0 || best > 0.01 * size_mm) {
+      throw InputError(where, "load point", "not within 1 % of the size of a face of the part");
+    }
+    load_tag = gmsh::model::occ::addPoint(foot.x(), foot.y(), foot.z());
+    for (const auto& pr : o.probes_m) {
+      const Eigen::Vector3d pm = pr * kMmPerM;
+      probe_tags.push_back(gmsh::model::occ::addPoint(pm.x(), pm.y(), pm.z()));
+    }
+    gmsh::model::occ::synchronize();
+    gmsh::model::mesh::embed(0, {load_tag}, 2, load_face);
+    if (!probe_tags.empty()) gmsh::model::mesh::embed(0, probe_tags, 3, volumes.front());
+    gmsh::model::setPhysicalName(3, gmsh::model::addPhysicalGroup(3, volumes), "BODY");
+    gmsh::model::setPhysicalName(0, gmsh::model::addPhysicalGroup(0, {load_tag}), "LOAD");
+    add_probe_groups(probe_tags);
+  });
+  generate_tets(where, o, p_mm, h0, h);
+  finish_point_mesh(where, o, folder, name, load_tag, probe_tags, p_mm, r);
+  fs::copy_file(cad, copy, fs::copy_options::overwrite_existing);
+
+  std::ostringstream g;
+  g << geo_header("CAD part from " + cad.filename().string() + " (copied as " + copy.filename().string() + ")");
+  g << "SetFactory(\"OpenCASCADE\");\nGeometry.OCCTargetUnit = \"MM\";\n" << geo_options(h, o.algorithm_3d);
+  g << "Merge \"" << copy.filename().string() << "\";\n";
+  if (scaled) g << "Dilate {{0, 0, 0}, {" << fmt(scale) << ", " << fmt(scale) << ", " << fmt(scale) << "}} { Volume{:}; }\n";
+  const Eigen::Vector3d lp = r.mesh.nodes_m[r.mesh.node_of("LOAD")] * kMmPerM;
+  g << "Point(2000) = {" << fmt(lp.x()) << ", " << fmt(lp.y()) << ", " << fmt(lp.z()) << "};\n"
+    << "Point{2000} In Surface{" << load_face << "};\n";
+  for (std::size_t i = 0; i < o.probes_m.size(); ++i) {
+    const Eigen::Vector3d pm = o.probes_m[i] * kMmPerM;
+    g << "Point(" << 1000 + i << ") = {" << fmt(pm.x()) << ", " << fmt(pm.y()) << ", " << fmt(pm.z())
+      << "};\nPoint{" << 1000 + i << "} In Volume{" << volumes.front() << "};\n";
+  }
+  g << geo_size_field(p_mm, h0, h);
+  g << "Physical Volume(\"BODY\") = {Volume{:}};\nPhysical Point(\"LOAD\") = {2000};\n";
+  g << geo_probe_groups(o);
+  r.geo = folder / (name + ".geo");
+  write_file_atomically(r.geo, g.str());
+  return r;
+}
+
 }  // namespace impactdeck::fem_export
 
 // The plugin's entry point (gmsh_plugin.hpp); everything else in this library is hidden.
-extern "C" __attribute__((visibility("default"))) const impactdeck::fem_export::detail::GmshMesherV1*
-impactdeck_gmsh_mesher_v1() {
+extern "C" __attribute__((visibility("default"))) const void* impactdeck_gmsh_mesher_v1() {
   using namespace impactdeck::fem_export;
   static const detail::GmshMesherV1 table{impactdeck::kVersion, sizeof(MeshResult), sizeof(MeshOptions),
-                                          &mesh_ellipsoid_with_gmsh, &mesh_stl_with_gmsh};
+                                          &mesh_ellipsoid_with_gmsh, &mesh_stl_with_gmsh,
+                                          &mesh_cad_with_gmsh};
   return &table;
 }

@@ -22,6 +22,9 @@ struct GmshMesherV1 {
   MeshResult (*mesh_stl)(const std::filesystem::path& stl, double stl_unit_m,
                          const Eigen::Vector3d& load_point_m, const MeshOptions& options,
                          const std::filesystem::path& folder, const std::string& name);
+  MeshResult (*mesh_cad)(const std::filesystem::path& cad, double cad_unit_m,
+                         const Eigen::Vector3d& load_point_m, const MeshOptions& options,
+                         const std::filesystem::path& folder, const std::string& name);
 };
 
 }  // namespace impactdeck::fem_export::detail

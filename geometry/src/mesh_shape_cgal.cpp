@@ -1,6 +1,7 @@
 // Surface queries on a triangulated part. CGAL (AABB tree, Monge_via_jet_fitting; GPL) stays in
 // this file behind MeshShape's pimpl.
 #include "impactdeck/geometry/mesh_shape.hpp"
+#include "impactdeck/geometry/section_radius.hpp"
 
 #include <algorithm>
 #include <array>
@@ -322,6 +323,11 @@ MeshShape::MeshShape(TriangleMesh mesh, const MeshMassProperties& mass, const Me
 
 MeshShape::~MeshShape() = default;
 
+int MeshShape::closest_triangle(const Eigen::Vector3d& query_m) const {
+  const auto hit = index_->tree.closest_point_and_primitive(cp(query_m));
+  return static_cast<int>(hit.second - index_->triangles.begin());
+}
+
 double MeshShape::size_m() const { return (index_->hi - index_->lo).maxCoeff(); }
 std::size_t MeshShape::sharp_edge_count() const { return index_->sharp_edge_count; }
 double MeshShape::mean_edge_length_m() const { return index_->mean_edge; }
@@ -556,28 +562,11 @@ double MeshShape::paper_radius_m(const SurfacePoint& at) const {
   if (fit.curvature.sharp_feature) {
     throw InputError("", "point", "lies on a sharp edge or corner: the Eq. 26 radius is undefined there");
   }
-  const Eigen::Vector3d n = at.normal;
-  const Curvature& c = fit.curvature;
   // A cut is tangent (degenerate, left out as in the analytic Eq. 26) when the surface normal is
   // within 1e-3 rad of the cut's normal: the mesh normal is not more accurate than that (the
   // analytic shape uses the exact condition s² <= 1e-12).
   constexpr double kTangentCut = 1e-3;
-  double sum = 0;
-  int count = 0;
-  for (int i = 0; i < 3; ++i) {
-    const Eigen::Vector3d e = Eigen::Vector3d::Unit(i);
-    const Eigen::Vector3d txe = n.cross(e);
-    const double cos_phi = txe.norm();
-  
-    if (!(cos_phi > kTangentCut)) continue;
-    const Eigen::Vector3d t = txe / cos_phi;
-    const double a1 = t.dot(c.d1), a2 = t.dot(c.d2);
-    const double kn = (c.k1_per_m * a1 * a1 + c.k2_per_m * a2 * a2) / std::max(a1 * a1 + a2 * a2, 1e-300);
-    sum += cos_phi / kn;  // radius of the section: 1/κ = |n×e| / κ_n
-    ++count;
-  }
-  if (count == 0) throw InputError("", "point", "no non-degenerate section for the Eq. 26 radius");
-  return sum / count;
+  return paper_radius_from_curvature(fit.curvature, at.normal, kTangentCut);
 }
 
 std::optional<SurfacePoint> MeshShape::ray_exit(const Eigen::Vector3d& o, const Eigen::Vector3d& dir) const {

@@ -10,6 +10,7 @@
 #include "impactdeck/common/atomic_file.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/fem_export/force_table.hpp"
+#include "impactdeck/geometry/cad_shape.hpp"
 #include "impactdeck/geometry/ellipsoid.hpp"
 #include "impactdeck/geometry/part.hpp"
 #include "impactdeck/geometry/plane.hpp"
@@ -64,6 +65,12 @@ class StageClock {
 
 std::string where(const Scene& s) { return s.file.string(); }
 
+void add_stage(RunReport& r, const std::string& name, double seconds) {
+  for (auto& st : r.stages_run)
+    if (st.name == name) { st.seconds += seconds; return; }
+  r.stages_run.push_back({name, seconds});
+}
+
 }  // namespace
 
 std::shared_ptr<const geometry::Shape> make_shape(const BodySpec& b, const Scene& scene, RunReport* report) {
@@ -77,6 +84,14 @@ std::shared_ptr<const geometry::Shape> make_shape(const BodySpec& b, const Scene
       case ShapeKind::plane:
         return std::make_shared<geometry::Plane>(b.plane_normal);
       case ShapeKind::mesh: {
+        if (geometry::cad_format(b.mesh_path)) {  // STEP / IGES / BREP: exact B-rep queries
+          auto cad = geometry::CadShape::load(b.mesh_path, scene.length_unit);
+          if (report) {
+            add_stage(*report, "mesh_load", cad->load_seconds());
+            for (const auto& w : cad->warnings()) report->warnings.push_back("body '" + b.name + "': " + w);
+          }
+          return cad;
+        }
         geometry::PartOptions opt;
         opt.length_unit = scene.length_unit;  // the scene's unit applies to the part file too
         opt.repair = b.mesh_repair;
@@ -197,12 +212,6 @@ collision::ImpactInput impact_input(const Scene& scene, const ImpactSpec& s, con
   return in;
 }
 
-void add_stage(RunReport& r, const std::string& name, double seconds) {
-  for (auto& st : r.stages_run)
-    if (st.name == name) { st.seconds += seconds; return; }
-  r.stages_run.push_back({name, seconds});
-}
-
 // The deck request of one impact: the target body alone, loaded by the force on it (along -n).
 fem_export::DeckRequest fem_request(const Scene& scene, const ImpactReport& ir, const PreparedBody& target) {
   const FemOutputs& f = *scene.outputs.fem;
@@ -228,6 +237,10 @@ fem_export::DeckRequest fem_request(const Scene& scene, const ImpactReport& ir, 
       r.body.kind = fem_export::BodyKind::stl;
       r.body.stl = b.mesh_path;
       r.body.stl_unit_m = metres_per(scene.length_unit);
+      if (const auto* cad = dynamic_cast<const geometry::CadShape*>(target.shape.get())) {
+        r.body.kind = fem_export::BodyKind::cad;  // meshed straight from the B-rep
+        if (cad->file_unit()) r.body.stl_unit_m = 1e-3;  // STEP/IGES: OpenCASCADE reads them in mm
+      }
       break;
   }
   r.material.youngs_modulus_Pa = target.material.youngs_modulus_Pa;

@@ -22,13 +22,14 @@ struct DeckMaterial {
   double density_kg_m3 = 0;
 };
 
-enum class BodyKind { ellipsoid, stl };
+/// stl: a triangulated part file; cad: a STEP/IGES/BREP file meshed from its B-rep (mesh_cad).
+enum class BodyKind { ellipsoid, stl, cad };
 
 struct DeckBody {
   BodyKind kind = BodyKind::ellipsoid;
   Eigen::Vector3d semi_axes_m = Eigen::Vector3d::Zero();  ///< ellipsoid, centred at the origin
-  std::filesystem::path stl;                             ///< stl
-  double stl_unit_m = 1e-3;                              ///< metres per STL coordinate unit
+  std::filesystem::path stl;                             ///< stl, cad: the part file
+  double stl_unit_m = 1e-3;                              ///< metres per file coordinate unit (cad: mesh_cad)
 };
 
 struct DeckOptions {

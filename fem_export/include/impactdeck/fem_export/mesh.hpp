@@ -84,6 +84,15 @@ MeshResult mesh_stl(const std::filesystem::path& stl, double stl_unit_m,
                     const Eigen::Vector3d& load_point_m, const MeshOptions& options,
                     const std::filesystem::path& folder, const std::string& name);
 
+/// Meshes the solid(s) of a CAD file (STEP, IGES, BREP) straight from the B-rep, through Gmsh's
+/// OpenCASCADE kernel: no STL detour. STEP and IGES are read in their own stated unit (converted
+/// to mm by OpenCASCADE; pass cad_unit_m = 1e-3); a BREP's coordinates are in `cad_unit_m` metres.
+/// The load point becomes a node exactly on the face nearest to it (embedded point). The file is
+/// copied into `folder` so that the .geo is self-contained. Same outputs and errors as above.
+MeshResult mesh_cad(const std::filesystem::path& cad, double cad_unit_m,
+                    const Eigen::Vector3d& load_point_m, const MeshOptions& options,
+                    const std::filesystem::path& folder, const std::string& name);
+
 /// Writes the mesh as MED (libmedc, the format Code_Aster reads by default): nodes in mm, TETRA4
 /// cells in group BODY, node groups as families. Throws InputError on failure.
 void write_med(const TetMesh& mesh, const std::filesystem::path& path, const std::string& mesh_name);

@@ -89,6 +89,9 @@ class MeshShape final : public Shape {
                           const Eigen::Vector3d& direction, double pad_m, double s_min, double s_max,
                           const std::function<double(int own_face, int mover_face, double s_max)>& visit) const;
 
+  /// Index of the triangle holding the closest surface point (AABB tree).
+  int closest_triangle(const Eigen::Vector3d& query_m) const;
+
   const TriangleMesh& mesh() const { return mesh_; }
   const MeshMassProperties& mass_properties() const { return mass_; }
   std::size_t sharp_edge_count() const;

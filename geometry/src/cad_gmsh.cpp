@@ -1,0 +1,403 @@
+// CAD parts through Gmsh's OpenCASCADE kernel (cad_plugin.hpp). gmsh.h is used only in this file,
+// which is built into the plugin libimpactdeck_gmsh_cad.so. The caller holds gmsh_mutex().
+//
+// Gmsh keeps one model per loaded part (named impactdeck_cad_N). Another Gmsh user in the process
+// (the FEM mesher plugin) initializes and finalizes Gmsh for each mesh, which drops every model:
+// each query first checks that its model is still there and reads the file again if not (the
+// same file read the same way gives the same entity tags).
+#include <gmsh.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <string>
+
+#include "cad_plugin.hpp"
+#include "impactdeck/common/error.hpp"
+#include "impactdeck/common/guarded_step.hpp"
+#include "impactdeck/common/version.hpp"
+
+namespace impactdeck::geometry {
+namespace fs = std::filesystem;
+using detail::CadLoaded;
+
+namespace {
+
+struct ModelState {
+  fs::path file;
+  double unit_m = 1;  // metres per model coordinate
+  std::string name;
+};
+
+std::map<int, ModelState>& models() {
+  static std::map<int, ModelState> m;
+  return m;
+}
+
+std::string last_gmsh_error() {
+  std::string e;
+  try {
+    gmsh::logger::getLastError(e);
+  } catch (...) {
+  }
+  return e;
+}
+
+// Runs a Gmsh step; whatever Gmsh throws becomes an InputError naming the file and step.
+template <class F>
+void gmsh_step(const fs::path& file, const std::string& step, F&& f) {
+  run_as_input_error(file.string(), step, std::forward<F>(f), &last_gmsh_error);
+}
+
+void ensure_initialized() {
+  bool alive = true;
+  try {
+    std::vector<std::string> names;
+    gmsh::model::list(names);
+    alive = !names.empty();
+  } catch (...) {
+    alive = false;
+  }
+  if (!alive) {
+    gmsh::initialize(0, nullptr, false);
+  }
+  gmsh::option::setNumber("General.Terminal", 0);
+  gmsh::option::setNumber("General.NumThreads", 1);
+}
+
+void import_into(const ModelState& st) {
+  gmsh::model::add(st.name);
+  gmsh::option::setString("Geometry.OCCTargetUnit", "MM");
+  gmsh::logger::start();
+  gmsh::vectorpair out;
+  gmsh::model::occ::importShapes(st.file.string(), out, true);
+  gmsh::model::occ::synchronize();
+}
+
+// Makes the part's model current, reading the file again when Gmsh lost it.
+void activate(int model) {
+  const ModelState& st = models().at(model);
+  ensure_initialized();
+  std::vector<std::string> names;
+  gmsh::model::list(names);
+  if (std::find(names.begin(), names.end(), st.name) == names.end()) {
+    import_into(st);
+  }
+  gmsh::model::setCurrent(st.name);
+}
+
+Eigen::Vector3d v3(const std::vector<double>& x, std::size_t i = 0) { return {x[i], x[i + 1], x[i + 2]}; }
+
+double model_size(double& x0, double& y0, double& z0) {
+  double x1, y1, z1;
+  gmsh::model::getBoundingBox(-1, -1, x0, y0, z0, x1, y1, z1);
+  return std::max({x1 - x0, y1 - y0, z1 - z0});
+}
+
+// Closest point of face `face` to q (model units): projection, then its parameters; false when
+// the projection fails or leaves the face's parameter box.
+bool project(int face, const Eigen::Vector3d& q, Eigen::Vector3d& p, double& u, double& v, double tol) {
+  try {
+    std::vector<double> cp, uv, uv2, back;
+    gmsh::model::getClosestPoint(2, face, {q.x(), q.y(), q.z()}, cp, uv);
+    if (cp.size() != 3) return false;
+    gmsh::model::getParametrization(2, face, cp, uv2);
+    if (uv2.size() != 2) return false;
+    gmsh::model::getValue(2, face, uv2, back);
+    p = v3(cp);
+    if (!p.allFinite() || !((v3(back) - p).norm() <= tol)) return false;
+    u = uv2[0];
+    v = uv2[1];
+    return true;
+  } catch (...) {
+    return false;
+  }
+}
+
+Eigen::Vector3d normal_at(int face, double u, double v) {
+  std::vector<double> n;
+  gmsh::model::getNormal(face, {u, v}, n);
+  return v3(n).normalized();
+}
+
+void release(int model);
+CadLoaded load_model(const fs::path& file, double unit_m, double mesh_size_relative, int model);
+
+// Reads a part into a new model; a failure drops the model again.
+CadLoaded load(const fs::path& file, double unit_m, double mesh_size_relative) {
+  static int next = 0;
+  const int model = ++next;
+  try {
+    return load_model(file, unit_m, mesh_size_relative, model);
+  } catch (...) {
+    release(model);
+    throw;
+  }
+}
+
+CadLoaded load_model(const fs::path& file, double unit_m, double mesh_size_relative, int model) {
+  ModelState st{file, unit_m, "impactdeck_cad_" + std::to_string(model)};
+  CadLoaded out;
+  out.model = model;
+  const std::string where = file.string();
+  models()[out.model] = st;
+  gmsh_step(file, "read", [&] {
+    ensure_initialized();
+    import_into(st);
+  });
+  gmsh::vectorpair vols, faces, edges;
+  double x0 = 0, y0 = 0, z0 = 0, size = 0;
+  gmsh_step(file, "mass properties", [&] {
+    gmsh::model::getEntities(vols, 3);
+    gmsh::model::getEntities(faces, 2);
+    gmsh::model::getEntities(edges, 1);
+    out.solids = static_cast<int>(vols.size());
+    if (vols.empty()) {
+      throw InputError(where, "solids", "the file holds no solid (" + std::to_string(faces.size()) +
+                       " faces, none closing a volume): mass properties need a closed solid");
+    }
+    size = model_size(x0, y0, z0);
+    // Mass properties about the part's centre of mass (summed over the solids: first moments,
+    // then each solid's inertia moved to the common centre by the parallel axis theorem).
+    const double L = unit_m;
+    double volume = 0;
+    Eigen::Vector3d first = Eigen::Vector3d::Zero();
+    std::vector<std::tuple<double, Eigen::Vector3d, Eigen::Matrix3d>> parts;
+    for (const auto& [d, t] : vols) {
+      double m = 0, cx = 0, cy = 0, cz = 0;
+      std::vector<double> I;
+      gmsh::model::occ::getMass(3, t, m);
+      gmsh::model::occ::getCenterOfMass(3, t, cx, cy, cz);
+      gmsh::model::occ::getMatrixOfInertia(3, t, I);
+      if (!(m > 0) || I.size() != 9) {
+        throw InputError(where, "solid " + std::to_string(t), "has no positive volume (is it closed?)");
+      }
+      Eigen::Matrix3d J;
+      for (int i = 0; i < 9; ++i) J(i / 3, i % 3) = I[i];
+      parts.emplace_back(m, Eigen::Vector3d(cx, cy, cz), J);
+      volume += m;
+      first += m * Eigen::Vector3d(cx, cy, cz);
+    }
+    const Eigen::Vector3d c = first / volume;
+    Eigen::Matrix3d J = Eigen::Matrix3d::Zero();
+    for (const auto& [m, ci, Ji] : parts) {
+      const Eigen::Vector3d r = ci - c;
+      J += Ji + m * (r.squaredNorm() * Eigen::Matrix3d::Identity() - r * r.transpose());
+    }
+    out.volume.volume_m3 = volume * L * L * L;
+    out.volume.centroid_m = c * L;
+    out.volume.inertia_per_density_m5 = 0.5 * (J + J.transpose()) * std::pow(L, 5);
+    double area = 0;
+    for (const auto& [d, t] : faces) {
+      double a = 0;
+      gmsh::model::occ::getMass(2, t, a);
+      area += a;
+    }
+    out.volume.area_m2 = area * L * L;
+  });
+  if (out.solids > 1) {
+    out.warnings.push_back(where + ": " + std::to_string(out.solids) +
+                           " solids taken as one body (mass properties summed; overlaps would count twice)");
+  }
+
+  // Triangulation: Gmsh's 2D mesh of the faces, options restored afterwards (the mesher plugin
+  // shares Gmsh's option table).
+  gmsh_step(file, "triangulation", [&] {
+    const std::vector<std::pair<std::string, double>> opts = {
+        {"Mesh.MeshSizeMax", mesh_size_relative * size}, {"Mesh.MeshSizeMin", 0.0},
+        {"Mesh.MeshSizeFromCurvature", 12},        {"Mesh.MeshSizeFromPoints", 0},
+        {"Mesh.MeshSizeExtendFromBoundary", 1},     {"Mesh.Algorithm", 6}};
+    std::vector<double> saved;
+    for (const auto& [k, v] : opts) {
+      double old = 0;
+      gmsh::option::getNumber(k, old);
+      saved.push_back(old);
+      gmsh::option::setNumber(k, v);
+    }
+    try {
+      gmsh::model::mesh::generate(2);
+    } catch (...) {
+      for (std::size_t i = 0; i < opts.size(); ++i) gmsh::option::setNumber(opts[i].first, saved[i]);
+      throw;
+    }
+    for (std::size_t i = 0; i < opts.size(); ++i) gmsh::option::setNumber(opts[i].first, saved[i]);
+
+    std::vector<std::size_t> tags;
+    std::vector<double> xyz, par;
+    gmsh::model::mesh::getNodes(tags, xyz, par, -1, -1, true, false);
+    std::map<std::size_t, int> index;
+    for (std::size_t i = 0; i < tags.size(); ++i) {
+      index[tags[i]] = static_cast<int>(out.nodes_m.size());
+      out.nodes_m.push_back(v3(xyz, 3 * i) * unit_m);
+    }
+    const double tol = 1e-7 * size;
+    for (const auto& [d, f] : faces) {
+      out.faces.push_back(f);
+      std::vector<double> lo, hi;
+      gmsh::model::getParametrizationBounds(2, f, lo, hi);
+      out.face_bounds.push_back({lo[0], hi[0], lo[1], hi[1]});
+      std::vector<std::size_t> etags, enodes;
+      gmsh::model::mesh::getElementsByType(2, etags, enodes, f);
+      const std::size_t first = out.triangles.size();
+      double best_area = -1;
+      std::size_t best = first;
+      for (std::size_t e = 0; e < etags.size(); ++e) {
+        std::array<int, 3> t{index.at(enodes[3 * e]), index.at(enodes[3 * e + 1]), index.at(enodes[3 * e + 2])};
+        out.triangles.push_back(t);
+        out.triangle_face.push_back(f);
+        const double a = (out.nodes_m[t[1]] - out.nodes_m[t[0]]).cross(out.nodes_m[t[2]] - out.nodes_m[t[0]]).norm();
+        if (a > best_area) best_area = a, best = out.triangles.size() - 1;
+      }
+      if (out.triangles.size() == first) continue;
+      // Orientation of the face's triangles against the face's outward normal at the largest one.
+      const auto& t = out.triangles[best];
+      const Eigen::Vector3d c = (out.nodes_m[t[0]] + out.nodes_m[t[1]] + out.nodes_m[t[2]]) / (3.0 * unit_m);
+      Eigen::Vector3d p;
+      double u = 0, v = 0;
+      if (!project(f, c, p, u, v, tol)) {
+        throw InputError(where, "face " + std::to_string(f), "cannot orient its triangulation (projection failed)");
+      }
+      const Eigen::Vector3d tn =
+          (out.nodes_m[t[1]] - out.nodes_m[t[0]]).cross(out.nodes_m[t[2]] - out.nodes_m[t[0]]);
+      if (tn.dot(normal_at(f, u, v)) < 0) {
+        for (std::size_t k = first; k < out.triangles.size(); ++k) std::swap(out.triangles[k][1], out.triangles[k][2]);
+      }
+    }
+    gmsh::model::mesh::clear();
+  });
+  if (out.triangles.empty()) throw InputError(where, "triangulation", "Gmsh produced no surface triangles");
+
+  // B-rep edges: adjacent faces and the largest angle between their normals along the edge.
+  gmsh_step(file, "edges", [&] {
+    for (const auto& [d, e] : edges) {
+      CadLoaded::Edge ed;
+      ed.tag = e;
+      std::vector<int> up, down;
+      gmsh::model::getAdjacencies(1, e, up, down);
+      ed.faces = up;
+      std::vector<double> lo, hi;
+      gmsh::model::getParametrizationBounds(1, e, lo, hi);
+      constexpr int kSamples = 16;
+      for (int i = 0; i <= kSamples; ++i) {
+        const double t = lo[0] + (hi[0] - lo[0]) * i / kSamples;
+        std::vector<double> x;
+        gmsh::model::getValue(1, e, {t}, x);
+        ed.polyline_m.push_back(v3(x) * unit_m);
+        if (up.size() == 2 && up[0] != up[1]) {
+          std::vector<double> uv0, uv1;
+          try {
+            gmsh::model::reparametrizeOnSurface(1, e, {t}, up[0], uv0, 0);
+            gmsh::model::reparametrizeOnSurface(1, e, {t}, up[1], uv1, 0);
+            const double c = std::clamp(normal_at(up[0], uv0[0], uv0[1]).dot(normal_at(up[1], uv1[0], uv1[1])), -1.0, 1.0);
+            ed.dihedral_deg = std::max(ed.dihedral_deg, std::acos(c) * 180.0 / 3.14159265358979323846);
+          } catch (...) {
+            ed.dihedral_deg = 180;  // cannot tell: count it as sharp
+          }
+        }
+      }
+      if (up.size() > 2) ed.dihedral_deg = 180;  // non-manifold edge
+      out.edges.push_back(std::move(ed));
+    }
+  });
+  return out;
+}
+
+bool project_on_face(int model, int face, const Eigen::Vector3d& q_m, detail::CadFacePoint& out) {
+  try {
+    activate(model);
+    const double L = models().at(model).unit_m;
+    double x0, y0, z0;
+    const double size = model_size(x0, y0, z0);
+    Eigen::Vector3d p;
+    double u = 0, v = 0;
+    if (!project(face, q_m / L, p, u, v, 1e-7 * size)) return false;
+    out.point_m = p * L;
+    out.u = u;
+    out.v = v;
+    out.normal = normal_at(face, u, v);
+    out.inside = gmsh::model::isInside(2, face, {u, v}) != 0;
+    return out.normal.allFinite();
+  } catch (...) {
+    return false;
+  }
+}
+
+bool face_frame(int model, int face, double u, double v, detail::CadFaceFrame& out) {
+  try {
+    activate(model);
+    const double L = models().at(model).unit_m;
+    std::vector<double> x, d1, d2, k1, k2, dir1, dir2;
+    gmsh::model::getValue(2, face, {u, v}, x);
+    gmsh::model::getDerivative(2, face, {u, v}, d1);
+    gmsh::model::getSecondDerivative(2, face, {u, v}, d2);
+    gmsh::model::getPrincipalCurvatures(face, {u, v}, k1, k2, dir1, dir2);
+    if (x.size() != 3 || d1.size() != 6 || d2.size() != 9 || k1.empty() || k2.empty()) return false;
+    out.point_m = v3(x) * L;
+    out.normal = normal_at(face, u, v);
+    out.xu = v3(d1, 0) * L;
+    out.xv = v3(d1, 3) * L;
+    out.xuu = v3(d2, 0) * L;
+    out.xvv = v3(d2, 3) * L;
+    out.xuv = v3(d2, 6) * L;
+    out.k1_gmsh = k1[0] / L;
+    out.k2_gmsh = k2[0] / L;
+    return true;
+  } catch (...) {
+    return false;
+  }
+}
+
+bool project_on_edge(int model, int edge, const Eigen::Vector3d& q_m, detail::CadEdgePoint& out) {
+  try {
+    activate(model);
+    const double L = models().at(model).unit_m;
+    const Eigen::Vector3d q = q_m / L;
+    std::vector<double> lo, hi, cp, t, a, b;
+    gmsh::model::getParametrizationBounds(1, edge, lo, hi);
+    gmsh::model::getValue(1, edge, {lo[0]}, a);
+    gmsh::model::getValue(1, edge, {hi[0]}, b);
+    // The nearer end, unless the projection falls inside the edge's range and is nearer still.
+    Eigen::Vector3d best = (v3(a) - q).norm() <= (v3(b) - q).norm() ? v3(a) : v3(b);
+    double best_t = (v3(a) - q).norm() <= (v3(b) - q).norm() ? lo[0] : hi[0];
+    try {
+      gmsh::model::getClosestPoint(1, edge, {q.x(), q.y(), q.z()}, cp, t);
+      gmsh::model::getParametrization(1, edge, cp, t);
+      if (cp.size() == 3 && t.size() == 1 && t[0] >= lo[0] && t[0] <= hi[0] && (v3(cp) - q).norm() < (best - q).norm()) {
+        best = v3(cp);
+        best_t = t[0];
+      }
+    } catch (...) {
+    }
+    out.point_m = best * L;
+    out.t = best_t;
+    return out.point_m.allFinite();
+  } catch (...) {
+    return false;
+  }
+}
+
+void release(int model) {
+  auto it = models().find(model);
+  if (it == models().end()) return;
+  try {
+    std::vector<std::string> names;
+    gmsh::model::list(names);
+    if (std::find(names.begin(), names.end(), it->second.name) != names.end()) {
+      gmsh::model::setCurrent(it->second.name);
+      gmsh::model::remove();
+    }
+  } catch (...) {
+  }
+  models().erase(it);
+}
+
+}  // namespace
+}  // namespace impactdeck::geometry
+
+// The plugin's entry point (cad_plugin.hpp); everything else in this library is hidden.
+extern "C" __attribute__((visibility("default"))) const void* impactdeck_gmsh_cad_v1() {
+  using namespace impactdeck::geometry;
+  static const detail::GmshCadV1 table{impactdeck::kVersion, sizeof(detail::CadLoaded), sizeof(detail::CadFaceFrame),
+                                       &load, &project_on_face, &face_frame, &project_on_edge, &release};
+  return &table;
+}

@@ -1,0 +1,448 @@
+// The Python module `impactdeck` (docs/python.md). Contract (issue 18):
+//   impactdeck.run(scene_path, out=None) -> the document of `impactdeck run --json`, as a dict
+//   impactdeck.inspect(path, length_unit, density_kg_m3=None, at=None) -> that of `inspect --json`
+// both built by the same library calls as the CLI (scene::to_json, geometry::inspect_part), so the
+// documents are the same. Also: solve_impact (plain numbers), load_part (mass properties, surface
+// queries), sweep (numpy arrays). Errors raise impactdeck.InputError (exit 3 of the CLI),
+// CheckFailed (4), UsageError (2), InternalError (1), all derived from impactdeck.Error, with the
+// CLI's one-line message and the exit code in `exit_code`.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <sstream>
+
+#include "impactdeck/collision/elliptical.hpp"
+#include "impactdeck/collision/hertz.hpp"
+#include "impactdeck/collision/impact.hpp"
+#include "impactdeck/common/error.hpp"
+#include "impactdeck/common/version.hpp"
+#include "impactdeck/geometry/cad_shape.hpp"
+#include "impactdeck/geometry/inspect.hpp"
+#include "impactdeck/geometry/mass_properties.hpp"
+#include "impactdeck/geometry/part.hpp"
+#include "impactdeck/scene/pipeline.hpp"
+#include "impactdeck/scene/report.hpp"
+#include "impactdeck/study/cloud.hpp"
+#include "impactdeck/study/scene_sweep.hpp"
+
+namespace py = pybind11;
+namespace fs = std::filesystem;
+using namespace impactdeck;
+
+namespace {
+
+py::object to_python(const nlohmann::json& j) { return py::module_::import("json").attr("loads")(j.dump()); }
+
+LengthUnit unit_of(const std::string& s) {
+  const auto u = parse_length_unit(s);
+  if (!u) throw UsageError("length_unit '" + s + "': expected m, cm, mm or in");
+  return *u;
+}
+
+Eigen::Vector3d vec3(const py::handle& h, const std::string& what) {
+  std::vector<double> v;
+  try {
+    v = h.cast<std::vector<double>>();
+  } catch (const py::cast_error&) {
+    throw UsageError(what + ": expected three numbers");
+  }
+  if (v.size() != 3 || !std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2])) {
+    throw UsageError(what + ": expected three finite numbers");
+  }
+  return {v[0], v[1], v[2]};
+}
+
+Eigen::Matrix3d inertia_of(const py::handle& h, const std::string& what) {
+  // Three principal moments, or a 3x3 tensor.
+  try {
+    const auto d = h.cast<std::vector<double>>();
+    if (d.size() == 3) return Eigen::Vector3d(d[0], d[1], d[2]).asDiagonal();
+  } catch (const py::cast_error&) {
+  }
+  try {
+    const auto rows = h.cast<std::vector<std::vector<double>>>();
+    if (rows.size() == 3) {
+      Eigen::Matrix3d m;
+      for (int i = 0; i < 3; ++i) {
+        if (rows[i].size() != 3) throw UsageError(what + ": expected 3 moments or a 3x3 tensor");
+        for (int k = 0; k < 3; ++k) m(i, k) = rows[i][k];
+      }
+      return m;
+    }
+  } catch (const py::cast_error&) {
+  }
+  throw UsageError(what + ": expected 3 principal moments or a 3x3 tensor (kg m^2)");
+}
+
+py::array_t<double> array(const Eigen::Vector3d& v) { return py::array_t<double>(3, v.data()); }
+py::array_t<double> array(const Eigen::Matrix3d& m) {
+  py::array_t<double> a({3, 3});
+  auto r = a.mutable_unchecked<2>();
+  for (int i = 0; i < 3; ++i)
+    for (int k = 0; k < 3; ++k) r(i, k) = m(i, k);
+  return a;
+}
+
+py::dict surface_point(const geometry::SurfacePoint& s) {
+  py::dict d;
+  d["point_m"] = array(s.point_m);
+  d["normal"] = array(s.normal);
+  d["distance_m"] = s.distance_m;
+  return d;
+}
+
+// A loaded part: its shape and exact (CAD) or mesh mass properties; queries in metres.
+struct PyPart {
+  std::shared_ptr<const geometry::Shape> shape;
+  std::string file, format;
+  geometry::VolumeProperties volume;
+};
+
+PyPart load_part(const std::string& path, const std::string& length_unit, bool repair, bool accept_approximate) {
+  PyPart p;
+  p.file = path;
+  const LengthUnit u = unit_of(length_unit);
+  if (const auto f = geometry::cad_format(path)) {
+    p.shape = geometry::CadShape::load(path, u);
+    p.format = geometry::to_string(*f);
+  } else {
+    geometry::PartOptions o;
+    o.length_unit = u;
+    o.repair = repair;
+    o.accept_approximate_mass = accept_approximate;
+    geometry::Part part = geometry::load_part(path, o);
+    p.shape = part.shape;
+    p.format = part.loaded.format;
+  }
+  p.volume = p.shape->volume_properties();
+  return p;
+}
+
+py::dict impact_dict(const collision::ImpactResult& r, std::size_t samples) {
+  py::dict d;
+  d["reduced_mass_kg"] = r.reduced_mass_kg;
+  d["effective_radius_m"] = r.effective_radius_m;
+  d["effective_modulus_Pa"] = r.effective_modulus_Pa;
+  d["hertz_constant"] = r.hertz_constant;
+  d["approach_velocity_m_s"] = r.approach_velocity_m_s;
+  d["max_force_N"] = r.history.compression.max_force_N;
+  d["max_indentation_m"] = r.history.compression.max_indentation_m;
+  d["compression_time_s"] = r.history.compression.compression_time_s;
+  d["contact_time_s"] = r.history.contact_time_s();
+  d["restitution"] = r.history.restitution;
+  d["impulse_Ns"] = r.history.impulse_total_Ns();
+  d["target_delta_velocity_m_s"] = array(r.target_jump.delta_velocity_m_s);
+  d["target_delta_angular_velocity_rad_s"] = array(r.target_jump.delta_angular_velocity_rad_s);
+  d["impactor_delta_velocity_m_s"] = array(r.impactor_jump.delta_velocity_m_s);
+  d["impactor_delta_angular_velocity_rad_s"] = array(r.impactor_jump.delta_angular_velocity_rad_s);
+  py::dict checks;
+  checks["passed"] = r.checks.passed;
+  checks["impulse_relative_error"] = r.checks.impulse_relative_error;
+  checks["energy_relative_error"] = r.checks.energy_relative_error;
+  checks["carnot_loss_J"] = r.checks.carnot_loss_J;
+  d["checks"] = checks;
+  d["warnings"] = r.warnings;
+  if (samples >= 2) {
+    py::array_t<double> t(samples), f(samples);
+    auto tt = t.mutable_unchecked<1>();
+    auto ff = f.mutable_unchecked<1>();
+    const double T = r.history.contact_time_s();
+    for (std::size_t k = 0; k < samples; ++k) {
+      tt(k) = T * static_cast<double>(k) / static_cast<double>(samples - 1);
+      ff(k) = r.history.force_N(tt(k));
+    }
+    d["time_s"] = t;
+    d["force_N"] = f;
+  }
+  return d;
+}
+
+}  // namespace
+
+PYBIND11_MODULE(impactdeck, m) {
+  m.doc() = "impactdeck: eccentric Hertz impacts of mesh and CAD parts, as in `impactdeck run` (docs/python.md)";
+  m.attr("__version__") = kVersion;
+
+  static py::exception<Error> base(m, "Error");
+  static py::exception<UsageError> usage(m, "UsageError", base.ptr());
+  static py::exception<InputError> input(m, "InputError", base.ptr());
+  static py::exception<CheckFailed> check(m, "CheckFailed", base.ptr());
+  static py::exception<Error> internal(m, "InternalError", base.ptr());
+  base.attr("exit_code") = static_cast<int>(ExitCode::internal_error);
+  usage.attr("exit_code") = static_cast<int>(ExitCode::usage);
+  input.attr("exit_code") = static_cast<int>(ExitCode::invalid_input);
+  check.attr("exit_code") = static_cast<int>(ExitCode::check_failed);
+  internal.attr("exit_code") = static_cast<int>(ExitCode::internal_error);
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const Error& e) {
+      switch (e.code()) {
+        case ExitCode::usage: PyErr_SetString(usage.ptr(), e.what()); return;
+        case ExitCode::invalid_input: PyErr_SetString(input.ptr(), e.what()); return;
+        case ExitCode::check_failed: PyErr_SetString(check.ptr(), e.what()); return;
+        default: PyErr_SetString(internal.ptr(), e.what()); return;
+      }
+    }
+  });
+
+  m.def(
+      "run",
+      [](const fs::path& scene_path, std::optional<fs::path> out) -> py::object {
+        nlohmann::json doc;
+        bool passed = true;
+        {
+          py::gil_scoped_release release;
+          const scene::Scene sc = scene::load_scene(scene_path);
+          const fs::path dir = out.value_or(fs::path("."));
+          std::error_code ec;
+          fs::create_directories(dir, ec);
+          if (!fs::is_directory(dir)) throw InputError(dir.string(), "--out", "cannot create the output folder");
+          scene::RunOptions opt;
+          opt.out_dir = dir;
+          const scene::RunReport rep = scene::run_scene(sc, opt);
+          doc = scene::to_json(sc, rep);
+          passed = rep.all_checks_passed();
+        }
+        py::object d = to_python(doc);
+        if (!passed) {
+          // As the CLI: the document is complete, and the run fails with exit code 4.
+          py::object e = py::handle(check.ptr())(py::str("a physics self-check failed (see checks above)"));
+          e.attr("document") = d;
+          PyErr_SetObject(check.ptr(), e.ptr());
+          throw py::error_already_set();
+        }
+        return d;
+      },
+      py::arg("scene_path"), py::arg("out") = py::none(),
+      "Runs a scene as `impactdeck run SCENE --out OUT --json` and returns its JSON document as a dict "
+      "(outputs go to `out`, default the current folder). A failed self-check raises CheckFailed whose "
+      "`document` attribute holds the document.");
+
+  m.def(
+      "inspect",
+      [](const fs::path& path, const std::string& length_unit, std::optional<double> density_kg_m3,
+         py::object at) -> py::object {
+        geometry::InspectOptions o;
+        o.part = path;
+        o.length_unit = unit_of(length_unit);
+        o.density_kg_m3 = density_kg_m3;
+        if (!at.is_none()) {
+          const double to_m = metres_per(o.length_unit);
+          for (const py::handle h : at) {
+            if (py::isinstance<py::str>(h)) {
+              const std::string s = h.cast<std::string>();
+              o.points_m.push_back(geometry::parse_point(s, to_m, "at"));
+              o.point_labels.push_back(s);
+            } else {
+              const Eigen::Vector3d v = vec3(h, "at");
+              std::ostringstream s;
+              s.precision(17);
+              s << v.x() << "," << v.y() << "," << v.z();
+              o.points_m.push_back(v * to_m);
+              o.point_labels.push_back(s.str());
+            }
+          }
+        }
+        geometry::InspectReport r;
+        {
+          py::gil_scoped_release release;
+          r = geometry::inspect_part(o);
+        }
+        return to_python(r.document);
+      },
+      py::arg("path"), py::arg("length_unit"), py::arg("density_kg_m3") = py::none(), py::arg("at") = py::none(),
+      "The document of `impactdeck inspect PATH --length-unit U [--density-kg-m3 D] [--at x,y,z ...] --json` "
+      "as a dict. `at`: points in the file's unit, as 'x,y,z' strings or sequences of three numbers.");
+
+  m.def(
+      "solve_impact",
+      [](double mass1_kg, double mass2_kg, py::object inertia1_kg_m2, py::object inertia2_kg_m2,
+         py::object lever_arm1_m, py::object lever_arm2_m, py::object normal, py::object velocity1_m_s,
+         py::object velocity2_m_s, py::object angular_velocity1_rad_s, py::object angular_velocity2_rad_s,
+         std::optional<double> radius_m, py::object curvatures1_per_m, py::object curvatures2_per_m,
+         py::object directions1, py::object directions2, double effective_modulus_Pa, py::object restitution,
+         std::size_t samples) {
+        collision::ImpactInput in;
+        const Eigen::Vector3d n = vec3(normal, "normal").normalized();
+        in.contact.point_m = Eigen::Vector3d::Zero();
+        in.contact.normal = n;
+        auto body = [&](collision::RigidBody& b, double m, py::object I, py::object r, py::object v, py::object w,
+                        const std::string& which) {
+          b.mass_kg = m;
+          b.inertia_kg_m2 = inertia_of(I, "inertia" + which + "_kg_m2");
+          b.center_of_mass_m = -vec3(r, "lever_arm" + which + "_m");  // contact point at the origin
+          b.velocity_m_s = vec3(v, "velocity" + which + "_m_s");
+          b.angular_velocity_rad_s = w.is_none() ? Eigen::Vector3d::Zero() : vec3(w, "angular_velocity" + which + "_rad_s");
+        };
+        body(in.target, mass1_kg, inertia1_kg_m2, lever_arm1_m, velocity1_m_s, angular_velocity1_rad_s, "1");
+        body(in.impactor, mass2_kg, inertia2_kg_m2, lever_arm2_m, velocity2_m_s, angular_velocity2_rad_s, "2");
+        if (radius_m && !curvatures1_per_m.is_none()) throw UsageError("give radius_m or curvatures, not both");
+        if (radius_m) {
+          // R* as the target's radius against a flat impactor: the same R* under every rule.
+          in.target_curvature = collision::ContactCurvature::sphere(*radius_m);
+          in.impactor_curvature = collision::ContactCurvature::flat();
+        } else {
+          if (curvatures1_per_m.is_none() || curvatures2_per_m.is_none()) {
+            throw UsageError("give radius_m (R*) or curvatures1_per_m and curvatures2_per_m (k1, k2 of each body)");
+          }
+          const auto k1 = curvatures1_per_m.cast<std::vector<double>>(), k2 = curvatures2_per_m.cast<std::vector<double>>();
+          if (k1.size() != 2 || k2.size() != 2) throw UsageError("curvatures: expected (k1, k2) per body, 1/m");
+          // Principal directions: given, or any tangent pair (enough when a body is isotropic).
+          const Eigen::Vector3d t = (std::abs(n.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY()).cross(n).normalized();
+          const Eigen::Vector3d d1a = directions1.is_none() ? t : vec3(directions1, "directions1");
+          const Eigen::Vector3d d1b = directions2.is_none() ? t : vec3(directions2, "directions2");
+          auto surface = [&](const std::vector<double>& k, const Eigen::Vector3d& d1) {
+            collision::ContactCurvature c;
+            c.k1_per_m = k[0];
+            c.k2_per_m = k[1];
+            c.d1 = d1.normalized();
+            c.d2 = n.cross(c.d1).normalized();
+            return c;
+          };
+          in.target_curvature = surface(k1, d1a);
+          in.impactor_curvature = surface(k2, d1b);
+          in.rule = collision::ContactRule::elliptical;
+        }
+        in.effective_modulus_Pa = effective_modulus_Pa;
+        if (py::isinstance<py::str>(restitution)) {
+          if (restitution.cast<std::string>() != "energy-flux") throw UsageError("restitution: a number in [0, 1] or \"energy-flux\"");
+          in.restitution.kind = collision::RestitutionModel::Kind::energy_flux;  // Eq. 14 + 30, flux in J/cm^3
+        } else {
+          in.restitution.kind = collision::RestitutionModel::Kind::constant;
+          in.restitution.constant = restitution.cast<double>();
+        }
+        return impact_dict(collision::solve_impact(in), samples);
+      },
+      py::kw_only(), py::arg("mass1_kg"), py::arg("mass2_kg"), py::arg("inertia1_kg_m2"), py::arg("inertia2_kg_m2"),
+      py::arg("lever_arm1_m"), py::arg("lever_arm2_m"), py::arg("normal"), py::arg("velocity1_m_s"),
+      py::arg("velocity2_m_s"), py::arg("angular_velocity1_rad_s") = py::none(),
+      py::arg("angular_velocity2_rad_s") = py::none(), py::arg("radius_m") = py::none(),
+      py::arg("curvatures1_per_m") = py::none(), py::arg("curvatures2_per_m") = py::none(),
+      py::arg("directions1") = py::none(), py::arg("directions2") = py::none(), py::arg("effective_modulus_Pa"),
+      py::arg("restitution") = 1.0, py::arg("samples") = 201,
+      "One eccentric impact from plain numbers (SI). Body 1 is the target, 2 the impactor; lever_armI_m "
+      "runs from body I's centre of mass to the contact point; `normal` is body 1's outward normal there. "
+      "Radius: R* (radius_m) or each body's principal curvatures (k1, k2), with d1 directions when not "
+      "isotropic (elliptical Hertz equivalent radius). restitution: R, or \"energy-flux\" (Eq. 30, J/cm^3). Returns a dict (max_force_N, impulse_Ns, jumps, "
+      "checks, and time_s / force_N arrays of `samples` points).");
+
+  py::class_<PyPart>(m, "Part", "A part file loaded as a shape: mass properties and surface queries (SI, metres).")
+      .def_readonly("file", &PyPart::file)
+      .def_readonly("format", &PyPart::format)
+      .def_property_readonly("kind", [](const PyPart& p) { return p.shape->kind(); })
+      .def_property_readonly("volume_m3", [](const PyPart& p) { return p.volume.volume_m3; })
+      .def_property_readonly("area_m2", [](const PyPart& p) { return p.volume.area_m2; })
+      .def_property_readonly("center_of_mass_m", [](const PyPart& p) { return array(p.volume.centroid_m); })
+      .def_property_readonly("inertia_per_density_m5", [](const PyPart& p) { return array(p.volume.inertia_per_density_m5); })
+      .def_property_readonly("size_m", [](const PyPart& p) { return p.shape->size_m(); })
+      .def("closest_point", [](const PyPart& p, py::object q) {
+        const Eigen::Vector3d x = vec3(q, "point");
+        geometry::SurfacePoint s;
+        {
+          py::gil_scoped_release release;
+          s = p.shape->closest_point(x);
+        }
+        return surface_point(s);
+      }, py::arg("point_m"))
+      .def("curvature", [](const PyPart& p, py::object q) {
+        const Eigen::Vector3d x = vec3(q, "point");
+        geometry::Curvature c;
+        double radius = std::numeric_limits<double>::quiet_NaN();
+        geometry::SurfacePoint s;
+        {
+          py::gil_scoped_release release;
+          s = p.shape->closest_point(x);
+          c = p.shape->curvature(s);
+          if (!c.sharp_feature) radius = p.shape->paper_radius_m(s);
+        }
+        py::dict d = surface_point(s);
+        d["sharp_feature"] = c.sharp_feature;
+        d["principal_curvatures_1_per_m"] = py::make_tuple(c.k1_per_m, c.k2_per_m);
+        d["principal_directions"] = py::make_tuple(array(c.d1), array(c.d2));
+        d["curvature_error_estimate_1_per_m"] = c.error_estimate_per_m;
+        d["paper_radius_m"] = c.sharp_feature ? py::object(py::none()) : py::object(py::float_(radius));
+        return d;
+      }, py::arg("point_m"), "Principal curvatures, directions and the Eq. 26 radius at the surface point nearest to point_m.")
+      .def("sample_surface", [](const PyPart& p, std::size_t count, std::uint64_t seed) {
+        std::vector<geometry::SurfacePoint> pts;
+        {
+          py::gil_scoped_release release;
+          pts = p.shape->sample_surface(count, seed);
+        }
+        py::array_t<double> xyz({pts.size(), std::size_t{3}}), nrm({pts.size(), std::size_t{3}});
+        auto a = xyz.mutable_unchecked<2>();
+        auto b = nrm.mutable_unchecked<2>();
+        for (std::size_t i = 0; i < pts.size(); ++i)
+          for (int k = 0; k < 3; ++k) a(i, k) = pts[i].point_m[k], b(i, k) = pts[i].normal[k];
+        return py::make_tuple(xyz, nrm);
+      }, py::arg("count"), py::arg("seed") = 1, "(points, normals): count x 3 arrays, uniform by area.");
+
+  m.def("load_part", &load_part, py::arg("path"), py::arg("length_unit"), py::arg("repair") = false,
+        py::arg("accept_approximate") = false,
+        "Loads a mesh part (STL, OBJ, PLY, OFF) or a CAD part (STEP, IGES, BREP) as `inspect` does.");
+
+  m.def(
+      "sweep",
+      [](const fs::path& scene_path, const std::string& impact, const std::string& cloud, std::size_t count,
+         std::uint64_t seed, int grid_steps, unsigned threads) {
+        study::SweepResult r;
+        {
+          py::gil_scoped_release release;
+          const scene::Scene sc = scene::load_scene(scene_path);
+          const study::SceneSweep ss = study::sweep_from_scene(sc, impact);
+          const bool analytic = ss.setup.target.shape->kind() == "ellipsoid";
+          study::CloudKind kind = study::CloudKind::area_uniform;
+          if (cloud == "auto") kind = analytic ? study::CloudKind::paper_grid : study::CloudKind::area_uniform;
+          else if (cloud == "grid") kind = study::CloudKind::paper_grid;
+          else if (cloud == "uniform") kind = study::CloudKind::area_uniform;
+          else if (cloud == "both") kind = study::CloudKind::both;
+          else if (cloud == "vertices") kind = study::CloudKind::vertices;
+          else throw UsageError("cloud: expected grid, uniform, both, vertices or auto, got \"" + cloud + "\"");
+          const auto pts = study::make_cloud(*ss.setup.target.shape, kind, grid_steps, count, seed);
+          study::SweepOptions o;
+          o.threads = threads;
+          r = study::run_sweep(ss.setup, pts, o);
+        }
+        const std::size_t N = r.points.size();
+        py::array_t<double> point({N, std::size_t{3}}), normal({N, std::size_t{3}});
+        py::array_t<double> fmax(N), mw(N), reff(N), tm(N), xmax(N);
+        py::array_t<bool> sharp(N);
+        auto P = point.mutable_unchecked<2>();
+        auto Nn = normal.mutable_unchecked<2>();
+        for (std::size_t i = 0; i < N; ++i) {
+          const auto& p = r.points[i];
+          for (int k = 0; k < 3; ++k) P(i, k) = p.point_m[k], Nn(i, k) = p.normal[k];
+          fmax.mutable_at(i) = p.max_force_N;
+          mw.mutable_at(i) = p.reduced_mass_kg;
+          reff.mutable_at(i) = p.effective_radius_m;
+          tm.mutable_at(i) = p.compression_time_s;
+          xmax.mutable_at(i) = p.max_indentation_m;
+          sharp.mutable_at(i) = p.sharp_feature;
+        }
+        py::dict d;
+        d["point_m"] = point;
+        d["normal"] = normal;
+        d["max_force_N"] = fmax;
+        d["reduced_mass_kg"] = mw;
+        d["effective_radius_m"] = reff;
+        d["compression_time_s"] = tm;
+        d["max_indentation_m"] = xmax;
+        d["sharp_feature"] = sharp;
+        d["force_ratio"] = r.force_ratio;
+        d["mass_only_ratio"] = r.mass_only_ratio;
+        d["min_index"] = r.min_index;
+        d["max_index"] = r.max_index;
+        d["sharp_count"] = r.sharp_count;
+        return d;
+      },
+      py::arg("scene_path"), py::arg("impact") = "", py::arg("cloud") = "auto", py::arg("count") = 2000,
+      py::arg("seed") = 1, py::arg("grid_steps") = 8, py::arg("threads") = 0,
+      "Force map of a scene's impact over the target's surface, as `impactdeck sweep`, with the per-point "
+      "results as numpy arrays (no files written).");
+}
