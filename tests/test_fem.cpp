@@ -13,6 +13,7 @@
 #include "impactdeck/fem_export/check.hpp"
 #include "impactdeck/fem_export/decks.hpp"
 #include "impactdeck/fem_export/mesh.hpp"
+#include "impactdeck/geometry/mesh_io.hpp"
 #include "tolerances.hpp"
 
 namespace fs = std::filesystem;
@@ -83,6 +84,12 @@ std::size_t msh22_tet_count(const std::string& msh) {
     if (inside && ls >> id >> type && type == 4) ++tets;
   }
   return tets;
+}
+
+// A part file's triangles as the FEM route receives them (from memory, any format).
+PartSurface part_surface(const fs::path& file, LengthUnit unit) {
+  const geometry::LoadedMesh lm = geometry::load_mesh(file, unit);
+  return {lm.mesh.vertices_m, lm.mesh.triangles};
 }
 
 bool no_stage_left(const fs::path& parent) {
@@ -360,27 +367,30 @@ TEST(FemCodeAster, ExportNamesEveryFileAndUnitTheCommUses) {
 TEST(FemDecks, MeshingFailuresGiveClearErrorsAndNoDeck) {
   const fs::path d = fresh_dir("failures");
   DeckRequest r = ellipsoid_request();
-  r.body.kind = BodyKind::stl;
-  r.body.stl = kData / "no_triangles.stl";
-  r.body.stl_unit_m = 1e-3;
+  r.body.kind = BodyKind::part;
+  r.body.name = "empty.stl";
   try {
     write_decks(r, d / "deck");
     FAIL() << "no error";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("no_triangles.stl"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("no triangles"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("body: the part has no triangles"), std::string::npos) << e.what();
   }
   EXPECT_FALSE(fs::exists(d / "deck"));
-  r.body.stl = kData / "open_surface.stl";
-  r.load_point_m = Eigen::Vector3d(0, 0.05, 0);
+  // An open surface (the validation refuses it before; here it reaches Gmsh): every try of the
+  // fallback fails, and the message lists them with Gmsh's reasons.
+  r.body.surface = part_surface(kData / "open_surface.stl", LengthUnit::mm);
+  r.body.name = (kData / "open_surface.stl").string();
+  r.load_point_m = r.body.surface.vertices_m[r.body.surface.triangles[0][0]];
   r.options.mesh.mesh_size_m = 0.02;
   r.options.mesh.probes_m.clear();
   try {
     write_decks(r, d / "deck");
     FAIL() << "no error";
   } catch (const InputError& e) {
-    // Gmsh's own reason ("No elements in volume 1"), prefixed by the file and the step.
-    EXPECT_NE(std::string(e.what()).find("open_surface.stl: gmsh mesh: "), std::string::npos) << e.what();
+    const std::string w = e.what();
+    EXPECT_TRUE(w.find("open_surface.stl: gmsh mesh: every try failed (") != std::string::npos ||
+                w.find("open_surface.stl: part surface: encloses no volume") != std::string::npos)
+        << w;
   }
   EXPECT_FALSE(fs::exists(d / "deck"));
   // A probe outside the body is refused before Gmsh runs.
@@ -410,8 +420,10 @@ TEST(FemDecks, FailedRewriteLeavesThePreviousDeckUntouched) {
   }
   // A failure inside Gmsh, after the staging folder exists.
   DeckRequest bad2 = ellipsoid_request();
-  bad2.body.kind = BodyKind::stl;
-  bad2.body.stl = kData / "no_triangles.stl";
+  bad2.body.kind = BodyKind::part;
+  bad2.body.surface = part_surface(kData / "ellipsoid_200x50x50.stl", LengthUnit::mm);
+  bad2.load_point_m = Eigen::Vector3d(0.5, 0.5, 0.5);  // not on the part: refused inside the mesher
+  bad2.options.mesh.probes_m.clear();
   EXPECT_THROW(write_decks(bad2, d / "deck"), InputError);
   EXPECT_EQ(slurp(d / "deck" / "deck.json"), before);
   EXPECT_TRUE(no_stage_left(d));
@@ -422,10 +434,15 @@ TEST(FemCheck, MeshPartFromStlEccentricHitConservesLinearAndAngularMomentum) {
   // The mesh-part route end to end: STL (written by Gmsh) -> volume mesh -> decks -> ccx -> checks.
   const fs::path d = fresh_dir("stl_ccx");
   DeckRequest r = ellipsoid_request();
-  r.body.kind = BodyKind::stl;
-  r.body.stl = kData / "ellipsoid_200x50x50.stl";
-  r.body.stl_unit_m = 1e-3;
-  const Eigen::Vector3d p(0.1, 0.05 * std::sqrt(0.75), 0);
+  r.body.kind = BodyKind::part;
+  r.body.surface = part_surface(kData / "ellipsoid_200x50x50.stl", LengthUnit::mm);
+  r.body.name = "ellipsoid_200x50x50.stl";
+  // A point on the faceted surface (the STL's vertex nearest to the ellipsoid's point).
+  const Eigen::Vector3d target(0.1, 0.05 * std::sqrt(0.75), 0);
+  Eigen::Vector3d p = r.body.surface.vertices_m.front();
+  for (const auto& v : r.body.surface.vertices_m) {
+    if ((v - target).norm() < (p - target).norm()) p = v;
+  }
   r.load_point_m = p;
   r.direction = -Eigen::Vector3d(p.x() / 0.04, p.y() / 0.0025, 0).normalized();
   r.force.time_s = {0, 2e-5, 4e-5};
@@ -437,7 +454,7 @@ TEST(FemCheck, MeshPartFromStlEccentricHitConservesLinearAndAngularMomentum) {
   r.options.mesh.load_mesh_size_m = 0.012;
   r.options.mesh.probes_m = {Eigen::Vector3d(-0.1, 0.0, 0.0)};
   const DeckResult res = write_decks(r, d / "deck");
-  EXPECT_LT(res.quality.load_node_distance_m, 0.012);
+  EXPECT_LT(res.quality.load_node_distance_m, 1e-12);  // a node exactly on the load point
   // Gmsh re-meshes the reparametrized surface at 30 mm on a body 100 mm thick: chords cut ~6 %.
   EXPECT_LT(std::abs(res.quality.volume_relative_difference), 0.10);
   // The STL encloses the gmsh-faceted ellipsoid: a little less than (4/3) pi a b c.

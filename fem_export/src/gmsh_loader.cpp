@@ -1,4 +1,4 @@
-// mesh_ellipsoid / mesh_stl (mesh.hpp): load the Gmsh mesher plugin on first use and forward to it
+// mesh_ellipsoid / mesh_part (mesh.hpp): load the Gmsh mesher plugin on first use and forward to it
 // (why a plugin: gmsh_plugin.hpp). Where the plugin is looked for, first hit wins:
 //   1. $IMPACTDECK_GMSH_PLUGIN (a path to the .so),
 //   2. beside the running executable (an installed or copied tool),
@@ -32,8 +32,8 @@ std::vector<fs::path> candidates() {
   return c;
 }
 
-const detail::GmshMesherV1& load() {
-  static const detail::GmshMesherV1* mesher = nullptr;
+const detail::GmshMesherV2& load() {
+  static const detail::GmshMesherV2* mesher = nullptr;
   static std::string failure;
   static std::once_flag once;
   std::call_once(once, [] {
@@ -51,11 +51,11 @@ const detail::GmshMesherV1& load() {
         failure = p.string() + ": cannot load the Gmsh mesher plugin: " + (e ? e : "dlopen failed");
         return;
       }
-      using Entry = const detail::GmshMesherV1* (*)();
+      using Entry = const detail::GmshMesherV2* (*)();
       auto entry = reinterpret_cast<Entry>(::dlsym(h, IMPACTDECK_GMSH_MESHER_ENTRY));
-      const detail::GmshMesherV1* m = entry ? entry() : nullptr;
+      const detail::GmshMesherV2* m = entry ? entry() : nullptr;
       if (!m || std::string(m->version) != kVersion || m->sizeof_mesh_result != sizeof(MeshResult) ||
-          m->sizeof_mesh_options != sizeof(MeshOptions)) {
+          m->sizeof_mesh_options != sizeof(MeshOptions) || m->sizeof_part_surface != sizeof(PartSurface)) {
         failure = p.string() + ": not the Gmsh mesher plugin of this impactdeck build (" + kVersion + ")";
         return;
       }
@@ -76,9 +76,9 @@ MeshResult mesh_ellipsoid(const Eigen::Vector3d& semi_axes_m, const Eigen::Vecto
   return load().mesh_ellipsoid(semi_axes_m, load_point_m, options, folder, name);
 }
 
-MeshResult mesh_stl(const fs::path& stl, double stl_unit_m, const Eigen::Vector3d& load_point_m,
-                    const MeshOptions& options, const fs::path& folder, const std::string& name) {
-  return load().mesh_stl(stl, stl_unit_m, load_point_m, options, folder, name);
+MeshResult mesh_part(const PartSurface& surface, const Eigen::Vector3d& load_point_m, const MeshOptions& options,
+                     const fs::path& folder, const std::string& name, const std::string& where) {
+  return load().mesh_part(surface, load_point_m, options, folder, name, where);
 }
 
 }  // namespace impactdeck::fem_export
