@@ -387,7 +387,8 @@ CheckResult run_check(const fs::path& dir, const CheckOptions& o) {
     r.model_delta_angular_velocity_rad_s = deck.model.delta_angular_velocity_rad_s;
     r.model_linear_velocity_relative_error =
         (r.fe_rigid_velocity_m_s - r.model_delta_velocity_m_s).norm() / r.model_delta_velocity_m_s.norm();
-    if (eccentric && r.model_delta_angular_velocity_rad_s.norm() > 0) {
+    if (spin_is_significant(deck.model, m.nodes_m.at(static_cast<std::size_t>(deck.load_node - 1)), d) &&
+        r.model_delta_angular_velocity_rad_s.norm() > 0) {
       r.model_angular_velocity_relative_error =
           (r.angular_velocity_fe_rad_s - r.model_delta_angular_velocity_rad_s).norm() /
           r.model_delta_angular_velocity_rad_s.norm();

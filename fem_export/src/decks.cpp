@@ -118,6 +118,12 @@ std::vector<std::string> probe_groups(const TetMesh& m) {
 
 const char* to_string(LoadKind k) { return k == LoadKind::hertz_patch ? "hertz-patch" : "point"; }
 
+bool spin_is_significant(const RigidReference& part, const Eigen::Vector3d& p, const Eigen::Vector3d& d) {
+  if (!(part.mass_kg > 0)) return false;
+  const double r_g = std::sqrt(part.inertia_kg_m2.trace() / (2.0 * part.mass_kg));
+  return (p - part.centroid_m).cross(d.normalized()).norm() > 0.1 * r_g;
+}
+
 BodyComparison compare_body(const TetMesh& m, double rho, const RigidReference& part, const FemTolerances& tol,
                             const Eigen::Vector3d& impulse, const Eigen::Vector3d& load_point) {
   BodyComparison c;
@@ -152,8 +158,7 @@ BodyComparison compare_body(const TetMesh& m, double rho, const RigidReference& 
     const double dv = part.delta_velocity_m_s.norm();
     if (impulse.norm() > 0 && dv > 0 && c.fe_mass_kg > 0) {
       c.predicted_model_linear_velocity_error = (impulse / c.fe_mass_kg - part.delta_velocity_m_s).norm() / dv;
-      const Eigen::Vector3d arm = load_point - part.centroid_m;
-      if (arm.cross(impulse.normalized()).norm() > 0.01 * arm.norm() && part.delta_angular_velocity_rad_s.norm() > 0) {
+      if (spin_is_significant(part, load_point, impulse) && part.delta_angular_velocity_rad_s.norm() > 0) {
         const Eigen::Vector3d w = mp.one_point_inertia_kg_m2.inverse() * (load_point - mp.centroid_m).cross(impulse);
         c.predicted_model_angular_velocity_error =
             (w - part.delta_angular_velocity_rad_s).norm() / part.delta_angular_velocity_rad_s.norm();

@@ -15,7 +15,8 @@
 // Beside this solver self-check, the FE result is compared with the rigid model (deck.json
 // "model": the part's exact mass properties and the impact's velocity jumps of the target):
 //   model_linear_velocity_relative_error  = |P_FE / M_FE - dv| / |dv|
-//   model_angular_velocity_relative_error = |I_FE^-1 L_FE - dw| / |dw|   (null for a central hit)
+//   model_angular_velocity_relative_error = |I_FE^-1 L_FE - dw| / |dw|   (null unless the lever arm
+//                                           exceeds a tenth of the radius of gyration: decks.hpp)
 // and the FE body with the part (volume, mass, inertia, Gmsh gamma floor; decks.hpp
 // compare_body). Then the stresses are read back from impact.frd (stress.hpp).
 #include <filesystem>

@@ -57,6 +57,14 @@ struct RigidReference {
   Eigen::Vector3d delta_angular_velocity_rad_s = Eigen::Vector3d::Zero();
 };
 
+/// Whether the hit makes the part spin enough for its spin to be compared: the lever arm
+/// |(p - c) x d| of the force about the part's centroid exceeds a tenth of its radius of gyration
+/// sqrt(trace(I) / (2 m)). Below that the spin's share of the motion is under 1 % (its term in
+/// 1/m_w is (lever / r_g)^2 of the linear one) and a relative error on it measures round-off of a
+/// small difference (a faceted sphere's normal misses the centre by a few % of the radius).
+bool spin_is_significant(const RigidReference& part, const Eigen::Vector3d& load_point_m,
+                         const Eigen::Vector3d& direction);
+
 /// Thresholds of the deck's checks; a miss fails the run (exit 4). Defaults: docs/fem.md.
 struct FemTolerances {
   double linear_momentum = 1e-3;   ///< FE momentum vs the impulse (solver self-check)
@@ -64,7 +72,7 @@ struct FemTolerances {
   /// FE rigid-body velocity (momentum / FE mass) vs the rigid model's delta v of the part: also
   /// carries the mesh's mass error.
   double model_linear_velocity = 0.05;
-  /// FE spin (I_FE^-1 L_FE) vs the rigid model's delta omega.
+  /// FE spin (I_FE^-1 L_FE) vs the rigid model's delta omega (when spin_is_significant).
   double model_angular_velocity = 0.05;
   double volume = 0.05;    ///< |V_FE - V_part| / V_part
   double mass = 0.05;      ///< |M_FE - M_part| / M_part
