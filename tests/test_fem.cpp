@@ -515,3 +515,61 @@ TEST(FemDecks, TimeScheduleRefinesThePulseAndDividesTheRest) {
   o.time_step_s = 1e-5;
   EXPECT_EQ(time_schedule(o, 6.9e-5).pulse_increments, 0u);
 }
+
+// The quality floor (Gmsh gamma >= 0.01 after optimisation, FemTolerances::min_gamma) holds for
+// real parts at whatever size a user asks for: where a 2D algorithm leaves slivers, the mesher's
+// fallback tries the next (every try is listed).
+TEST(FemMesh, QualityFloorHoldsOnRealPartsAtAnySize) {
+  struct Part {
+    const char* file;
+    Eigen::Vector3d point;  // file units (cm), projected onto a vertex of the part below
+  };
+  for (const Part& p : {Part{"fandisk.off", {0.1, 0.3, 0.2}}, Part{"empty_mat.obj", {0.3, 0.2, 1.2}},
+                        Part{"sphere.ply", {0.3, 0.2, 1.2}}}) {
+    const PartSurface s = part_surface(kData / p.file, LengthUnit::cm);
+    Eigen::Vector3d lo = s.vertices_m[0], hi = lo, load = lo;
+    for (const auto& v : s.vertices_m) {
+      lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+      if ((v - p.point * 0.01).norm() < (load - p.point * 0.01).norm()) load = v;
+    }
+    const double diag = (hi - lo).norm();
+    for (double fraction : {1.0 / 3, 1.0 / 7, 1.0 / 15}) {
+      const fs::path d = fresh_dir("quality");
+      MeshOptions o;
+      o.mesh_size_m = fraction * diag;
+      const MeshResult r = mesh_part(s, load, o, d, "mesh", p.file);
+      EXPECT_GE(r.quality.min_gamma, 0.01) << p.file << " at " << fraction << " of the diagonal";
+      EXPECT_LE(r.quality.load_node_distance_m, 1e-12 * diag);
+      std::cout << "[ quality   ] " << p.file << " size " << o.mesh_size_m * 1e3 << " mm: " << r.quality.tet_count
+                << " tets, min gamma " << r.quality.min_gamma << ", " << r.quality.attempts.size() << " tr"
+                << (r.quality.attempts.size() == 1 ? "y" : "ies") << "\n";
+    }
+  }
+}
+
+// The fallback's sequence, forced by an unreachable floor: every 2D algorithm, half and quarter
+// size, then the part's own triangles; the best try is kept and the list says so.
+TEST(FemMesh, FallbackTriesEachSettingInTurnAndKeepsTheBest) {
+  const PartSurface s = part_surface(kData / "sphere.ply", LengthUnit::cm);
+  const fs::path d = fresh_dir("fallback");
+  MeshOptions o;
+  o.mesh_size_m = 0.004;
+  o.quality_floor_gamma = 0.9;  // no tetrahedral mesh of a sphere reaches it
+  const MeshResult r = mesh_part(s, s.vertices_m[0], o, d, "mesh", "sphere.ply");
+  const auto& a = r.quality.attempts;
+  ASSERT_EQ(a.size(), 7u);
+  const int algorithms[] = {6, 1, 5, 6, 6};
+  const double sizes[] = {0.004, 0.004, 0.004, 0.002, 0.001};
+  for (int i = 0; i < 5; ++i) {
+    EXPECT_EQ(a[i].surface, "remeshed");
+    EXPECT_EQ(a[i].algorithm_2d, algorithms[i]);
+    EXPECT_NEAR(a[i].mesh_size_m, sizes[i], 1e-15);
+    EXPECT_EQ(a[i].outcome.rfind("min gamma ", 0), 0u) << a[i].outcome;
+  }
+  EXPECT_EQ(a[5].surface, "part triangles");
+  EXPECT_EQ(a[6].outcome, "kept: the best min gamma of the tries");
+  EXPECT_LT(r.quality.min_gamma, 0.9);
+  EXPECT_LE(r.quality.load_node_distance_m, 1e-15);
+  // The .geo of the kept try reproduces it (the same settings are written).
+  EXPECT_NE(slurp(r.geo).find("Settings of try"), std::string::npos);
+}
