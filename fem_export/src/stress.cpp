@@ -284,7 +284,9 @@ void write_stress_files(const fs::path& dir, const TetMesh& m, StressResult& r, 
     std::vector<plot::StressSeries> ps;
     double lo = 1e300, hi = 0;
     for (const auto* p : series) {
-      ps.push_back({p->name + " " + mm_text(p->point_m), r.time_s, p->von_mises_Pa});
+      // The contact node in vermilion, the probes in the other colours.
+      ps.push_back({p->name + " " + mm_text(p->point_m), r.time_s, p->von_mises_Pa,
+                    p == &r.load ? plot::kVermilion : static_cast<int>(ps.size()) % plot::kVermilion});
       lo = std::min(lo, p->max_von_mises_Pa);
       hi = std::max(hi, p->max_von_mises_Pa);
     }

@@ -8,11 +8,8 @@
 namespace impactdeck::plot {
 namespace {
 
-// Distinct line colours (Okabe-Ito, readable for colour-blind viewers); the last series (the
-// contact node) is drawn in vermilion.
-const Colour kPalette[] = {{0.0, 0.45, 0.70}, {0.0, 0.62, 0.45}, {0.90, 0.62, 0.0},
-                           {0.80, 0.47, 0.65}, {0.34, 0.71, 0.91}, {0.94, 0.89, 0.26}};
-const Colour kLoadColour{0.84, 0.37, 0.0};
+const Colour kPalette[kStressPaletteSize] = {{0.0, 0.45, 0.70},  {0.0, 0.62, 0.45},  {0.90, 0.62, 0.0},
+                                             {0.80, 0.47, 0.65}, {0.34, 0.71, 0.91}, {0.84, 0.37, 0.0}};
 
 }  // namespace
 
@@ -110,8 +107,9 @@ Drawing stress_time_drawing(const std::vector<StressSeries>& series, const Stres
   for (std::size_t i = 0; i < series.size(); ++i) {
     const auto& s = series[i];
     Style st;
-    st.stroke = i + 1 == series.size() && series.size() > 1 ? kLoadColour : kPalette[i % 6];
+    st.stroke = kPalette[(s.colour >= 0 ? s.colour : static_cast<int>(i)) % kStressPaletteSize];
     st.stroke_width = 1.8;
+    if (s.dashed) st.dash = 6;
     std::vector<Point2> pts;
     pts.reserve(s.time_s.size());
     for (std::size_t k = 0; k < s.time_s.size(); ++k) pts.push_back({X(s.time_s[k]), Y(s.von_mises_Pa[k])});

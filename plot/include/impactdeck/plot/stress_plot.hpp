@@ -15,7 +15,14 @@ struct StressSeries {
   std::string label;  ///< e.g. "PROBE1 (0, 400, 250) mm"
   std::vector<double> time_s;
   std::vector<double> von_mises_Pa;
+  int colour = -1;      ///< index into the palette (kStressPalette); -1: the series' own index
+  bool dashed = false;  ///< e.g. an analytic reference
 };
+
+/// Line colours (Okabe-Ito, readable for colour-blind viewers): blue, green, orange, purple, sky
+/// blue, vermilion.
+inline constexpr int kStressPaletteSize = 6;
+inline constexpr int kVermilion = 5;
 
 struct StressPlotOptions {
   std::string title;
