@@ -14,6 +14,7 @@
 #include "impactdeck/fem_export/decks.hpp"
 #include "impactdeck/fem_export/patch_load.hpp"
 #include "impactdeck/fem_export/stress.hpp"
+#include "fem_test_util.hpp"
 #include "tolerances.hpp"
 
 namespace fs = std::filesystem;
@@ -22,19 +23,8 @@ using namespace impactdeck::fem_export;
 
 namespace {
 
-fs::path fresh_dir(const std::string& name) {
-  const fs::path d = fs::path(IMPACTDECK_BINARY_DIR) / "test_fem_patch_out" / name;
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+fs::path fresh_dir(const std::string& name) { return test::fresh_dir("test_fem_patch_out", name); }
+using test::slurp;
 
 // A box [0, nx h] x [-ny h / 2, ny h / 2] x [-nz h, 0] of cubes split into six positive
 // tetrahedra each (Kuhn triangulation): its top face z = 0 is flat and evenly triangulated.

@@ -12,6 +12,7 @@
 #include "impactdeck/fem_export/check.hpp"
 #include "impactdeck/scene/pipeline.hpp"
 #include "impactdeck/scene/scene.hpp"
+#include "fem_test_util.hpp"
 #include "tolerances.hpp"
 
 namespace fs = std::filesystem;
@@ -21,19 +22,8 @@ namespace {
 
 const fs::path kData = fs::path(IMPACTDECK_SOURCE_DIR) / "tests" / "data";
 
-fs::path fresh_dir(const std::string& name) {
-  const fs::path d = fs::path(IMPACTDECK_BINARY_DIR) / "test_fem_route_out" / name;
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+fs::path fresh_dir(const std::string& name) { return test::fresh_dir("test_fem_route_out", name); }
+using test::slurp;
 
 std::size_t count(const std::string& s, const std::string& what) {
   std::size_t n = 0;

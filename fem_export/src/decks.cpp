@@ -177,6 +177,19 @@ BodyComparison compare_body(const TetMesh& m, double rho, const RigidReference& 
   return c;
 }
 
+nlohmann::json to_json(const std::vector<MeshAttempt>& attempts) {
+  nlohmann::json j = nlohmann::json::array();
+  for (const auto& a : attempts) {
+    j.push_back({{"surface", a.surface},
+                 {"algorithm_2d", a.algorithm_2d},
+                 {"algorithm_3d", a.algorithm_3d},
+                 {"mesh_size_m", a.mesh_size_m},
+                 {"load_mesh_size_m", a.load_mesh_size_m},
+                 {"outcome", a.outcome}});
+  }
+  return j;
+}
+
 nlohmann::json to_json(const BodyComparison& c) {
   using nlohmann::json;
   const bool ref = c.part_volume_m3 > 0;
@@ -546,15 +559,6 @@ DeckResult write_decks(const DeckRequest& r, const fs::path& folder) {
     using nlohmann::json;
     auto v3 = [](const Eigen::Vector3d& v) { return json::array({v.x() + 0.0, v.y() + 0.0, v.z() + 0.0}); };
     auto m3 = [&](const Eigen::Matrix3d& a) { return json::array({v3(a.row(0)), v3(a.row(1)), v3(a.row(2))}); };
-    json attempts = json::array();
-    for (const auto& a : q.attempts) {
-      attempts.push_back({{"surface", a.surface},
-                          {"algorithm_2d", a.algorithm_2d},
-                          {"algorithm_3d", a.algorithm_3d},
-                          {"mesh_size_m", a.mesh_size_m},
-                          {"load_mesh_size_m", a.load_mesh_size_m},
-                          {"outcome", a.outcome}});
-    }
     json quality = {{"node_count", q.node_count},
                     {"tet_count", q.tet_count},
                     {"min_quality", q.min_quality},
@@ -571,7 +575,7 @@ DeckResult write_decks(const DeckRequest& r, const fs::path& folder) {
                     {"mesh_size_m", q.mesh_size_m},
                     {"load_mesh_size_m", q.load_mesh_size_m},
                     {"load_zone_radius_m", mo.load_zone_radius_m},
-                    {"mesh_attempts", attempts},
+                    {"mesh_attempts", to_json(q.attempts)},
                     {"fallback_used", q.attempts.size() > 1}};
     write_file_atomically(stage / "mesh_quality.json", quality.dump(2) + "\n");
     names.push_back("mesh_quality.json");

@@ -242,24 +242,32 @@ int node_of_point_entity(int point_tag, const std::map<std::size_t, int>& index,
   return index.at(tags[0]);
 }
 
+// Node groups LOAD (node `load`) and PROBEk (the nodes on the embedded probe points), with their
+// distances to the requested points (both routes).
+void add_node_groups(MeshResult& r, int load, const Eigen::Vector3d& p_mm, const std::vector<int>& probe_tags,
+                     const std::map<std::size_t, int>& index, const MeshOptions& o, const std::string& where) {
+  r.mesh.node_groups.emplace_back("LOAD", load);
+  r.quality.load_node_distance_m = (r.mesh.nodes_m[load] * kMmPerM - p_mm).norm() / kMmPerM;
+  for (std::size_t i = 0; i < probe_tags.size(); ++i) {
+    const int pn = node_of_point_entity(probe_tags[i], index, where, probe_name(i));
+    r.mesh.node_groups.emplace_back(probe_name(i), pn);
+    r.quality.probe_node_distance_m.push_back((r.mesh.nodes_m[pn] - o.probes_m[i]).norm());
+  }
+}
+
 void fill_quality(const TetMesh& m, MeshQuality& q) {
   q.node_count = m.nodes_m.size();
   q.tet_count = m.tets.size();
-  q.min_quality = 1.0;
-  double sum = 0;
+  q.min_quality = q.min_gamma = 1.0;
+  double sum = 0, gsum = 0;
   for (std::size_t e = 0; e < m.tets.size(); ++e) {
-    const double g = tet_quality(m, e);
-    q.min_quality = std::min(q.min_quality, g);
-    sum += g;
-  }
-  q.mean_quality = sum / static_cast<double>(m.tets.size());
-  q.min_gamma = 1.0;
-  double gsum = 0;
-  for (std::size_t e = 0; e < m.tets.size(); ++e) {
-    const double g = tet_gamma(m, e);
+    const double rr = tet_quality(m, e), g = tet_gamma(m, e);
+    q.min_quality = std::min(q.min_quality, rr);
     q.min_gamma = std::min(q.min_gamma, g);
+    sum += rr;
     gsum += g;
   }
+  q.mean_quality = sum / static_cast<double>(m.tets.size());
   q.mean_gamma = gsum / static_cast<double>(m.tets.size());
   q.fe_volume_m3 = m.volume_m3();
   q.volume_relative_difference = (q.fe_volume_m3 - q.part_volume_m3) / q.part_volume_m3;
@@ -357,14 +365,7 @@ MeshResult mesh_ellipsoid_with_gmsh(const Eigen::Vector3d& semi_axes_m, const Ei
   std::map<std::size_t, int> index;
   gmsh_step(where, "mesh", [&] {
     index = extract(r.mesh, where);
-    const int ln = node_of_point_entity(load_tag, index, where, "LOAD");
-    r.mesh.node_groups.emplace_back("LOAD", ln);
-    r.quality.load_node_distance_m = (r.mesh.nodes_m[ln] * kMmPerM - p_mm).norm() / kMmPerM;
-    for (std::size_t i = 0; i < probe_tags.size(); ++i) {
-      const int pn = node_of_point_entity(probe_tags[i], index, where, probe_name(i));
-      r.mesh.node_groups.emplace_back(probe_name(i), pn);
-      r.quality.probe_node_distance_m.push_back((r.mesh.nodes_m[pn] - o.probes_m[i]).norm());
-    }
+    add_node_groups(r, node_of_point_entity(load_tag, index, where, "LOAD"), p_mm, probe_tags, index, o, where);
   });
   fill_quality(r.mesh, r.quality);
   check_mesh(r, where);
@@ -547,14 +548,6 @@ std::vector<Try> part_tries(const MeshOptions& o) {
   return t;
 }
 
-std::string describe(const MeshAttempt& a) {
-  std::ostringstream s;
-  if (a.surface == "remeshed") s << "Mesh.Algorithm " << a.algorithm_2d << ", ";
-  else s << a.surface << ", ";
-  s << "size " << a.mesh_size_m * kMmPerM << " mm";
-  return s.str();
-}
-
 }  // namespace
 
 MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& load_point_m, const MeshOptions& o,
@@ -675,13 +668,7 @@ MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& l
       } else {
         ln = node_of_point_entity(kLoadPointTag, index, where, "LOAD");
       }
-      r.mesh.node_groups.emplace_back("LOAD", ln);
-      r.quality.load_node_distance_m = (r.mesh.nodes_m[ln] * kMmPerM - p_mm).norm() / kMmPerM;
-      for (std::size_t i = 0; i < probe_tags.size(); ++i) {
-        const int pn = node_of_point_entity(probe_tags[i], index, where, probe_name(i));
-        r.mesh.node_groups.emplace_back(probe_name(i), pn);
-        r.quality.probe_node_distance_m.push_back((r.mesh.nodes_m[pn] - o.probes_m[i]).norm());
-      }
+      add_node_groups(r, ln, p_mm, probe_tags, index, o, where);
     });
     fill_quality(r.mesh, r.quality);
     check_mesh(r, where);

@@ -2,11 +2,20 @@
 // computes the mesh quality itself.
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 
 #include "impactdeck/fem_export/mesh.hpp"
 
 namespace impactdeck::fem_export {
+
+std::string describe(const MeshAttempt& a) {
+  std::ostringstream s;
+  if (a.surface == "remeshed") s << "Mesh.Algorithm " << a.algorithm_2d << ", ";
+  else s << a.surface << ", ";
+  s << "size " << a.mesh_size_m * 1e3 << " mm";
+  return s.str();
+}
 
 int TetMesh::node_of(const std::string& group) const {
   for (const auto& [n, i] : node_groups)
@@ -26,13 +35,25 @@ double TetMesh::volume_m3() const {
   return v;
 }
 
-double tet_quality(const TetMesh& m, std::size_t e) {
+namespace {
+
+// The corners of tetrahedron e and the sum of its face areas.
+struct TetShape {
+  Eigen::Vector3d a, b, c, d;
+  double volume, area;
+};
+TetShape shape_of(const TetMesh& m, std::size_t e) {
   const auto& t = m.tets[e];
-  const Eigen::Vector3d a = m.nodes_m[t[0]], b = m.nodes_m[t[1]], c = m.nodes_m[t[2]],
-                        d = m.nodes_m[t[3]];
-  const double V = std::abs(tet_volume_m3(m, e));
-  const double area = 0.5 * ((b - a).cross(c - a).norm() + (b - a).cross(d - a).norm() +
-                             (c - a).cross(d - a).norm() + (c - b).cross(d - b).norm());
+  TetShape s{m.nodes_m[t[0]], m.nodes_m[t[1]], m.nodes_m[t[2]], m.nodes_m[t[3]], std::abs(tet_volume_m3(m, e)), 0};
+  s.area = 0.5 * ((s.b - s.a).cross(s.c - s.a).norm() + (s.b - s.a).cross(s.d - s.a).norm() +
+                  (s.c - s.a).cross(s.d - s.a).norm() + (s.c - s.b).cross(s.d - s.b).norm());
+  return s;
+}
+
+}  // namespace
+
+double tet_quality(const TetMesh& m, std::size_t e) {
+  const auto [a, b, c, d, V, area] = shape_of(m, e);
   if (!(V > 0) || !(area > 0)) return 0.0;
   const double r_in = 3.0 * V / area;
   // Circumradius: |A|^2 (B x C) + |B|^2 (C x A) + |C|^2 (A x B) over 12 V, edges from a.
@@ -44,12 +65,7 @@ double tet_quality(const TetMesh& m, std::size_t e) {
 }
 
 double tet_gamma(const TetMesh& m, std::size_t e) {
-  const auto& t = m.tets[e];
-  const Eigen::Vector3d a = m.nodes_m[t[0]], b = m.nodes_m[t[1]], c = m.nodes_m[t[2]],
-                        d = m.nodes_m[t[3]];
-  const double V = std::abs(tet_volume_m3(m, e));
-  const double area = 0.5 * ((b - a).cross(c - a).norm() + (b - a).cross(d - a).norm() +
-                             (c - a).cross(d - a).norm() + (c - b).cross(d - b).norm());
+  const auto [a, b, c, d, V, area] = shape_of(m, e);
   const double lmax = std::sqrt(std::max({(b - a).squaredNorm(), (c - a).squaredNorm(), (d - a).squaredNorm(),
                                           (c - b).squaredNorm(), (d - b).squaredNorm(), (d - c).squaredNorm()}));
   if (!(V > 0) || !(area > 0) || !(lmax > 0)) return 0.0;

@@ -60,28 +60,14 @@ Drawing stress_time_drawing(const std::vector<StressSeries>& series, const Stres
     return bottom - (bottom - top) * (y - y_lo) / (y_hi - y_lo);
   };
 
-  Style grid;
-  grid.stroke = {0.85, 0.85, 0.85};
-  grid.stroke_width = 0.8;
-  Style axis;
-  axis.stroke_width = 1.2;
-  for (double v : nice_ticks(0.0, t_hi, 6)) {
-    const double x = left + (right - left) * v / t_hi;
-    d.line({x, top}, {x, bottom}, grid);
-    d.line({x, bottom}, {x, bottom + 5}, axis);
-    d.text({x, bottom + 20}, format_number(v), 12, Anchor::middle);
-  }
+  std::vector<Tick> xt, yt;
+  for (double v : nice_ticks(0.0, t_hi, 6)) xt.push_back({left + (right - left) * v / t_hi, format_number(v)});
   for (double v : yticks) {
-    const double y = bottom - (bottom - top) * (v - y_lo) / (y_hi - y_lo);
-    d.line({left, y}, {right, y}, grid);
-    d.line({left - 5, y}, {left, y}, axis);
-    d.text({left - 9, y + 4}, log ? format_number(std::pow(10.0, v)) : format_number(v), 12, Anchor::end);
+    yt.push_back({bottom - (bottom - top) * (v - y_lo) / (y_hi - y_lo),
+                  log ? format_number(std::pow(10.0, v)) : format_number(v)});
   }
-  d.polyline({{left, top}, {left, bottom}, {right, bottom}}, axis);
-  d.text({0.5 * (left + right), bottom + 44}, std::string("time t [") + tu + "]", 13, Anchor::middle);
-  d.text({24, 0.5 * (top + bottom)},
-         std::string("von Mises stress [") + su + "]" + (log ? " (log scale)" : ""), 13, Anchor::middle, kBlack,
-         false, 90);
+  chart_frame(d, left, top, right, bottom, xt, yt, std::string("time t [") + tu + "]",
+              std::string("von Mises stress [") + su + "]" + (log ? " (log scale)" : ""));
   d.text({left, 30}, opt.title.empty() ? "Von Mises stress against time" : opt.title, 15, Anchor::start, kBlack, true);
 
   Style mark;

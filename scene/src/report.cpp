@@ -100,15 +100,6 @@ nlohmann::json to_json(const Scene& scene, const RunReport& rep) {
     if (ir.fem_deck) {
       const auto& d = *ir.fem_deck;
       const auto& q = d.quality;
-      nlohmann::json attempts = nlohmann::json::array();
-      for (const auto& a : q.attempts) {
-        attempts.push_back({{"surface", a.surface},
-                          {"algorithm_2d", a.algorithm_2d},
-                            {"algorithm_3d", a.algorithm_3d},
-                            {"mesh_size_m", a.mesh_size_m},
-                            {"load_mesh_size_m", a.load_mesh_size_m},
-                            {"outcome", a.outcome}});
-      }
       i["fem"] = {{"folder", d.folder.string()},
                   {"node_count", q.node_count},
                   {"tet_count", q.tet_count},
@@ -116,7 +107,7 @@ nlohmann::json to_json(const Scene& scene, const RunReport& rep) {
                   {"min_gamma", q.min_gamma},
                   {"mesh_size_m", q.mesh_size_m},
                   {"load_mesh_size_m", q.load_mesh_size_m},
-                  {"mesh_attempts", attempts},
+                  {"mesh_attempts", fem_export::to_json(q.attempts)},
                   {"fallback_used", q.attempts.size() > 1},
                   {"fe_volume_m3", q.fe_volume_m3},
                   {"part_volume_m3", q.part_volume_m3},
@@ -209,8 +200,7 @@ std::string format_summary(const Scene& scene, const RunReport& rep) {
       if (q.attempts.size() > 1) {
         o << "; mesher fallback used (" << q.attempts.size() << " tries: ";
         for (std::size_t k = 0; k < q.attempts.size(); ++k) {
-          o << (k ? "; " : "") << "Mesh.Algorithm " << q.attempts[k].algorithm_2d << ", size "
-            << q.attempts[k].mesh_size_m << " m: " << q.attempts[k].outcome;
+          o << (k ? "; " : "") << fem_export::describe(q.attempts[k]) << ": " << q.attempts[k].outcome;
         }
         o << ")";
       }

@@ -147,6 +147,10 @@ struct BodyComparison {
   bool passed = false;
   std::vector<std::string> failures;  ///< one line per missed threshold
 };
+/// The mesher's tries as JSON (mesh_attempts: surface, algorithm_2d, algorithm_3d, mesh_size_m,
+/// load_mesh_size_m, outcome).
+nlohmann::json to_json(const std::vector<MeshAttempt>& attempts);
+
 /// Compares the tetrahedra (density `density_kg_m3`) with the part; with the impulse vector
 /// (Pi times the force direction, N s) and the load point, also predicts the velocity checks.
 BodyComparison compare_body(const TetMesh& mesh, double density_kg_m3, const RigidReference& part,

@@ -79,6 +79,9 @@ struct MeshAttempt {
   std::string outcome;  ///< "ok", or why this try was rejected (Gmsh's message, quality)
 };
 
+/// "Mesh.Algorithm 6, size 25 mm" / "part triangles, size 25 mm" / "analytic, size 250 mm".
+std::string describe(const MeshAttempt& a);
+
 struct MeshOptions {
   double mesh_size_m = 0;       ///< global target element size (required, > 0)
   double load_mesh_size_m = 0;  ///< element size at the load point; 0: mesh_size_m / 3
