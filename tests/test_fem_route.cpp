@@ -121,6 +121,7 @@ TEST_P(FemRoute, PartMeshesFromMemoryAndRunsThroughCcx) {
   if (c.patch) {
     EXPECT_EQ(deck.load, fem_export::LoadKind::hertz_patch);
     EXPECT_GT(deck.patch.load_node_count, 3u);
+    EXPECT_GE(deck.patch.largest_ellipse_elements, 2.0);  // contact_elements
     EXPECT_LE(deck.patch.max_sum_relative_error, 1e-9);
     EXPECT_LE(deck.patch.max_moment_relative, 1e-12);
     EXPECT_EQ(count(slurp(deck.folder / "impact.comm"), "= AFFE_CHAR_MECA("), deck.patch.load_node_count);

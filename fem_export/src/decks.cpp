@@ -516,10 +516,29 @@ DeckResult write_decks(const DeckRequest& r, const fs::path& folder) {
     out.load = r.options.load;
     std::optional<PatchLoad> patch;
     if (r.options.load == LoadKind::hertz_patch) {
-      try {
-        patch = hertz_patch_load(m, m.node_of("LOAD"), r.direction, r.patch, r.force);
-      } catch (const InputError& e) {
-        throw InputError(where, "load", e.place() + ": " + e.reason());
+      auto compute = [&] {
+        try {
+          patch = hertz_patch_load(mr.mesh, mr.mesh.node_of("LOAD"), r.direction, r.patch, r.force);
+        } catch (const InputError& e) {
+          throw InputError(where, "load", e.place() + ": " + e.reason());
+        }
+      };
+      compute();
+      // Gmsh's edges come out near, not below, the size asked for: until the largest ellipse
+      // spans contact_elements elements, mesh again with the load size scaled by what is missing
+      // (twice at most; not when the part's own triangles are the boundary, they do not refine).
+      for (int k = 0; k < 2 && patch->largest_ellipse_elements < r.options.contact_elements &&
+                      mr.quality.attempts.back().surface != "part triangles";
+           ++k) {
+        mo.load_mesh_size_m *= 0.95 * patch->largest_ellipse_elements / r.options.contact_elements;
+        const auto t_again = std::chrono::steady_clock::now();
+        std::vector<MeshAttempt> before = mr.quality.attempts;
+        before.back().outcome = "the largest contact ellipse spans " + std::to_string(patch->largest_ellipse_elements) +
+                                " elements: smaller load size";
+        mr = mesh_once();
+        mr.quality.attempts.insert(mr.quality.attempts.begin(), before.begin(), before.end());
+        out.mesh_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t_again).count();
+        compute();
       }
       for (std::size_t k = 0; k < patch->nodes.size(); ++k) {
         m.node_groups.emplace_back("LP" + std::to_string(k + 1), patch->nodes[k]);

@@ -414,6 +414,15 @@ RunReport run_scene(const Scene& scene, const RunOptions& opt) {
                            what + e.reason());
         }
         const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        const auto& patch = ir.fem_deck->patch;
+        if (ir.fem_deck->load == fem_export::LoadKind::hertz_patch &&
+            patch.largest_ellipse_elements < scene.outputs.fem->contact_elements) {
+          std::ostringstream m;
+          m << "impact '" << ir.spec->name << "': the largest contact ellipse spans " << patch.largest_ellipse_elements
+            << " elements, fewer than contact_elements = " << scene.outputs.fem->contact_elements
+            << " (the mesher kept the part's own triangles, or a coarser load size was asked for)";
+          report.warnings.push_back(m.str());
+        }
         add_stage(report, "fem_mesh", ir.fem_deck->mesh_seconds);
         add_stage(report, "fem_decks", total - ir.fem_deck->mesh_seconds);
         for (const auto& f : ir.fem_deck->files) report.files_written.push_back(f);
