@@ -69,6 +69,9 @@ struct PartCase {
   std::size_t triangles;  // of the validated (and repaired) part, as the deck's STL must hold them
 };
 
+// Test names and failure messages show the case's name, not its bytes.
+void PrintTo(const PartCase& c, std::ostream* os) { *os << c.name; }
+
 class FemRoute : public ::testing::TestWithParam<PartCase> {};
 
 }  // namespace
