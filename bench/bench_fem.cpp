@@ -60,9 +60,9 @@ void strip_stress_output(const fs::path& inp) {
 int main(int argc, char** argv) {
   const fs::path src = argc > 1 ? fs::path(argv[1]) : fs::path(".");
   const fs::path work = fs::temp_directory_path() / "impactdeck_bench_fem";
-  std::string load;
-  std::getline(std::ifstream("/proc/loadavg"), load);
-  load = load.substr(0, 14);
+  std::string l1, l5, l15;
+  std::ifstream("/proc/loadavg") >> l1 >> l5 >> l15;
+  const std::string load = l1 + " " + l5 + " " + l15;
   std::printf("## Cost\n\n`bench/bench_fem` on `samples/eccentric_fem.toml` (2 ms, 100 increments across the contact "
               "and 99 after), one ccx thread; load average %s at the start (2 cores shared).\n\n",
               load.c_str());
