@@ -20,15 +20,17 @@ void register_fem_check(CLI::App& app, Context& ctx) {
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
-      "fem-check", "Run ccx on a deck folder and check linear/angular momentum against the impulse");
+      "fem-check", "Run ccx on a deck folder: momentum, the FE body and motion against the rigid model, stresses");
   cmd->add_option("dir", args->dir, "Deck folder (fem_<impact>/ written by 'impactdeck run')")->required();
   cmd->add_flag("--json", args->json, "Print one JSON document on stdout (keys: docs/fem.md)");
   cmd->add_option("--ccx", args->options.ccx, "CalculiX executable (default: ccx from PATH)");
   cmd->add_flag("--no-run", args->no_run, "Do not run ccx; check the existing impact.dat");
   cmd->add_option("--linear-tolerance", args->options.linear_tolerance,
-                  "Max relative error of the linear momentum (default 1e-3)")->check(CLI::PositiveNumber);
+                  "Max relative error of the linear momentum (default: the deck's, 1e-3 unless the scene set it)")
+      ->check(CLI::PositiveNumber);
   cmd->add_option("--angular-tolerance", args->options.angular_tolerance,
-                  "Max relative error of the angular momentum (default 1e-2)")->check(CLI::PositiveNumber);
+                  "Max relative error of the angular momentum (default: the deck's, 1e-2 unless the scene set it)")
+      ->check(CLI::PositiveNumber);
   cmd->add_option("--threads", args->options.threads, "Threads for ccx (default 1)")->check(CLI::PositiveNumber);
   cmd->add_flag("--verbose", args->verbose, "Echo the settings on stderr");
   cmd->callback([args, &ctx] {
@@ -47,7 +49,7 @@ void register_fem_check(CLI::App& app, Context& ctx) {
       std::cout << fem_export::format_check(r);
     }
     if (!r.passed) {
-      std::cerr << "impactdeck: error: FEM momentum check failed\n";
+      std::cerr << "impactdeck: error: FEM check failed: " << r.failures.front() << "\n";
       ctx.exit_code = static_cast<int>(ExitCode::check_failed);
     }
   });

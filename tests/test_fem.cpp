@@ -13,6 +13,8 @@
 #include "impactdeck/fem_export/check.hpp"
 #include "impactdeck/fem_export/decks.hpp"
 #include "impactdeck/fem_export/mesh.hpp"
+#include "impactdeck/geometry/mesh_io.hpp"
+#include "fem_test_util.hpp"
 #include "tolerances.hpp"
 
 namespace fs = std::filesystem;
@@ -23,19 +25,8 @@ namespace {
 
 const fs::path kData = fs::path(IMPACTDECK_SOURCE_DIR) / "tests" / "data";
 
-fs::path fresh_dir(const std::string& name) {
-  const fs::path d = fs::path(IMPACTDECK_BINARY_DIR) / "test_fem_out" / name;
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+fs::path fresh_dir(const std::string& name) { return test::fresh_dir("test_fem_out", name); }
+using test::slurp;
 
 std::string run(const std::string& cmd) {
   std::string out;
@@ -83,6 +74,12 @@ std::size_t msh22_tet_count(const std::string& msh) {
     if (inside && ls >> id >> type && type == 4) ++tets;
   }
   return tets;
+}
+
+// A part file's triangles as the FEM route receives them (from memory, any format).
+PartSurface part_surface(const fs::path& file, LengthUnit unit) {
+  const geometry::LoadedMesh lm = geometry::load_mesh(file, unit);
+  return {lm.mesh.vertices_m, lm.mesh.triangles};
 }
 
 bool no_stage_left(const fs::path& parent) {
@@ -360,27 +357,30 @@ TEST(FemCodeAster, ExportNamesEveryFileAndUnitTheCommUses) {
 TEST(FemDecks, MeshingFailuresGiveClearErrorsAndNoDeck) {
   const fs::path d = fresh_dir("failures");
   DeckRequest r = ellipsoid_request();
-  r.body.kind = BodyKind::stl;
-  r.body.stl = kData / "no_triangles.stl";
-  r.body.stl_unit_m = 1e-3;
+  r.body.kind = BodyKind::part;
+  r.body.name = "empty.stl";
   try {
     write_decks(r, d / "deck");
     FAIL() << "no error";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("no_triangles.stl"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("no triangles"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("body: the part has no triangles"), std::string::npos) << e.what();
   }
   EXPECT_FALSE(fs::exists(d / "deck"));
-  r.body.stl = kData / "open_surface.stl";
-  r.load_point_m = Eigen::Vector3d(0, 0.05, 0);
+  // An open surface (the validation refuses it before; here it reaches Gmsh): every try of the
+  // fallback fails, and the message lists them with Gmsh's reasons.
+  r.body.surface = part_surface(kData / "open_surface.stl", LengthUnit::mm);
+  r.body.name = (kData / "open_surface.stl").string();
+  r.load_point_m = r.body.surface.vertices_m[r.body.surface.triangles[0][0]];
   r.options.mesh.mesh_size_m = 0.02;
   r.options.mesh.probes_m.clear();
   try {
     write_decks(r, d / "deck");
     FAIL() << "no error";
   } catch (const InputError& e) {
-    // Gmsh's own reason ("No elements in volume 1"), prefixed by the file and the step.
-    EXPECT_NE(std::string(e.what()).find("open_surface.stl: gmsh mesh: "), std::string::npos) << e.what();
+    const std::string w = e.what();
+    EXPECT_TRUE(w.find("open_surface.stl: gmsh mesh: every try failed (") != std::string::npos ||
+                w.find("open_surface.stl: part surface: encloses no volume") != std::string::npos)
+        << w;
   }
   EXPECT_FALSE(fs::exists(d / "deck"));
   // A probe outside the body is refused before Gmsh runs.
@@ -410,8 +410,10 @@ TEST(FemDecks, FailedRewriteLeavesThePreviousDeckUntouched) {
   }
   // A failure inside Gmsh, after the staging folder exists.
   DeckRequest bad2 = ellipsoid_request();
-  bad2.body.kind = BodyKind::stl;
-  bad2.body.stl = kData / "no_triangles.stl";
+  bad2.body.kind = BodyKind::part;
+  bad2.body.surface = part_surface(kData / "ellipsoid_200x50x50.stl", LengthUnit::mm);
+  bad2.load_point_m = Eigen::Vector3d(0.5, 0.5, 0.5);  // not on the part: refused inside the mesher
+  bad2.options.mesh.probes_m.clear();
   EXPECT_THROW(write_decks(bad2, d / "deck"), InputError);
   EXPECT_EQ(slurp(d / "deck" / "deck.json"), before);
   EXPECT_TRUE(no_stage_left(d));
@@ -422,10 +424,15 @@ TEST(FemCheck, MeshPartFromStlEccentricHitConservesLinearAndAngularMomentum) {
   // The mesh-part route end to end: STL (written by Gmsh) -> volume mesh -> decks -> ccx -> checks.
   const fs::path d = fresh_dir("stl_ccx");
   DeckRequest r = ellipsoid_request();
-  r.body.kind = BodyKind::stl;
-  r.body.stl = kData / "ellipsoid_200x50x50.stl";
-  r.body.stl_unit_m = 1e-3;
-  const Eigen::Vector3d p(0.1, 0.05 * std::sqrt(0.75), 0);
+  r.body.kind = BodyKind::part;
+  r.body.surface = part_surface(kData / "ellipsoid_200x50x50.stl", LengthUnit::mm);
+  r.body.name = "ellipsoid_200x50x50.stl";
+  // A point on the faceted surface (the STL's vertex nearest to the ellipsoid's point).
+  const Eigen::Vector3d target(0.1, 0.05 * std::sqrt(0.75), 0);
+  Eigen::Vector3d p = r.body.surface.vertices_m.front();
+  for (const auto& v : r.body.surface.vertices_m) {
+    if ((v - target).norm() < (p - target).norm()) p = v;
+  }
   r.load_point_m = p;
   r.direction = -Eigen::Vector3d(p.x() / 0.04, p.y() / 0.0025, 0).normalized();
   r.force.time_s = {0, 2e-5, 4e-5};
@@ -437,7 +444,7 @@ TEST(FemCheck, MeshPartFromStlEccentricHitConservesLinearAndAngularMomentum) {
   r.options.mesh.load_mesh_size_m = 0.012;
   r.options.mesh.probes_m = {Eigen::Vector3d(-0.1, 0.0, 0.0)};
   const DeckResult res = write_decks(r, d / "deck");
-  EXPECT_LT(res.quality.load_node_distance_m, 0.012);
+  EXPECT_LT(res.quality.load_node_distance_m, 1e-12);  // a node exactly on the load point
   // Gmsh re-meshes the reparametrized surface at 30 mm on a body 100 mm thick: chords cut ~6 %.
   EXPECT_LT(std::abs(res.quality.volume_relative_difference), 0.10);
   // The STL encloses the gmsh-faceted ellipsoid: a little less than (4/3) pi a b c.
@@ -497,4 +504,62 @@ TEST(FemDecks, TimeScheduleRefinesThePulseAndDividesTheRest) {
   o.pulse_increments = 0;
   o.time_step_s = 1e-5;
   EXPECT_EQ(time_schedule(o, 6.9e-5).pulse_increments, 0u);
+}
+
+// The quality floor (Gmsh gamma >= 0.01 after optimisation, FemTolerances::min_gamma) holds for
+// real parts at whatever size a user asks for: where a 2D algorithm leaves slivers, the mesher's
+// fallback tries the next (every try is listed).
+TEST(FemMesh, QualityFloorHoldsOnRealPartsAtAnySize) {
+  struct Part {
+    const char* file;
+    Eigen::Vector3d point;  // file units (cm), projected onto a vertex of the part below
+  };
+  for (const Part& p : {Part{"fandisk.off", {0.1, 0.3, 0.2}}, Part{"empty_mat.obj", {0.3, 0.2, 1.2}},
+                        Part{"sphere.ply", {0.3, 0.2, 1.2}}}) {
+    const PartSurface s = part_surface(kData / p.file, LengthUnit::cm);
+    Eigen::Vector3d lo = s.vertices_m[0], hi = lo, load = lo;
+    for (const auto& v : s.vertices_m) {
+      lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+      if ((v - p.point * 0.01).norm() < (load - p.point * 0.01).norm()) load = v;
+    }
+    const double diag = (hi - lo).norm();
+    for (double fraction : {1.0 / 3, 1.0 / 7, 1.0 / 15}) {
+      const fs::path d = fresh_dir("quality");
+      MeshOptions o;
+      o.mesh_size_m = fraction * diag;
+      const MeshResult r = mesh_part(s, load, o, d, "mesh", p.file);
+      EXPECT_GE(r.quality.min_gamma, 0.01) << p.file << " at " << fraction << " of the diagonal";
+      EXPECT_LE(r.quality.load_node_distance_m, 1e-12 * diag);
+      std::cout << "[ quality   ] " << p.file << " size " << o.mesh_size_m * 1e3 << " mm: " << r.quality.tet_count
+                << " tets, min gamma " << r.quality.min_gamma << ", " << r.quality.attempts.size() << " tr"
+                << (r.quality.attempts.size() == 1 ? "y" : "ies") << "\n";
+    }
+  }
+}
+
+// The fallback's sequence, forced by an unreachable floor: every 2D algorithm, half and quarter
+// size, then the part's own triangles; the best try is kept and the list says so.
+TEST(FemMesh, FallbackTriesEachSettingInTurnAndKeepsTheBest) {
+  const PartSurface s = part_surface(kData / "sphere.ply", LengthUnit::cm);
+  const fs::path d = fresh_dir("fallback");
+  MeshOptions o;
+  o.mesh_size_m = 0.004;
+  o.quality_floor_gamma = 0.9;  // no tetrahedral mesh of a sphere reaches it
+  const MeshResult r = mesh_part(s, s.vertices_m[0], o, d, "mesh", "sphere.ply");
+  const auto& a = r.quality.attempts;
+  ASSERT_EQ(a.size(), 7u);
+  const int algorithms[] = {6, 1, 5, 6, 6};
+  const double sizes[] = {0.004, 0.004, 0.004, 0.002, 0.001};
+  for (int i = 0; i < 5; ++i) {
+    EXPECT_EQ(a[i].surface, "remeshed");
+    EXPECT_EQ(a[i].algorithm_2d, algorithms[i]);
+    EXPECT_NEAR(a[i].mesh_size_m, sizes[i], 1e-15);
+    EXPECT_EQ(a[i].outcome.rfind("min gamma ", 0), 0u) << a[i].outcome;
+  }
+  EXPECT_EQ(a[5].surface, "part triangles");
+  EXPECT_EQ(a[6].outcome, "kept: the best min gamma of the tries");
+  EXPECT_LT(r.quality.min_gamma, 0.9);
+  EXPECT_LE(r.quality.load_node_distance_m, 1e-15);
+  // The .geo of the kept try reproduces it (the same settings are written).
+  EXPECT_NE(slurp(r.geo).find("Settings of try"), std::string::npos);
 }

@@ -3,6 +3,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <iomanip>
@@ -58,6 +59,40 @@ void validate(const DeckRequest& r, const std::string& where) {
     throw InputError(where, "material", "modulus and density must be > 0");
   }
   if (!(r.impulse_Ns > 0)) throw InputError(where, "impulse", "must be > 0");
+  if (r.body.kind == BodyKind::part && r.body.surface.triangles.empty()) {
+    throw InputError(where, "body", "the part has no triangles");
+  }
+  if (o.load == LoadKind::hertz_patch) {
+    if (o.contact_elements < 1 || o.contact_elements > 64) throw InputError(where, "contact_elements", "must lie in [1, 64]");
+    if (!(r.patch.a_max_m > 0) || !(r.patch.b_max_m > 0) || !(r.patch.max_force_N > 0)) {
+      throw InputError(where, "load", "hertz-patch needs the contact ellipse (a_max, b_max > 0) and its force");
+    }
+  }
+  if (!(o.contact_zone_factor > 0) || !std::isfinite(o.contact_zone_factor)) {
+    throw InputError(where, "contact_zone_factor", "must be > 0");
+  }
+  const FemTolerances& t = o.tolerances;
+  for (double v : {t.linear_momentum, t.angular_momentum, t.model_linear_velocity, t.model_angular_velocity, t.volume,
+                   t.mass, t.inertia}) {
+    if (!(v > 0) || !std::isfinite(v)) throw InputError(where, "tolerances", "every tolerance must be > 0");
+  }
+  if (!(t.min_gamma >= 0 && t.min_gamma < 1)) throw InputError(where, "min_gamma", "must lie in [0, 1)");
+  if (r.yield_strength_Pa && !(*r.yield_strength_Pa > 0)) throw InputError(where, "yield_strength_Pa", "must be > 0");
+}
+
+// The frd output interval of the free-vibration step: every increment unless nodes x increments
+// exceeds the budget (DeckOptions::stress_output_budget).
+std::size_t output_every(const DeckOptions& o, const TimeSchedule& ts, std::size_t nodes) {
+  const double work = static_cast<double>(nodes) * static_cast<double>(ts.main_increments);
+  if (!(o.stress_output_budget > 0) || work <= o.stress_output_budget) return 1;
+  return static_cast<std::size_t>(std::ceil(work / o.stress_output_budget));
+}
+
+// Pairs (t, f) four to a line, as ccx's *AMPLITUDE reads them.
+void amplitude_rows(std::ostream& s, const std::vector<double>& t, const std::vector<double>& f) {
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    s << num(t[i]) << ", " << num(f[i]) << ((i % 4 == 3 || i + 1 == t.size()) ? "\n" : ", ");
+  }
 }
 
 std::string header_lines(const std::string& c, const DeckRequest& r, const std::string& what) {
@@ -80,6 +115,121 @@ std::vector<std::string> probe_groups(const TetMesh& m) {
 }
 
 }  // namespace
+
+const char* to_string(LoadKind k) { return k == LoadKind::hertz_patch ? "hertz-patch" : "point"; }
+
+bool spin_is_significant(const RigidReference& part, const Eigen::Vector3d& p, const Eigen::Vector3d& d) {
+  if (!(part.mass_kg > 0)) return false;
+  const double r_g = std::sqrt(part.inertia_kg_m2.trace() / (2.0 * part.mass_kg));
+  return (p - part.centroid_m).cross(d.normalized()).norm() > 0.1 * r_g;
+}
+
+BodyComparison compare_body(const TetMesh& m, double rho, const RigidReference& part, const FemTolerances& tol,
+                            const Eigen::Vector3d& impulse, const Eigen::Vector3d& load_point) {
+  BodyComparison c;
+  c.tolerances = tol;
+  const TetMassProperties mp = tet_mass_properties(m, rho);
+  c.fe_volume_m3 = m.volume_m3();
+  c.fe_mass_kg = mp.mass_kg;
+  c.part_volume_m3 = part.volume_m3;
+  c.part_mass_kg = part.mass_kg;
+  c.min_gamma = 1.0;
+  c.min_radius_ratio = 1.0;
+  for (std::size_t e = 0; e < m.tets.size(); ++e) {
+    c.min_gamma = std::min(c.min_gamma, tet_gamma(m, e));
+    c.min_radius_ratio = std::min(c.min_radius_ratio, tet_quality(m, e));
+  }
+  auto percent = [](double x) {
+    std::ostringstream s;
+    s << std::setprecision(3) << 100.0 * x << " %";
+    return s.str();
+  };
+  auto miss = [&](const std::string& what, double err, double limit) {
+    if (err <= limit) return;
+    c.failures.push_back(what + " " + percent(err) + " (tolerance " + percent(limit) + ")");
+  };
+  if (part.volume_m3 > 0 && part.mass_kg > 0) {
+    c.volume_relative_error = std::abs(c.fe_volume_m3 - part.volume_m3) / part.volume_m3;
+    c.mass_relative_error = std::abs(c.fe_mass_kg - part.mass_kg) / part.mass_kg;
+    const double in = part.inertia_kg_m2.norm();
+    c.inertia_relative_error = in > 0 ? (mp.inertia_kg_m2 - part.inertia_kg_m2).norm() / in : 0.0;
+    c.solver_inertia_relative_error = in > 0 ? (mp.one_point_inertia_kg_m2 - part.inertia_kg_m2).norm() / in : 0.0;
+    c.centroid_offset_m = (mp.centroid_m - part.centroid_m).norm();
+    const double dv = part.delta_velocity_m_s.norm();
+    if (impulse.norm() > 0 && dv > 0 && c.fe_mass_kg > 0) {
+      c.predicted_model_linear_velocity_error = (impulse / c.fe_mass_kg - part.delta_velocity_m_s).norm() / dv;
+      if (spin_is_significant(part, load_point, impulse) && part.delta_angular_velocity_rad_s.norm() > 0) {
+        const Eigen::Vector3d w = mp.one_point_inertia_kg_m2.inverse() * (load_point - mp.centroid_m).cross(impulse);
+        c.predicted_model_angular_velocity_error =
+            (w - part.delta_angular_velocity_rad_s).norm() / part.delta_angular_velocity_rad_s.norm();
+      }
+    }
+    miss("FE volume differs from the part's by", c.volume_relative_error, tol.volume);
+    miss("FE mass differs from the part's by", c.mass_relative_error, tol.mass);
+    miss("FE inertia tensor differs from the part's by", c.inertia_relative_error, tol.inertia);
+  }
+  if (c.min_gamma < tol.min_gamma) {
+    std::ostringstream s;
+    s << "mesh quality: min gamma " << std::setprecision(3) << c.min_gamma << " below the floor " << tol.min_gamma;
+    c.failures.push_back(s.str());
+  }
+  c.passed = c.failures.empty();
+  return c;
+}
+
+nlohmann::json to_json(const std::vector<MeshAttempt>& attempts) {
+  nlohmann::json j = nlohmann::json::array();
+  for (const auto& a : attempts) {
+    j.push_back({{"surface", a.surface},
+                 {"algorithm_2d", a.algorithm_2d},
+                 {"algorithm_3d", a.algorithm_3d},
+                 {"mesh_size_m", a.mesh_size_m},
+                 {"load_mesh_size_m", a.load_mesh_size_m},
+                 {"outcome", a.outcome}});
+  }
+  return j;
+}
+
+nlohmann::json to_json(const BodyComparison& c) {
+  using nlohmann::json;
+  const bool ref = c.part_volume_m3 > 0;
+  auto rel = [&](double x) { return ref ? json(x) : json(nullptr); };
+  return {{"fe_volume_m3", c.fe_volume_m3},
+          {"part_volume_m3", rel(c.part_volume_m3)},
+          {"volume_relative_error", rel(c.volume_relative_error)},
+          {"fe_mass_kg", c.fe_mass_kg},
+          {"part_mass_kg", rel(c.part_mass_kg)},
+          {"mass_relative_error", rel(c.mass_relative_error)},
+          {"inertia_relative_error", rel(c.inertia_relative_error)},
+          {"solver_inertia_relative_error", rel(c.solver_inertia_relative_error)},
+          {"centroid_offset_m", rel(c.centroid_offset_m)},
+          {"predicted_model_linear_velocity_error",
+           c.predicted_model_linear_velocity_error ? json(*c.predicted_model_linear_velocity_error) : json(nullptr)},
+          {"predicted_model_angular_velocity_error",
+           c.predicted_model_angular_velocity_error ? json(*c.predicted_model_angular_velocity_error) : json(nullptr)},
+          {"min_gamma", c.min_gamma},
+          {"min_radius_ratio", c.min_radius_ratio},
+          {"tolerances", {{"volume", c.tolerances.volume},
+                          {"mass", c.tolerances.mass},
+                          {"inertia", c.tolerances.inertia},
+                          {"min_gamma", c.tolerances.min_gamma}}},
+          {"passed", c.passed},
+          {"failures", c.failures}};
+}
+
+std::string format_body(const BodyComparison& c) {
+  std::ostringstream s;
+  s << std::setprecision(4);
+  if (c.part_volume_m3 > 0) {
+    s << "FE body vs the part: volume " << 100.0 * c.volume_relative_error << " %, mass "
+      << 100.0 * c.mass_relative_error << " %, inertia " << 100.0 * c.inertia_relative_error
+      << " % (tolerances " << 100.0 * c.tolerances.volume << ", " << 100.0 * c.tolerances.mass << ", "
+      << 100.0 * c.tolerances.inertia << " %); ";
+  }
+  s << "min gamma " << c.min_gamma << " (floor " << c.tolerances.min_gamma << ")\n";
+  for (const auto& f : c.failures) s << "  " << f << "\n";
+  return s.str();
+}
 
 TimeSchedule time_schedule(const DeckOptions& o, double contact_end_s) {
   TimeSchedule t;
@@ -114,41 +264,62 @@ std::string calculix_mesh_inp(const TetMesh& m) {
   return s.str();
 }
 
-std::string calculix_inp(const DeckRequest& r, const TetMesh& m) {
+std::string calculix_inp(const DeckRequest& r, const TetMesh& m, const PatchLoad* patch) {
   const DeckOptions& o = r.options;
+  const TimeSchedule ts = time_schedule(o, r.force.time_s.back());
+  const std::size_t every = output_every(o, ts, m.nodes_m.size());
   std::ostringstream s;
   s << header_lines("**", r, "CalculiX deck (ccx 2.20), run: ccx -i impact");
   s << "** Step 1: implicit direct dynamics (fixed steps; refined while the force acts) through\n"
-       "** end_time_s, probe velocities every increment. Step 2: one increment printing every node's\n"
-       "** velocity and the total mass (the momentum check). The amplitude uses TOTAL TIME and stays\n"
-       "** at its closing zero.\n";
+       "** end_time_s, probe velocities, nodal stresses S and displacements U (impact.frd) every\n"
+       "** increment" << (every > 1 ? " (every " + std::to_string(every) + "th after the contact)" : std::string()) << ".\n"
+       "** Step 2: one increment printing every node's velocity and the total mass (the momentum check).\n"
+       "** The amplitudes use TOTAL TIME and stay at their closing zero.\n";
+  if (patch) {
+    s << "** Load: the Hertz pressure of each instant's contact ellipse as nodal forces on "
+      << patch->nodes.size() << " surface nodes,\n** one amplitude per node (N), sum F(t), zero moment about the contact point.\n";
+  }
   s << "*HEADING\nimpactdeck hybrid impact " << r.impact << "\n";
   s << "*INCLUDE, INPUT=mesh.inp\n";
   s << "*MATERIAL, NAME=BODYMAT\n*ELASTIC\n" << num(r.material.youngs_modulus_Pa * kMPa) << ", "
     << num(r.material.poisson_ratio) << "\n*DENSITY\n" << num(r.material.density_kg_m3 * kTonnePerMm3) << "\n";
-  s << "*SOLID SECTION, ELSET=BODY, MATERIAL=BODYMAT\n";
-  s << "*AMPLITUDE, NAME=HERTZ, TIME=TOTAL TIME\n" << std::setprecision(15);
-  for (std::size_t i = 0; i < r.force.time_s.size(); ++i) {
-    s << num(r.force.time_s[i]) << ", " << num(r.force.force_N[i]) << "\n";
+  s << "*SOLID SECTION, ELSET=BODY, MATERIAL=BODYMAT\n" << std::setprecision(15);
+  if (patch) {
+    for (std::size_t k = 0; k < patch->nodes.size(); ++k) {
+      s << "*AMPLITUDE, NAME=P" << k + 1 << ", TIME=TOTAL TIME\n";
+      amplitude_rows(s, patch->time_s, patch->force_N[k]);
+    }
+  } else {
+    s << "*AMPLITUDE, NAME=HERTZ, TIME=TOTAL TIME\n";
+    for (std::size_t i = 0; i < r.force.time_s.size(); ++i) {
+      s << num(r.force.time_s[i]) << ", " << num(r.force.force_N[i]) << "\n";
+    }
   }
-  const TimeSchedule ts = time_schedule(o, r.force.time_s.back());
   auto step = [&](std::size_t incs, double dt, double period, const std::string& what) {
     s << "** " << what << "\n*STEP, INC=" << incs + 10 << "\n*DYNAMIC, DIRECT\n" << num(dt) << ", " << num(period) << "\n";
   };
+  auto loads_and_output = [&](std::size_t frequency) {
+    if (patch) {
+      for (std::size_t k = 0; k < patch->nodes.size(); ++k) {
+        s << "*CLOAD, AMPLITUDE=P" << k + 1 << "\n";
+        for (int c = 0; c < 3; ++c) s << patch->nodes[k] + 1 << ", " << c + 1 << ", " << num(r.direction[c]) << "\n";
+      }
+    } else {
+      s << "*CLOAD, AMPLITUDE=HERTZ\n";
+      for (int k = 0; k < 3; ++k) s << "LOAD, " << k + 1 << ", " << num(r.direction[k]) << "\n";
+    }
+    for (const auto& p : probe_groups(m)) s << "*NODE PRINT, NSET=" << p << ", FREQUENCY=" << frequency << "\nV\n";
+    s << "*NODE FILE, FREQUENCY=" << frequency << "\nU\n*EL FILE, FREQUENCY=" << frequency << "\nS\n";
+    s << "*END STEP\n";
+  };
   if (ts.pulse_increments > 0) {
     step(ts.pulse_increments, ts.pulse_step_s, ts.pulse_end_s, "Step 1a: through the end of the contact, refined");
-    s << "*CLOAD, AMPLITUDE=HERTZ\n";
-    for (int k = 0; k < 3; ++k) s << "LOAD, " << k + 1 << ", " << num(r.direction[k]) << "\n";
-    for (const auto& p : probe_groups(m)) s << "*NODE PRINT, NSET=" << p << ", FREQUENCY=1\nV\n";
-    s << "*END STEP\n";
+    loads_and_output(1);
     step(ts.main_increments, ts.main_step_s, o.end_time_s - ts.pulse_end_s, "Step 1b: free vibration through end_time_s");
   } else {
     step(ts.main_increments, ts.main_step_s, o.end_time_s, "Step 1: through end_time_s");
   }
-  s << "*CLOAD, AMPLITUDE=HERTZ\n";
-  for (int k = 0; k < 3; ++k) s << "LOAD, " << k + 1 << ", " << num(r.direction[k]) << "\n";
-  for (const auto& p : probe_groups(m)) s << "*NODE PRINT, NSET=" << p << ", FREQUENCY=1\nV\n";
-  s << "*END STEP\n";
+  loads_and_output(every);
   s << "** Step 2: one increment printing all velocities and the mass (momentum check)\n";
   s << "*STEP, INC=10\n*DYNAMIC, DIRECT\n" << num(ts.main_step_s) << ", " << num(ts.main_step_s) << "\n";
   s << "*NODE PRINT, NSET=BODYN, FREQUENCY=1\nV\n";
@@ -157,11 +328,12 @@ std::string calculix_inp(const DeckRequest& r, const TetMesh& m) {
   return s.str();
 }
 
-std::string code_aster_comm(const DeckRequest& r, const TetMesh& m) {
+std::string code_aster_comm(const DeckRequest& r, const TetMesh& m, const PatchLoad* patch) {
   const DeckOptions& o = r.options;
   std::ostringstream s;
   s << header_lines("#", r, "Code_Aster command file (DYNA_VIBRA, versions 15.x and later)");
-  s << "# Files (units): mesh.med (20), probe velocity tables (38), results MED (80); see impact.export.\n";
+  s << "# Files (units): mesh.med (20), probe velocity tables (38), von Mises at the probes and LOAD (39),\n"
+       "# results MED (80); see impact.export.\n";
   s << "DEBUT()\n\n";
   s << "MAIL = LIRE_MAILLAGE(FORMAT='MED', UNITE=20)\n\n";
   s << "MODELE = AFFE_MODELE(MAILLAGE=MAIL,\n"
@@ -170,18 +342,38 @@ std::string code_aster_comm(const DeckRequest& r, const TetMesh& m) {
     << ", NU=" << num(r.material.poisson_ratio) << ", RHO=" << num(r.material.density_kg_m3 * kTonnePerMm3)
     << "))\n\n";
   s << "CHMAT = AFFE_MATERIAU(MAILLAGE=MAIL, AFFE=_F(GROUP_MA=('BODY',), MATER=MATER))\n\n";
-  s << "# Hertz force history F(t) in N; constant extrapolation on both sides, closing zero.\n";
-  s << "FHERTZ = DEFI_FONCTION(NOM_PARA='INST',\n                      VALE=(\n";
-  for (std::size_t i = 0; i < r.force.time_s.size(); ++i) {
-    s << "                          " << num(r.force.time_s[i]) << ", " << num(r.force.force_N[i]) << ",\n";
+  auto function = [&](const std::string& name, const std::vector<double>& t, const std::vector<double>& f) {
+    s << name << " = DEFI_FONCTION(NOM_PARA='INST',\n                      VALE=(\n";
+    for (std::size_t i = 0; i < t.size(); ++i) s << "                          " << num(t[i]) << ", " << num(f[i]) << ",\n";
+    s << "                      ),\n"
+         "                      INTERPOL=('LIN', 'LIN'),\n"
+         "                      PROL_GAUCHE='CONSTANT',\n"
+         "                      PROL_DROITE='CONSTANT')\n";
+  };
+  auto force_on = [&](const std::string& name, const std::string& group) {
+    s << name << " = AFFE_CHAR_MECA(MODELE=MODELE,\n                        FORCE_NODALE=_F(GROUP_NO=('" << group
+      << "',), FX=" << num(r.direction.x()) << ", FY=" << num(r.direction.y()) << ", FZ=" << num(r.direction.z())
+      << "))\n";
+  };
+  std::string excit;
+  if (patch) {
+    s << "# Hertz-patch load: one force history (N) per surface node LPk, along the unit direction of the\n"
+         "# force; at every time the forces sum to F(t) and have no moment about the contact point.\n";
+    for (std::size_t k = 0; k < patch->nodes.size(); ++k) {
+      const std::string id = std::to_string(k + 1);
+      function("FP" + id, patch->time_s, patch->force_N[k]);
+      force_on("CP" + id, "LP" + id);
+      excit += std::string(excit.empty() ? "" : ",\n                         ") + "_F(CHARGE=CP" + id + ", FONC_MULT=FP" + id + ")";
+    }
+    s << "\n";
+  } else {
+    s << "# Hertz force history F(t) in N; constant extrapolation on both sides, closing zero.\n";
+    function("FHERTZ", r.force.time_s, r.force.force_N);
+    s << "\n# Unit direction of the force on the target (times FHERTZ).\n";
+    force_on("CHARGE", "LOAD");
+    s << "\n";
+    excit = "_F(CHARGE=CHARGE, FONC_MULT=FHERTZ)";
   }
-  s << "                      ),\n"
-       "                      INTERPOL=('LIN', 'LIN'),\n"
-       "                      PROL_GAUCHE='CONSTANT',\n"
-       "                      PROL_DROITE='CONSTANT')\n\n";
-  s << "# Unit direction of the force on the target (times FHERTZ).\n";
-  s << "CHARGE = AFFE_CHAR_MECA(MODELE=MODELE,\n                        FORCE_NODALE=_F(GROUP_NO=('LOAD',), FX="
-    << num(r.direction.x()) << ", FY=" << num(r.direction.y()) << ", FZ=" << num(r.direction.z()) << "))\n\n";
   const TimeSchedule ts = time_schedule(o, r.force.time_s.back());
   s << "# Time steps: refined through the end of the contact, then the main step.\n";
   s << "LINST = DEFI_LIST_REEL(DEBUT=0.0,\n                       INTERVALLE=(";
@@ -203,8 +395,8 @@ std::string code_aster_comm(const DeckRequest& r, const TetMesh& m) {
        "                  MATR_RIGI=RIGI,\n"
        "                  SCHEMA_TEMPS=_F(SCHEMA='NEWMARK', BETA=0.25, GAMMA=0.5),\n"
        "                  INCREMENT=_F(LIST_INST=LINST),\n"
-       "                  EXCIT=_F(CHARGE=CHARGE, FONC_MULT=FHERTZ))\n\n";
-  s << "# Von Mises stress (component VMIS); singular at the load node itself (point force).\n";
+       "                  EXCIT=(" << excit << "))\n\n";
+  s << "# Von Mises stress (component VMIS)" << (patch ? "" : "; singular at the load node itself (point force)") << ".\n";
   s << "RESU = CALC_CHAMP(reuse=RESU,\n"
        "                  RESULTAT=RESU,\n"
        "                  CONTRAINTE=('SIGM_ELNO',),\n"
@@ -224,6 +416,18 @@ std::string code_aster_comm(const DeckRequest& r, const TetMesh& m) {
     }
     s << "))\n\n";
   }
+  s << "# Von Mises (MPa) against time at each probe and at LOAD (unit 39).\n";
+  std::vector<std::string> at = probes;
+  at.push_back("LOAD");
+  for (std::size_t i = 0; i < at.size(); ++i) {
+    const std::string f = i + 1 == at.size() ? "VMLOAD" : "VM" + std::to_string(i + 1);
+    s << f << " = RECU_FONCTION(RESULTAT=RESU, NOM_CHAM='SIEQ_NOEU', NOM_CMP='VMIS', GROUP_NO=('" << at[i] << "',))\n";
+  }
+  s << "IMPR_FONCTION(FORMAT='TABLEAU', UNITE=39,\n              COURBE=(";
+  for (std::size_t i = 0; i < at.size(); ++i) {
+    s << (i ? ", " : "") << "_F(FONCTION=" << (i + 1 == at.size() ? std::string("VMLOAD") : "VM" + std::to_string(i + 1)) << ")";
+  }
+  s << "))\n\n";
   s << "IMPR_RESU(FORMAT='MED', UNITE=80,\n"
        "          RESU=_F(RESULTAT=RESU, NOM_CHAM=('DEPL', 'VITE', 'SIEQ_NOEU')))\n\n";
   s << "FIN()\n";
@@ -245,6 +449,7 @@ std::string code_aster_export(const DeckRequest& r, const TetMesh& m) {
     << "F mess " << kJobName << ".mess R 6\n"
     << "F resu " << kJobName << ".resu R 8\n"
     << "F libr " << kJobName << "_probes.txt R 38\n"
+    << "F libr " << kJobName << "_von_mises.txt R 39\n"
     << "F rmed " << kJobName << "_results.rmed R 80\n";
   return s.str();
 }
@@ -261,25 +466,110 @@ DeckResult write_decks(const DeckRequest& r, const fs::path& folder) {
 
   DeckResult out;
   try {
+    // The mesh options this request needs: a hertz-patch load refines the surface so the largest
+    // contact ellipse spans contact_elements elements along its short axis, evenly over the patch.
+    MeshOptions mo = r.options.mesh;
+    mo.quality_floor_gamma = r.options.tolerances.min_gamma;
+    if (r.options.load == LoadKind::hertz_patch) {
+      const double h_patch = 2.0 * r.patch.b_max_m / r.options.contact_elements;
+      const double h0 = mo.load_mesh_size_m > 0 ? mo.load_mesh_size_m : mo.mesh_size_m / 3.0;
+      mo.load_mesh_size_m = std::min({h0, h_patch, mo.mesh_size_m});
+      mo.load_zone_radius_m = std::max(mo.load_zone_radius_m, 1.25 * r.patch.a_max_m);
+    }
     const auto t_mesh = std::chrono::steady_clock::now();
-    MeshResult mr = r.body.kind == BodyKind::ellipsoid
-                        ? mesh_ellipsoid(r.body.semi_axes_m, r.load_point_m, r.options.mesh, stage, "mesh")
-                    : r.body.kind == BodyKind::cad
-                        ? mesh_cad(r.body.stl, r.body.stl_unit_m, r.load_point_m, r.options.mesh, stage, "mesh")
-                        : mesh_stl(r.body.stl, r.body.stl_unit_m, r.load_point_m, r.options.mesh, stage, "mesh");
+    auto mesh_once = [&] {
+      switch (r.body.kind) {
+        case BodyKind::ellipsoid: return mesh_ellipsoid(r.body.semi_axes_m, r.load_point_m, mo, stage, "mesh");
+        case BodyKind::cad: return mesh_cad(r.body.cad, r.body.cad_unit_m, r.load_point_m, mo, stage, "mesh");
+        case BodyKind::part: break;
+      }
+      return mesh_part(r.body.surface, r.load_point_m, mo, stage, "mesh", r.body.name);
+    };
+    MeshResult mr = mesh_once();
+    if (r.options.adapt_mesh_size && r.model.volume_m3 > 0) {
+      // A default size: refine until the FE body matches the part to half the tolerances.
+      const FemTolerances& tol = r.options.tolerances;
+      std::vector<MeshAttempt> coarser;
+      for (int k = 0; k < DeckOptions::kMaxSizeRefinements; ++k) {
+        const BodyComparison bc =
+            compare_body(mr.mesh, r.material.density_kg_m3, r.model, tol, r.impulse_Ns * r.direction, r.load_point_m);
+        const double inertia = std::max(bc.inertia_relative_error, bc.solver_inertia_relative_error);
+        const double lin = bc.predicted_model_linear_velocity_error.value_or(0);
+        const double ang = bc.predicted_model_angular_velocity_error.value_or(0);
+        if (bc.volume_relative_error <= 0.5 * tol.volume && inertia <= 0.5 * tol.inertia &&
+            lin <= 0.5 * tol.model_linear_velocity && ang <= 0.5 * tol.model_angular_velocity) {
+          break;
+        }
+        std::ostringstream why;
+        why << std::setprecision(3) << "default size too coarse: FE volume " << 100 * bc.volume_relative_error
+            << " %, inertia " << 100 * inertia << " %, predicted velocity " << 100 * lin << " % and spin "
+            << 100 * ang << " % off the rigid model (more than half a tolerance): size / sqrt(2)";
+        for (auto a : mr.quality.attempts) {
+          if (a.outcome == "ok") a.outcome = why.str();
+          coarser.push_back(a);
+        }
+        mo.mesh_size_m /= std::sqrt(2.0);
+        if (mo.load_mesh_size_m > mo.mesh_size_m) mo.load_mesh_size_m = mo.mesh_size_m;
+        mr = mesh_once();
+      }
+      mr.quality.attempts.insert(mr.quality.attempts.begin(), coarser.begin(), coarser.end());
+    }
     out.mesh_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_mesh).count();
-    const TetMesh& m = mr.mesh;
+    TetMesh& m = mr.mesh;
+    const MeshQuality& q = mr.quality;
+    out.load = r.options.load;
+    std::optional<PatchLoad> patch;
+    if (r.options.load == LoadKind::hertz_patch) {
+      auto compute = [&] {
+        try {
+          patch = hertz_patch_load(mr.mesh, mr.mesh.node_of("LOAD"), r.direction, r.patch, r.force);
+        } catch (const InputError& e) {
+          throw InputError(where, "load", e.place() + ": " + e.reason());
+        }
+      };
+      compute();
+      // Gmsh's edges come out near, not below, the size asked for: until the largest ellipse
+      // spans contact_elements elements, mesh again with the load size scaled by what is missing
+      // (twice at most; not when the part's own triangles are the boundary, they do not refine).
+      for (int k = 0; k < 2 && patch->largest_ellipse_elements < r.options.contact_elements &&
+                      mr.quality.attempts.back().surface != "part triangles";
+           ++k) {
+        mo.load_mesh_size_m *= 0.95 * patch->largest_ellipse_elements / r.options.contact_elements;
+        const auto t_again = std::chrono::steady_clock::now();
+        std::vector<MeshAttempt> before = mr.quality.attempts;
+        before.back().outcome = "the largest contact ellipse spans " + std::to_string(patch->largest_ellipse_elements) +
+                                " elements: smaller load size";
+        mr = mesh_once();
+        mr.quality.attempts.insert(mr.quality.attempts.begin(), before.begin(), before.end());
+        out.mesh_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t_again).count();
+        compute();
+      }
+      for (std::size_t k = 0; k < patch->nodes.size(); ++k) {
+        m.node_groups.emplace_back("LP" + std::to_string(k + 1), patch->nodes[k]);
+      }
+      out.patch = {patch->nodes.size(), patch->max_nodes_loaded_at_once, patch->patch_triangles,
+                   patch->largest_ellipse_elements, patch->point_load_samples, patch->max_sum_relative_error,
+                   patch->max_moment_relative};
+    } else {
+      out.patch.load_node_count = 1;
+      out.patch.max_nodes_loaded_at_once = 1;
+    }
+    out.contact_zone_radius_m = std::max(r.options.contact_zone_factor * r.patch.a_max_m, 2.0 * q.load_mesh_size_m);
+    out.body_check = compare_body(m, r.material.density_kg_m3, r.model, r.options.tolerances,
+                                  r.impulse_Ns * r.direction, r.load_point_m);
+    const PatchLoad* pl = patch ? &*patch : nullptr;
+
     std::vector<std::string> names = {"mesh.geo", "mesh.msh", "mesh_v22.msh"};
-    if (r.body.kind == BodyKind::stl) names.push_back("mesh_part.stl");
-    if (r.body.kind == BodyKind::cad) names.push_back("mesh_part" + r.body.stl.extension().string());
+    if (r.body.kind == BodyKind::part) names.push_back("mesh_part.stl");
+    if (r.body.kind == BodyKind::cad) names.push_back("mesh_part" + r.body.cad.extension().string());
     if (r.options.calculix) {
       write_file_atomically(stage / "mesh.inp", calculix_mesh_inp(m));
-      write_file_atomically(stage / (std::string(kJobName) + ".inp"), calculix_inp(r, m));
+      write_file_atomically(stage / (std::string(kJobName) + ".inp"), calculix_inp(r, m, pl));
       names.insert(names.end(), {"mesh.inp", std::string(kJobName) + ".inp"});
     }
     if (r.options.code_aster) {
       write_med(m, stage / "mesh.med", kMedMesh);
-      write_file_atomically(stage / (std::string(kJobName) + ".comm"), code_aster_comm(r, m));
+      write_file_atomically(stage / (std::string(kJobName) + ".comm"), code_aster_comm(r, m, pl));
       write_file_atomically(stage / (std::string(kJobName) + ".export"), code_aster_export(r, m));
       names.insert(names.end(), {"mesh.med", std::string(kJobName) + ".comm", std::string(kJobName) + ".export"});
     }
@@ -292,20 +582,25 @@ DeckResult write_decks(const DeckRequest& r, const fs::path& folder) {
 
     using nlohmann::json;
     auto v3 = [](const Eigen::Vector3d& v) { return json::array({v.x() + 0.0, v.y() + 0.0, v.z() + 0.0}); };
-    const MeshQuality& q = mr.quality;
+    auto m3 = [&](const Eigen::Matrix3d& a) { return json::array({v3(a.row(0)), v3(a.row(1)), v3(a.row(2))}); };
     json quality = {{"node_count", q.node_count},
                     {"tet_count", q.tet_count},
                     {"min_quality", q.min_quality},
                     {"mean_quality", q.mean_quality},
                     {"quality_measure", "radius ratio 3 r_in / r_circ (1 = regular tetrahedron)"},
+                    {"min_gamma", q.min_gamma},
+                    {"mean_gamma", q.mean_gamma},
+                    {"gamma_measure", "Gmsh's gamma 2 sqrt(6) r_in / l_max (1 = regular tetrahedron)"},
                     {"fe_volume_m3", q.fe_volume_m3},
                     {"part_volume_m3", q.part_volume_m3},
                     {"volume_relative_difference", q.volume_relative_difference},
                     {"load_node_distance_m", q.load_node_distance_m},
                     {"probe_node_distance_m", q.probe_node_distance_m},
-                    {"mesh_size_m", r.options.mesh.mesh_size_m},
-                    {"load_mesh_size_m", r.options.mesh.load_mesh_size_m > 0 ? r.options.mesh.load_mesh_size_m
-                                                                             : r.options.mesh.mesh_size_m / 3}};
+                    {"mesh_size_m", q.mesh_size_m},
+                    {"load_mesh_size_m", q.load_mesh_size_m},
+                    {"load_zone_radius_m", mo.load_zone_radius_m},
+                    {"mesh_attempts", to_json(q.attempts)},
+                    {"fallback_used", q.attempts.size() > 1}};
     write_file_atomically(stage / "mesh_quality.json", quality.dump(2) + "\n");
     names.push_back("mesh_quality.json");
 
@@ -313,27 +608,65 @@ DeckResult write_decks(const DeckRequest& r, const fs::path& folder) {
     for (const auto& [g, n] : m.node_groups) {
       if (g.rfind("PROBE", 0) == 0) probes.push_back({{"name", g}, {"node", n + 1}, {"point_m", v3(m.nodes_m[n])}});
     }
+    const FemTolerances& t = r.options.tolerances;
+    json patch_json = {{"a_max_m", r.patch.a_max_m},
+                       {"b_max_m", r.patch.b_max_m},
+                       {"axis_a", v3(r.patch.axis_a)},
+                       {"max_force_N", r.patch.max_force_N},
+                       {"max_pressure_Pa", 3.0 * r.patch.max_force_N / (2.0 * M_PI * r.patch.a_max_m * r.patch.b_max_m)}};
+    if (pl) {
+      patch_json["contact_elements"] = r.options.contact_elements;
+      patch_json["largest_ellipse_elements"] = pl->largest_ellipse_elements;
+      patch_json["patch_triangles"] = pl->patch_triangles;
+      patch_json["max_nodes_loaded_at_once"] = pl->max_nodes_loaded_at_once;
+      patch_json["point_load_samples"] = pl->point_load_samples;
+      patch_json["max_sum_relative_error"] = pl->max_sum_relative_error;
+      patch_json["max_moment_relative"] = pl->max_moment_relative;
+    }
+    const TimeSchedule ts = time_schedule(r.options, r.force.time_s.back());
     names.push_back("deck.json");
     json deck = {{"impactdeck_version", kVersion},
                  {"source", r.source},
                  {"impact", r.impact},
                  {"job", kJobName},
                  {"deck_units", "mm-N-s-tonne"},
+                 {"frame", "target"},
                  {"impulse_Ns", r.impulse_Ns},
                  {"direction", v3(r.direction)},
+                 {"load", to_string(r.options.load)},
+                 {"load_node_count", out.patch.load_node_count},
                  {"load_point_m", v3(r.load_point_m)},
                  {"load_node", m.node_of("LOAD") + 1},
                  {"load_node_point_m", v3(m.nodes_m[m.node_of("LOAD")])},
+                 {"contact_patch", patch_json},
+                 {"contact_zone_radius_m", out.contact_zone_radius_m},
+                 {"contact_zone_factor", r.options.contact_zone_factor},
                  {"contact_end_s", r.force.time_s.back()},
                  {"end_time_s", r.options.end_time_s},
                  {"time_step_s", r.options.time_step_s},
-                 {"pulse_increments", time_schedule(r.options, r.force.time_s.back()).pulse_increments},
+                 {"pulse_increments", ts.pulse_increments},
+                 {"stress_output_every_increments", output_every(r.options, ts, m.nodes_m.size())},
                  {"youngs_modulus_Pa", r.material.youngs_modulus_Pa},
                  {"poisson_ratio", r.material.poisson_ratio},
                  {"density_kg_m3", r.material.density_kg_m3},
+                 {"yield_strength_Pa", r.yield_strength_Pa ? json(*r.yield_strength_Pa) : json(nullptr)},
                  {"probes", probes},
                  {"calculix", r.options.calculix},
                  {"code_aster", r.options.code_aster},
+                 {"model", {{"mass_kg", r.model.mass_kg},
+                            {"volume_m3", r.model.volume_m3},
+                            {"centroid_m", v3(r.model.centroid_m)},
+                            {"inertia_kg_m2", m3(r.model.inertia_kg_m2)},
+                            {"delta_velocity_m_s", v3(r.model.delta_velocity_m_s)},
+                            {"delta_angular_velocity_rad_s", v3(r.model.delta_angular_velocity_rad_s)}}},
+                 {"tolerances", {{"linear_momentum", t.linear_momentum},
+                                 {"angular_momentum", t.angular_momentum},
+                                 {"model_linear_velocity", t.model_linear_velocity},
+                                 {"model_angular_velocity", t.model_angular_velocity},
+                                 {"volume", t.volume},
+                                 {"mass", t.mass},
+                                 {"inertia", t.inertia},
+                                 {"min_gamma", t.min_gamma}}},
                  {"mesh", quality},
                  {"files", names}};
     write_file_atomically(stage / "deck.json", deck.dump(2) + "\n");

@@ -75,33 +75,34 @@ std::string fmt(double v) {
   return s.str();
 }
 
-// The mesh-size field: size h0 at the load point growing linearly to h at distance 4 h.
-std::string size_formula(const Eigen::Vector3d& p_mm, double h0_mm, double h_mm) {
+// The mesh-size field: size h0 within r0 of the load point, then growing with slope
+// (h - h0) / (4 h) up to h (r0 = 0: h0 growing linearly to h at distance 4 h).
+std::string size_formula(const Eigen::Vector3d& p_mm, double h0_mm, double h_mm, double r0_mm) {
   std::ostringstream f;
   f.precision(17);
-  f << h0_mm << " + (" << h_mm - h0_mm << ") * Min(1, Sqrt((x - (" << p_mm.x() << "))^2 + (y - ("
-    << p_mm.y() << "))^2 + (z - (" << p_mm.z() << "))^2) / " << 4.0 * h_mm << ")";
+  f << "Min(" << h_mm << ", " << h0_mm << " + " << (h_mm - h0_mm) / (4.0 * h_mm) << " * Max(0, Sqrt((x - ("
+    << p_mm.x() << "))^2 + (y - (" << p_mm.y() << "))^2 + (z - (" << p_mm.z() << "))^2) - " << r0_mm << "))";
   return f.str();
 }
 
-void set_common_options(double h_mm, int algorithm_3d) {
+void set_common_options(double h_mm, int algorithm_2d, int algorithm_3d) {
   gmsh::option::setNumber("Mesh.CharacteristicLengthMax", h_mm);
   gmsh::option::setNumber("Mesh.CharacteristicLengthFromPoints", 0);
   gmsh::option::setNumber("Mesh.CharacteristicLengthFromCurvature", 0);
   gmsh::option::setNumber("Mesh.CharacteristicLengthExtendFromBoundary", 0);
-  gmsh::option::setNumber("Mesh.Algorithm", 1);     // MeshAdapt: the dilated OCC sphere (DECKS.md)
+  gmsh::option::setNumber("Mesh.Algorithm", algorithm_2d);
   gmsh::option::setNumber("Mesh.Algorithm3D", algorithm_3d);
   gmsh::option::setNumber("Mesh.ElementOrder", 1);
   gmsh::option::setNumber("Mesh.Optimize", 1);
 }
 
-std::string geo_options(double h_mm, int algorithm_3d) {
+std::string geo_options(double h_mm, int algorithm_2d, int algorithm_3d) {
   std::ostringstream g;
   g << "Mesh.CharacteristicLengthMax = " << fmt(h_mm) << ";\n"
     << "Mesh.CharacteristicLengthFromPoints = 0;\n"
     << "Mesh.CharacteristicLengthFromCurvature = 0;\n"
     << "Mesh.CharacteristicLengthExtendFromBoundary = 0;\n"
-    << "Mesh.Algorithm = 1;    // MeshAdapt\n"
+    << "Mesh.Algorithm = " << algorithm_2d << "; // 1 MeshAdapt, 5 Delaunay, 6 Frontal-Delaunay\n"
     << "Mesh.Algorithm3D = " << algorithm_3d << "; // 1 Delaunay, 10 HXT\n"
     << "Mesh.ElementOrder = 1;\n"
     << "Mesh.Optimize = 1;\n"
@@ -109,9 +110,9 @@ std::string geo_options(double h_mm, int algorithm_3d) {
   return g.str();
 }
 
-int add_size_field(const Eigen::Vector3d& p_mm, double h0_mm, double h_mm) {
+int add_size_field(const Eigen::Vector3d& p_mm, double h0_mm, double h_mm, double r0_mm) {
   const int f = gmsh::model::mesh::field::add("MathEval");
-  gmsh::model::mesh::field::setString(f, "F", size_formula(p_mm, h0_mm, h_mm));
+  gmsh::model::mesh::field::setString(f, "F", size_formula(p_mm, h0_mm, h_mm, r0_mm));
   gmsh::model::mesh::field::setAsBackgroundMesh(f);
   return f;
 }
@@ -119,11 +120,11 @@ int add_size_field(const Eigen::Vector3d& p_mm, double h0_mm, double h_mm) {
 std::string probe_name(std::size_t i) { return "PROBE" + std::to_string(i + 1); }
 
 // Size field around the load point, then the 3D mesh (both routes).
-void generate_tets(const std::string& where, const MeshOptions& o, const Eigen::Vector3d& p_mm, double h0,
-                   double h) {
+void generate_tets(const std::string& where, const MeshOptions& o, int algorithm_2d, const Eigen::Vector3d& p_mm,
+                   double h0, double h) {
   gmsh_step(where, "mesh", [&] {
-    set_common_options(h, o.algorithm_3d);
-    add_size_field(p_mm, h0, h);
+    set_common_options(h, algorithm_2d, o.algorithm_3d);
+    add_size_field(p_mm, h0, h, o.load_zone_radius_m * kMmPerM);
     gmsh::model::mesh::generate(3);
   });
 }
@@ -137,26 +138,26 @@ void add_probe_groups(const std::vector<int>& probe_tags) {
 
 // Probe points embedded in volume 1 (numbered from 1000) and their physical groups PROBEk: the
 // same in both .geo routes.
-std::string geo_probe_points(const MeshOptions& o) {
+std::string geo_probe_points(const MeshOptions& o, int first_tag = 1000) {
   std::ostringstream g;
   for (std::size_t i = 0; i < o.probes_m.size(); ++i) {
     const Eigen::Vector3d pm = o.probes_m[i] * kMmPerM;
-    g << "Point(" << 1000 + i << ") = {" << fmt(pm.x()) << ", " << fmt(pm.y()) << ", " << fmt(pm.z())
-      << "};\nPoint{" << 1000 + i << "} In Volume{1};\n";
+    g << "Point(" << first_tag + i << ") = {" << fmt(pm.x()) << ", " << fmt(pm.y()) << ", " << fmt(pm.z())
+      << "};\nPoint{" << first_tag + i << "} In Volume{1};\n";
   }
   return g.str();
 }
 
-std::string geo_probe_groups(const MeshOptions& o) {
+std::string geo_probe_groups(const MeshOptions& o, int first_tag = 1000) {
   std::ostringstream g;
   for (std::size_t i = 0; i < o.probes_m.size(); ++i) {
-    g << "Physical Point(\"" << probe_name(i) << "\") = {" << 1000 + i << "};\n";
+    g << "Physical Point(\"" << probe_name(i) << "\") = {" << first_tag + i << "};\n";
   }
   return g.str();
 }
 
-std::string geo_size_field(const Eigen::Vector3d& p_mm, double h0_mm, double h_mm) {
-  return "Field[1] = MathEval;\nField[1].F = \"" + size_formula(p_mm, h0_mm, h_mm) +
+std::string geo_size_field(const Eigen::Vector3d& p_mm, double h0_mm, double h_mm, double r0_mm) {
+  return "Field[1] = MathEval;\nField[1].F = \"" + size_formula(p_mm, h0_mm, h_mm, r0_mm) +
          "\";\nBackground Field = 1;\n";
 }
 
@@ -168,6 +169,12 @@ void check_options(const MeshOptions& o, const std::string& where) {
     throw InputError(where, "load_mesh_size", "must be >= 0");
   }
   if (o.algorithm_3d != 1 && o.algorithm_3d != 10) throw InputError(where, "algorithm_3d", "must be 1 or 10");
+  if (o.algorithm_2d != 0 && o.algorithm_2d != 1 && o.algorithm_2d != 5 && o.algorithm_2d != 6) {
+    throw InputError(where, "algorithm_2d", "must be 0 (default), 1, 5 or 6");
+  }
+  if (o.load_zone_radius_m < 0.0 || !std::isfinite(o.load_zone_radius_m)) {
+    throw InputError(where, "load_zone_radius", "must be >= 0");
+  }
   if (o.probes_m.size() > 99) throw InputError(where, "probes", "at most 99 probes");
 }
 
@@ -221,17 +228,33 @@ int node_of_point_entity(int point_tag, const std::map<std::size_t, int>& index,
   return index.at(tags[0]);
 }
 
+// Node groups LOAD (node `load`) and PROBEk (the nodes on the embedded probe points), with their
+// distances to the requested points (both routes).
+void add_node_groups(MeshResult& r, int load, const Eigen::Vector3d& p_mm, const std::vector<int>& probe_tags,
+                     const std::map<std::size_t, int>& index, const MeshOptions& o, const std::string& where) {
+  r.mesh.node_groups.emplace_back("LOAD", load);
+  r.quality.load_node_distance_m = (r.mesh.nodes_m[load] * kMmPerM - p_mm).norm() / kMmPerM;
+  for (std::size_t i = 0; i < probe_tags.size(); ++i) {
+    const int pn = node_of_point_entity(probe_tags[i], index, where, probe_name(i));
+    r.mesh.node_groups.emplace_back(probe_name(i), pn);
+    r.quality.probe_node_distance_m.push_back((r.mesh.nodes_m[pn] - o.probes_m[i]).norm());
+  }
+}
+
 void fill_quality(const TetMesh& m, MeshQuality& q) {
   q.node_count = m.nodes_m.size();
   q.tet_count = m.tets.size();
-  q.min_quality = 1.0;
-  double sum = 0;
+  q.min_quality = q.min_gamma = 1.0;
+  double sum = 0, gsum = 0;
   for (std::size_t e = 0; e < m.tets.size(); ++e) {
-    const double g = tet_quality(m, e);
-    q.min_quality = std::min(q.min_quality, g);
-    sum += g;
+    const double rr = tet_quality(m, e), g = tet_gamma(m, e);
+    q.min_quality = std::min(q.min_quality, rr);
+    q.min_gamma = std::min(q.min_gamma, g);
+    sum += rr;
+    gsum += g;
   }
   q.mean_quality = sum / static_cast<double>(m.tets.size());
+  q.mean_gamma = gsum / static_cast<double>(m.tets.size());
   q.fe_volume_m3 = m.volume_m3();
   q.volume_relative_difference = (q.fe_volume_m3 - q.part_volume_m3) / q.part_volume_m3;
 }
@@ -256,23 +279,22 @@ void write_msh(const fs::path& folder, const std::string& name, MeshResult& r) {
 }
 
 // After meshing a body whose load point and probes are geometry points (ellipsoid and CAD routes):
-// extract the tetrahedra, name LOAD and PROBEk, check the quality, write the .msh files.
+// extract the tetrahedra, name LOAD and PROBEk, check and record the quality and the attempt,
+// write the .msh files.
 void finish_point_mesh(const std::string& where, const MeshOptions& o, const fs::path& folder,
                        const std::string& name, int load_tag, const std::vector<int>& probe_tags,
-                       const Eigen::Vector3d& p_mm, MeshResult& r) {
+                       const Eigen::Vector3d& p_mm, double h0_mm, int algorithm_2d, const char* route,
+                       MeshResult& r) {
+  std::map<std::size_t, int> index;
   gmsh_step(where, "mesh", [&] {
-    const std::map<std::size_t, int> index = extract(r.mesh, where);
-    const int ln = node_of_point_entity(load_tag, index, where, "LOAD");
-    r.mesh.node_groups.emplace_back("LOAD", ln);
-    r.quality.load_node_distance_m = (r.mesh.nodes_m[ln] * kMmPerM - p_mm).norm() / kMmPerM;
-    for (std::size_t i = 0; i < probe_tags.size(); ++i) {
-      const int pn = node_of_point_entity(probe_tags[i], index, where, probe_name(i));
-      r.mesh.node_groups.emplace_back(probe_name(i), pn);
-      r.quality.probe_node_distance_m.push_back((r.mesh.nodes_m[pn] - o.probes_m[i]).norm());
-    }
+    index = extract(r.mesh, where);
+    add_node_groups(r, node_of_point_entity(load_tag, index, where, "LOAD"), p_mm, probe_tags, index, o, where);
   });
   fill_quality(r.mesh, r.quality);
   check_mesh(r, where);
+  r.quality.mesh_size_m = o.mesh_size_m;
+  r.quality.load_mesh_size_m = h0_mm / kMmPerM;
+  r.quality.attempts.push_back({route, algorithm_2d, o.algorithm_3d, o.mesh_size_m, h0_mm / kMmPerM, "ok"});
   gmsh_step(where, "write", [&] { write_msh(folder, name, r); });
 }
 
@@ -344,13 +366,14 @@ MeshResult mesh_ellipsoid_with_gmsh(const Eigen::Vector3d& semi_axes_m, const Ei
     gmsh::model::setPhysicalName(0, gmsh::model::addPhysicalGroup(0, {load_tag}), "LOAD");
     add_probe_groups(probe_tags);
   });
-  generate_tets(where, o, p_mm, h0, h);
-  finish_point_mesh(where, o, folder, name, load_tag, probe_tags, p_mm, r);
+  const int alg2 = o.algorithm_2d ? o.algorithm_2d : 1;  // MeshAdapt: the dilated OCC sphere (DECKS.md)
+  generate_tets(where, o, alg2, p_mm, h0, h);
+  finish_point_mesh(where, o, folder, name, load_tag, probe_tags, p_mm, h0, alg2, "analytic", r);
 
   std::ostringstream g;
   g << geo_header("ellipsoid " + fmt(ax.x()) + " x " + fmt(ax.y()) + " x " + fmt(ax.z()) +
                   " mm (semi-axes), load point at a sphere pole");
-  g << "SetFactory(\"OpenCASCADE\");\n" << geo_options(h, o.algorithm_3d);
+  g << "SetFactory(\"OpenCASCADE\");\n" << geo_options(h, alg2, o.algorithm_3d);
   g << "Sphere(1) = {0, 0, 0, 1};\n";
   if (angle > 1e-14) {
     g << "Rotate {{" << fmt(axis.x()) << ", " << fmt(axis.y()) << ", " << fmt(axis.z())
@@ -363,7 +386,7 @@ MeshResult mesh_ellipsoid_with_gmsh(const Eigen::Vector3d& semi_axes_m, const Ei
     << fmt(p_mm.z() - e) << ", " << fmt(p_mm.x() + e) << ", " << fmt(p_mm.y() + e) << ", "
     << fmt(p_mm.z() + e) << "};\n";
   g << geo_probe_points(o);
-  g << geo_size_field(p_mm, h0, h);
+  g << geo_size_field(p_mm, h0, h, o.load_zone_radius_m * kMmPerM);
   g << "Physical Volume(\"BODY\") = {1};\nPhysical Point(\"LOAD\") = {load()};\n";
   g << geo_probe_groups(o);
   r.geo = folder / (name + ".geo");
@@ -371,127 +394,355 @@ MeshResult mesh_ellipsoid_with_gmsh(const Eigen::Vector3d& semi_axes_m, const Ei
   return r;
 }
 
-MeshResult mesh_stl_with_gmsh(const fs::path& stl, double stl_unit_m, const Eigen::Vector3d& load_point_m,
-                    const MeshOptions& o, const fs::path& folder, const std::string& name) {
-  const std::string where = stl.string();
+namespace {
+
+// Tags of the geometry points the part route adds (above any tag createGeometry hands out).
+constexpr int kLoadPointTag = 100000;
+constexpr int kFirstProbeTag = 100001;
+
+// The part surface as ASCII STL in mm with 17 significant digits: Gmsh reads it back exactly.
+std::string part_stl(const PartSurface& s) {
+  std::ostringstream o;
+  o.precision(17);
+  o << "solid part\n";
+  for (const auto& t : s.triangles) {
+    const Eigen::Vector3d a = s.vertices_m[t[0]] * kMmPerM, b = s.vertices_m[t[1]] * kMmPerM,
+                          c = s.vertices_m[t[2]] * kMmPerM;
+    Eigen::Vector3d n = (b - a).cross(c - a);
+    if (n.norm() > 0) n.normalize();
+    o << "facet normal " << n.x() << " " << n.y() << " " << n.z() << "\n outer loop\n";
+    for (const Eigen::Vector3d* v : {&a, &b, &c}) o << "  vertex " << v->x() << " " << v->y() << " " << v->z() << "\n";
+    o << " endloop\nendfacet\n";
+  }
+  o << "endsolid part\n";
+  return o.str();
+}
+
+// Volume enclosed by the outward surface (divergence theorem about the first vertex).
+double enclosed_volume_m3(const PartSurface& s) {
+  const Eigen::Vector3d o = s.vertices_m.front();
+  double v6 = 0;
+  for (const auto& t : s.triangles) {
+    v6 += (s.vertices_m[t[0]] - o).dot((s.vertices_m[t[1]] - o).cross(s.vertices_m[t[2]] - o));
+  }
+  return v6 / 6.0;
+}
+
+// Winding number of the closed surface around q (1 inside, 0 outside; van Oosterom-Strackee).
+double winding_number(const PartSurface& s, const Eigen::Vector3d& q) {
+  double w = 0;
+  for (const auto& t : s.triangles) {
+    const Eigen::Vector3d a = s.vertices_m[t[0]] - q, b = s.vertices_m[t[1]] - q, c = s.vertices_m[t[2]] - q;
+    const double la = a.norm(), lb = b.norm(), lc = c.norm();
+    const double num = a.dot(b.cross(c));
+    const double den = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
+    w += 2.0 * std::atan2(num, den);
+  }
+  return w / (4.0 * kPi);
+}
+
+void check_part_surface(const PartSurface& s, const std::string& where) {
+  if (s.triangles.empty() || s.vertices_m.empty()) throw InputError(where, "part surface", "no triangles");
+  for (const auto& v : s.vertices_m) {
+    if (!v.allFinite()) throw InputError(where, "part surface", "a vertex is not finite");
+  }
+  const int n = static_cast<int>(s.vertices_m.size());
+  for (const auto& t : s.triangles) {
+    for (int k : t) {
+      if (k < 0 || k >= n) throw InputError(where, "part surface", "a triangle names a vertex that does not exist");
+    }
+  }
+}
+
+// The part surface with a vertex exactly at p (a point on it): an existing vertex within
+// 1e-9 of the size, else the nearest triangle split in three, or its edge (and the neighbour
+// across it) split in two when p lies close to that edge (barycentric coordinate < 0.05, which
+// would give a sliver). Returns the vertex index in `at`.
+PartSurface with_vertex_at(const PartSurface& s, const Eigen::Vector3d& p, double size, int& at) {
+  PartSurface r = s;
+  std::size_t best = 0;
+  double best_d = 1e300;
+  Eigen::Vector3d bary(1, 0, 0);
+  for (std::size_t t = 0; t < s.triangles.size(); ++t) {
+    const Eigen::Vector3d a = s.vertices_m[s.triangles[t][0]], b = s.vertices_m[s.triangles[t][1]],
+                          c = s.vertices_m[s.triangles[t][2]];
+    // Closest point on the triangle (Ericson, Real-Time Collision Detection, 5.1.5).
+    const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
+    const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+    Eigen::Vector3d w;
+    const Eigen::Vector3d bp = p - b, cp = p - c;
+    const double d3 = ab.dot(bp), d4 = ac.dot(bp), d5 = ab.dot(cp), d6 = ac.dot(cp);
+    const double va = d3 * d6 - d5 * d4, vb = d5 * d2 - d1 * d6, vc = d1 * d4 - d3 * d2;
+    if (d1 <= 0 && d2 <= 0) w = {1, 0, 0};
+    else if (d3 >= 0 && d4 <= d3) w = {0, 1, 0};
+    else if (d6 >= 0 && d5 <= d6) w = {0, 0, 1};
+    else if (vc <= 0 && d1 >= 0 && d3 <= 0) w = {1 - d1 / (d1 - d3), d1 / (d1 - d3), 0};
+    else if (vb <= 0 && d2 >= 0 && d6 <= 0) w = {1 - d2 / (d2 - d6), 0, d2 / (d2 - d6)};
+    else if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+      const double x = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+      w = {0, 1 - x, x};
+    } else {
+      const double den = 1.0 / (va + vb + vc);
+      w = {va * den, vb * den, vc * den};
+    }
+    const double d = (w[0] * a + w[1] * b + w[2] * c - p).norm();
+    if (d < best_d) best_d = d, best = t, bary = w;
+  }
+  const std::array<int, 3> T = s.triangles[best];
+  for (int k = 0; k < 3; ++k) {
+    if ((s.vertices_m[T[k]] - p).norm() <= 1e-9 * size) {
+      at = T[k];
+      return r;
+    }
+  }
+  at = static_cast<int>(r.vertices_m.size());
+  r.vertices_m.push_back(p);
+  int k_min = 0;
+  for (int k = 1; k < 3; ++k) {
+    if (bary[k] < bary[k_min]) k_min = k;
+  }
+  if (bary[k_min] >= 0.05) {
+    r.triangles[best] = {T[0], T[1], at};
+    r.triangles.push_back({T[1], T[2], at});
+    r.triangles.push_back({T[2], T[0], at});
+    return r;
+  }
+  // Split the edge opposite corner k_min, in this triangle and in its neighbour across it.
+  const int e0 = T[(k_min + 1) % 3], e1 = T[(k_min + 2) % 3], apex = T[k_min];
+  r.triangles[best] = {apex, e0, at};
+  r.triangles.push_back({apex, at, e1});
+  for (std::size_t t = 0; t < s.triangles.size(); ++t) {
+    const auto& u = s.triangles[t];
+    for (int k = 0; k < 3; ++k) {
+      if (u[k] == e1 && u[(k + 1) % 3] == e0) {
+        const int other = u[(k + 2) % 3];
+        r.triangles[t] = {other, e1, at};
+        r.triangles.push_back({other, at, e0});
+        return r;
+      }
+    }
+  }
+  return r;  // an open edge: the part is validated closed, so this does not happen
+}
+
+// The tries of the mesh-part route (MeshOptions::fallback).
+struct Try {
+  bool own_triangles;
+  int algorithm_2d;
+  double size_factor;
+};
+std::vector<Try> part_tries(const MeshOptions& o) {
+  const int first = o.algorithm_2d ? o.algorithm_2d : 6;
+  std::vector<Try> t{{false, first, 1.0}};
+  if (!o.fallback) return t;
+  for (int a : {6, 1, 5}) {
+    if (a != first) t.push_back({false, a, 1.0});
+  }
+  t.push_back({false, first, 0.5});
+  t.push_back({false, first, 0.25});
+  t.push_back({true, 0, 1.0});
+  return t;
+}
+
+}  // namespace
+
+MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& load_point_m, const MeshOptions& o,
+                               const fs::path& folder, const std::string& name, const std::string& where) {
   check_options(o, where);
-  if (!fs::is_regular_file(stl)) throw InputError(where, "file", "cannot be opened (missing or unreadable)");
-  if (!(stl_unit_m > 0)) throw InputError(where, "unit", "must be > 0");
-  const double scale = stl_unit_m * kMmPerM;  // STL unit -> mm
-  const double h = o.mesh_size_m * kMmPerM, h0 = load_size(o) * kMmPerM;
+  check_part_surface(surf, where);
+  Eigen::Vector3d lo = surf.vertices_m.front(), hi = lo;
+  for (const auto& v : surf.vertices_m) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+  const double size_m = (hi - lo).norm();
+  const double size_mm = size_m * kMmPerM;
+  const double part_volume = enclosed_volume_m3(surf);
+  if (!(part_volume > 0)) throw InputError(where, "part surface", "encloses no volume (open or inward-oriented?)");
+  for (std::size_t i = 0; i < o.probes_m.size(); ++i) {
+    if (!(winding_number(surf, o.probes_m[i]) > 0.5)) {
+      throw InputError(where, probe_name(i), "probe point is not inside the part");
+    }
+  }
   const Eigen::Vector3d p_mm = load_point_m * kMmPerM;
   const fs::path stl_copy = folder / (name + "_part.stl");
 
-  MeshResult r;
+  const double h_first = o.mesh_size_m * kMmPerM, h0_first = load_size(o) * kMmPerM;
+  const std::vector<Try> tries = part_tries(o);
+  std::vector<MeshAttempt> attempts;
   GmshSession session(name);
-  // 1. Read the STL with Gmsh, rescale it to mm into one discrete surface, write the copy the
-  //    .geo merges, and integrate the enclosed volume (divergence theorem).
-  gmsh_step(where, "read STL", [&] {
-    gmsh::merge(stl.string());
-    std::vector<std::size_t> ntags;
-    std::vector<double> xyz, par;
-    gmsh::model::mesh::getNodes(ntags, xyz, par, 2, -1, true, false);
-    std::vector<std::size_t> etags, enodes;
-    gmsh::model::mesh::getElementsByType(2, etags, enodes);
-    if (etags.empty()) throw InputError(where, "STL", "no triangles");
-    std::map<std::size_t, Eigen::Vector3d> x;
-    for (std::size_t i = 0; i < ntags.size(); ++i) {
-      x[ntags[i]] = Eigen::Vector3d(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]) * scale;
-    }
-    double v6 = 0;
-    for (std::size_t e = 0; e < etags.size(); ++e) {
-      v6 += x.at(enodes[3 * e]).dot(x.at(enodes[3 * e + 1]).cross(x.at(enodes[3 * e + 2])));
-    }
-    r.quality.part_volume_m3 = std::abs(v6) / 6.0 / std::pow(kMmPerM, 3);
-    if (!(r.quality.part_volume_m3 > 0)) throw InputError(where, "STL", "encloses no volume");
-    gmsh::clear();
-    gmsh::model::add(name);
-    const int s = gmsh::model::addDiscreteEntity(2);
-    std::vector<double> coords;
-    for (std::size_t t : ntags) {
-      const Eigen::Vector3d& p = x.at(t);
-      coords.insert(coords.end(), {p.x(), p.y(), p.z()});
-    }
-    gmsh::model::mesh::addNodes(2, s, ntags, coords);
-    gmsh::model::mesh::addElementsByType(s, 2, {}, enodes);
-    gmsh::model::mesh::removeDuplicateNodes();
-    gmsh::write(stl_copy.string());
-    gmsh::clear();
-    gmsh::model::add(name);
-    gmsh::merge(stl_copy.string());
-  });
-  // 2. Surfaces -> geometry -> volume.
-  int vol = -1;
+  int load_surface = -1;       // remeshed: the surface the load point is embedded in
+  std::size_t load_tag = 0;    // part triangles: the Gmsh node at the load point
   std::vector<int> probe_tags;
-  gmsh_step(where, "classify surfaces", [&] {
-    gmsh::model::mesh::classifySurfaces(o.feature_angle_deg * kPi / 180.0, true, true, kPi);
-    gmsh::model::mesh::createGeometry();
-    gmsh::vectorpair surfs;
-    gmsh::model::getEntities(surfs, 2);
-    std::vector<int> st;
-    for (const auto& [d, t] : surfs) st.push_back(t);
-    const int loop = gmsh::model::geo::addSurfaceLoop(st);
-    vol = gmsh::model::geo::addVolume({loop});
-    for (const auto& pr : o.probes_m) {
-      const Eigen::Vector3d pm = pr * kMmPerM;
-      probe_tags.push_back(gmsh::model::geo::addPoint(pm.x(), pm.y(), pm.z()));
+  std::string stl_written;     // which surface the STL copy holds now ("remeshed" / "part triangles")
+
+  // Writes the STL copy the try merges (the .geo merges the same file).
+  auto write_stl = [&](bool own) {
+    const std::string kind = own ? "part triangles" : "remeshed";
+    if (stl_written == kind) return;
+    if (own) {
+      int at = -1;
+      const PartSurface split = with_vertex_at(surf, load_point_m, size_m, at);
+      if ((split.vertices_m[at] - load_point_m).norm() > 1e-6 * size_m) {
+        throw InputError(where, "load point", "is not on the part's surface");
+      }
+      write_file_atomically(stl_copy, part_stl(split));
+    } else {
+      write_file_atomically(stl_copy, part_stl(surf));
     }
-    gmsh::model::geo::synchronize();
-    if (!probe_tags.empty()) gmsh::model::mesh::embed(0, probe_tags, 3, vol);
-    gmsh::model::setPhysicalName(3, gmsh::model::addPhysicalGroup(3, {vol}), "BODY");
-    add_probe_groups(probe_tags);
-  });
-  generate_tets(where, o, p_mm, h0, h);
-  std::map<std::size_t, int> index;
-  std::size_t load_gmsh_tag = 0;
-  gmsh_step(where, "mesh", [&] {
-    index = extract(r.mesh, where);
-    // LOAD: the surface node nearest to the load point.
-    std::vector<std::size_t> tags;
-    std::vector<double> xyz, par;
-    gmsh::model::mesh::getNodes(tags, xyz, par, 2, -1, true, false);
-    double best = 1e300;
-    for (std::size_t i = 0; i < tags.size(); ++i) {
-      if (!index.count(tags[i])) continue;
-      const double d = (Eigen::Vector3d(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]) - p_mm).norm();
-      if (d < best) best = d, load_gmsh_tag = tags[i];
+    stl_written = kind;
+  };
+
+  // Builds the geometry from the STL copy and meshes it with one try's settings.
+  auto mesh_try = [&](const Try& t, MeshResult& r) {
+    const double h = h_first * t.size_factor, h0 = std::min(h0_first, h);
+    r = MeshResult{};
+    r.quality.part_volume_m3 = part_volume;
+    r.quality.mesh_size_m = h / kMmPerM;
+    r.quality.load_mesh_size_m = h0 / kMmPerM;
+    probe_tags.clear();
+    write_stl(t.own_triangles);
+    gmsh_step(where, "read part", [&] {
+      gmsh::clear();
+      gmsh::model::add(name);
+      gmsh::merge(stl_copy.string());
+    });
+    gmsh_step(where, t.own_triangles ? "volume" : "classify surfaces", [&] {
+      std::vector<int> st;
+      if (!t.own_triangles) {
+        gmsh::model::mesh::classifySurfaces(o.feature_angle_deg * kPi / 180.0, true, true, kPi);
+        gmsh::model::mesh::createGeometry();
+      }
+      gmsh::vectorpair surfs;
+      gmsh::model::getEntities(surfs, 2);
+      for (const auto& [d, tag] : surfs) st.push_back(tag);
+      gmsh::model::geo::addSurfaceLoop(st, 1);
+      gmsh::model::geo::addVolume({1}, 1);
+      if (!t.own_triangles) gmsh::model::geo::addPoint(p_mm.x(), p_mm.y(), p_mm.z(), 0, kLoadPointTag);
+      for (std::size_t i = 0; i < o.probes_m.size(); ++i) {
+        const Eigen::Vector3d pm = o.probes_m[i] * kMmPerM;
+        probe_tags.push_back(gmsh::model::geo::addPoint(pm.x(), pm.y(), pm.z(), 0, kFirstProbeTag + static_cast<int>(i)));
+      }
+      gmsh::model::geo::synchronize();
+      if (!t.own_triangles) {
+        // The load point becomes a node of the surface that holds it.
+        double best = 1e300;
+        for (int tag : st) {
+          std::vector<double> cp, par;
+          gmsh::model::getClosestPoint(2, tag, {p_mm.x(), p_mm.y(), p_mm.z()}, cp, par);
+          const double dist = (Eigen::Vector3d(cp[0], cp[1], cp[2]) - p_mm).norm();
+          if (dist < best) best = dist, load_surface = tag;
+        }
+        if (load_surface < 0 || !(best <= 1e-6 * size_mm)) {
+          std::ostringstream m;
+          m << "the load point is " << best / kMmPerM << " m from the part's surface (must lie on it)";
+          throw InputError(where, "load point", m.str());
+        }
+        gmsh::model::mesh::embed(0, {kLoadPointTag}, 2, load_surface);
+      }
+      if (!probe_tags.empty()) gmsh::model::mesh::embed(0, probe_tags, 3, 1);
+      gmsh::model::setPhysicalName(3, gmsh::model::addPhysicalGroup(3, {1}), "BODY");
+      if (!t.own_triangles) gmsh::model::setPhysicalName(0, gmsh::model::addPhysicalGroup(0, {kLoadPointTag}), "LOAD");
+      add_probe_groups(probe_tags);
+    });
+    generate_tets(where, o, t.own_triangles ? 6 : t.algorithm_2d, p_mm, h0, h);
+    gmsh_step(where, "mesh", [&] {
+      const std::map<std::size_t, int> index = extract(r.mesh, where);
+      int ln = -1;
+      if (t.own_triangles) {
+        // LOAD: the part's vertex at the load point; a discrete point entity in the .msh files.
+        std::vector<std::size_t> tags;
+        std::vector<double> xyz, par;
+        gmsh::model::mesh::getNodes(tags, xyz, par, 2, -1, true, false);
+        double best = 1e300;
+        for (std::size_t i = 0; i < tags.size(); ++i) {
+          const double d = (Eigen::Vector3d(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]) - p_mm).norm();
+          if (d < best && index.count(tags[i])) best = d, load_tag = tags[i];
+        }
+        if (!(best <= 1e-6 * size_mm)) throw InputError(where, "gmsh mesh", "no mesh node at the load point");
+        ln = index.at(load_tag);
+        const int pt = gmsh::model::addDiscreteEntity(0);
+        gmsh::model::mesh::addElementsByType(pt, 15, {}, {load_tag});
+        gmsh::model::setPhysicalName(0, gmsh::model::addPhysicalGroup(0, {pt}), "LOAD");
+      } else {
+        ln = node_of_point_entity(kLoadPointTag, index, where, "LOAD");
+      }
+      add_node_groups(r, ln, p_mm, probe_tags, index, o, where);
+    });
+    fill_quality(r.mesh, r.quality);
+    check_mesh(r, where);
+  };
+
+  MeshResult r;
+  std::size_t kept = tries.size();  // index of the try whose mesh is kept
+  double best_gamma = -1;
+  bool accepted = false;
+  for (std::size_t i = 0; i < tries.size() && !accepted; ++i) {
+    const Try& t = tries[i];
+    MeshAttempt a{t.own_triangles ? "part triangles" : "remeshed", t.algorithm_2d, o.algorithm_3d,
+                  o.mesh_size_m * t.size_factor, std::min(h0_first, h_first * t.size_factor) / kMmPerM, "ok"};
+    try {
+      MeshResult ri;
+      mesh_try(t, ri);
+      if (o.fallback && ri.quality.min_gamma < o.quality_floor_gamma) {
+        std::ostringstream m;
+        m << "min gamma " << ri.quality.min_gamma << " below " << o.quality_floor_gamma;
+        a.outcome = m.str();
+        if (ri.quality.min_gamma > best_gamma) best_gamma = ri.quality.min_gamma, kept = i;
+      } else {
+        r = std::move(ri);
+        kept = i;
+        accepted = true;
+      }
+      attempts.push_back(a);
+    } catch (const InputError& e) {
+      // Bad input (a probe, the load point) is not a mesher failure: no retry.
+      if (e.place() == "load point" || e.place().rfind("PROBE", 0) == 0 || !o.fallback) throw;
+      a.outcome = e.place() + ": " + e.reason();
+      attempts.push_back(a);
+      // Gmsh could not classify / reparametrize the surface: other 2D settings will not help.
+      if (e.place() == "gmsh classify surfaces") {
+        while (i + 1 < tries.size() && !tries[i + 1].own_triangles) ++i;
+      }
     }
-    if (load_gmsh_tag == 0) throw InputError(where, "gmsh mesh", "no surface node for LOAD");
-    const int ln = index.at(load_gmsh_tag);
-    r.mesh.node_groups.emplace_back("LOAD", ln);
-    r.quality.load_node_distance_m = best / kMmPerM;
-    for (std::size_t i = 0; i < probe_tags.size(); ++i) {
-      const int pn = node_of_point_entity(probe_tags[i], index, where, probe_name(i));
-      r.mesh.node_groups.emplace_back(probe_name(i), pn);
-      r.quality.probe_node_distance_m.push_back((r.mesh.nodes_m[pn] - o.probes_m[i]).norm());
-    }
-    // LOAD in the .msh files: a discrete point entity holding one point element on that node.
-    const int pt = gmsh::model::addDiscreteEntity(0);
-    gmsh::model::mesh::addElementsByType(pt, 15, {}, {load_gmsh_tag});
-    gmsh::model::setPhysicalName(0, gmsh::model::addPhysicalGroup(0, {pt}), "LOAD");
-  });
-  fill_quality(r.mesh, r.quality);
-  if (r.quality.load_node_distance_m > 2.0 * o.mesh_size_m) {
-    throw InputError(where, "load point", "no surface node within 2 mesh sizes of the load point "
-                     "(is the point on the part's surface?)");
   }
-  check_mesh(r, where);
+  if (kept == tries.size()) {
+    std::string why;
+    for (const auto& a : attempts) why += (why.empty() ? "" : "; ") + describe(a) + ": " + a.outcome;
+    throw InputError(where, "gmsh mesh", "every try failed (" + why + ")");
+  }
+  if (!accepted) {
+    // No try met the quality floor: keep the best one (the decks' quality check reports it).
+    mesh_try(tries[kept], r);
+    attempts.push_back({tries[kept].own_triangles ? "part triangles" : "remeshed", tries[kept].algorithm_2d,
+                        o.algorithm_3d, o.mesh_size_m * tries[kept].size_factor, r.quality.load_mesh_size_m,
+                        "kept: the best min gamma of the tries"});
+  }
+  r.quality.attempts = attempts;
   gmsh_step(where, "write", [&] { write_msh(folder, name, r); });
 
+  const Try& t = tries[kept];
+  const double h = h_first * t.size_factor, h0 = std::min(h0_first, h);
   std::ostringstream g;
-  g << geo_header("mesh part from " + stl.filename().string() + " (copied in mm as " +
-                  stl_copy.filename().string() + ")");
-  g << "// LOAD is the surface node nearest to (" << fmt(p_mm.x()) << ", " << fmt(p_mm.y()) << ", "
-    << fmt(p_mm.z()) << ") mm, picked after meshing (impactdeck writes it into the .msh files).\n";
-  g << geo_options(h, o.algorithm_3d);
-  g << "Merge \"" << stl_copy.filename().string() << "\";\n"
-    << "ClassifySurfaces{" << fmt(o.feature_angle_deg * kPi / 180.0) << ", 1, 1, " << fmt(kPi) << "};\n"
-    << "CreateGeometry;\n"
-    << "Surface Loop(1) = Surface{:};\nVolume(1) = {1};\n";
-  g << geo_probe_points(o);
-  g << geo_size_field(p_mm, h0, h);
+  g << geo_header("mesh part (" + where + ") from memory, written as " + stl_copy.filename().string() +
+                  " (mm)");
+  if (attempts.size() > 1) g << "// Settings of try " << kept + 1 << " (see mesh_attempts in mesh_quality.json).\n";
+  g << geo_options(h, t.own_triangles ? 6 : t.algorithm_2d, o.algorithm_3d);
+  g << "Merge \"" << stl_copy.filename().string() << "\";\n";
+  if (t.own_triangles) {
+    g << "// The part's own triangles are the boundary (no 2D remeshing); LOAD is its vertex at (" << fmt(p_mm.x())
+      << ", " << fmt(p_mm.y()) << ", " << fmt(p_mm.z()) << ") mm\n// (impactdeck writes it into the .msh files).\n"
+      << "Surface Loop(1) = Surface{:};\nVolume(1) = {1};\n";
+  } else {
+    g << "ClassifySurfaces{" << fmt(o.feature_angle_deg * kPi / 180.0) << ", 1, 1, " << fmt(kPi) << "};\n"
+      << "CreateGeometry;\n"
+      << "Surface Loop(1) = Surface{:};\nVolume(1) = {1};\n";
+    g << "Point(" << kLoadPointTag << ") = {" << fmt(p_mm.x()) << ", " << fmt(p_mm.y()) << ", " << fmt(p_mm.z())
+      << "};  // the load point, a node of the surface that holds it\n"
+      << "Point{" << kLoadPointTag << "} In Surface{" << load_surface << "};\n";
+  }
+  g << geo_probe_points(o, kFirstProbeTag);
+  g << geo_size_field(p_mm, h0, h, o.load_zone_radius_m * kMmPerM);
   g << "Physical Volume(\"BODY\") = {1};\n";
-  g << geo_probe_groups(o);
+  if (!t.own_triangles) g << "Physical Point(\"LOAD\") = {" << kLoadPointTag << "};\n";
+  g << geo_probe_groups(o, kFirstProbeTag);
   r.geo = folder / (name + ".geo");
   write_file_atomically(r.geo, g.str());
   return r;
@@ -570,13 +821,14 @@ MeshResult mesh_cad_with_gmsh(const fs::path& cad, double cad_unit_m, const Eige
     gmsh::model::setPhysicalName(0, gmsh::model::addPhysicalGroup(0, {load_tag}), "LOAD");
     add_probe_groups(probe_tags);
   });
-  generate_tets(where, o, p_mm, h0, h);
-  finish_point_mesh(where, o, folder, name, load_tag, probe_tags, p_mm, r);
+  const int alg2 = o.algorithm_2d ? o.algorithm_2d : 6;  // Frontal-Delaunay on the B-rep faces
+  generate_tets(where, o, alg2, p_mm, h0, h);
+  finish_point_mesh(where, o, folder, name, load_tag, probe_tags, p_mm, h0, alg2, "cad", r);
   fs::copy_file(cad, copy, fs::copy_options::overwrite_existing);
 
   std::ostringstream g;
   g << geo_header("CAD part from " + cad.filename().string() + " (copied as " + copy.filename().string() + ")");
-  g << "SetFactory(\"OpenCASCADE\");\nGeometry.OCCTargetUnit = \"MM\";\n" << geo_options(h, o.algorithm_3d);
+  g << "SetFactory(\"OpenCASCADE\");\nGeometry.OCCTargetUnit = \"MM\";\n" << geo_options(h, alg2, o.algorithm_3d);
   g << "Merge \"" << copy.filename().string() << "\";\n";
   if (scaled) g << "Dilate {{0, 0, 0}, {" << fmt(scale) << ", " << fmt(scale) << ", " << fmt(scale) << "}} { Volume{:}; }\n";
   const Eigen::Vector3d lp = r.mesh.nodes_m[r.mesh.node_of("LOAD")] * kMmPerM;
@@ -587,7 +839,7 @@ MeshResult mesh_cad_with_gmsh(const fs::path& cad, double cad_unit_m, const Eige
     g << "Point(" << 1000 + i << ") = {" << fmt(pm.x()) << ", " << fmt(pm.y()) << ", " << fmt(pm.z())
       << "};\nPoint{" << 1000 + i << "} In Volume{" << volumes.front() << "};\n";
   }
-  g << geo_size_field(p_mm, h0, h);
+  g << geo_size_field(p_mm, h0, h, o.load_zone_radius_m * kMmPerM);
   g << "Physical Volume(\"BODY\") = {Volume{:}};\nPhysical Point(\"LOAD\") = {2000};\n";
   g << geo_probe_groups(o);
   r.geo = folder / (name + ".geo");
@@ -598,10 +850,10 @@ MeshResult mesh_cad_with_gmsh(const fs::path& cad, double cad_unit_m, const Eige
 }  // namespace impactdeck::fem_export
 
 // The plugin's entry point (gmsh_plugin.hpp); everything else in this library is hidden.
-extern "C" __attribute__((visibility("default"))) const void* impactdeck_gmsh_mesher_v1() {
+extern "C" __attribute__((visibility("default"))) const void* impactdeck_gmsh_mesher_v2() {
   using namespace impactdeck::fem_export;
-  static const detail::GmshMesherV1 table{impactdeck::kVersion, sizeof(MeshResult), sizeof(MeshOptions),
-                                          &mesh_ellipsoid_with_gmsh, &mesh_stl_with_gmsh,
+  static const detail::GmshMesherV2 table{impactdeck::kVersion,     sizeof(MeshResult),      sizeof(MeshOptions),
+                                          sizeof(PartSurface),      &mesh_ellipsoid_with_gmsh, &mesh_part_with_gmsh,
                                           &mesh_cad_with_gmsh};
   return &table;
 }

@@ -13,15 +13,15 @@
 
 namespace impactdeck::fem_export::detail {
 
-struct GmshMesherV1 {
+struct GmshMesherV2 {
   const char* version;  ///< kVersion of the plugin's build
-  std::size_t sizeof_mesh_result, sizeof_mesh_options;
+  std::size_t sizeof_mesh_result, sizeof_mesh_options, sizeof_part_surface;
   MeshResult (*mesh_ellipsoid)(const Eigen::Vector3d& semi_axes_m, const Eigen::Vector3d& load_point_m,
                                const MeshOptions& options, const std::filesystem::path& folder,
                                const std::string& name);
-  MeshResult (*mesh_stl)(const std::filesystem::path& stl, double stl_unit_m,
-                         const Eigen::Vector3d& load_point_m, const MeshOptions& options,
-                         const std::filesystem::path& folder, const std::string& name);
+  MeshResult (*mesh_part)(const PartSurface& surface, const Eigen::Vector3d& load_point_m,
+                          const MeshOptions& options, const std::filesystem::path& folder,
+                          const std::string& name, const std::string& where);
   MeshResult (*mesh_cad)(const std::filesystem::path& cad, double cad_unit_m,
                          const Eigen::Vector3d& load_point_m, const MeshOptions& options,
                          const std::filesystem::path& folder, const std::string& name);
@@ -30,4 +30,4 @@ struct GmshMesherV1 {
 }  // namespace impactdeck::fem_export::detail
 
 /// The plugin's one exported symbol.
-#define IMPACTDECK_GMSH_MESHER_ENTRY "impactdeck_gmsh_mesher_v1"
+#define IMPACTDECK_GMSH_MESHER_ENTRY "impactdeck_gmsh_mesher_v2"

@@ -160,6 +160,28 @@ std::string style_attrs(const Style& s) {
 
 }  // namespace
 
+void chart_frame(Drawing& d, double left, double top, double right, double bottom, const std::vector<Tick>& x,
+                 const std::vector<Tick>& y, const std::string& x_title, const std::string& y_title) {
+  Style grid;
+  grid.stroke = {0.85, 0.85, 0.85};
+  grid.stroke_width = 0.8;
+  Style axis;
+  axis.stroke_width = 1.2;
+  for (const Tick& t : x) {
+    d.line({t.px, top}, {t.px, bottom}, grid);
+    d.line({t.px, bottom}, {t.px, bottom + 5}, axis);
+    d.text({t.px, bottom + 20}, t.label, 12, Anchor::middle);
+  }
+  for (const Tick& t : y) {
+    d.line({left, t.px}, {right, t.px}, grid);
+    d.line({left - 5, t.px}, {left, t.px}, axis);
+    d.text({left - 9, t.px + 4}, t.label, 12, Anchor::end);
+  }
+  d.polyline({{left, top}, {left, bottom}, {right, bottom}}, axis);
+  d.text({0.5 * (left + right), bottom + 44}, x_title, 13, Anchor::middle);
+  d.text({24, 0.5 * (top + bottom)}, y_title, 13, Anchor::middle, kBlack, false, 90);
+}
+
 std::string to_svg(const Drawing& d) {
   std::ostringstream o;
   o << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"

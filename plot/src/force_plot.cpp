@@ -50,29 +50,12 @@ Drawing force_time_drawing(const collision::ForceHistory& h, const ForcePlotOpti
   auto X = [&](double t_s) { return left + (right - left) * (t_s * tu.factor) / t_hi; };
   auto Y = [&](double f_N) { return bottom - (bottom - top) * (f_N * fu.factor) / f_hi; };
 
-  Style grid;
-  grid.stroke = {0.85, 0.85, 0.85};
-  grid.stroke_width = 0.8;
-  Style axis;
-  axis.stroke_width = 1.2;
-
   // Grid and ticks.
-  for (double v : nice_ticks(0.0, t_hi, 6)) {
-    const double x = left + (right - left) * v / t_hi;
-    d.line({x, top}, {x, bottom}, grid);
-    d.line({x, bottom}, {x, bottom + 5}, axis);
-    d.text({x, bottom + 20}, format_number(v), 12, Anchor::middle);
-  }
-  for (double v : fticks) {
-    const double y = bottom - (bottom - top) * v / f_hi;
-    d.line({left, y}, {right, y}, grid);
-    d.line({left - 5, y}, {left, y}, axis);
-    d.text({left - 9, y + 4}, format_number(v), 12, Anchor::end);
-  }
-  d.polyline({{left, top}, {left, bottom}, {right, bottom}}, axis);
-  d.text({0.5 * (left + right), bottom + 44}, std::string("time t [") + tu.unit + "]", 13, Anchor::middle);
-  d.text({24, 0.5 * (top + bottom)}, std::string("contact force F [") + fu.unit + "]", 13, Anchor::middle,
-         kBlack, false, 90);
+  std::vector<Tick> xt, yt;
+  for (double v : nice_ticks(0.0, t_hi, 6)) xt.push_back({left + (right - left) * v / t_hi, format_number(v)});
+  for (double v : fticks) yt.push_back({bottom - (bottom - top) * v / f_hi, format_number(v)});
+  chart_frame(d, left, top, right, bottom, xt, yt, std::string("time t [") + tu.unit + "]",
+              std::string("contact force F [") + fu.unit + "]");
   d.text({left, 30}, opt.title.empty() ? "Hertz contact force" : opt.title, 15, Anchor::start, kBlack, true);
 
   // The curve: compression then restitution, uniform in time within each phase.

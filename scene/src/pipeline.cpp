@@ -12,6 +12,7 @@
 #include "impactdeck/fem_export/force_table.hpp"
 #include "impactdeck/geometry/cad_shape.hpp"
 #include "impactdeck/geometry/ellipsoid.hpp"
+#include "impactdeck/geometry/mesh_shape.hpp"
 #include "impactdeck/geometry/part.hpp"
 #include "impactdeck/geometry/plane.hpp"
 #include "impactdeck/plot/force_plot.hpp"
@@ -30,6 +31,7 @@ const std::vector<std::string>& all_stages() {
 bool RunReport::all_checks_passed() const {
   for (const auto& i : impacts) {
     if (!i.result.checks.passed) return false;
+    if (i.fem_deck && !i.fem_deck->body_check.passed) return false;
     if (i.fem_check && !i.fem_check->passed) return false;
   }
   return true;
@@ -212,7 +214,24 @@ collision::ImpactInput impact_input(const Scene& scene, const ImpactSpec& s, con
   return in;
 }
 
+// The contact ellipse at the force's maximum (fem_export::ContactPatch), from the same contact
+// model as the impact: elliptical Hertz from both bodies' principal curvatures for the
+// "elliptical" rule, else the circle of radius (3 F R* / (4 E*))^(1/3).
+// The contact ellipse at F_max from the physics kernel (elliptical rule: both curvature tensors;
+// the other rules: the circle of their R*), its long axis in the target's own frame.
+fem_export::ContactPatch contact_patch(const ImpactReport& ir, const PreparedBody& target) {
+  const collision::KernelResult& k = ir.result.kernel;
+  fem_export::ContactPatch p;
+  p.max_force_N = k.max_force_N;
+  p.a_max_m = k.contact_semi_axis_a_m;
+  p.b_max_m = k.contact_semi_axis_b_m;
+  p.axis_a = ir.spec->contact_radius == ContactRadiusRule::elliptical ? target.pose.direction_to_own(k.direction_A)
+                                                                      : ir.contact.target_curvature.d1;
+  return p;
+}
+
 // The deck request of one impact: the target body alone, loaded by the force on it (along -n).
+// Everything in the target's frame (DeckRequest).
 fem_export::DeckRequest fem_request(const Scene& scene, const ImpactReport& ir, const PreparedBody& target) {
   const FemOutputs& f = *scene.outputs.fem;
   const BodySpec& b = *target.spec;
@@ -233,31 +252,64 @@ fem_export::DeckRequest fem_request(const Scene& scene, const ImpactReport& ir, 
       break;
     case ShapeKind::plane:  // fixed, refused above
       break;
-    case ShapeKind::mesh:
-      r.body.kind = fem_export::BodyKind::stl;
-      r.body.stl = b.mesh_path;
-      r.body.stl_unit_m = metres_per(scene.length_unit);
+    case ShapeKind::mesh: {
+      // The part as loaded, validated and repaired (whatever its file format), from memory.
       if (const auto* cad = dynamic_cast<const geometry::CadShape*>(target.shape.get())) {
         r.body.kind = fem_export::BodyKind::cad;  // meshed straight from the B-rep
-        if (cad->file_unit()) r.body.stl_unit_m = 1e-3;  // STEP/IGES: OpenCASCADE reads them in mm
+        r.body.cad = b.mesh_path;
+        // STEP/IGES: OpenCASCADE reads them in mm; a BREP is in the scene's unit.
+        r.body.cad_unit_m = cad->file_unit() ? 1e-3 : metres_per(scene.length_unit);
+        break;
       }
+      const auto* part = dynamic_cast<const geometry::MeshShape*>(target.shape.get());
+      if (!part) throw Error(ExitCode::internal_error, "mesh body without a MeshShape");
+      r.body.kind = fem_export::BodyKind::part;
+      r.body.surface.vertices_m = part->mesh().vertices_m;
+      r.body.surface.triangles = part->mesh().triangles;
+      r.body.name = b.mesh_path.string();
       break;
+    }
   }
   r.material.youngs_modulus_Pa = target.material.youngs_modulus_Pa;
   r.material.poisson_ratio = target.material.poisson_ratio;
   r.material.density_kg_m3 = target.mass_kg / target.volume.volume_m3;  // honours mass_kg
+  r.yield_strength_Pa = scene.materials.at(b.material).yield_strength_Pa;
   r.force = *ir.table;
   r.impulse_Ns = ir.result.history.impulse_total_Ns();
   r.direction = -ir.contact.target_point.normal;
   r.load_point_m = ir.contact.target_point.point_m;
+  r.patch = contact_patch(ir, target);
+  r.model.mass_kg = target.mass_kg;
+  r.model.volume_m3 = target.volume.volume_m3;
+  r.model.centroid_m = target.volume.centroid_m;
+  r.model.inertia_kg_m2 = target.inertia_kg_m2;
+  // The rigid model's jumps, from the world into the target's frame (the deck's).
+  r.model.delta_velocity_m_s = target.pose.direction_to_own(ir.result.target_jump.delta_velocity_m_s);
+  r.model.delta_angular_velocity_rad_s =
+      target.pose.direction_to_own(ir.result.target_jump.delta_angular_velocity_rad_s);
   r.options.end_time_s = f.end_time_s;
   r.options.time_step_s = f.time_step_s;
   r.options.code_aster = f.code_aster;
   r.options.calculix = f.calculix;
   r.options.mesh.mesh_size_m = f.mesh_size_m.value_or(
       b.shape == ShapeKind::mesh ? 0.25 * target.shape->size_m() : 0.5 * r.body.semi_axes_m.minCoeff());
+  r.options.adapt_mesh_size = !f.mesh_size_m;
   r.options.mesh.load_mesh_size_m = f.load_mesh_size_m.value_or(0.0);
   r.options.mesh.probes_m = f.probes_m;
+  r.options.load = f.load == FemOutputs::Load::hertz_patch ? fem_export::LoadKind::hertz_patch
+                                                           : fem_export::LoadKind::point;
+  r.options.contact_elements = f.contact_elements;
+  r.options.contact_zone_factor = f.contact_zone_factor;
+  fem_export::FemTolerances& t = r.options.tolerances;
+  const FemOutputs::Tolerances& u = f.tolerances;
+  t.linear_momentum = u.linear_momentum.value_or(t.linear_momentum);
+  t.angular_momentum = u.angular_momentum.value_or(t.angular_momentum);
+  t.model_linear_velocity = u.model_linear_velocity.value_or(t.model_linear_velocity);
+  t.model_angular_velocity = u.model_angular_velocity.value_or(t.model_angular_velocity);
+  t.volume = u.volume.value_or(t.volume);
+  t.mass = u.mass.value_or(t.mass);
+  t.inertia = u.inertia.value_or(t.inertia);
+  t.min_gamma = u.min_gamma.value_or(t.min_gamma);
   return r;
 }
 
@@ -374,6 +426,15 @@ RunReport run_scene(const Scene& scene, const RunOptions& opt) {
                            what + e.reason());
         }
         const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        const auto& patch = ir.fem_deck->patch;
+        if (ir.fem_deck->load == fem_export::LoadKind::hertz_patch &&
+            patch.largest_ellipse_elements < scene.outputs.fem->contact_elements) {
+          std::ostringstream m;
+          m << "impact '" << ir.spec->name << "': the largest contact ellipse spans " << patch.largest_ellipse_elements
+            << " elements, fewer than contact_elements = " << scene.outputs.fem->contact_elements
+            << " (the mesher kept the part's own triangles, or a coarser load size was asked for)";
+          report.warnings.push_back(m.str());
+        }
         add_stage(report, "fem_mesh", ir.fem_deck->mesh_seconds);
         add_stage(report, "fem_decks", total - ir.fem_deck->mesh_seconds);
         for (const auto& f : ir.fem_deck->files) report.files_written.push_back(f);
@@ -381,6 +442,11 @@ RunReport run_scene(const Scene& scene, const RunOptions& opt) {
       if (scene.outputs.fem->run == FemOutputs::Run::calculix) {
         clock.run("fem_run", [&] {
           for (auto& ir : report.impacts) {
+            // A mesh that misses the body checks is not worth a solver run (it fails anyway).
+            if (!ir.fem_deck->body_check.passed) {
+              report.warnings.push_back("impact '" + ir.spec->name + "': FEM deck fails its body checks: ccx not run");
+              continue;
+            }
             fem_export::CheckOptions co;
             co.progress = opt.progress;
             ir.fem_check = fem_export::run_check(ir.fem_deck->folder, co);

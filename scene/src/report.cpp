@@ -130,10 +130,25 @@ nlohmann::json to_json(const Scene& scene, const RunReport& rep) {
                   {"node_count", q.node_count},
                   {"tet_count", q.tet_count},
                   {"min_quality", q.min_quality},
+                  {"min_gamma", q.min_gamma},
+                  {"mesh_size_m", q.mesh_size_m},
+                  {"load_mesh_size_m", q.load_mesh_size_m},
+                  {"mesh_attempts", fem_export::to_json(q.attempts)},
+                  {"fallback_used", q.attempts.size() > 1},
                   {"fe_volume_m3", q.fe_volume_m3},
                   {"part_volume_m3", q.part_volume_m3},
                   {"volume_relative_difference", q.volume_relative_difference},
+                  {"load", fem_export::to_string(d.load)},
+                  {"load_node_count", d.patch.load_node_count},
+                  {"contact_zone_radius_m", d.contact_zone_radius_m},
+                  {"body_check", fem_export::to_json(d.body_check)},
                   {"check", ir.fem_check ? fem_export::to_json(*ir.fem_check) : nlohmann::json(nullptr)}};
+      if (d.load == fem_export::LoadKind::hertz_patch) {
+        i["fem"]["largest_ellipse_elements"] = d.patch.largest_ellipse_elements;
+        i["fem"]["max_nodes_loaded_at_once"] = d.patch.max_nodes_loaded_at_once;
+        i["fem"]["load_sum_max_relative_error"] = d.patch.max_sum_relative_error;
+        i["fem"]["load_moment_max_relative"] = d.patch.max_moment_relative;
+      }
     }
     impacts.push_back(std::move(i));
   }
@@ -216,6 +231,20 @@ std::string format_summary(const Scene& scene, const RunReport& rep) {
         << q.tet_count << " tetrahedra, min quality " << std::setprecision(3) << q.min_quality
         << ", FE volume " << std::showpos << 100.0 * q.volume_relative_difference << std::noshowpos
         << " % vs the part" << std::setprecision(6) << "\n";
+      o << "  FEM load              " << fem_export::to_string(ir.fem_deck->load) << " on "
+        << ir.fem_deck->patch.load_node_count << " node(s)";
+      if (q.attempts.size() > 1) {
+        o << "; mesher fallback used (" << q.attempts.size() << " tries: ";
+        for (std::size_t k = 0; k < q.attempts.size(); ++k) {
+          o << (k ? "; " : "") << fem_export::describe(q.attempts[k]) << ": " << q.attempts[k].outcome;
+        }
+        o << ")";
+      }
+      o << "\n";
+      if (!ir.fem_check) {  // the check repeats these lines
+        std::istringstream body(fem_export::format_body(ir.fem_deck->body_check));
+        for (std::string l; std::getline(body, l);) o << "  FEM body: " << l << "\n";
+      }
     }
     if (ir.fem_check) {
       std::istringstream lines(fem_export::format_check(*ir.fem_check));

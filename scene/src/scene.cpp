@@ -366,6 +366,10 @@ const toml::table& sub_table(const toml::node* n, const std::string& key, const 
 
 FemOutputs read_fem(const toml::table& t, const std::string& file, double to_m) {
   Reader r(t, "outputs.fem", file);
+  r.allow({"mesh_size", "load_mesh_size", "end_time_s", "time_step_s", "probes", "code_aster", "calculix", "run",
+           "load", "contact_elements", "contact_zone_factor", "linear_momentum_tolerance",
+           "angular_momentum_tolerance", "model_linear_velocity_tolerance", "model_angular_velocity_tolerance",
+           "volume_tolerance", "mass_tolerance", "inertia_tolerance", "min_gamma"});
   FemOutputs f;
   f.place = r.self();
   if (r.has("mesh_size")) f.mesh_size_m = r.positive("mesh_size") * to_m;
@@ -395,6 +399,30 @@ FemOutputs read_fem(const toml::table& t, const std::string& file, double to_m) 
   f.run = r.choice<FemOutputs::Run>("run", {{"none", FemOutputs::Run::none}, {"calculix", FemOutputs::Run::calculix}},
                                     FemOutputs::Run::none);
   if (f.run == FemOutputs::Run::calculix && !f.calculix) r.fail("run", "run = \"calculix\" needs calculix = true");
+  f.load = r.choice<FemOutputs::Load>("load", {{"point", FemOutputs::Load::point},
+                                               {"hertz-patch", FemOutputs::Load::hertz_patch}},
+                                      FemOutputs::Load::point);
+  if (r.has("contact_elements")) {
+    const double n = r.positive("contact_elements");
+    if (n != std::floor(n) || n > 64) r.fail("contact_elements", "must be a whole number in [1, 64]");
+    f.contact_elements = static_cast<int>(n);
+  }
+  if (r.has("contact_zone_factor")) f.contact_zone_factor = r.positive("contact_zone_factor");
+  auto tolerance = [&](const char* key, std::optional<double>& into) {
+    if (r.has(key)) into = r.positive(key);
+  };
+  tolerance("linear_momentum_tolerance", f.tolerances.linear_momentum);
+  tolerance("angular_momentum_tolerance", f.tolerances.angular_momentum);
+  tolerance("model_linear_velocity_tolerance", f.tolerances.model_linear_velocity);
+  tolerance("model_angular_velocity_tolerance", f.tolerances.model_angular_velocity);
+  tolerance("volume_tolerance", f.tolerances.volume);
+  tolerance("mass_tolerance", f.tolerances.mass);
+  tolerance("inertia_tolerance", f.tolerances.inertia);
+  if (r.has("min_gamma")) {
+    const double g = r.required_number("min_gamma");
+    if (!(g >= 0.0 && g < 1.0)) r.fail("min_gamma", "must lie in [0, 1), got " + Reader::fmt(g));
+    f.tolerances.min_gamma = g;
+  }
   if (!f.code_aster && !f.calculix) r.fail("calculix", "code_aster and calculix are both false: no deck to write");
   r.reject_unknown();
   return f;

@@ -1,15 +1,24 @@
 #pragma once
 // FEM decks of the hybrid approach: the target body alone, meshed, with the impactor replaced by
-// the Hertz force history at the load node. One folder per impact holds everything a solver needs
-// (files listed in docs/fem.md); it appears complete or not at all.
+// the Hertz force history at the contact node (or spread over the Hertz contact patch). One folder
+// per impact holds everything a solver needs (files listed in docs/fem.md); it appears complete or
+// not at all.
+//
+// Frames: every position and direction of a DeckRequest is in the TARGET's own frame (the
+// coordinates of its part file, or the ellipsoid's axes): load point, force direction, probes,
+// patch axis, and the rigid model's reference (centroid, inertia, velocity jumps). A caller that
+// places bodies in a world frame transforms these into the target's frame first.
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <Eigen/Dense>
+#include <nlohmann/json.hpp>
 
 #include "impactdeck/collision/force_history.hpp"
 #include "impactdeck/fem_export/mesh.hpp"
+#include "impactdeck/fem_export/patch_load.hpp"
 
 namespace impactdeck::fem_export {
 
@@ -22,14 +31,57 @@ struct DeckMaterial {
   double density_kg_m3 = 0;
 };
 
-/// stl: a triangulated part file; cad: a STEP/IGES/BREP file meshed from its B-rep (mesh_cad).
-enum class BodyKind { ellipsoid, stl, cad };
+/// part: a triangulated part from memory (mesh_part); cad: a STEP/IGES/BREP file meshed from its
+/// B-rep (mesh_cad).
+enum class BodyKind { ellipsoid, part, cad };
 
 struct DeckBody {
   BodyKind kind = BodyKind::ellipsoid;
   Eigen::Vector3d semi_axes_m = Eigen::Vector3d::Zero();  ///< ellipsoid, centred at the origin
-  std::filesystem::path stl;                             ///< stl, cad: the part file
-  double stl_unit_m = 1e-3;                              ///< metres per file coordinate unit (cad: mesh_cad)
+  std::filesystem::path cad;  ///< cad: the part file
+  double cad_unit_m = 1e-3;   ///< cad: metres per file coordinate unit (a BREP; STEP/IGES state theirs)
+  PartSurface surface;  ///< part: the loaded, validated (and repaired) triangulation, target frame
+  std::string name;     ///< part: its file, named in messages
+};
+
+/// How the force enters the deck.
+enum class LoadKind {
+  point,        ///< F(t) on the contact node (the paper's way; stresses near it are not meaningful)
+  hertz_patch,  ///< the Hertz pressure of each instant's contact ellipse (patch_load.hpp)
+};
+const char* to_string(LoadKind k);
+
+/// The rigid model's numbers the FE result is compared with (target frame, SI).
+struct RigidReference {
+  double mass_kg = 0;                                     ///< the part's exact mass
+  double volume_m3 = 0;                                   ///< the part's exact volume
+  Eigen::Vector3d centroid_m = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d inertia_kg_m2 = Eigen::Matrix3d::Zero();  ///< about the centroid
+  Eigen::Vector3d delta_velocity_m_s = Eigen::Vector3d::Zero();          ///< the target's jump
+  Eigen::Vector3d delta_angular_velocity_rad_s = Eigen::Vector3d::Zero();
+};
+
+/// Whether the hit makes the part spin enough for its spin to be compared: the lever arm
+/// |(p - c) x d| of the force about the part's centroid exceeds a tenth of its radius of gyration
+/// sqrt(trace(I) / (2 m)). Below that the spin's share of the motion is under 1 % (its term in
+/// 1/m_w is (lever / r_g)^2 of the linear one) and a relative error on it measures round-off of a
+/// small difference (a faceted sphere's normal misses the centre by a few % of the radius).
+bool spin_is_significant(const RigidReference& part, const Eigen::Vector3d& load_point_m,
+                         const Eigen::Vector3d& direction);
+
+/// Thresholds of the deck's checks; a miss fails the run (exit 4). Defaults: docs/fem.md.
+struct FemTolerances {
+  double linear_momentum = 1e-3;   ///< FE momentum vs the impulse (solver self-check)
+  double angular_momentum = 1e-2;  ///< FE angular momentum vs (p - c) x Pi (solver self-check)
+  /// FE rigid-body velocity (momentum / FE mass) vs the rigid model's delta v of the part: also
+  /// carries the mesh's mass error.
+  double model_linear_velocity = 0.05;
+  /// FE spin (I_FE^-1 L_FE) vs the rigid model's delta omega (when spin_is_significant).
+  double model_angular_velocity = 0.05;
+  double volume = 0.05;    ///< |V_FE - V_part| / V_part
+  double mass = 0.05;      ///< |M_FE - M_part| / M_part
+  double inertia = 0.05;   ///< ||I_FE - I_part||_F / ||I_part||_F (about each one's centroid)
+  double min_gamma = 0.01; ///< floor of Gmsh's gamma over the tetrahedra, after optimisation
 };
 
 struct DeckOptions {
@@ -43,6 +95,23 @@ struct DeckOptions {
   bool code_aster = true;      ///< write impact.comm, impact.export and mesh.med
   bool calculix = true;        ///< write impact.inp and mesh.inp
   MeshOptions mesh;
+  /// The mesh size is a default, not the user's: while the FE body's volume or inertia (of the
+  /// tetrahedra, or of ccx's mass matrix) differs from the part's by more than half its
+  /// tolerance, mesh again at size / sqrt(2) (at most
+  /// kMaxSizeRefinements times; each try is listed in MeshQuality::attempts).
+  bool adapt_mesh_size = false;
+  static constexpr int kMaxSizeRefinements = 4;
+  LoadKind load = LoadKind::point;
+  /// hertz_patch: the load element size is at most 2 b_max / contact_elements, so the largest
+  /// ellipse spans at least this many elements along its short axis.
+  int contact_elements = 4;
+  /// Radius of the contact zone (von Mises inside it is reported apart) in contact semi-axes
+  /// a_max; it is never less than 2 load element sizes.
+  double contact_zone_factor = 3.0;
+  FemTolerances tolerances;
+  /// ccx writes stresses and displacements (.frd) every increment; when nodes x increments of the
+  /// free-vibration step would exceed this, every k-th increment instead (velocities too).
+  double stress_output_budget = 4e6;
 };
 
 struct DeckRequest {
@@ -53,8 +122,57 @@ struct DeckRequest {
   collision::ForceTable force;  ///< F(t) on the target, N vs s; first and last force 0
   double impulse_Ns = 0;        ///< exact impulse of the force history (the checks' reference)
   Eigen::Vector3d direction = Eigen::Vector3d::Zero();     ///< unit direction of the force
-  Eigen::Vector3d load_point_m = Eigen::Vector3d::Zero();  ///< target frame
+  Eigen::Vector3d load_point_m = Eigen::Vector3d::Zero();  ///< target frame, on the surface
+  /// The contact ellipse at the force's maximum: always given (the contact zone's size); the
+  /// patch load uses it when options.load is hertz_patch.
+  ContactPatch patch;
+  RigidReference model;                     ///< the rigid model (FE-vs-model checks)
+  std::optional<double> yield_strength_Pa;  ///< the target's material: the stress verdict
   DeckOptions options;
+};
+
+/// The FE body against the part of the rigid model: geometry only, known before any solver run.
+struct BodyComparison {
+  double fe_volume_m3 = 0, part_volume_m3 = 0, volume_relative_error = 0;
+  double fe_mass_kg = 0, part_mass_kg = 0, mass_relative_error = 0;
+  /// ||I_FE - I_part||_F / ||I_part||_F, each about its own centroid (I_FE of the tetrahedra)
+  double inertia_relative_error = 0;
+  /// The same for the inertia of ccx's C3D4 mass matrix (TetMassProperties::one_point_inertia):
+  /// what the FE spin follows. Reported; the adaptive default size keeps it within half the
+  /// inertia tolerance too.
+  double solver_inertia_relative_error = 0;
+  double centroid_offset_m = 0;  ///< |c_FE - c_part|
+  /// What the FE-vs-model velocity checks will find if the solver conserves momentum exactly:
+  /// |Pi/M_FE - dv| / |dv| and |I_1pt^-1 ((p - c_FE) x Pi) - dw| / |dw| (null: central hit).
+  std::optional<double> predicted_model_linear_velocity_error, predicted_model_angular_velocity_error;
+  double min_gamma = 0;          ///< Gmsh's gamma (tet_gamma)
+  double min_radius_ratio = 0;
+  FemTolerances tolerances;
+  bool passed = false;
+  std::vector<std::string> failures;  ///< one line per missed threshold
+};
+/// The mesher's tries as JSON (mesh_attempts: surface, algorithm_2d, algorithm_3d, mesh_size_m,
+/// load_mesh_size_m, outcome).
+nlohmann::json to_json(const std::vector<MeshAttempt>& attempts);
+
+/// Compares the tetrahedra (density `density_kg_m3`) with the part; with the impulse vector
+/// (Pi times the force direction, N s) and the load point, also predicts the velocity checks.
+BodyComparison compare_body(const TetMesh& mesh, double density_kg_m3, const RigidReference& part,
+                            const FemTolerances& tolerances,
+                            const Eigen::Vector3d& impulse_Ns = Eigen::Vector3d::Zero(),
+                            const Eigen::Vector3d& load_point_m = Eigen::Vector3d::Zero());
+/// JSON (keys in docs/fem.md; relative errors null without a part reference) and text lines.
+nlohmann::json to_json(const BodyComparison& c);
+std::string format_body(const BodyComparison& c);
+
+/// What the patch load did (hertz_patch only).
+struct PatchSummary {
+  std::size_t load_node_count = 0;  ///< nodes that carry force at some time (1 for a point load)
+  std::size_t max_nodes_loaded_at_once = 0;
+  std::size_t patch_triangles = 0;
+  double largest_ellipse_elements = 0;
+  std::size_t point_load_samples = 0;
+  double max_sum_relative_error = 0, max_moment_relative = 0;
 };
 
 struct DeckResult {
@@ -63,6 +181,10 @@ struct DeckResult {
   MeshQuality quality;
   std::size_t node_count = 0, tet_count = 0;
   double mesh_seconds = 0;  ///< wall time of the meshing part
+  LoadKind load = LoadKind::point;
+  PatchSummary patch;
+  double contact_zone_radius_m = 0;
+  BodyComparison body_check;
 };
 
 /// The time stepping of a deck: a refined phase through the end of the contact, then the user's
@@ -81,12 +203,13 @@ TimeSchedule time_schedule(const DeckOptions& options, double contact_end_s);
 /// failure, leaving `folder` as it was.
 DeckResult write_decks(const DeckRequest& request, const std::filesystem::path& folder);
 
-/// Text of the Code_Aster command file (exposed for tests).
-std::string code_aster_comm(const DeckRequest& request, const TetMesh& mesh);
+/// Text of the Code_Aster command file (exposed for tests). `patch`: the hertz-patch nodal forces
+/// (nullptr: the point load on LOAD); its nodes are the mesh's groups LP1, LP2, ... in order.
+std::string code_aster_comm(const DeckRequest& request, const TetMesh& mesh, const PatchLoad* patch = nullptr);
 /// Text of the run_aster .export file.
 std::string code_aster_export(const DeckRequest& request, const TetMesh& mesh);
 /// Text of the CalculiX main deck and of its included mesh.
-std::string calculix_inp(const DeckRequest& request, const TetMesh& mesh);
+std::string calculix_inp(const DeckRequest& request, const TetMesh& mesh, const PatchLoad* patch = nullptr);
 std::string calculix_mesh_inp(const TetMesh& mesh);
 
 }  // namespace impactdeck::fem_export

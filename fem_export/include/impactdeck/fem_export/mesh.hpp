@@ -4,8 +4,10 @@
 //   - an analytic ellipsoid: OCC unit sphere rotated so that a pole lands on the load point's
 //     direction, then dilated by the semi-axes; the pole is a model vertex, so a mesh node lies
 //     exactly on the load point (DECKS.md);
-//   - a mesh part: STL -> classifySurfaces -> createGeometry -> volume; the load node is the
-//     surface node nearest to the load point (its distance is reported).
+//   - a mesh part: the part's triangulated surface, handed over from memory (whatever file format
+//     it came from, after validation and repair) -> one discrete surface -> classifySurfaces ->
+//     createGeometry -> volume; the load point is a geometry point embedded in the surface that
+//     holds it, so a mesh node lies exactly on it too.
 // Gmsh works in the decks' unit system (mm); TetMesh is SI (m).
 #include <array>
 #include <cstddef>
@@ -36,18 +38,77 @@ double tet_volume_m3(const TetMesh& m, std::size_t e);
 /// Radius ratio 3 r_in / r_circ of tetrahedron `e`: 1 for a regular one, 0 for a flat one.
 double tet_quality(const TetMesh& m, std::size_t e);
 
+/// Gmsh's "gamma" quality of tetrahedron `e` (Mesh.QualityType = 2): inscribed radius over the
+/// longest edge, 2 sqrt(6) r_in / l_max = 6 sqrt(6) V / (sum of face areas x l_max); 1 for a
+/// regular tetrahedron, 0 for a flat one.
+double tet_gamma(const TetMesh& m, std::size_t e);
+
+/// The boundary triangles of a tetrahedral mesh (faces that belong to one tetrahedron only),
+/// each ordered so that its normal (x1-x0) x (x2-x0) points out of the body. #F by 3 node indices.
+std::vector<std::array<int, 3>> boundary_triangles(const TetMesh& m);
+
+/// Mass properties of the tetrahedra for a uniform density (exact for straight-sided tetrahedra).
+struct TetMassProperties {
+  double mass_kg = 0;
+  Eigen::Vector3d centroid_m = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d inertia_kg_m2 = Eigen::Matrix3d::Zero();  ///< about the centroid
+  /// The rigid-rotation inertia of the mass matrix ccx 2.20 builds for C3D4 (one integration
+  /// point: each element's mass at its centroid), sum m_e (|y_e|^2 1 - y_e y_e^T), y_e = element
+  /// centroid - centroid. Smaller than inertia_kg_m2 by the elements' own moments: O(h^2).
+  Eigen::Matrix3d one_point_inertia_kg_m2 = Eigen::Matrix3d::Zero();
+};
+TetMassProperties tet_mass_properties(const TetMesh& m, double density_kg_m3);
+
+/// A closed, outward-oriented triangulated surface (a mesh part after loading, validation and
+/// repair), in the target's frame, SI. #V vertices, #F triangles (counter-clockwise = outward).
+struct PartSurface {
+  std::vector<Eigen::Vector3d> vertices_m;
+  std::vector<std::array<int, 3>> triangles;
+};
+
+/// One try of the mesher: how the surface was made, Gmsh's 2D and 3D algorithm and the sizes.
+struct MeshAttempt {
+  /// "remeshed": classifySurfaces + createGeometry + Gmsh's 2D mesh at the requested sizes;
+  /// "part triangles": the part's own triangulation kept as the boundary (the contact point
+  /// inserted as a vertex), only the volume meshed; "analytic": the ellipsoid route.
+  std::string surface = "remeshed";
+  int algorithm_2d = 0;
+  int algorithm_3d = 0;
+  double mesh_size_m = 0;
+  double load_mesh_size_m = 0;
+  std::string outcome;  ///< "ok", or why this try was rejected (Gmsh's message, quality)
+};
+
+/// "Mesh.Algorithm 6, size 25 mm" / "part triangles, size 25 mm" / "analytic, size 250 mm".
+std::string describe(const MeshAttempt& a);
+
 struct MeshOptions {
   double mesh_size_m = 0;       ///< global target element size (required, > 0)
   double load_mesh_size_m = 0;  ///< element size at the load point; 0: mesh_size_m / 3
+  /// Radius around the load point inside which the size stays load_mesh_size_m (a contact patch
+  /// must be covered evenly); beyond it the size grows with slope (h - h0) / (4 h) up to h.
+  double load_zone_radius_m = 0;
   /// Probe points (target frame, m) that become embedded nodes PROBE1, PROBE2, ...; each must lie
   /// inside the body.
   std::vector<Eigen::Vector3d> probes_m;
+  /// Gmsh Mesh.Algorithm (2D) of the first try; 0 = the route's default (ellipsoid: 1 MeshAdapt,
+  /// DECKS.md; mesh part: 6 Frontal-Delaunay).
+  int algorithm_2d = 0;
   /// Gmsh Mesh.Algorithm3D: 1 Delaunay (default: the same mesh on every run), 10 HXT (DECKS.md
   /// suggests it against slivers, but Gmsh 4.8.4's HXT gives a different mesh on each run, which
-  /// breaks "the .geo reproduces the mesh"). Slivers are caught by the min-quality check.
+  /// breaks "the .geo reproduces the mesh"). Slivers are caught by the quality floor.
   int algorithm_3d = 1;
-  /// STL route only: feature angle for classifySurfaces, degrees.
+  /// Mesh part only: feature angle for classifySurfaces, degrees.
   double feature_angle_deg = 40;
+  /// Mesh part only: when a try fails (Gmsh error, no tetrahedra, or min_gamma below
+  /// quality_floor_gamma after optimisation), try the next of: the other 2D algorithms (6, 1, 5),
+  /// the first one at mesh_size_m / 2 and / 4, then the part's own triangles as the boundary
+  /// (no 2D remeshing; also tried at once when Gmsh cannot classify and reparametrize the
+  /// surface). Every try is reported.
+  bool fallback = true;
+  /// Smallest acceptable Gmsh gamma after optimisation (a try below it counts as failed when
+  /// fallback is on; the decks' quality check compares the final mesh with its own floor).
+  double quality_floor_gamma = 0.01;
 };
 
 struct MeshQuality {
@@ -55,11 +116,15 @@ struct MeshQuality {
   std::size_t tet_count = 0;
   double min_quality = 0;       ///< min radius ratio over the tetrahedra
   double mean_quality = 0;
+  double min_gamma = 0;         ///< min Gmsh gamma (tet_gamma) over the tetrahedra
+  double mean_gamma = 0;
   double fe_volume_m3 = 0;      ///< sum of the tetrahedra
-  double part_volume_m3 = 0;    ///< exact (ellipsoid) or of the closed STL surface
+  double part_volume_m3 = 0;    ///< exact (ellipsoid) or of the closed part surface
   double volume_relative_difference = 0;  ///< (fe - part) / part
   double load_node_distance_m = 0;        ///< load node to the requested load point
   std::vector<double> probe_node_distance_m;
+  double mesh_size_m = 0, load_mesh_size_m = 0;  ///< sizes of the try that was kept
+  std::vector<MeshAttempt> attempts;             ///< every try, in order; the last "ok" one was kept
 };
 
 /// What a meshing run produced: the mesh, its report, and the files written (in `folder`).
@@ -78,11 +143,14 @@ MeshResult mesh_ellipsoid(const Eigen::Vector3d& semi_axes_m, const Eigen::Vecto
                           const MeshOptions& options, const std::filesystem::path& folder,
                           const std::string& name);
 
-/// Meshes the closed STL surface `stl` (coordinates in `stl_unit_m` metres per unit); the STL is
-/// copied into `folder` so that the .geo is self-contained. Same outputs and errors as above.
-MeshResult mesh_stl(const std::filesystem::path& stl, double stl_unit_m,
-                    const Eigen::Vector3d& load_point_m, const MeshOptions& options,
-                    const std::filesystem::path& folder, const std::string& name);
+/// Meshes the closed part surface (from memory). The surface is written as `<name>_part.stl`
+/// (ASCII, mm, 17 digits: read back exactly) into `folder`, which both this call and the .geo
+/// merge, so the .geo reproduces the mesh. `load_point_m` must lie on the surface (within 1e-6 of
+/// the part's size): it becomes a mesh node exactly. `where` names the part in messages. Same
+/// outputs and errors as mesh_ellipsoid; a probe outside the part is an InputError.
+MeshResult mesh_part(const PartSurface& surface, const Eigen::Vector3d& load_point_m,
+                     const MeshOptions& options, const std::filesystem::path& folder,
+                     const std::string& name, const std::string& where);
 
 /// Meshes the solid(s) of a CAD file (STEP, IGES, BREP) straight from the B-rep, through Gmsh's
 /// OpenCASCADE kernel: no STL detour. STEP and IGES are read in their own stated unit (converted

@@ -84,6 +84,18 @@ void write_svg(const std::filesystem::path& path, const Drawing& d);
 /// a PNG atomically.
 void write_png(const std::filesystem::path& path, const Drawing& d, double scale = 1.0);
 
+/// A tick of a chart axis: its position (px) along the axis and its label.
+struct Tick {
+  double px = 0;
+  std::string label;
+};
+
+/// The frame of a 2-D chart in the box [left, right] x [top, bottom] (px): light grid lines and
+/// labelled ticks along the bottom (x) and left (y) axes, the two axes, and the axis titles (the
+/// y title turned by 90 degrees). Figures draw their curves on top.
+void chart_frame(Drawing& d, double left, double top, double right, double bottom, const std::vector<Tick>& x,
+                 const std::vector<Tick>& y, const std::string& x_title, const std::string& y_title);
+
 /// About `count` "nice" tick values (1, 2, 5 x 10^k steps) covering [lo, hi].
 std::vector<double> nice_ticks(double lo, double hi, int count = 5);
 

@@ -88,6 +88,16 @@ struct FemOutputs {
   bool code_aster = true;
   bool calculix = true;
   enum class Run { none, calculix } run = Run::none;  ///< "calculix": run ccx and the check
+  /// "point": F(t) on the contact node; "hertz-patch": the Hertz pressure of each instant's
+  /// contact ellipse as nodal forces (docs/fem.md).
+  enum class Load { point, hertz_patch } load = Load::point;
+  int contact_elements = 4;          ///< hertz-patch: elements across the largest ellipse (short axis)
+  double contact_zone_factor = 3.0;  ///< contact zone radius in contact semi-axes a_max
+  /// Check thresholds; unset: fem_export::FemTolerances' defaults (docs/fem.md).
+  struct Tolerances {
+    std::optional<double> linear_momentum, angular_momentum, model_linear_velocity, model_angular_velocity,
+        volume, mass, inertia, min_gamma;
+  } tolerances;
   Place place;
 };
 

@@ -1,0 +1,380 @@
+// Stresses of a CalculiX run read back from the .frd (see stress.hpp).
+#include "impactdeck/fem_export/stress.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+
+#include "impactdeck/common/atomic_file.hpp"
+#include "impactdeck/common/error.hpp"
+#include "impactdeck/plot/stress_plot.hpp"
+
+namespace impactdeck::fem_export {
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+constexpr double kPaPerMPa = 1e6;
+constexpr double kMPerMm = 1e-3;
+
+double von_mises(const double s[6]) {
+  const double a = s[0] - s[1], b = s[1] - s[2], c = s[2] - s[0];
+  return std::sqrt(0.5 * (a * a + b * b + c * c) + 3.0 * (s[3] * s[3] + s[4] * s[4] + s[5] * s[5]));
+}
+
+// Fixed-width field [pos, pos + width) of an .frd line as a number (frd writes 1.23456E-07 and
+// runs fields together when a sign fills the gap).
+bool field(const std::string& line, std::size_t pos, std::size_t width, double& v) {
+  if (line.size() < pos + width) return false;
+  char buf[32];
+  const std::size_t n = std::min<std::size_t>(width, sizeof buf - 1);
+  line.copy(buf, n, pos);
+  buf[n] = '\0';
+  char* end = nullptr;
+  v = std::strtod(buf, &end);
+  return end != buf && std::isfinite(v);
+}
+
+std::string mm_text(const Eigen::Vector3d& p_m) {
+  std::ostringstream s;
+  s << std::setprecision(4) << "(" << p_m.x() * 1e3 + 0.0 << ", " << p_m.y() * 1e3 + 0.0 << ", "
+    << p_m.z() * 1e3 + 0.0 << ") mm";
+  return s.str();
+}
+
+}  // namespace
+
+const char* to_string(VerdictKind k) {
+  switch (k) {
+    case VerdictKind::survives: return "survives";
+    case VerdictKind::yields: return "yields";
+    case VerdictKind::no_yield_strength: return "no yield strength given";
+  }
+  return "?";
+}
+
+StressResult read_stresses(const fs::path& frd, const TetMesh& mesh, const StressInputs& in) {
+  const std::string where = frd.string();
+  std::ifstream f(frd, std::ios::binary);
+  if (!f) throw InputError(where, "file", "CalculiX results (.frd) cannot be opened (missing or unreadable)");
+  const std::size_t n = mesh.nodes_m.size();
+  if (in.load_node < 0 || static_cast<std::size_t>(in.load_node) >= n) {
+    throw InputError(where, "LOAD", "load node is not a node of the mesh");
+  }
+  StressResult r;
+  r.contact_zone_radius_m = in.contact_zone_radius_m;
+  r.inside_zone_meaningful = in.patch_load;
+  const Eigen::Vector3d c = mesh.nodes_m[in.load_node];
+  std::vector<char> inside(n, 0);
+  for (std::size_t i = 0; i < n; ++i) inside[i] = (mesh.nodes_m[i] - c).norm() <= in.contact_zone_radius_m;
+  r.node_peak_Pa.assign(n, 0.0);
+  r.node_peak_time_s.assign(n, 0.0);
+  r.von_mises_at_peak_Pa.assign(n, 0.0);
+  r.displacement_at_peak_m.assign(n, Eigen::Vector3d::Zero());
+  for (const auto& [name, node] : in.probes) r.probes.push_back({name, node, mesh.nodes_m.at(node), 0, 0, {}});
+  r.load = {"LOAD", in.load_node, c, 0, 0, {}};
+
+  // One pass: each output time has a DISP block then a STRESS block (ccx 2.20); the displacement
+  // of the current time is kept until its stresses are read.
+  std::vector<Eigen::Vector3d> disp(n, Eigen::Vector3d::Zero());
+  std::vector<double> vm(n, 0.0);
+  std::vector<char> seen(n, 0);
+  enum class Block { none, disp, stress } block = Block::none;
+  double t = 0, governing_best = -1;
+  bool skip = false;
+  std::string line;
+  std::size_t lineno = 0;
+  auto finish_stress = [&] {
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!seen[i]) throw InputError(where, "time " + std::to_string(t), "stress block misses node " + std::to_string(i + 1));
+    }
+    r.time_s.push_back(t);
+    for (auto& p : r.probes) p.von_mises_Pa.push_back(vm[p.node]);
+    r.load.von_mises_Pa.push_back(vm[in.load_node]);
+    double out_max = -1, in_max = -1;
+    int out_node = -1, in_node = -1;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (vm[i] > r.node_peak_Pa[i]) r.node_peak_Pa[i] = vm[i], r.node_peak_time_s[i] = t;
+      if (inside[i]) {
+        if (vm[i] > in_max) in_max = vm[i], in_node = static_cast<int>(i);
+      } else if (vm[i] > out_max) {
+        out_max = vm[i], out_node = static_cast<int>(i);
+      }
+    }
+    auto update = [&](VonMisesPeak& p, double v, int node) {
+      if (node >= 0 && v > p.von_mises_Pa) p = {v, t, node, mesh.nodes_m[node]};
+    };
+    update(r.outside_zone, out_max, out_node);
+    update(r.inside_zone, in_max, in_node);
+    const double governing = in.patch_load ? std::max(out_max, in_max) : out_max;
+    if (in.yield_strength_Pa && governing > *in.yield_strength_Pa && !r.verdict.first_yield_time_s) {
+      r.verdict.first_yield_time_s = t;
+    }
+    if (governing > governing_best) {
+      governing_best = governing;
+      r.peak_field_time_s = t;
+      r.von_mises_at_peak_Pa = vm;
+      r.displacement_at_peak_m = disp;
+    }
+  };
+  while (std::getline(f, line)) {
+    ++lineno;
+    r.frd_bytes += line.size() + 1;
+    if (line.rfind("  100C", 0) == 0) {
+      double v;
+      if (!field(line, 12, 12, v)) throw InputError(where, "line " + std::to_string(lineno), "bad time in a result header");
+      t = v;
+      skip = t > in.end_time_s * (1 + 1e-6);  // the momentum step's increment
+      continue;
+    }
+    if (line.rfind(" -4  DISP", 0) == 0) {
+      block = skip ? Block::none : Block::disp;
+      continue;
+    }
+    if (line.rfind(" -4  STRESS", 0) == 0) {
+      block = skip ? Block::none : Block::stress;
+      std::fill(seen.begin(), seen.end(), 0);
+      continue;
+    }
+    if (line.rfind(" -4", 0) == 0) {
+      block = Block::none;
+      continue;
+    }
+    if (line.rfind(" -3", 0) == 0) {
+      if (block == Block::stress) finish_stress();
+      block = Block::none;
+      continue;
+    }
+    if (block == Block::none || line.rfind(" -1", 0) != 0) continue;
+    double id;
+    if (!field(line, 3, 10, id) || id < 1 || id > static_cast<double>(n)) {
+      throw InputError(where, "line " + std::to_string(lineno), "a result line names a node the mesh does not have");
+    }
+    const std::size_t node = static_cast<std::size_t>(id) - 1;
+    if (block == Block::disp) {
+      double u[3];
+      for (int k = 0; k < 3; ++k) {
+        if (!field(line, 13 + 12 * k, 12, u[k])) throw InputError(where, "line " + std::to_string(lineno), "bad displacement");
+      }
+      disp[node] = Eigen::Vector3d(u[0], u[1], u[2]) * kMPerMm;
+    } else {
+      double sv[6];
+      for (int k = 0; k < 6; ++k) {
+        if (!field(line, 13 + 12 * k, 12, sv[k])) throw InputError(where, "line " + std::to_string(lineno), "bad stress");
+      }
+      vm[node] = von_mises(sv) * kPaPerMPa;
+      seen[node] = 1;
+    }
+  }
+  if (r.time_s.empty()) {
+    throw InputError(where, "STRESS", "no stress output (the deck requests *EL FILE S; did ccx finish?)");
+  }
+  auto peak_of = [&](ProbeStress& p) {
+    for (std::size_t k = 0; k < r.time_s.size(); ++k) {
+      if (p.von_mises_Pa[k] > p.max_von_mises_Pa) p.max_von_mises_Pa = p.von_mises_Pa[k], p.max_von_mises_time_s = r.time_s[k];
+    }
+  };
+  for (auto& p : r.probes) peak_of(p);
+  peak_of(r.load);
+
+  Verdict& v = r.verdict;
+  v.yield_strength_Pa = in.yield_strength_Pa;
+  const bool inside_governs = in.patch_load && r.inside_zone.von_mises_Pa > r.outside_zone.von_mises_Pa;
+  v.governing = inside_governs ? r.inside_zone : r.outside_zone;
+  v.governing_region = inside_governs ? "inside the contact zone" : "outside the contact zone";
+  if (in.yield_strength_Pa) {
+    v.safety_factor = v.governing.von_mises_Pa > 0 ? *in.yield_strength_Pa / v.governing.von_mises_Pa : 0.0;
+    v.kind = v.governing.von_mises_Pa > *in.yield_strength_Pa ? VerdictKind::yields : VerdictKind::survives;
+    if (v.kind == VerdictKind::survives) v.first_yield_time_s.reset();
+  }
+  return r;
+}
+
+void write_stress_files(const fs::path& dir, const TetMesh& m, StressResult& r, const std::string& title) {
+  std::vector<const ProbeStress*> series;
+  for (const auto& p : r.probes) series.push_back(&p);
+  series.push_back(&r.load);
+
+  // 1. History CSV, SI.
+  const fs::path csv = dir / "von_mises_history.csv";
+  write_file_atomically(csv, [&](std::ostream& o) {
+    o << "# von Mises stress (Pa) against time (s) at each probe and at the contact node LOAD (impactdeck)\n";
+    for (const auto* p : series) o << "# " << p->name << " at " << mm_text(p->point_m) << "\n";
+    o << "time_s";
+    for (const auto* p : series) o << "," << p->name << "_von_mises_Pa";
+    o << "\n" << std::setprecision(9);
+    for (std::size_t k = 0; k < r.time_s.size(); ++k) {
+      o << r.time_s[k];
+      for (const auto* p : series) o << "," << p->von_mises_Pa[k];
+      o << "\n";
+    }
+  });
+
+  // 2. VTK XML unstructured grid (ASCII): positions in m, tetrahedra (VTK type 10).
+  const fs::path vtu = dir / "von_mises_peak.vtu";
+  write_file_atomically(vtu, [&](std::ostream& o) {
+    o << std::setprecision(9);
+    o << "<?xml version=\"1.0\"?>\n<!-- impactdeck: peak von Mises over time (Pa) and the fields at the time of the "
+         "governing peak, t = " << r.peak_field_time_s << " s -->\n"
+      << "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n"
+      << "<Piece NumberOfPoints=\"" << m.nodes_m.size() << "\" NumberOfCells=\"" << m.tets.size() << "\">\n"
+      << "<PointData Scalars=\"von_mises_peak_Pa\" Vectors=\"displacement_at_peak_m\">\n";
+    auto scalars = [&](const char* name, const std::vector<double>& v) {
+      o << "<DataArray type=\"Float64\" Name=\"" << name << "\" format=\"ascii\">\n";
+      for (double x : v) o << x << "\n";
+      o << "</DataArray>\n";
+    };
+    scalars("von_mises_peak_Pa", r.node_peak_Pa);
+    scalars("von_mises_peak_time_s", r.node_peak_time_s);
+    scalars("von_mises_at_peak_Pa", r.von_mises_at_peak_Pa);
+    o << "<DataArray type=\"Float64\" Name=\"displacement_at_peak_m\" NumberOfComponents=\"3\" format=\"ascii\">\n";
+    for (const auto& u : r.displacement_at_peak_m) o << u.x() << " " << u.y() << " " << u.z() << "\n";
+    o << "</DataArray>\n</PointData>\n<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
+    for (const auto& x : m.nodes_m) o << x.x() << " " << x.y() << " " << x.z() << "\n";
+    o << "</DataArray>\n</Points>\n<Cells>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
+    for (const auto& t : m.tets) o << t[0] << " " << t[1] << " " << t[2] << " " << t[3] << "\n";
+    o << "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
+    for (std::size_t e = 0; e < m.tets.size(); ++e) o << 4 * (e + 1) << "\n";
+    o << "</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
+    for (std::size_t e = 0; e < m.tets.size(); ++e) o << "10\n";
+    o << "</DataArray>\n</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
+  });
+
+  // 3. Gmsh MSH 2.2 with $NodeData views (open with gmsh; positions in m like the .vtu).
+  const fs::path msh = dir / "von_mises_peak.msh";
+  write_file_atomically(msh, [&](std::ostream& o) {
+    o << std::setprecision(9);
+    o << "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n" << m.nodes_m.size() << "\n";
+    for (std::size_t i = 0; i < m.nodes_m.size(); ++i) {
+      o << i + 1 << " " << m.nodes_m[i].x() << " " << m.nodes_m[i].y() << " " << m.nodes_m[i].z() << "\n";
+    }
+    o << "$EndNodes\n$Elements\n" << m.tets.size() << "\n";
+    for (std::size_t e = 0; e < m.tets.size(); ++e) {
+      const auto& t = m.tets[e];
+      o << e + 1 << " 4 2 1 1 " << t[0] + 1 << " " << t[1] + 1 << " " << t[2] + 1 << " " << t[3] + 1 << "\n";
+    }
+    o << "$EndElements\n";
+    auto view = [&](const std::string& name, int comps, const auto& value) {
+      o << "$NodeData\n1\n\"" << name << "\"\n1\n" << r.peak_field_time_s << "\n3\n0\n" << comps << "\n"
+        << m.nodes_m.size() << "\n";
+      for (std::size_t i = 0; i < m.nodes_m.size(); ++i) {
+        o << i + 1;
+        value(o, i);
+        o << "\n";
+      }
+      o << "$EndNodeData\n";
+    };
+    view("peak von Mises over time (Pa)", 1, [&](std::ostream& s, std::size_t i) { s << " " << r.node_peak_Pa[i]; });
+    view("time of the peak von Mises (s)", 1, [&](std::ostream& s, std::size_t i) { s << " " << r.node_peak_time_s[i]; });
+    view("von Mises at the governing peak's time (Pa)", 1,
+         [&](std::ostream& s, std::size_t i) { s << " " << r.von_mises_at_peak_Pa[i]; });
+    view("displacement at the governing peak's time (m)", 3, [&](std::ostream& s, std::size_t i) {
+      const auto& u = r.displacement_at_peak_m[i];
+      s << " " << u.x() << " " << u.y() << " " << u.z();
+    });
+  });
+
+  // 4. The paper's Fig. 15.
+  const fs::path svg = dir / "von_mises.svg";
+  if (r.time_s.size() >= 2) {
+    std::vector<plot::StressSeries> ps;
+    double lo = 1e300, hi = 0;
+    for (const auto* p : series) {
+      // The contact node in vermilion, the probes in the other colours.
+      ps.push_back({p->name + " " + mm_text(p->point_m), r.time_s, p->von_mises_Pa,
+                    p == &r.load ? plot::kVermilion : static_cast<int>(ps.size()) % plot::kVermilion});
+      lo = std::min(lo, p->max_von_mises_Pa);
+      hi = std::max(hi, p->max_von_mises_Pa);
+    }
+    plot::StressPlotOptions po;
+    po.title = title;
+    po.yield_strength_Pa = r.verdict.yield_strength_Pa;
+    po.log_scale = lo > 0 && hi / lo > 30;  // a point load's node dwarfs the probes
+    plot::write_svg(svg, plot::stress_time_drawing(ps, po));
+    r.files.push_back(svg);
+  }
+  r.files.insert(r.files.begin(), {csv, vtu, msh});
+}
+
+std::string format_stress(const StressResult& r) {
+  std::ostringstream s;
+  s << std::setprecision(4);
+  auto mpa = [](double pa) { return pa * 1e-6; };
+  for (const auto& p : r.probes) {
+    s << p.name << " " << mm_text(p.point_m) << ": max von Mises " << mpa(p.max_von_mises_Pa) << " MPa at "
+      << p.max_von_mises_time_s << " s\n";
+  }
+  s << "contact zone (radius " << r.contact_zone_radius_m * 1e3 << " mm): ";
+  if (r.inside_zone.node >= 0) {
+    s << "max von Mises " << mpa(r.inside_zone.von_mises_Pa) << " MPa at " << mm_text(r.inside_zone.point_m) << ", "
+      << r.inside_zone.time_s << " s" << (r.inside_zone_meaningful ? "" : " (not meaningful under a point load)");
+  } else {
+    s << "no node";
+  }
+  s << "\noutside the contact zone: max von Mises " << mpa(r.outside_zone.von_mises_Pa) << " MPa at "
+    << mm_text(r.outside_zone.point_m) << ", " << r.outside_zone.time_s << " s\n";
+  const Verdict& v = r.verdict;
+  s << "verdict: " << to_string(v.kind);
+  if (v.kind == VerdictKind::survives) {
+    s << ", safety factor " << v.safety_factor << " against yield " << mpa(*v.yield_strength_Pa) << " MPa ("
+      << v.governing_region << ")";
+  } else if (v.kind == VerdictKind::yields) {
+    s << ": " << mpa(v.governing.von_mises_Pa) << " MPa > yield " << mpa(*v.yield_strength_Pa) << " MPa at "
+      << mm_text(v.governing.point_m) << ", " << v.governing.time_s << " s (" << v.governing_region
+      << "; first above yield at " << v.first_yield_time_s.value_or(v.governing.time_s) << " s)";
+  }
+  s << "\n";
+  return s.str();
+}
+
+json to_json(const StressResult& r) {
+  auto v3 = [](const Eigen::Vector3d& v) { return json::array({v.x() + 0.0, v.y() + 0.0, v.z() + 0.0}); };
+  auto peak = [&](const VonMisesPeak& p) {
+    if (p.node < 0) return json(nullptr);
+    return json{{"max_von_mises_Pa", p.von_mises_Pa}, {"time_s", p.time_s}, {"node", p.node + 1}, {"point_m", v3(p.point_m)}};
+  };
+  auto probe = [&](const ProbeStress& p) {
+    return json{{"name", p.name},
+                {"node", p.node + 1},
+                {"point_m", v3(p.point_m)},
+                {"max_von_mises_Pa", p.max_von_mises_Pa},
+                {"max_von_mises_time_s", p.max_von_mises_time_s}};
+  };
+  json probes = json::array();
+  for (const auto& p : r.probes) probes.push_back(probe(p));
+  json load = probe(r.load);
+  load["meaningful"] = r.inside_zone_meaningful;
+  json inside = peak(r.inside_zone);
+  if (!inside.is_null()) {
+    inside["meaningful"] = r.inside_zone_meaningful;
+    if (!r.inside_zone_meaningful) {
+      inside["note"] = "not meaningful: a point load's stress near its node grows without bound as the mesh is "
+                       "refined (use load = \"hertz-patch\")";
+    }
+  }
+  const Verdict& v = r.verdict;
+  json verdict = {{"result", to_string(v.kind)},
+                  {"yield_strength_Pa", v.yield_strength_Pa ? json(*v.yield_strength_Pa) : json(nullptr)},
+                  {"governing_region", v.governing_region},
+                  {"governing", peak(v.governing)},
+                  {"safety_factor", v.yield_strength_Pa && v.governing.von_mises_Pa > 0 ? json(v.safety_factor) : json(nullptr)},
+                  {"first_yield_time_s", v.first_yield_time_s ? json(*v.first_yield_time_s) : json(nullptr)}};
+  json files = json::array();
+  for (const auto& f : r.files) files.push_back(f.string());
+  return {{"probes", probes},
+          {"load_node", load},
+          {"contact_zone_radius_m", r.contact_zone_radius_m},
+          {"outside_contact_zone", peak(r.outside_zone)},
+          {"inside_contact_zone", inside},
+          {"verdict", verdict},
+          {"output_times", r.time_s.size()},
+          {"peak_field_time_s", r.peak_field_time_s},
+          {"frd_bytes", r.frd_bytes},
+          {"files", files}};
+}
+
+}  // namespace impactdeck::fem_export
