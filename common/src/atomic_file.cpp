@@ -44,7 +44,8 @@ fs::path write_temporary(const fs::path& path, const std::function<void(std::ost
   if (!fs::is_directory(dir, ec)) {
     throw InputError(path.string(), "output", "folder '" + dir.string() + "' does not exist");
   }
-  const fs::path tmp = dir / ("." + path.filename().string() + ".tmp-" + random_suffix());
+  // A fixed-length temporary name, whatever the target's: a legal 255-byte name stays legal.
+  const fs::path tmp = dir / (".impactdeck-tmp-" + random_suffix());
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
     if (!out) {
@@ -53,8 +54,13 @@ fs::path write_temporary(const fs::path& path, const std::function<void(std::ost
     }
     try {
       fill(out);
+      errno = 0;
       out.flush();
-      if (!out) throw InputError(path.string(), "output", "write failed (disk full?)");
+      if (!out) {
+        const int e = errno;
+        throw InputError(path.string(), "output",
+                         std::string("write failed: ") + (e ? std::strerror(e) : "I/O error (disk full?)"));
+      }
     } catch (...) {
       out.close();
       fs::remove(tmp, ec);
@@ -69,8 +75,9 @@ void rename_into_place(const fs::path& tmp, const fs::path& path) {
   std::error_code ec;
   fs::rename(tmp, path, ec);
   if (ec) {
+    const std::string why = ec.message();
     fs::remove(tmp, ec);
-    throw InputError(path.string(), "output", "cannot rename temporary file into place");
+    throw InputError(path.string(), "output", "cannot rename temporary file into place: " + why);
   }
 }
 
