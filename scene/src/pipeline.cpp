@@ -8,11 +8,13 @@
 #include "impactdeck/collision/elliptical.hpp"
 #include "impactdeck/collision/hertz.hpp"
 #include "impactdeck/common/atomic_file.hpp"
+#include "impactdeck/common/run_transaction.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/fem_export/force_table.hpp"
 #include "impactdeck/geometry/ellipsoid.hpp"
 #include "impactdeck/geometry/part.hpp"
 #include "impactdeck/plot/force_plot.hpp"
+#include "numeric_checks.hpp"
 
 namespace impactdeck::scene {
 namespace fs = std::filesystem;
@@ -120,6 +122,7 @@ PreparedBody prepare_body(const BodySpec& b, const Scene& scene, RunReport* repo
   const double density = b.mass_kg ? *b.mass_kg / p.volume.volume_m3 : *m.density_kg_m3;
   p.mass_kg = density * p.volume.volume_m3;
   p.inertia_kg_m2 = density * p.volume.inertia_per_density_m5;
+  detail::check_body_magnitudes(scene, b, p);
   return p;
 }
 
@@ -252,21 +255,61 @@ fem_export::DeckRequest fem_request(const Scene& scene, const ImpactReport& ir, 
       b.shape == ShapeKind::mesh ? 0.25 * target.shape->size_m() : 0.5 * r.body.semi_axes_m.minCoeff());
   r.options.mesh.load_mesh_size_m = f.load_mesh_size_m.value_or(0.0);
   r.options.mesh.probes_m = f.probes_m;
+  r.body.volume_m3 = target.volume.volume_m3;
+  if (f.max_elements) r.options.max_elements = *f.max_elements;
   return r;
 }
 
 }  // namespace
 
-RunReport run_scene(const Scene& scene, const RunOptions& opt) {
-  RunReport report;
-  StageClock clock(report);
-  report.stages_run.push_back({"scene", 0.0});
-  if (const auto left = AtomicFileSet::interrupted_commit(opt.out_dir); !left.empty()) {
-    report.warnings.push_back("a previous run was killed while replacing its " + std::to_string(left.size()) +
-                              " output files in '" + opt.out_dir.string() +
-                              "': they may mix two runs until this run replaces them (see " +
-                              AtomicFileSet::kMarker + ")");
+namespace {
+
+// Where each output of the scene goes, reserved in the run's transaction before any work (a bad
+// name fails at once): staged paths, one per impact.
+struct StagedOutputs {
+  std::vector<fs::path> table, plot, fem;
+};
+
+StagedOutputs reserve_outputs(const Scene& scene, RunTransaction& txn) {
+  StagedOutputs st;
+  const std::string file = where(scene);
+  const std::size_t n = scene.impacts.size();
+  auto place_of = [&](const char* key) {
+    const auto it = scene.outputs.places.find(key);
+    return (it != scene.outputs.places.end() ? it->second : Place{0, std::string("outputs.") + key}).describe();
+  };
+  // One file per impact; with several impacts the impact's name is appended to the stem.
+  auto per_impact = [&](const fs::path& base, const ImpactSpec& s, const char* key) {
+    if (n == 1) return base.string();
+    RunTransaction::check_name(base.string(), file, place_of(key));  // before the name is changed
+    return (base.parent_path() / (base.stem().string() + "_" + s.name + base.extension().string())).string();
+  };
+  auto name_in_file_names = [&](const ImpactSpec& s) {
+    if (s.name.find('/') != std::string::npos) {
+      throw InputError(file, Place{s.place.line, s.place.key + ".name"}.describe(),
+                       "impact '" + s.name + "': the name is part of output file names, so it must not contain '/'");
+    }
+  };
+  for (const auto& s : scene.impacts) {
+    if (scene.outputs.fem || (n > 1 && (scene.outputs.force_table_csv || scene.outputs.force_plot_svg))) {
+      name_in_file_names(s);
+    }
+    if (scene.outputs.fem) {
+      st.fem.push_back(txn.folder("fem_" + s.name, file, Place{s.place.line, s.place.key + ".name"}.describe() +
+                                                             " (deck folder of [outputs.fem])"));
+    }
+    if (scene.outputs.force_table_csv) {
+      st.table.push_back(txn.file(per_impact(*scene.outputs.force_table_csv, s, "force_table_csv"), file, place_of("force_table_csv")));
+    }
+    if (scene.outputs.force_plot_svg) {
+      st.plot.push_back(txn.file(per_impact(*scene.outputs.force_plot_svg, s, "force_plot_svg"), file, place_of("force_plot_svg")));
+    }
   }
+  return st;
+}
+
+void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, RunReport& report, StageClock& clock) {
+  const StagedOutputs staged = reserve_outputs(scene, txn);
 
   // Bodies that take part in an impact (others are not even built).
   std::map<std::string, PreparedBody> bodies;
@@ -308,7 +351,13 @@ RunReport run_scene(const Scene& scene, const RunOptions& opt) {
             collision::effective_modulus_Pa(target.material, impactor.material, scene.modulus_convention);
         in.restitution = s.restitution;
         in.thresholds = scene.thresholds;
-        return collision::solve_impact(in);
+        detail::check_impact_magnitudes(scene, s, in);
+        try {
+          return collision::solve_impact(in);
+        } catch (const InputError& e) {
+          if (e.place() != "numeric range") throw;
+          throw InputError("", e.place(), e.reason() + "; check " + detail::impact_input_keys(scene, s));
+        }
       });
     });
     for (const auto& w : ir.result.warnings) report.warnings.push_back("impact '" + s.name + "': " + w);
@@ -318,87 +367,122 @@ RunReport run_scene(const Scene& scene, const RunOptions& opt) {
   const bool want_fem = scene.outputs.fem.has_value();
   if (!report.all_checks_passed()) {
     report.warnings.push_back("a self-check failed: no output file was written");
-  } else {
-    // One file per impact; with several impacts the impact's name is appended to the stem.
-    auto per_impact = [&](const fs::path& base, const ImpactReport& ir) {
-      fs::path p = base;
-      if (report.impacts.size() > 1) {
-        p = base.parent_path() / (base.stem().string() + "_" + ir.spec->name + base.extension().string());
-      }
-      return p.is_absolute() ? p : opt.out_dir / p;
-    };
-    if (scene.outputs.force_table_csv || want_fem) {
-      clock.run("force_table", [&] {
-        for (auto& ir : report.impacts) {
-          ir.table = collision::sample_force_table(ir.result.history, scene.outputs.force_table);
-          if (!ir.table->tolerance_met) {
-            std::ostringstream m;
-            m << "impact '" << ir.spec->name << "': force table impulse error "
-              << ir.table->impulse_relative_error << " exceeds the tolerance "
-              << ir.table->impulse_tolerance;
-            report.warnings.push_back(m.str());
-          }
-        }
-      });
-    }
-    // FEM decks first: a meshing failure then leaves no CSV behind either. Each deck folder is
-    // staged and renamed whole (fem_export::write_decks).
-    if (want_fem) {
+    return;
+  }
+  if (scene.outputs.force_table_csv || want_fem) {
+    clock.run("force_table", [&] {
       for (auto& ir : report.impacts) {
-        fem_export::DeckRequest req = fem_request(scene, ir, bodies.at(ir.spec->target));
-        const fs::path folder = opt.out_dir / ("fem_" + ir.spec->name);
-        const auto t0 = std::chrono::steady_clock::now();
         try {
-          ir.fem_deck = fem_export::write_decks(req, folder);
+          ir.table = collision::sample_force_table(ir.result.history, scene.outputs.force_table);
         } catch (const InputError& e) {
-          // One line naming the scene, the [outputs.fem] table, and what failed where.
-          std::string what = "impact '" + ir.spec->name + "': FEM deck " + e.where() + ": ";
-          if (!e.place().empty()) what += e.place() + ": ";
-          throw InputError(where(scene), Place{scene.outputs.fem->place.line, "outputs.fem"}.describe(),
-                           what + e.reason());
+          const auto it = scene.outputs.places.find(e.place());
+          const Place place = it != scene.outputs.places.end() ? it->second : Place{0, "outputs." + e.place()};
+          throw InputError(where(scene), place.describe(), "impact '" + ir.spec->name + "': " + e.reason());
         }
-        const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        add_stage(report, "fem_mesh", ir.fem_deck->mesh_seconds);
-        add_stage(report, "fem_decks", total - ir.fem_deck->mesh_seconds);
-        for (const auto& f : ir.fem_deck->files) report.files_written.push_back(f);
+        if (!ir.table->tolerance_met) {
+          std::ostringstream m;
+          m << "impact '" << ir.spec->name << "': force table impulse error "
+            << ir.table->impulse_relative_error << " exceeds the tolerance "
+            << ir.table->impulse_tolerance;
+          report.warnings.push_back(m.str());
+        }
       }
-      if (scene.outputs.fem->run == FemOutputs::Run::calculix) {
-        clock.run("fem_run", [&] {
-          for (auto& ir : report.impacts) {
-            fem_export::CheckOptions co;
-            co.progress = opt.progress;
-            ir.fem_check = fem_export::run_check(ir.fem_deck->folder, co);
-          }
-        });
+    });
+  }
+  // FEM decks first (the slow part), written into the run's staging folder with the solver's
+  // results: they appear in --out only with everything else, after every check passed.
+  if (want_fem) {
+    for (std::size_t k = 0; k < report.impacts.size(); ++k) {
+      auto& ir = report.impacts[k];
+      fem_export::DeckRequest req = fem_request(scene, ir, bodies.at(ir.spec->target));
+      const auto t0 = std::chrono::steady_clock::now();
+      try {
+        ir.fem_deck = fem_export::write_deck_files(req, staged.fem[k]);
+      } catch (const InputError& e) {
+        // One line naming the scene, the [outputs.fem] table, and what failed where.
+        std::string what = "impact '" + ir.spec->name + "': FEM deck " + txn.public_text(e.where()) + ": ";
+        if (!e.place().empty()) what += e.place() + ": ";
+        throw InputError(where(scene), Place{scene.outputs.fem->place.line, "outputs.fem"}.describe(),
+                         what + e.reason());
       }
+      const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      add_stage(report, "fem_mesh", ir.fem_deck->mesh_seconds);
+      add_stage(report, "fem_decks", total - ir.fem_deck->mesh_seconds);
     }
-    if (scene.outputs.force_table_csv || scene.outputs.force_plot_svg) {
-      clock.run("write_outputs", [&] {
-        AtomicFileSet files;  // all or nothing: a failure leaves the previous outputs as they were
+    if (scene.outputs.fem->run == FemOutputs::Run::calculix) {
+      clock.run("fem_run", [&] {
         for (auto& ir : report.impacts) {
-          if (scene.outputs.force_table_csv) {
-            const fs::path full = per_impact(*scene.outputs.force_table_csv, ir);
-            fem_export::ForceTableHeader h;
-            h.source = scene.file.string();
-            h.impact = ir.spec->name;
-            h.direction = -ir.contact.target_point.normal;  // force on the target: along -n
-            files.add(full, [&](std::ostream& out) { fem_export::write_force_table_csv(out, *ir.table, h); });
-            ir.table_path = full;
-          }
-          if (scene.outputs.force_plot_svg) {
-            const fs::path full = per_impact(*scene.outputs.force_plot_svg, ir);
-            plot::ForcePlotOptions po;
-            po.title = "Contact force, impact '" + ir.spec->name + "': " + ir.spec->impactor + " hits " +
-                       ir.spec->target;
-            files.add(full, plot::to_svg(plot::force_time_drawing(ir.result.history, po)));
-            ir.plot_path = full;
-          }
+          fem_export::CheckOptions co;
+          co.progress = opt.progress;
+          co.timeout_s = opt.solver_timeout_s;
+          ir.fem_check = fem_export::run_check(ir.fem_deck->folder, co);
         }
-        for (const auto& f : files.commit()) report.files_written.push_back(f);
       });
     }
   }
+  if (scene.outputs.force_table_csv || scene.outputs.force_plot_svg) {
+    clock.run("write_outputs", [&] {
+      for (std::size_t k = 0; k < report.impacts.size(); ++k) {
+        auto& ir = report.impacts[k];
+        if (scene.outputs.force_table_csv) {
+          fem_export::ForceTableHeader h;
+          h.source = scene.file.string();
+          h.impact = ir.spec->name;
+          h.direction = -ir.contact.target_point.normal;  // force on the target: along -n
+          write_file_atomically(staged.table[k], [&](std::ostream& out) {
+            fem_export::write_force_table_csv(out, *ir.table, h);
+          });
+          ir.table_path = txn.public_path(staged.table[k]);
+        }
+        if (scene.outputs.force_plot_svg) {
+          plot::ForcePlotOptions po;
+          po.title = "Contact force, impact '" + ir.spec->name + "': " + ir.spec->impactor + " hits " +
+                     ir.spec->target;
+          write_file_atomically(staged.plot[k], plot::to_svg(plot::force_time_drawing(ir.result.history, po)));
+          ir.plot_path = txn.public_path(staged.plot[k]);
+        }
+      }
+    });
+  }
+  if (!report.all_checks_passed()) {
+    report.warnings.push_back("a self-check failed: no output file was written");
+    return;  // the transaction is rolled back: nothing of this run is visible
+  }
+  if (scene.outputs.force_table_csv || scene.outputs.force_plot_svg) {
+    clock.run("write_outputs", [&] { txn.commit(); });
+  } else {
+    txn.commit();
+  }
+  for (auto& ir : report.impacts) {
+    if (ir.fem_deck) {
+      ir.fem_deck->folder = txn.public_path(ir.fem_deck->folder);
+      for (auto& f : ir.fem_deck->files) {
+        f = txn.public_path(f);
+        report.files_written.push_back(f);
+      }
+    }
+  }
+  for (const auto& ir : report.impacts) {
+    if (ir.table_path) report.files_written.push_back(*ir.table_path);
+    if (ir.plot_path) report.files_written.push_back(*ir.plot_path);
+  }
+}
 
+}  // namespace
+
+RunReport run_scene(const Scene& scene, const RunOptions& opt) {
+  RunReport report;
+  StageClock clock(report);
+  report.stages_run.push_back({"scene", 0.0});
+  RunTransaction txn(opt.out_dir);
+  for (const auto& w : txn.warnings()) report.warnings.push_back(w);
+  try {
+    run_stages(scene, opt, txn, report, clock);
+  } catch (const InputError& e) {
+    throw txn.public_error(e);  // name the final paths, not the staging folder
+  } catch (const Error& e) {
+    throw Error(e.code(), txn.public_text(e.what()));
+  }
   for (const auto& st : all_stages()) {
     bool ran = false;
     for (const auto& r : report.stages_run) ran = ran || r.name == st;

@@ -80,6 +80,9 @@ struct FemOutputs {
   bool code_aster = true;
   bool calculix = true;
   enum class Run { none, calculix } run = Run::none;  ///< "calculix": run ccx and the check
+  /// `max_elements`: most tetrahedra a deck may have (estimated before meshing); default
+  /// fem_export::DeckOptions::max_elements.
+  std::optional<std::size_t> max_elements;
   Place place;
 };
 
@@ -88,6 +91,7 @@ struct Outputs {
   std::optional<std::filesystem::path> force_plot_svg;   ///< F(t) picture, relative to the output folder
   collision::ForceTableOptions force_table;
   std::optional<FemOutputs> fem;
+  std::map<std::string, Place> places;  ///< line and key of the [outputs] keys given (messages)
 };
 
 struct Scene {
