@@ -1,14 +1,19 @@
 // `impactdeck fem-check DIR [--json] [--ccx PATH] [--no-run] [--linear-tolerance X]
 // [--angular-tolerance X]`: run CalculiX on a deck folder written by `run` ([outputs.fem]) and
 // check that the body carries the impulse as linear and angular momentum (docs/fem.md).
+#include <filesystem>
 #include <iostream>
 #include <memory>
+#include <optional>
+#include <sstream>
 
 #include "commands.hpp"
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/common/run_transaction.hpp"
 #include "impactdeck/fem_export/check.hpp"
 
 namespace impactdeck::cli {
+namespace fs = std::filesystem;
 
 void register_fem_check(CLI::App& app, Context& ctx) {
   struct Args {
@@ -31,6 +36,9 @@ void register_fem_check(CLI::App& app, Context& ctx) {
                   "Max relative error of the angular momentum (default 1e-2)")->check(CLI::PositiveNumber);
   cmd->add_option("--threads", args->options.threads, "Threads for ccx (default 1)")->check(CLI::PositiveNumber);
   cmd->add_flag("--verbose", args->verbose, "Echo the settings on stderr");
+  cmd->add_option("--solver-timeout-s", args->options.timeout_s,
+                  "Wall-time limit of the ccx run (default: derived from the deck's size, stated in --json)")
+      ->check(CLI::PositiveNumber);
   cmd->callback([args, &ctx] {
     fem_export::CheckOptions o = args->options;
     o.run_solver = !args->no_run;
@@ -40,15 +48,53 @@ void register_fem_check(CLI::App& app, Context& ctx) {
                 << ", linear tolerance " << o.linear_tolerance << ", angular tolerance "
                 << o.angular_tolerance << ", threads " << o.threads << "\n";
     }
-    const fem_export::CheckResult r = fem_export::run_check(args->dir, o);
+    std::error_code ec;
+    if (!fs::is_directory(args->dir, ec)) throw InputError(args->dir, "deck folder", "does not exist");
+    // ccx runs in a private folder of a transaction on the deck folder: its results replace the
+    // folder's previous ones only when the run and the checks passed; otherwise nothing changes.
+    std::optional<RunTransaction> txn;
+    if (o.run_solver) {
+      txn.emplace(args->dir, "deck folder");
+      o.work_dir = txn->scratch("ccx");
+    }
+    fem_export::CheckResult r;
+    try {
+      r = fem_export::run_check(args->dir, o);
+    } catch (const InputError& e) {
+      if (txn) throw txn->public_error(e);
+      throw;
+    }
+    if (!r.passed) {
+      std::ostringstream m;
+      m << (fs::path(args->dir) / "impact.dat").string() << ": momentum check: ";
+      for (std::size_t i = 0; i < r.failures.size(); ++i) m << (i ? "; " : "") << r.failures[i];
+      m << (txn ? " (the deck folder was left as it was)" : "");
+      if (args->json) {
+        std::cout << fem_export::to_json(r).dump(2) << "\n";
+      } else {
+        std::cout << fem_export::format_check(r);
+      }
+      std::cerr << "impactdeck: error: " << m.str() << "\n";
+      ctx.exit_code = static_cast<int>(ExitCode::check_failed);
+      return;
+    }
+    if (txn) {
+      try {
+        for (const auto& f : r.solver_files) {
+          const fs::path staged = txn->file(f.filename().string(), args->dir, "ccx results");
+          fs::rename(f, staged);
+        }
+        txn->commit();
+      } catch (const InputError& e) {
+        throw txn->public_error(e);
+      }
+      for (auto& f : r.solver_files) f = fs::path(args->dir) / f.filename();
+      for (const auto& w : txn->warnings()) std::cerr << "impactdeck: warning: " << w << "\n";
+    }
     if (args->json) {
       std::cout << fem_export::to_json(r).dump(2) << "\n";
     } else {
       std::cout << fem_export::format_check(r);
-    }
-    if (!r.passed) {
-      std::cerr << "impactdeck: error: FEM momentum check failed\n";
-      ctx.exit_code = static_cast<int>(ExitCode::check_failed);
     }
   });
 }

@@ -1,4 +1,7 @@
 // impactdeck — eccentric Hertz impacts to FEM decks. Exit codes: docs/cli.md.
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <exception>
 #include <iostream>
 
@@ -35,6 +38,14 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {
     std::cerr << "impactdeck: internal error: " << e.what() << "\n";
     return static_cast<int>(ExitCode::internal_error);
+  }
+  // Every write is checked, stdout included: `impactdeck run ... > /dev/full` must not exit 0.
+  errno = 0;
+  std::cout.flush();
+  if (std::fflush(stdout) != 0 || std::ferror(stdout) || !std::cout) {
+    const int e = errno;
+    std::cerr << "impactdeck: error: stdout: write failed: " << (e ? std::strerror(e) : "I/O error") << "\n";
+    return static_cast<int>(ExitCode::invalid_input);
   }
   return ctx.exit_code;
 }
