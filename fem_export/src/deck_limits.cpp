@@ -6,10 +6,12 @@
 namespace impactdeck::fem_export {
 
 namespace {
-// Tetrahedra per h^3 of volume in Gmsh 4.8.4's Delaunay meshes at a uniform target size h,
-// measured on the decks' ellipsoids and mesh parts (docs/reliability.md). A regular tetrahedron
-// of edge h holds h^3 / (6 sqrt 2), i.e. 8.5 per h^3; Gmsh's elements are smaller on average.
-constexpr double kTetsPerCubicSize = 11.0;
+// Tetrahedra per h^3 of volume in Gmsh 4.8.4's meshes of the decks (MeshAdapt surface, Delaunay
+// volume, the load-point size field), measured: the paper's ellipsoid 2000/500/500 mm at h = 400,
+// 250, 150, 100, 60, 40 mm gave 3.9, 5.0, 5.3, 5.0, 4.7, 4.6 times V/h^3 (plus the refinement
+// term); the mesh part ellipsoid_200x50x50.stl at h = 30, 15, 8 mm gave 4.0, 4.8, 4.7
+// (docs/reliability.md). Regular tetrahedra of edge h would give 8.5.
+constexpr double kTetsPerCubicSize = 5.0;
 }  // namespace
 
 double estimate_tet_count(double volume_m3, double mesh_size_m, double load_mesh_size_m) {

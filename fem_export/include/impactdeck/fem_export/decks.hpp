@@ -45,9 +45,10 @@ struct DeckOptions {
   bool calculix = true;        ///< write impact.inp and mesh.inp
   /// Most tetrahedra a deck may have (scene key outputs.fem.max_elements). Checked before meshing
   /// against estimate_tet_count (a mesh size too small for the body would run Gmsh for hours) and
-  /// after it against the real count. A million linear tetrahedra take Gmsh about a minute; ccx's
-  /// implicit dynamics on them takes hours.
-  std::size_t max_elements = 1000000;
+  /// after it against the real count. Measured here: Gmsh makes about 1300 tetrahedra per second
+  /// (151 000 in 118 s), so the default bounds meshing to minutes; ccx's implicit dynamics on
+  /// such a mesh takes hours (its own limit: --solver-timeout-s).
+  std::size_t max_elements = 500000;
   MeshOptions mesh;
 };
 
@@ -83,8 +84,8 @@ TimeSchedule time_schedule(const DeckOptions& options, double contact_end_s);
 
 /// Tetrahedra Gmsh makes for a body of `volume_m3` at the global size `mesh_size_m`, refined to
 /// `load_mesh_size_m` (0: a third) around a surface load point as the decks' size field does.
-/// Calibrated on Gmsh 4.8.4 meshes (docs/reliability.md: within a factor 2 from 300 to 60 000
-/// tetrahedra); used to refuse hopeless meshes before meshing.
+/// Calibrated on Gmsh 4.8.4 meshes (docs/reliability.md: real counts 0.78 to 1.07 times the
+/// estimate from 700 to 150 000 tetrahedra); used to refuse hopeless meshes before meshing.
 double estimate_tet_count(double volume_m3, double mesh_size_m, double load_mesh_size_m);
 
 /// Meshes the body and writes the decks into the staging folder `folder` (created here; its parent
