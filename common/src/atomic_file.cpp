@@ -44,6 +44,12 @@ fs::path write_temporary(const fs::path& path, const std::function<void(std::ost
   if (!fs::is_directory(dir, ec)) {
     throw InputError(path.string(), "output", "folder '" + dir.string() + "' does not exist");
   }
+  // Only a file (or a symbolic link, itself replaced) is replaced: never a folder, a device or a
+  // FIFO (`-o /dev/full` must not replace the device node).
+  const fs::file_status st = fs::symlink_status(path, ec);
+  if (!ec && fs::exists(st) && !fs::is_regular_file(st) && !fs::is_symlink(st)) {
+    throw InputError(path.string(), "output", "exists and is not a regular file: not replaced");
+  }
   // A fixed-length temporary name, whatever the target's: a legal 255-byte name stays legal.
   const fs::path tmp = dir / (".impactdeck-tmp-" + random_suffix());
   {

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <fstream>
 #include <iomanip>
+#include <limits>
 #include <sstream>
 
 #include <assimp/Importer.hpp>
@@ -216,6 +217,22 @@ LoadedMesh load_mesh(const fs::path& file, LengthUnit unit) {
 }
 
 namespace {
+// STL holds float32 coordinates: every one must be finite and, unless 0, a normal float (a part
+// 1e39 or 1e-60 units across would be written as Inf or as zeros).
+void check_float32(const fs::path& file, const TriangleMesh& mesh, double scale) {
+  for (std::size_t v = 0; v < mesh.vertices_m.size(); ++v)
+    for (int i = 0; i < 3; ++i) {
+      const double x = mesh.vertices_m[v][i] * scale;
+      const float f = static_cast<float>(x);
+      if (x != 0.0 && (!std::isfinite(f) || std::abs(f) < std::numeric_limits<float>::min())) {
+        std::ostringstream m;
+        m << "vertex " << v << " has the coordinate " << x << ", which float32, the STL coordinate type, cannot "
+          << "hold (finite and normal: 1.2e-38 to 3.4e+38 in magnitude, or 0); nothing was written";
+        throw InputError(file.string(), "coordinates", m.str());
+      }
+    }
+}
+
 void put_f32(std::ostream& o, float x) {
   char b[4];
   std::memcpy(b, &x, 4);
@@ -226,6 +243,7 @@ void put_f32(std::ostream& o, float x) {
 void write_stl_binary(const fs::path& file, const TriangleMesh& mesh, LengthUnit unit,
                       const std::string& header) {
   const double s = 1.0 / metres_per(unit);
+  check_float32(file, mesh, s);
   write_file_atomically(file, [&](std::ostream& o) {
     char h[80] = {};
     std::string text = header;
@@ -251,6 +269,7 @@ void write_stl_binary(const fs::path& file, const TriangleMesh& mesh, LengthUnit
 void write_stl_ascii(const fs::path& file, const TriangleMesh& mesh, LengthUnit unit,
                      const std::string& name) {
   const double s = 1.0 / metres_per(unit);
+  check_float32(file, mesh, s);
   write_file_atomically(file, [&](std::ostream& o) {
     o << std::setprecision(9) << "solid " << name << "\n";
     for (const auto& t : mesh.triangles) {
