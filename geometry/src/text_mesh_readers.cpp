@@ -521,9 +521,7 @@ Raw read_ply(const std::string& text, const std::string& where) {
     } else if (word == "end_header") {
       header_done = true;
       break;
-    } else {
-      fail("unknown PLY header line starting with " + shown(word));
-    }
+    }  // any other line is free text, as assimp and Blender's exporter ("Created by ...") take it
   }
   if (!header_done) t.fail("no end_header: the PLY header is incomplete");
   if (format == Format::none) t.fail("the PLY header has no format line");
