@@ -188,14 +188,18 @@ DatFile read_dat(const fs::path& p) {
   return d;
 }
 
-// First "*ERROR" line and last non-empty line of a ccx log.
+// First "*ERROR" line and last non-empty line of a ccx log; "No space left on device" anywhere
+// in it is reported in first_error's place when there is no *ERROR line.
 void scan_log(const fs::path& log, std::string& first_error, std::string& last_line) {
   std::ifstream in(log);
+  std::string no_space;
   for (std::string l; std::getline(in, l);) {
     if (!l.empty() && l.back() == '\r') l.pop_back();
     if (first_error.empty() && l.find("*ERROR") != std::string::npos) first_error = l;
+    if (no_space.empty() && l.find("No space left") != std::string::npos) no_space = l;
     if (l.find_first_not_of(" \t") != std::string::npos) last_line = l;
   }
+  if (first_error.empty()) first_error = no_space;
   auto trim = [](std::string& t) {
     t.erase(0, t.find_first_not_of(" \t"));
     if (t.size() > 200) t = t.substr(0, 200) + "...";
@@ -224,9 +228,12 @@ std::string sta_progress(const fs::path& sta, double end_time_s) {
 std::string disk_full_note(const fs::path& work, const std::string& log_text) {
   const long long free = detail::free_bytes(work);
   const bool said = log_text.find("No space left") != std::string::npos;
-  if (!said && (free < 0 || free >= (1 << 20))) return "";
-  return "the disk is full (" + (free >= 0 ? std::to_string(free) + " bytes free" : std::string("no space left")) +
-         " on the file system of '" + work.string() + "')";
+  const bool full_now = free >= 0 && free < (1 << 20);
+  if (!said && !full_now) return "";
+  std::string note = "the disk is full";
+  if (full_now) note += " (" + std::to_string(free) + " bytes free on the file system of '" + work.string() + "')";
+  else note += " (ccx's log says so; " + std::to_string(free) + " bytes are free now)";
+  return note;
 }
 
 // Runs ccx in `work` (output to impact.log; progress from impact.sta). Returns the wall time.
@@ -343,11 +350,21 @@ CheckResult run_check(const fs::path& dir, const CheckOptions& o) {
     }
   }
   const fs::path dat_path = work / (std::string(kJobName) + ".dat");
+  if (std::error_code ec; !fs::exists(dat_path, ec)) {
+    std::string first_error, last_line;
+    scan_log(work / (std::string(kJobName) + ".log"), first_error, last_line);
+    if (!o.run_solver) throw InputError(dat_path.string(), "ccx results", "missing: run without --no-run to make them");
+    throw InputError(dat_path.string(), "ccx results",
+                     "ccx ended without writing impact.dat" +
+                         (last_line.empty() ? std::string("; its log is empty") : "; last line of impact.log: '" + last_line + "'"));
+  }
   DatFile dat;
   try {
     dat = read_dat(dat_path);
   } catch (const InputError& e) {
-    const std::string disk = o.run_solver ? disk_full_note(work, "") : "";
+    std::string first_error, last_line;
+    if (o.run_solver) scan_log(work / (std::string(kJobName) + ".log"), first_error, last_line);
+    const std::string disk = o.run_solver ? disk_full_note(work, first_error + "\n" + last_line) : "";
     if (disk.empty()) throw;
     throw InputError(e.where(), e.place(), e.reason() + "; " + disk);
   }
@@ -382,10 +399,13 @@ CheckResult run_check(const fs::path& dir, const CheckOptions& o) {
       why = "the total mass print of step 2 (*EL PRINT, EMAS) is missing";
     }
     if (o.run_solver) {
-      const std::string disk = disk_full_note(work, "");
+      std::string first_error, last_line;
+      scan_log(work / (std::string(kJobName) + ".log"), first_error, last_line);
+      const std::string disk = disk_full_note(work, first_error + "\n" + last_line);
       const std::string progress = sta_progress(work / (std::string(kJobName) + ".sta"), deck.end_time_s);
       if (!disk.empty()) why += "; " + disk;
       if (!progress.empty()) why += "; " + progress;
+      if (disk.empty() && !last_line.empty()) why += "; last line of impact.log: '" + last_line + "'";
     } else {
       why += " (run without --no-run to make it)";
     }

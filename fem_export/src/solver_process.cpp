@@ -59,8 +59,14 @@ struct ChildFailure {
 SolverRun run_solver(const std::vector<std::string>& argv, const fs::path& cwd, const fs::path& log,
                      const std::vector<std::string>& env, double timeout_s, const std::function<void()>& poll) {
   // Everything the child needs is prepared before fork: after it, only async-signal-safe calls.
+  // A program named by a path is made absolute first: the child changes folder before exec.
+  std::vector<std::string> argv_abs = argv;
+  if (!argv_abs.empty() && argv_abs[0].find('/') != std::string::npos) {
+    std::error_code ec;
+    argv_abs[0] = fs::absolute(argv_abs[0], ec).string();
+  }
   std::vector<char*> args;
-  for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+  for (const auto& a : argv_abs) args.push_back(const_cast<char*>(a.c_str()));
   args.push_back(nullptr);
   std::vector<std::string> env_text;
   for (char** e = environ; e && *e; ++e) {
