@@ -169,7 +169,9 @@ RunTransaction::RunTransaction(const fs::path& out_dir, std::string flag)
     struct stat st {};
     if (::stat(out_.c_str(), &st) == 0) {
       if (!S_ISDIR(st.st_mode)) throw InputError(where, flag_, "exists and is " + kind_of(st) + ", not a folder");
-    } else if (errno == ENOENT || errno == ENOTDIR) {
+    } else if (errno == ENOTDIR) {
+      throw InputError(where, flag_, "cannot create the output folder: Not a directory (a part of the path is a file)");
+    } else if (errno == ENOENT) {
       std::vector<fs::path> missing;
       fs::path p = out_;
       while (!p.empty() && ::stat(p.c_str(), &st) != 0 && errno == ENOENT) {
@@ -588,7 +590,7 @@ std::string RunTransaction::public_text(std::string text) const {
   };
   // stage/scratch/NAME/rest -> out/rest (fem-check's solver work folder holds the deck's files).
   for (std::size_t at = text.find(scratch + "/"); at != std::string::npos; at = text.find(scratch + "/", at)) {
-    const std::size_t name_end = text.find('/', at + scratch.size() + 1);
+    const std::size_t name_end = text.find_first_of("/'\" ,;:()\n", at + scratch.size() + 1);
     const std::size_t cut = name_end == std::string::npos ? text.size() : name_end;
     text.replace(at, cut - at, out);
     at += out.size();

@@ -105,6 +105,16 @@ void check_impact_magnitudes(const Scene& scene, const ImpactSpec& s, const coll
   }
 }
 
+std::string indentation_warning(const Scene& scene, const ImpactSpec& s, const collision::ImpactResult& r) {
+  const double x = r.history.compression.max_indentation_m, R = r.effective_radius_m;
+  if (!(x >= R)) return "";
+  std::ostringstream m;
+  m << "the maximal indentation " << x << " m reaches the effective radius " << R
+    << " m: Hertz contact does not hold at all (the bodies would pass through each other), whatever the numbers "
+       "say; check " << impact_input_keys(scene, s);
+  return m.str();
+}
+
 std::string impact_input_keys(const Scene& scene, const ImpactSpec& s) {
   const BodySpec& t = scene.body(s.target);
   const BodySpec& i = scene.body(s.impactor);

@@ -17,6 +17,11 @@ void check_body_magnitudes(const Scene& scene, const BodySpec& body, const Prepa
 /// E*, R*, the reduced mass and the approach velocity of an impact, before it is solved.
 void check_impact_magnitudes(const Scene& scene, const ImpactSpec& impact, const collision::ImpactInput& input);
 
+/// A warning (empty when none) for a solved impact whose maximal indentation reaches the
+/// effective radius: no Hertz contact at all (the bodies would pass through each other), however
+/// finite the numbers.
+std::string indentation_warning(const Scene& scene, const ImpactSpec& impact, const collision::ImpactResult& result);
+
 /// The scene keys an impact's numbers come from ("line 3, key 'materials.steel.youngs_modulus_Pa';
 /// ..."), for errors raised inside the solve.
 std::string impact_input_keys(const Scene& scene, const ImpactSpec& impact);

@@ -361,6 +361,9 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
       });
     });
     for (const auto& w : ir.result.warnings) report.warnings.push_back("impact '" + s.name + "': " + w);
+    if (const std::string w = detail::indentation_warning(scene, s, ir.result); !w.empty()) {
+      report.warnings.push_back("impact '" + s.name + "': " + w);
+    }
     report.impacts.push_back(std::move(ir));
   }
 

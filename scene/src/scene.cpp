@@ -347,7 +347,8 @@ Outputs read_outputs(const toml::table& t, const std::string& file, double to_m)
   Reader r(t, "outputs", file);
   r.allow({"force_table_csv", "force_table_impulse_tolerance", "force_table_time_step_s", "force_table_max_samples"});
   Outputs o;
-  for (const char* k : {"force_table_csv", "force_plot_svg", "force_table_time_step_s", "force_table_impulse_tolerance"})
+  for (const char* k : {"force_table_csv", "force_plot_svg", "force_table_time_step_s", "force_table_impulse_tolerance",
+                        "force_table_max_samples"})
     if (r.has(k)) o.places[k] = r.place(k);
   if (auto s = r.string("force_table_csv")) {
     if (s->empty()) r.fail("force_table_csv", "must not be empty");
