@@ -1,12 +1,15 @@
 // `impactdeck fem-check DIR [--json] [--ccx PATH] [--no-run] [--linear-tolerance X]
 // [--angular-tolerance X]`: run CalculiX on a deck folder written by `run` ([outputs.fem]) and
 // check that the body carries the impulse as linear and angular momentum (docs/fem.md).
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <iostream>
 #include <memory>
 #include <optional>
 #include <sstream>
 
+#include "cli_limits.hpp"
 #include "commands.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/common/run_transaction.hpp"
@@ -40,6 +43,8 @@ void register_fem_check(CLI::App& app, Context& ctx) {
                   "Wall-time limit of the ccx run (default: derived from the deck's size, stated in --json)")
       ->check(CLI::PositiveNumber);
   cmd->callback([args, &ctx] {
+    check_threads(static_cast<unsigned>(std::min(args->options.threads, 1 << 30)));
+    if (!std::isfinite(args->options.timeout_s)) throw UsageError("--solver-timeout-s must be a finite number of seconds");
     fem_export::CheckOptions o = args->options;
     o.run_solver = !args->no_run;
     o.progress = &std::cerr;
@@ -89,7 +94,7 @@ void register_fem_check(CLI::App& app, Context& ctx) {
         throw txn->public_error(e);
       }
       for (auto& f : r.solver_files) f = fs::path(args->dir) / f.filename();
-      for (const auto& w : txn->warnings()) std::cerr << "impactdeck: warning: " << w << "\n";
+      for (const auto& w : txn->warnings()) std::cerr << "impactdeck: warning: " << InputError::one_line(w) << "\n";
     }
     if (args->json) {
       std::cout << fem_export::to_json(r).dump(2) << "\n";

@@ -206,7 +206,7 @@ void register_inspect(CLI::App& app, Context& /*ctx*/) {
 
     if (args->json) {
       std::cout << j.dump(2) << "\n";
-      for (const auto& w : warnings) std::cerr << "impactdeck: warning: " << w << "\n";
+      for (const auto& w : warnings) std::cerr << "impactdeck: warning: " << InputError::one_line(w) << "\n";
       return;
     }
     std::ostringstream o;

@@ -1,4 +1,5 @@
 // `impactdeck run SCENE [--json] [--out DIR]`: compute what the scene asks for, nothing more.
+#include <cmath>
 #include <iostream>
 #include <memory>
 
@@ -27,6 +28,7 @@ void register_run(CLI::App& app, Context& ctx) {
                   "Wall-time limit of each ccx run (default: derived from the deck's size, stated in --json)")
       ->check(CLI::PositiveNumber);
   cmd->callback([args, &ctx] {
+    if (!std::isfinite(args->solver_timeout_s)) throw UsageError("--solver-timeout-s must be a finite number of seconds");
     const scene::Scene sc = scene::load_scene(args->scene);
     scene::RunOptions opt;
     opt.out_dir = args->out;
@@ -39,7 +41,7 @@ void register_run(CLI::App& app, Context& ctx) {
       std::cout << scene::format_summary(sc, rep);
     }
     if (args->json)
-      for (const auto& w : rep.warnings) std::cerr << "impactdeck: warning: " << w << "\n";
+      for (const auto& w : rep.warnings) std::cerr << "impactdeck: warning: " << InputError::one_line(w) << "\n";
     if (!rep.all_checks_passed()) {
       std::cerr << "impactdeck: error: " << scene::failed_checks_summary(sc, rep) << "\n";
       ctx.exit_code = static_cast<int>(ExitCode::check_failed);

@@ -10,6 +10,7 @@
 #include "impactdeck/common/run_transaction.hpp"
 #include "impactdeck/common/atomic_file.hpp"
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/common/numeric.hpp"
 #include "impactdeck/geometry/ellipsoid.hpp"
 #include "impactdeck/plot/drawing.hpp"
 #include "impactdeck/scene/scene.hpp"
@@ -38,6 +39,13 @@ std::vector<double> parse_list(const std::string& text, const char* option) {
     }
   }
   if (v.empty()) throw UsageError(std::string(option) + ": give a comma-separated list of numbers");
+  for (double x : v) {  // > 0 and within [1e-100, 1e100] (numeric.hpp): masses and sizes stay in range
+    if (!(x > 0) || !within_magnitude_range(x)) {
+      std::ostringstream m;
+      m << option << ": every value must be > 0 and within 1e-100 .. 1e+100, got " << x;
+      throw UsageError(m.str());
+    }
+  }
   return v;
 }
 
@@ -98,7 +106,12 @@ void register_study(CLI::App& app, Context& ctx) {
                        " applies to the paper's setting only: with --scene, sizes come from the scene and the "
                        "radius rule from its impact's contact_radius");
     }
-    if (a->size_ratio != 0) o.size_ratio = a->size_ratio;
+    if (a->size_ratio != 0) {
+      if (!(a->size_ratio > 0) || !within_magnitude_range(a->size_ratio)) {
+        throw UsageError("--size-ratio must be > 0 and within 1e-100 .. 1e+100");
+      }
+      o.size_ratio = a->size_ratio;
+    }
     if (!a->rule.empty()) {
       if (a->rule == "paper") o.target_radius_rule = study::RadiusRule::paper;
       else if (a->rule == "mean") o.target_radius_rule = study::RadiusRule::mean;
@@ -158,7 +171,7 @@ void register_study(CLI::App& app, Context& ctx) {
     } catch (const InputError& e) {
       throw txn.public_error(e);
     }
-    for (const auto& w : txn.warnings()) std::cerr << "impactdeck: warning: " << w << "\n";
+    for (const auto& w : txn.warnings()) std::cerr << "impactdeck: warning: " << InputError::one_line(w) << "\n";
 
     if (a->json) {
       std::cout << study::table1_json(r).dump(2) << "\n";

@@ -154,7 +154,7 @@ void register_sweep(CLI::App& app, Context& ctx) {
       plot::write_svg(svg_path, pic);
       if (!a->no_png) plot::write_png(png_path, pic, 1.5);
       txn.commit();
-      for (const auto& w : txn.warnings()) std::cerr << "impactdeck: warning: " << w << "\n";
+      for (const auto& w : txn.warnings()) std::cerr << "impactdeck: warning: " << InputError::one_line(w) << "\n";
 
       const auto& pmin = r.points[r.min_index];
       const auto& pmax = r.points[r.max_index];

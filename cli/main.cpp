@@ -33,10 +33,10 @@ int main(int argc, char** argv) {
     std::cerr << "impactdeck: usage error: " << e.what() << "\n(run 'impactdeck --help')\n";
     return static_cast<int>(ExitCode::usage);
   } catch (const impactdeck::Error& e) {
-    std::cerr << "impactdeck: error: " << e.what() << "\n";
+    std::cerr << "impactdeck: error: " << impactdeck::InputError::one_line(e.what()) << "\n";
     return static_cast<int>(e.code());
   } catch (const std::exception& e) {
-    std::cerr << "impactdeck: internal error: " << e.what() << "\n";
+    std::cerr << "impactdeck: internal error: " << impactdeck::InputError::one_line(e.what()) << "\n";
     return static_cast<int>(ExitCode::internal_error);
   }
   // Every write is checked, stdout included: `impactdeck run ... > /dev/full` must not exit 0.

@@ -27,21 +27,10 @@ constexpr std::size_t kMaxPathBytes = 4000;      // below PATH_MAX (4096) with r
 
 std::string errno_text(int e) { return std::strerror(e); }
 
-// A name as it may appear in a one-line message: control characters as \xNN.
+// A name as it may appear in a one-line message: control characters as \xNN, at most max_bytes.
 std::string printable(const std::string& s, std::size_t max_bytes = 120) {
-  std::string out;
-  for (std::size_t i = 0; i < s.size() && i < max_bytes; ++i) {
-    const unsigned char c = static_cast<unsigned char>(s[i]);
-    if (c < 0x20 || c == 0x7f) {
-      char b[8];
-      std::snprintf(b, sizeof b, "\\x%02X", c);
-      out += b;
-    } else {
-      out += static_cast<char>(c);
-    }
-  }
-  if (s.size() > max_bytes) out += "...";
-  return out;
+  if (s.size() <= max_bytes) return InputError::one_line(s);
+  return InputError::one_line(s.substr(0, max_bytes)) + "...";
 }
 
 std::string kind_of(const struct stat& st) {

@@ -239,6 +239,8 @@ BodySpec read_body(std::size_t index, const toml::table& t, const std::string& f
     }
     case ShapeKind::mesh: {
       const std::string p = r.required_string("mesh");
+      for (const char c : p)  // a NUL would cut the path short where the system reads it
+        if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) r.fail("mesh", "the path contains a control character");
       b.mesh_path = fs::path(p).is_absolute() ? fs::path(p) : base_dir / p;
       b.mesh_repair = r.boolean("repair").value_or(false);
       b.mesh_approximate_mass = r.boolean("approximate_mass_properties").value_or(false);
