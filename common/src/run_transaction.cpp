@@ -151,9 +151,9 @@ std::string RunTransaction::check_name(const std::string& name, const std::strin
   return out;
 }
 
-RunTransaction::RunTransaction(const fs::path& out_dir, std::string flag)
-    : out_(out_dir.empty() ? fs::path(".") : out_dir), flag_(std::move(flag)) {
+RunTransaction::RunTransaction(const fs::path& out_dir, std::string flag) : out_(out_dir), flag_(std::move(flag)) {
   const std::string where = out_.string();
+  if (out_.empty()) throw InputError("", flag_, "the output folder must not be empty (use . for the current one)");
   try {
     struct stat st {};
     if (::stat(out_.c_str(), &st) == 0) {
@@ -161,6 +161,9 @@ RunTransaction::RunTransaction(const fs::path& out_dir, std::string flag)
     } else if (errno == ENOTDIR) {
       throw InputError(where, flag_, "cannot create the output folder: Not a directory (a part of the path is a file)");
     } else if (errno == ENOENT) {
+      if (::lstat(out_.c_str(), &st) == 0) {
+        throw InputError(where, flag_, "is a symbolic link to a folder that does not exist");
+      }
       std::vector<fs::path> missing;
       fs::path p = out_;
       while (!p.empty() && ::stat(p.c_str(), &st) != 0 && errno == ENOENT) {

@@ -32,7 +32,7 @@ namespace impactdeck {
 class RunTransaction {
  public:
   /// Opens a transaction on `out_dir` (created when missing). `flag` names the option in messages
-  /// ("--out"). Throws InputError when `out_dir` is not a folder or cannot be created. Finishes an
+  /// ("--out"). Throws InputError when `out_dir` is empty, not a folder or cannot be created. Finishes an
   /// interrupted commit and removes stale staging folders left in it by killed runs (warnings()).
   explicit RunTransaction(const std::filesystem::path& out_dir, std::string flag = "--out");
   ~RunTransaction();  ///< rolls back when not committed
