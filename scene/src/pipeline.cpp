@@ -290,19 +290,39 @@ StagedOutputs reserve_outputs(const Scene& scene, RunTransaction& txn) {
                        "impact '" + s.name + "': the name is part of output file names, so it must not contain '/'");
     }
   };
+  // No output may replace the run's own inputs (the scene, a part), however named: checked on the
+  // final path before anything is staged.
+  std::vector<fs::path> inputs = {scene.file};
+  for (const auto& b : scene.bodies)
+    if (b.shape == ShapeKind::mesh) inputs.push_back(b.mesh_path);
+  auto reserve = [&](const std::string& name, const std::string& place, bool folder) {
+    const fs::path target_path = txn.out_dir() / RunTransaction::check_name(name, file, place);
+    std::error_code ec;
+    const fs::path target = fs::weakly_canonical(target_path, ec);
+    for (const fs::path& in : inputs) {
+      std::error_code ec2;
+      const fs::path c = fs::weakly_canonical(in, ec2);
+      const bool inside = c.string().rfind(target.string() + "/", 0) == 0;  // a part inside a deck folder
+      if (!ec && !ec2 && !in.empty() && (c == target || inside)) {
+        throw InputError(file, place, "the output '" + target_path.string() + "' would replace the run's own input '" +
+                                          in.string() + "'");
+      }
+    }
+    return folder ? txn.folder(name, file, place) : txn.file(name, file, place);
+  };
   for (const auto& s : scene.impacts) {
     if (scene.outputs.fem || (n > 1 && (scene.outputs.force_table_csv || scene.outputs.force_plot_svg))) {
       name_in_file_names(s);
     }
     if (scene.outputs.fem) {
-      st.fem.push_back(txn.folder("fem_" + s.name, file, Place{s.place.line, s.place.key + ".name"}.describe() +
-                                                             " (deck folder of [outputs.fem])"));
+      st.fem.push_back(reserve("fem_" + s.name,
+                               Place{s.place.line, s.place.key + ".name"}.describe() + " (deck folder of [outputs.fem])", true));
     }
     if (scene.outputs.force_table_csv) {
-      st.table.push_back(txn.file(per_impact(*scene.outputs.force_table_csv, s, "force_table_csv"), file, place_of("force_table_csv")));
+      st.table.push_back(reserve(per_impact(*scene.outputs.force_table_csv, s, "force_table_csv"), place_of("force_table_csv"), false));
     }
     if (scene.outputs.force_plot_svg) {
-      st.plot.push_back(txn.file(per_impact(*scene.outputs.force_plot_svg, s, "force_plot_svg"), file, place_of("force_plot_svg")));
+      st.plot.push_back(reserve(per_impact(*scene.outputs.force_plot_svg, s, "force_plot_svg"), place_of("force_plot_svg"), false));
     }
   }
   return st;
