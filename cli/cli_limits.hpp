@@ -5,6 +5,8 @@
 #include <cstddef>
 #include <string>
 
+#include <CLI/CLI.hpp>
+
 #include "impactdeck/geometry/shape.hpp"
 #include "impactdeck/study/cloud.hpp"
 
@@ -27,5 +29,9 @@ void check_curve_samples(double points, std::size_t samples, std::size_t limit, 
 
 /// --threads above kMaxThreads is a usage error.
 void check_threads(unsigned threads);
+
+/// An option's value must be a finite number > 0 (CLI11's PositiveNumber prints its range up to
+/// 1.8e308 in full and lets NaN through).
+CLI::Validator positive_number();
 
 }  // namespace impactdeck::cli

@@ -34,14 +34,14 @@ void register_fem_check(CLI::App& app, Context& ctx) {
   cmd->add_option("--ccx", args->options.ccx, "CalculiX executable (default: ccx from PATH)");
   cmd->add_flag("--no-run", args->no_run, "Do not run ccx; check the existing impact.dat");
   cmd->add_option("--linear-tolerance", args->options.linear_tolerance,
-                  "Max relative error of the linear momentum (default 1e-3)")->check(CLI::PositiveNumber);
+                  "Max relative error of the linear momentum (default 1e-3)")->check(positive_number());
   cmd->add_option("--angular-tolerance", args->options.angular_tolerance,
-                  "Max relative error of the angular momentum (default 1e-2)")->check(CLI::PositiveNumber);
-  cmd->add_option("--threads", args->options.threads, "Threads for ccx (default 1)")->check(CLI::PositiveNumber);
+                  "Max relative error of the angular momentum (default 1e-2)")->check(positive_number());
+  cmd->add_option("--threads", args->options.threads, "Threads for ccx (default 1)")->check(positive_number());
   cmd->add_flag("--verbose", args->verbose, "Echo the settings on stderr");
   cmd->add_option("--solver-timeout-s", args->options.timeout_s,
                   "Wall-time limit of the ccx run (default: derived from the deck's size, stated in --json)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   cmd->callback([args, &ctx] {
     check_threads(static_cast<unsigned>(std::min(args->options.threads, 1 << 30)));
     if (!std::isfinite(args->options.timeout_s)) throw UsageError("--solver-timeout-s must be a finite number of seconds");

@@ -3,6 +3,7 @@
 #include <iostream>
 #include <memory>
 
+#include "cli_limits.hpp"
 #include "commands.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/scene/pipeline.hpp"
@@ -26,7 +27,7 @@ void register_run(CLI::App& app, Context& ctx) {
                   "a run writes appears there only when every stage and check passed (docs/reliability.md)");
   cmd->add_option("--solver-timeout-s", args->solver_timeout_s,
                   "Wall-time limit of each ccx run (default: derived from the deck's size, stated in --json)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   cmd->callback([args, &ctx] {
     if (!std::isfinite(args->solver_timeout_s)) throw UsageError("--solver-timeout-s must be a finite number of seconds");
     const scene::Scene sc = scene::load_scene(args->scene);

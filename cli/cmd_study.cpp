@@ -92,7 +92,7 @@ void register_study(CLI::App& app, Context& ctx) {
   cmd->add_flag("--quiet", a->quiet, "No progress bar");
   cmd->add_option("--max-points", a->max_points,
                   "Most impact evaluations (cells x points per cell) of the study (default 1000000)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   cmd->callback([a, &ctx] {
     check_threads(a->threads);
     study::Table1Options o = study::table1_preset(a->preset);

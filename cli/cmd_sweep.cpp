@@ -70,10 +70,10 @@ void register_sweep(CLI::App& app, Context& ctx) {
   cmd->add_flag("--json", a->json, "Print a JSON summary on stdout");
   cmd->add_flag("--quiet", a->quiet, "No progress bar");
   cmd->add_option("--max-points", a->max_points, "Most points a sweep may evaluate (default 1000000)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   cmd->add_option("--max-curve-samples", a->max_curve_samples,
                   "With --curves: most samples over all curves (default 20000000, 160 MB)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   cmd->callback([a, &ctx] {
     check_threads(a->threads);
     const scene::Scene sc = scene::load_scene(a->scene);

@@ -30,7 +30,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::cerr << "impactdeck: usage error: " << e.what() << "\n(run 'impactdeck --help')\n";
+    std::cerr << "impactdeck: usage error: " << impactdeck::InputError::one_line(e.what()) << " (run 'impactdeck --help')\n";  // one line, as every error
     return static_cast<int>(ExitCode::usage);
   } catch (const impactdeck::Error& e) {
     std::cerr << "impactdeck: error: " << impactdeck::InputError::one_line(e.what()) << "\n";
