@@ -15,27 +15,18 @@
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/common/input_file.hpp"
 #include "impactdeck/common/run_transaction.hpp"
+#include "scratch_files.hpp"
 
 namespace fs = std::filesystem;
 using namespace impactdeck;
 
 namespace {
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using test::slurp;
 
 void put(const fs::path& p, const std::string& text) { std::ofstream(p, std::ios::binary) << text; }
 
-fs::path fresh_dir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("impactdeck_txn_" + std::to_string(::getpid()) + "_" + name);
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+fs::path fresh_dir(const std::string& name) { return test::fresh_dir("impactdeck_txn_" + name); }
 
 // Every entry of a folder, hidden ones included, sorted.
 std::string listing(const fs::path& d) {

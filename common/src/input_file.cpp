@@ -19,14 +19,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string not_regular(const struct stat& st) {
-  if (S_ISDIR(st.st_mode)) return "is a directory";
-  if (S_ISFIFO(st.st_mode)) return "is a FIFO (named pipe)";
-  if (S_ISCHR(st.st_mode)) return "is a character device";
-  if (S_ISBLK(st.st_mode)) return "is a block device";
-  if (S_ISSOCK(st.st_mode)) return "is a socket";
-  return "is not a regular file";
-}
 
 // Opens `path` for reading without blocking (O_NONBLOCK: a FIFO replaced between the checks
 // cannot hang the run), checks it again on the open descriptor; returns the descriptor and size.
@@ -40,7 +32,7 @@ int open_checked(const fs::path& path, const std::string& noun, std::uintmax_t m
     if (errno == ENOTDIR) fail("does not exist (a component of the path is not a folder)");
     fail(std::string("cannot be opened: ") + std::strerror(errno));
   }
-  if (!S_ISREG(st.st_mode)) fail(not_regular(st) + ", not a " + noun + ": only regular files are read");
+  if (!S_ISREG(st.st_mode)) fail("is " + file_type_text(st.st_mode) + ", not a " + noun + ": only regular files are read");
   const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
   if (fd < 0) fail(std::string("cannot be opened (unreadable): ") + std::strerror(errno));
   if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
@@ -82,6 +74,17 @@ std::uintmax_t read_number(const char* file) {
 }
 
 }  // namespace
+
+std::string file_type_text(unsigned mode) {
+  if (S_ISREG(mode)) return "a file";
+  if (S_ISDIR(mode)) return "a directory";
+  if (S_ISLNK(mode)) return "a symbolic link";
+  if (S_ISFIFO(mode)) return "a FIFO (named pipe)";
+  if (S_ISSOCK(mode)) return "a socket";
+  if (S_ISCHR(mode)) return "a character device";
+  if (S_ISBLK(mode)) return "a block device";
+  return "of an unknown type";
+}
 
 std::string format_bytes(double b) {
   std::ostringstream s;

@@ -15,6 +15,8 @@
 #include <sstream>
 #include <thread>
 
+#include "impactdeck/common/input_file.hpp"
+
 namespace impactdeck {
 namespace fs = std::filesystem;
 
@@ -33,16 +35,7 @@ std::string printable(const std::string& s, std::size_t max_bytes = 120) {
   return InputError::one_line(s.substr(0, max_bytes)) + "...";
 }
 
-std::string kind_of(const struct stat& st) {
-  if (S_ISREG(st.st_mode)) return "a file";
-  if (S_ISDIR(st.st_mode)) return "a folder";
-  if (S_ISLNK(st.st_mode)) return "a symbolic link";
-  if (S_ISFIFO(st.st_mode)) return "a FIFO";
-  if (S_ISSOCK(st.st_mode)) return "a socket";
-  if (S_ISCHR(st.st_mode)) return "a character device";
-  if (S_ISBLK(st.st_mode)) return "a block device";
-  return "not a folder";
-}
+std::string kind_of(const struct stat& st) { return file_type_text(st.st_mode); }
 
 bool starts_with(const std::string& s, const std::string& prefix) { return s.rfind(prefix, 0) == 0; }
 
@@ -419,8 +412,11 @@ void RunTransaction::recover_locked() {
   const fs::path marker = out_ / kMarker;
   struct stat st {};
   if (::lstat(marker.c_str(), &st) == 0) {
-    if (!S_ISREG(st.st_mode)) {
-      warnings_.push_back("'" + marker.string() + "' is " + kind_of(st) + ", not impactdeck's commit journal: left alone");
+    if (S_ISDIR(st.st_mode)) {
+      warnings_.push_back("'" + marker.string() + "' is a folder, not impactdeck's commit journal: left alone");
+    } else if (!S_ISREG(st.st_mode)) {
+      warnings_.push_back("removed '" + marker.string() + "', " + kind_of(st) + " where impactdeck keeps its commit journal");
+      ::unlink(marker.c_str());
     } else {
       bool legacy = false;
       std::size_t legacy_count = 0;
@@ -500,6 +496,14 @@ std::vector<fs::path> RunTransaction::commit() {
   lock_out();
   try {
     recover_locked();
+    if (struct stat st {}; ::lstat((out_ / kMarker).c_str(), &st) == 0) {
+      // A journal left by a run that is still alive (its commit failed), or a folder of that name:
+      // never overwritten.
+      throw InputError(out_.string(), flag_,
+                       S_ISDIR(st.st_mode) ? std::string("'") + kMarker + "' is a folder: remove it, impactdeck keeps its commit journal there"
+                                           : std::string("another run's commit journal ") + kMarker +
+                                                 " is pending (its staging folder is in use); retry when it has ended");
+    }
     std::vector<std::pair<std::string, bool>> entries;
     for (const Output& o : outputs_) {
       struct stat st {};

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <sstream>
 
 #include "impactdeck/common/error.hpp"
@@ -208,18 +209,32 @@ void scan_log(const fs::path& log, std::string& first_error, std::string& last_l
   trim(last_line);
 }
 
-// How far ccx got, from the last line of its .sta file ("" when unknown).
-std::string sta_progress(const fs::path& sta, double end_time_s) {
+// The last line of ccx's .sta file: step, increment and total time (nullopt when there is none).
+struct StaLine {
+  int step = 0, increment = 0;
+  double time_s = 0;
+  std::string text;
+};
+std::optional<StaLine> last_sta_line(const fs::path& sta) {
   std::ifstream in(sta);
   std::string l, tail;
   while (std::getline(in, l))
     if (!l.empty()) tail = l;
   std::istringstream ls(tail);
-  int step, inc, att, it;
-  double tot;
-  if (!(ls >> step >> inc >> att >> it >> tot)) return "";
+  StaLine s;
+  int attempts, iterations;
+  if (!(ls >> s.step >> s.increment >> attempts >> iterations >> s.time_s)) return std::nullopt;
+  s.text = tail;
+  return s;
+}
+
+// How far ccx got ("" when unknown).
+std::string sta_progress(const fs::path& sta, double end_time_s) {
+  const auto s = last_sta_line(sta);
+  if (!s) return "";
   std::ostringstream m;
-  m << "ccx reached t = " << tot << " s of " << end_time_s << " s (step " << step << ", increment " << inc << ")";
+  m << "ccx reached t = " << s->time_s << " s of " << end_time_s << " s (step " << s->step << ", increment "
+    << s->increment << ")";
   return m.str();
 }
 
@@ -250,20 +265,14 @@ double run_ccx(const fs::path& work, const CheckOptions& o, double end_time_s, d
   auto poll = [&] {
     if (!o.progress || std::chrono::steady_clock::now() - last_print < std::chrono::seconds(2)) return;
     last_print = std::chrono::steady_clock::now();
-    std::ifstream sta(work / (job + ".sta"));
-    std::string l, tail;
-    while (std::getline(sta, l))
-      if (!l.empty()) tail = l;
-    std::istringstream ls(tail);
-    int step, inc, att, it;
-    double tot;
-    if (ls >> step >> inc >> att >> it >> tot && tail != last) {
+    const auto s = last_sta_line(work / (job + ".sta"));
+    if (s && s->text != last) {
       const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      *o.progress << "ccx: step " << step << ", increment " << inc << ", time " << tot << " s of " << end_time_s
-                  << " s (" << static_cast<int>(100.0 * std::min(1.0, tot / end_time_s)) << " %), "
+      *o.progress << "ccx: step " << s->step << ", increment " << s->increment << ", time " << s->time_s << " s of "
+                  << end_time_s << " s (" << static_cast<int>(100.0 * std::min(1.0, s->time_s / end_time_s)) << " %), "
                   << static_cast<int>(el) << " s elapsed\n";
       o.progress->flush();
-      last = tail;
+      last = s->text;
     }
   };
   const std::string threads = std::to_string(std::max(1, o.threads));

@@ -200,19 +200,7 @@ LoadedMesh load_mesh(const fs::path& file, LengthUnit unit) {
   }
   // Vertices of skipped points/lines never get an id (vertex_id runs for triangle corners only),
   // and ids are given in order of first use: every vertex is a triangle corner, no remap needed.
-  if (out.lines_ignored + out.points_ignored > 0) {
-    out.warnings.push_back(where + ": ignored " + std::to_string(out.lines_ignored) + " line(s) and " +
-                           std::to_string(out.points_ignored) +
-                           " point(s): only triangles and polygons describe a surface");
-  }
-  if (out.mesh.triangles.empty()) {
-    std::string detail;
-    if (out.lines_ignored + out.points_ignored > 0) {
-      detail = " (only " + std::to_string(out.points_ignored) + " point(s) and " +
-               std::to_string(out.lines_ignored) + " line(s))";
-    }
-    throw InputError(where, "faces", "the file contains no triangles" + detail);
-  }
+  detail::finish_loaded(out, where);
   return out;
 }
 

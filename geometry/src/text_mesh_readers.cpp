@@ -471,6 +471,7 @@ Raw read_ply(const std::string& text, const std::string& where) {
   bool header_done = false;
   while (!t.at_end()) {
     const std::size_t line = t.line();
+    if (line > 10000) break;  // a header is a few dozen lines: no end_header near the start
     std::istringstream ls{std::string(t.rest_of_line())};
     std::string word;
     ls >> word;
@@ -808,6 +809,11 @@ std::optional<LoadedMesh> read_own_format(const fs::path& file, const std::strin
   else return std::nullopt;
   std::string().swap(text);  // the file's bytes are no longer needed
   LoadedMesh out = build(raw, ext.substr(1), unit, where, points, lines);
+  finish_loaded(out, where);
+  return out;
+}
+
+void finish_loaded(LoadedMesh& out, const std::string& where) {
   if (out.lines_ignored + out.points_ignored > 0) {
     out.warnings.push_back(where + ": ignored " + std::to_string(out.lines_ignored) + " line(s) and " +
                            std::to_string(out.points_ignored) +
@@ -821,7 +827,6 @@ std::optional<LoadedMesh> read_own_format(const fs::path& file, const std::strin
     }
     throw InputError(where, "faces", "the file contains no triangles" + detail);
   }
-  return out;
 }
 
 std::uintmax_t check_part_file(const fs::path& file) {

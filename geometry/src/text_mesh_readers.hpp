@@ -22,6 +22,10 @@ namespace impactdeck::geometry::detail {
 std::optional<LoadedMesh> read_own_format(const std::filesystem::path& file, const std::string& ext, LengthUnit unit,
                                           std::uintmax_t bytes);
 
+/// The end of every reader: a warning for the points and lines skipped, an InputError(file,
+/// "faces", ...) when no triangle is left.
+void finish_loaded(LoadedMesh& mesh, const std::string& where);
+
 /// A part file that may be read: a regular file whose reading fits in the free memory. Returns its
 /// size; throws InputError(file, "file", reason) naming the figures.
 std::uintmax_t check_part_file(const std::filesystem::path& file);

@@ -22,6 +22,10 @@ std::uintmax_t check_input_file(const std::filesystem::path& path, const std::st
 std::string read_input_file(const std::filesystem::path& path, const std::string& noun,
                             std::uintmax_t max_bytes, const std::string& limit_hint = "");
 
+/// What a stat(2) mode is, for messages: "a file", "a directory", "a symbolic link", "a FIFO
+/// (named pipe)", "a socket", "a character device", "a block device".
+std::string file_type_text(unsigned mode);
+
 /// Bytes of memory this process can still use: the smallest of MemAvailable (/proc/meminfo), the
 /// cgroup's memory.max minus memory.current, and the RLIMIT_AS / RLIMIT_DATA headroom. A very
 /// large value when none can be read.
