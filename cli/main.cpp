@@ -44,7 +44,8 @@ int main(int argc, char** argv) {
   std::cout.flush();
   if (std::fflush(stdout) != 0 || std::ferror(stdout) || !std::cout) {
     const int e = errno;
-    std::cerr << "impactdeck: error: stdout: write failed: " << (e ? std::strerror(e) : "I/O error") << "\n";
+    std::cerr << "impactdeck: error: stdout: write failed: " << (e ? std::strerror(e) : "disk full, or the output was closed")
+              << "\n";
     return static_cast<int>(ExitCode::invalid_input);
   }
   return ctx.exit_code;

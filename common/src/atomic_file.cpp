@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include <fcntl.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include "impactdeck/common/error.hpp"
@@ -59,13 +60,19 @@ fs::path write_temporary(const fs::path& path, const std::function<void(std::ost
                        "cannot write in folder '" + dir.string() + "': " + std::strerror(errno));
     }
     try {
-      fill(out);
       errno = 0;
-      out.flush();
+      fill(out);
+      int e = errno;  // the first failed write's reason (a bad stream writes nothing more)
+      if (out) {
+        errno = 0;
+        out.flush();
+        e = errno;
+      }
       if (!out) {
-        const int e = errno;
+        struct statvfs fs_st {};
+        if (e == 0 && ::statvfs(dir.c_str(), &fs_st) == 0 && fs_st.f_bavail == 0) e = ENOSPC;
         throw InputError(path.string(), "output",
-                         std::string("write failed: ") + (e ? std::strerror(e) : "I/O error (disk full?)"));
+                         std::string("write failed: ") + (e ? std::strerror(e) : "I/O error"));
       }
     } catch (...) {
       out.close();

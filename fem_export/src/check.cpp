@@ -231,7 +231,7 @@ std::optional<StaLine> last_sta_line(const fs::path& sta) {
 // How far ccx got ("" when unknown).
 std::string sta_progress(const fs::path& sta, double end_time_s) {
   const auto s = last_sta_line(sta);
-  if (!s) return "";
+  if (!s || !(s->time_s >= 0 && s->time_s <= 1.01 * end_time_s)) return "";  // none, or a line cut short
   std::ostringstream m;
   m << "ccx reached t = " << s->time_s << " s of " << end_time_s << " s (step " << s->step << ", increment "
     << s->increment << ")";
