@@ -12,6 +12,7 @@
 
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/common/input_file.hpp"
+#include "impactdeck/common/numeric.hpp"
 
 namespace impactdeck::geometry::detail {
 namespace fs = std::filesystem;
@@ -853,6 +854,16 @@ void check_part_extent(const LoadedMesh& m, const std::string& where) {
       s << "a vertex at (" << x.x() << ", " << x.y() << ", " << x.z() << ") m lies more than " << kMaxCoordinateM
         << " m from the origin (check the length unit)";
       throw InputError(where, "vertices", s.str());
+    }
+    for (int i = 0; i < 3; ++i) {
+      // 0 or at least 1e-100 m (numeric.hpp): a coordinate like 1e-300 m makes vertices 1e-300 m
+      // apart, whose cross products underflow to 0 and whose normals become NaN.
+      if (x[i] != 0.0 && !within_magnitude_range(x[i])) {
+        std::ostringstream s;
+        s << "a vertex at (" << x.x() << ", " << x.y() << ", " << x.z() << ") m has a coordinate below 1e-100 m "
+          << "in magnitude (it would underflow in the geometry): write it as 0";
+        throw InputError(where, "vertices", s.str());
+      }
     }
     lo = lo.cwiseMin(x);
     hi = hi.cwiseMax(x);

@@ -30,7 +30,8 @@ void finish_loaded(LoadedMesh& mesh, const std::string& where);
 /// size; throws InputError(file, "file", reason) naming the figures.
 std::uintmax_t check_part_file(const std::filesystem::path& file);
 
-/// After loading: every coordinate within 1e20 m of the origin and the part between 1e-20 m and
+/// After loading: every coordinate within 1e20 m of the origin and 0 or at least 1e-100 m in
+/// magnitude, the part between 1e-20 m and
 /// 1e20 m across (its volume integrals, up to size^5, stay within [1e-100, 1e100]), and enough
 /// free memory for validation, mass properties and the surface index (about 700 bytes per
 /// triangle, measured).
