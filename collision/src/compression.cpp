@@ -10,6 +10,7 @@
 #include <gsl/gsl_sf_gamma.h>
 
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/common/numeric.hpp"
 
 namespace impactdeck::collision {
 namespace {
@@ -188,6 +189,21 @@ CompressionPhase compression_phase(double m_w, double v_w, double k_h) noexcept 
   c.max_force_N = std::exp(std::log(k_h) + kHertzExponent * log_xmax);
   c.compression_time_s = compression_time_factor() * std::exp(log_xmax - std::log(v_w));
   c.impulse_Ns = m_w * v_w;
+  // Every number of the solve within [1e-100, 1e100] (numeric.hpp): beyond, the self-checks'
+  // products under- or overflow and would print NaN or fail as "physics".
+  const std::pair<const char*, double> values[] = {
+      {"reduced mass (kg)", m_w},          {"approach velocity (m/s)", v_w},
+      {"Hertz constant (N/m^1.5)", k_h},   {"maximal indentation (m)", c.max_indentation_m},
+      {"maximal force (N)", c.max_force_N}, {"compression time (s)", c.compression_time_s},
+      {"compression impulse (N s)", c.impulse_Ns}};
+  for (const auto& [name, value] : values) {
+    if (std::isfinite(value) && value > 0.0 && within_magnitude_range(value)) continue;
+    std::ostringstream s;
+    s << "the " << name << " is " << value << ", outside the magnitudes impactdeck computes with (1e-100 to "
+      << "1e+100, SI): the inputs (reduced mass " << m_w << " kg, approach velocity " << v_w
+      << " m/s, Hertz constant " << k_h << " N/m^1.5) are too extreme";
+    throw InputError("", "numeric range", s.str());
+  }
   return c;
 }
 
