@@ -9,7 +9,6 @@
 
 #include "commands.hpp"
 #include "impactdeck/common/error.hpp"
-#include "impactdeck/plot/drawing.hpp"
 #include "impactdeck/scene/scene.hpp"
 #include "impactdeck/study/cloud.hpp"
 #include "impactdeck/study/progress.hpp"
@@ -40,6 +39,7 @@ nlohmann::json point_json(std::size_t index, const study::PointResult& p) {
 void register_sweep(CLI::App& app, Context& ctx) {
   struct Args {
     std::string scene, impact, cloud = "auto", out = ".", prefix, azimuth, elevation;
+    std::string formats = "csv,vtp,pos,svg,png";
     int grid_steps = 8;
     std::size_t count = 2000;
     std::uint64_t seed = 1;
@@ -63,10 +63,20 @@ void register_sweep(CLI::App& app, Context& ctx) {
   cmd->add_option("--threads", a->threads, "Worker threads (default 0: all cores)");
   cmd->add_option("--out", a->out, "Output folder (created if missing; default: current folder)");
   cmd->add_option("--prefix", a->prefix, "File name prefix (default sweep_IMPACT)");
-  cmd->add_flag("--no-png", a->no_png, "Do not render the PNG picture");
+  cmd->add_option("--formats", a->formats,
+                  "Files to write, comma-separated: csv,vtp,pos,svg,png (default: all five)");
+  cmd->add_flag("--no-png", a->no_png, "Do not render the PNG picture (png left out of --formats)");
   cmd->add_flag("--json", a->json, "Print a JSON summary on stdout");
   cmd->add_flag("--quiet", a->quiet, "No progress bar");
   cmd->callback([a, &ctx] {
+    study::SweepFormats formats;
+    try {
+      formats = study::parse_sweep_formats(a->formats);
+    } catch (const std::invalid_argument& e) {
+      throw UsageError("--formats '" + a->formats + "': " + e.what());
+    }
+    if (a->no_png) formats.png = false;
+    formats.curves = a->curves;
     const scene::Scene sc = scene::load_scene(a->scene);
     const study::SceneSweep ss = study::sweep_from_scene(sc, a->impact);
     const scene::ImpactSpec& imp = *ss.impact;
@@ -117,23 +127,16 @@ void register_sweep(CLI::App& app, Context& ctx) {
       meta.cloud += ", " + std::to_string(a->count) + " area-uniform (seed " + std::to_string(a->seed) + ")";
 
     const std::string prefix = a->prefix.empty() ? "sweep_" + imp.name : a->prefix;
-    const fs::path base = fs::path(a->out) / prefix;
-    std::vector<fs::path> files;
-    auto with = [&](const std::string& suffix) {
-      fs::path p = base;
-      p += suffix;
-      files.push_back(p);
-      return p;
-    };
-    study::write_sweep_csv(with(".csv"), r, meta);
-    if (a->curves) study::write_sweep_curves_csv(with("_curves.csv"), r, meta);
-    study::write_sweep_pos(with(".pos"), r, meta);
-    study::write_sweep_vtp(with(".vtp"), r, meta);
-    study::ForceMapOptions fo;
-    fo.title = "Maximal collision force: " + imp.impactor + " hits " + imp.target + " (impact '" + imp.name + "')";
-    const plot::Drawing pic = study::force_map_drawing(*ss.setup.target.shape, ss.setup.target.centroid_m, r, fo);
-    plot::write_svg(with(".svg"), pic);
-    if (!a->no_png) plot::write_png(with(".png"), pic, 1.5);
+    study::SweepPicture picture;
+    picture.target = ss.setup.target.shape.get();
+    picture.centroid_m = ss.setup.target.centroid_m;
+    picture.options.title = "Maximal collision force: " + imp.impactor + " hits " + imp.target + " (impact '" + imp.name + "')";
+    study::ProgressBar write_bar("write", !a->quiet);
+    study::SweepWriteOptions wo;
+    wo.threads = a->threads;
+    wo.progress = [&write_bar](std::size_t done, std::size_t total) { write_bar.update(done, total); };
+    const std::vector<fs::path> files = study::write_sweep_files(fs::path(a->out) / prefix, formats, r, meta, picture, wo);
+    write_bar.finish();
 
     const auto& pmin = r.points[r.min_index];
     const auto& pmax = r.points[r.max_index];
