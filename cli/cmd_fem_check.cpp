@@ -29,7 +29,9 @@ void register_fem_check(CLI::App& app, Context& ctx) {
                   "Max relative error of the linear momentum (default 1e-3)")->check(CLI::PositiveNumber);
   cmd->add_option("--angular-tolerance", args->options.angular_tolerance,
                   "Max relative error of the angular momentum (default 1e-2)")->check(CLI::PositiveNumber);
-  cmd->add_option("--threads", args->options.threads, "Threads for ccx (default 1)")->check(CLI::PositiveNumber);
+  cmd->add_option("--threads", args->options.threads,
+                  "Threads for ccx: OMP_NUM_THREADS, CCX_NPROC_EQUATION_SOLVER (default 0: all cores)")
+      ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--verbose", args->verbose, "Echo the settings on stderr");
   cmd->callback([args, &ctx] {
     fem_export::CheckOptions o = args->options;

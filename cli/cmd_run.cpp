@@ -17,12 +17,16 @@ void register_run(CLI::App& app, Context& ctx) {
     std::string scene;
     bool json = false;
     std::string out = ".";
+    int threads = 0;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand("run", "Run a scene: impacts, force tables and decks it asks for");
   cmd->add_option("scene", args->scene, "Scene file (TOML, docs/scene-format.md)")->required();
   cmd->add_flag("--json", args->json, "Print one JSON document on stdout (keys: docs/cli.md)");
   cmd->add_option("--out", args->out, "Output folder (created if missing; default: current folder)");
+  cmd->add_option("--threads", args->threads,
+                  "Threads for ccx when [outputs.fem] run = \"calculix\" (default 0: all cores)")
+      ->check(CLI::NonNegativeNumber);
   cmd->callback([args, &ctx] {
     const scene::Scene sc = scene::load_scene(args->scene);
     std::error_code ec;
@@ -33,6 +37,7 @@ void register_run(CLI::App& app, Context& ctx) {
     scene::RunOptions opt;
     opt.out_dir = args->out;
     opt.progress = &std::cerr;  // ccx progress when [outputs.fem] run = "calculix"
+    opt.solver_threads = args->threads;
     const scene::RunReport rep = scene::run_scene(sc, opt);
     if (args->json) {
       std::cout << scene::to_json(sc, rep).dump(2) << "\n";

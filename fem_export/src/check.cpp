@@ -148,6 +148,11 @@ DatFile read_dat(const fs::path& p) {
   return d;
 }
 
+int solver_threads(const CheckOptions& o) {
+  if (o.threads > 0) return o.threads;
+  return static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+}
+
 // Runs ccx in `dir`, output to impact.log; progress from impact.sta. Returns wall time.
 double run_ccx(const fs::path& dir, const CheckOptions& o, double end_time_s) {
   const std::string job = kJobName;
@@ -166,7 +171,7 @@ double run_ccx(const fs::path& dir, const CheckOptions& o, double end_time_s) {
       ::dup2(fd, 2);
       ::close(fd);
     }
-    const std::string threads = std::to_string(std::max(1, o.threads));
+    const std::string threads = std::to_string(solver_threads(o));
     ::setenv("OMP_NUM_THREADS", threads.c_str(), 1);
     ::setenv("CCX_NPROC_EQUATION_SOLVER", threads.c_str(), 1);
     ::execlp(o.ccx.c_str(), o.ccx.c_str(), "-i", job.c_str(), static_cast<char*>(nullptr));
@@ -229,7 +234,10 @@ CheckResult run_check(const fs::path& dir, const CheckOptions& o) {
   r.linear_tolerance = o.linear_tolerance;
   r.angular_tolerance = o.angular_tolerance;
   r.impulse_Ns = deck.impulse_Ns;
-  if (o.run_solver) r.solver_wall_time_s = run_ccx(dir, o, deck.end_time_s);
+  if (o.run_solver) {
+    r.solver_wall_time_s = run_ccx(dir, o, deck.end_time_s);
+    r.solver_threads = solver_threads(o);
+  }
   const fs::path dat_path = dir / (std::string(kJobName) + ".dat");
   const DatFile dat = read_dat(dat_path);
 
@@ -369,6 +377,7 @@ json to_json(const CheckResult& r) {
             {"angular_velocity_expected_rad_s", v3(r.angular_velocity_expected_rad_s)},
             {"probes", probes},
             {"solver_wall_time_s", r.solver_wall_time_s},
+            {"solver_threads", r.solver_threads},
             {"momentum_time_s", r.momentum_time_s},
             {"linear_tolerance", r.linear_tolerance},
             {"angular_tolerance", r.angular_tolerance},
@@ -397,7 +406,7 @@ std::string format_check(const CheckResult& r) {
       << " m/s over quarter windows), rigid body " << p.rigid_body_velocity_m_s << " m/s, difference "
       << 100.0 * p.relative_difference << " %\n";
   }
-  s << "solver wall time " << r.solver_wall_time_s << " s; " << (r.passed ? "PASSED" : "FAILED") << "\n";
+  s << "solver wall time " << r.solver_wall_time_s << " s on " << r.solver_threads << " thread(s); " << (r.passed ? "PASSED" : "FAILED") << "\n";
   for (const auto& f : r.failures) s << "  " << f << "\n";
   return s.str();
 }

@@ -81,6 +81,20 @@ std::vector<std::string> probe_groups(const TetMesh& m) {
 
 }  // namespace
 
+const char* to_string(CcxSolver s) {
+  switch (s) {
+    case CcxSolver::automatic: return "auto";
+    case CcxSolver::spooles: return "spooles";
+    case CcxSolver::iterative: return "iterative";
+  }
+  return "?";
+}
+
+CcxSolver ccx_solver_for(CcxSolver requested, std::size_t nodes) {
+  if (requested != CcxSolver::automatic) return requested;
+  return nodes >= kIterativeSolverMinNodes ? CcxSolver::iterative : CcxSolver::spooles;
+}
+
 TimeSchedule time_schedule(const DeckOptions& o, double contact_end_s) {
   TimeSchedule t;
   double start = 0;
@@ -132,8 +146,12 @@ std::string calculix_inp(const DeckRequest& r, const TetMesh& m) {
     s << num(r.force.time_s[i]) << ", " << num(r.force.force_N[i]) << "\n";
   }
   const TimeSchedule ts = time_schedule(o, r.force.time_s.back());
+  // The equation solver by deck size (CcxSolver; bench/bench_ccx.cpp measured the choice).
+  const char* dynamic = ccx_solver_for(o.solver, m.nodes_m.size()) == CcxSolver::iterative
+                            ? "*DYNAMIC, DIRECT, SOLVER=ITERATIVE SCALING\n"
+                            : "*DYNAMIC, DIRECT\n";
   auto step = [&](std::size_t incs, double dt, double period, const std::string& what) {
-    s << "** " << what << "\n*STEP, INC=" << incs + 10 << "\n*DYNAMIC, DIRECT\n" << num(dt) << ", " << num(period) << "\n";
+    s << "** " << what << "\n*STEP, INC=" << incs + 10 << "\n" << dynamic << num(dt) << ", " << num(period) << "\n";
   };
   if (ts.pulse_increments > 0) {
     step(ts.pulse_increments, ts.pulse_step_s, ts.pulse_end_s, "Step 1a: through the end of the contact, refined");
@@ -150,7 +168,7 @@ std::string calculix_inp(const DeckRequest& r, const TetMesh& m) {
   for (const auto& p : probe_groups(m)) s << "*NODE PRINT, NSET=" << p << ", FREQUENCY=1\nV\n";
   s << "*END STEP\n";
   s << "** Step 2: one increment printing all velocities and the mass (momentum check)\n";
-  s << "*STEP, INC=10\n*DYNAMIC, DIRECT\n" << num(ts.main_step_s) << ", " << num(ts.main_step_s) << "\n";
+  s << "*STEP, INC=10\n" << dynamic << num(ts.main_step_s) << ", " << num(ts.main_step_s) << "\n";
   s << "*NODE PRINT, NSET=BODYN, FREQUENCY=1\nV\n";
   s << "*EL PRINT, ELSET=BODY, TOTALS=ONLY, FREQUENCY=1\nEMAS\n";
   s << "*END STEP\n";
@@ -330,6 +348,7 @@ DeckResult write_decks(const DeckRequest& r, const fs::path& folder) {
                  {"density_kg_m3", r.material.density_kg_m3},
                  {"probes", probes},
                  {"calculix", r.options.calculix},
+                 {"ccx_solver", to_string(ccx_solver_for(r.options.solver, m.nodes_m.size()))},
                  {"code_aster", r.options.code_aster},
                  {"mesh", quality},
                  {"files", names}};

@@ -320,6 +320,11 @@ FemOutputs read_fem(const toml::table& t, const std::string& file, double to_m) 
   f.run = r.choice<FemOutputs::Run>("run", {{"none", FemOutputs::Run::none}, {"calculix", FemOutputs::Run::calculix}},
                                     FemOutputs::Run::none);
   if (f.run == FemOutputs::Run::calculix && !f.calculix) r.fail("run", "run = \"calculix\" needs calculix = true");
+  f.solver = r.choice<FemOutputs::Solver>("solver",
+                                          {{"auto", FemOutputs::Solver::automatic},
+                                           {"spooles", FemOutputs::Solver::spooles},
+                                           {"iterative", FemOutputs::Solver::iterative}},
+                                          FemOutputs::Solver::automatic);
   if (!f.code_aster && !f.calculix) r.fail("calculix", "code_aster and calculix are both false: no deck to write");
   r.reject_unknown();
   return f;

@@ -28,7 +28,8 @@ struct CheckOptions {
   double linear_tolerance = 1e-3;    ///< max relative error of the mean velocity (0.1 %)
   double angular_tolerance = 1e-2;   ///< max relative error of the angular velocity (1 %)
   std::ostream* progress = nullptr;  ///< progress lines from the .sta file (e.g. &std::cerr)
-  int threads = 1;                   ///< OMP_NUM_THREADS for ccx
+  /// OMP_NUM_THREADS and CCX_NPROC_EQUATION_SOLVER for ccx; 0: all cores.
+  int threads = 0;
 };
 
 struct ProbeResult {
@@ -54,6 +55,7 @@ struct CheckResult {
   Eigen::Vector3d angular_velocity_expected_rad_s = Eigen::Vector3d::Zero();
   std::vector<ProbeResult> probes;
   double solver_wall_time_s = 0;
+  int solver_threads = 0;              ///< threads ccx was given
   double momentum_time_s = 0;          ///< time of the all-node velocity print
   double linear_tolerance = 0, angular_tolerance = 0;
   bool passed = false;

@@ -31,6 +31,20 @@ struct DeckBody {
   double stl_unit_m = 1e-3;                              ///< metres per STL coordinate unit
 };
 
+/// CalculiX's equation solver for the implicit dynamic steps (`*DYNAMIC, DIRECT[, SOLVER=...]`).
+enum class CcxSolver {
+  automatic,  ///< by deck size: `iterative` from kIterativeSolverMinNodes nodes, else `spooles`
+  spooles,    ///< ccx's default sparse direct solver (SPOOLES)
+  iterative,  ///< SOLVER=ITERATIVE SCALING (diagonally scaled conjugate gradients)
+};
+/// From this many nodes `automatic` takes the iterative solver (measured, bench/bench_ccx.cpp and
+/// docs/fem.md: below it SPOOLES is as fast or faster; above, the iterative solver wins by a factor
+/// growing with the size, with the same momentum).
+inline constexpr std::size_t kIterativeSolverMinNodes = 1000;
+const char* to_string(CcxSolver s);
+/// The solver a deck of `nodes` nodes is written with (`automatic` resolved).
+CcxSolver ccx_solver_for(CcxSolver requested, std::size_t nodes);
+
 struct DeckOptions {
   double end_time_s = 0.02;    ///< simulated time (the paper: 0.02 s)
   double time_step_s = 1e-5;   ///< solver step after the contact (the paper: 1e-5 s)
@@ -41,6 +55,7 @@ struct DeckOptions {
   int pulse_increments = 100;
   bool code_aster = true;      ///< write impact.comm, impact.export and mesh.med
   bool calculix = true;        ///< write impact.inp and mesh.inp
+  CcxSolver solver = CcxSolver::automatic;  ///< impact.inp's equation solver
   MeshOptions mesh;
 };
 

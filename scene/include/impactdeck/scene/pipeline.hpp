@@ -69,6 +69,7 @@ struct RunReport {
 struct RunOptions {
   std::filesystem::path out_dir = ".";  ///< outputs are written here (must exist)
   std::ostream* progress = nullptr;     ///< solver progress lines (e.g. &std::cerr)
+  int solver_threads = 0;               ///< threads for ccx ([outputs.fem] run); 0: all cores
 };
 
 /// Builds the shape of a body (analytic or mesh). Throws InputError.

@@ -80,6 +80,8 @@ struct FemOutputs {
   bool code_aster = true;
   bool calculix = true;
   enum class Run { none, calculix } run = Run::none;  ///< "calculix": run ccx and the check
+  /// ccx's equation solver: "auto" (by deck size), "spooles", "iterative" (docs/fem.md).
+  enum class Solver { automatic, spooles, iterative } solver = Solver::automatic;
   Place place;
 };
 
