@@ -176,7 +176,7 @@ TEST(BinaryStl, OnlyFilesOfExactlyTheBinarySizeTakeTheFastPath) {
 
 TEST(SelfIntersections, TriangleArrayCountEqualsCgalSurfaceMeshRoute) {
   struct Case {
-    std::string name;
+    std::string name;  // also the test property "pairs: NAME" (docs/accuracy-geometry.md)
     TriangleMesh mesh;
     bool intersecting;
   };
@@ -223,6 +223,7 @@ TEST(SelfIntersections, TriangleArrayCountEqualsCgalSurfaceMeshRoute) {
     EXPECT_EQ(self_intersections(c.mesh, false, 1), reference);
     EXPECT_EQ(self_intersections(c.mesh, false, 3), reference);
     EXPECT_EQ(reference > 0, c.intersecting) << reference;
+    RecordProperty("pairs: " + c.name, static_cast<int>(reference));
   }
 }
 
