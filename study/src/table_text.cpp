@@ -5,7 +5,6 @@
 #include <chrono>
 #include <condition_variable>
 #include <exception>
-#include <limits>
 #include <mutex>
 #include <thread>
 
@@ -61,8 +60,7 @@ void write_rows(std::ostream& o, std::size_t rows, const RowsText& text, const R
   std::condition_variable to_workers, to_writer;
   std::size_t next = 0, written = 0;
   bool stop = false;
-  std::exception_ptr error;
-  std::size_t error_chunk = std::numeric_limits<std::size_t>::max();
+  FirstError first_error;
 
   auto work = [&] {
     for (;;) {
@@ -80,10 +78,7 @@ void write_rows(std::ostream& o, std::size_t rows, const RowsText& text, const R
         text(b, e, slot.text);
       } catch (...) {
         std::lock_guard<std::mutex> lock(m);
-        if (c < error_chunk) {
-          error_chunk = c;
-          error = std::current_exception();
-        }
+        first_error.keep(c, std::current_exception());
         stop = true;
         to_writer.notify_all();
         to_workers.notify_all();
@@ -135,7 +130,7 @@ void write_rows(std::ostream& o, std::size_t rows, const RowsText& text, const R
   }
   {
     std::lock_guard<std::mutex> lock(m);
-    if (error) std::rethrow_exception(error);
+    if (first_error.error) std::rethrow_exception(first_error.error);
   }
   report(rows, true);
 }
