@@ -352,20 +352,27 @@ TEST_F(SweepFiles, FilesDoNotDependOnTheThreadCount) {
   for (unsigned threads : {1u, 3u}) {
     SweepWriteOptions o;
     o.threads = threads;
-    std::size_t last_done = 0, calls = 0;
+    // Per file: progress never goes back, stays within its total, and ends at it.
+    std::size_t last_done = 0, last_total = 0, calls = 0;
     o.progress = [&](std::size_t done, std::size_t total) {
       EXPECT_LE(done, total);
       EXPECT_GE(done, last_done);
       last_done = done;
+      last_total = total;
       ++calls;
+    };
+    auto file = [&](auto&& write) {
+      last_done = last_total = calls = 0;
+      write();
+      EXPECT_GT(calls, 0u);
+      EXPECT_EQ(last_done, last_total);
     };
     const fs::path d = *dir / ("threads" + std::to_string(threads));
     fs::create_directories(d);
-    write_sweep_csv(d / "s.csv", *result, meta, o);
-    EXPECT_GT(calls, 0u);
-    write_sweep_curves_csv(d / "s_curves.csv", *result, meta, o);
-    write_sweep_pos(d / "s.pos", *result, meta, o);
-    write_sweep_vtp(d / "s.vtp", *result, meta, o);
+    file([&] { write_sweep_csv(d / "s.csv", *result, meta, o); });
+    file([&] { write_sweep_curves_csv(d / "s_curves.csv", *result, meta, o); });
+    file([&] { write_sweep_pos(d / "s.pos", *result, meta, o); });
+    file([&] { write_sweep_vtp(d / "s.vtp", *result, meta, o); });
   }
   for (const char* f : {"s.csv", "s_curves.csv", "s.pos", "s.vtp"}) {
     EXPECT_TRUE(slurp(*dir / "threads1" / f) == slurp(*dir / "threads3" / f)) << f;

@@ -147,8 +147,14 @@ void write_sweep_pos(const std::filesystem::path& path, const SweepResult& r, co
   write_file_atomically(path, [&](std::ostream& o) {
     header(o, "//", meta, r);
     o << "// open with: gmsh " << path.filename().string() << "\n";
-    // SP(x,y,z){v}; for the points of one view (chunks of points formatted in parallel).
+    // SP(x,y,z){v}; for the points of one view (chunks of points formatted in parallel). Progress
+    // runs over all views: view k of m reports k n + done of m n.
+    const std::size_t views = r.sharp_count > 0 ? 4 : 3;
+    std::size_t views_done = 0;
     auto view = [&](const char* name, bool sharp, auto value) {
+      detail::RowWriteOptions w = row_options(options);
+      if (options.progress)
+        w.progress = [&](std::size_t d, std::size_t) { options.progress(views_done * n + d, views * n); };
       o << "View \"" << name << "\" {\n";
       detail::write_rows(o, n, [&](std::size_t begin, std::size_t end, std::string& out) {
         for (std::size_t i = begin; i < end; ++i) {
@@ -158,8 +164,9 @@ void write_sweep_pos(const std::filesystem::path& path, const SweepResult& r, co
           detail::append_shortest(out, value(p), kWhat);
           out.append("};\n", 3);
         }
-      }, row_options(options));
+      }, w);
       o << "};\n";
+      ++views_done;
     };
     // The computed views hold the points off sharp features; those get a view of their own.
     view("max_force_N", false, [](const PointResult& p) { return p.max_force_N; });
