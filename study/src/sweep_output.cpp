@@ -8,6 +8,7 @@
 #include <numeric>
 #include <sstream>
 #include <stdexcept>
+#include <mutex>
 #include <thread>
 
 #include "impactdeck/common/atomic_file.hpp"
@@ -337,67 +338,74 @@ std::vector<std::filesystem::path> write_sweep_files(const std::filesystem::path
     p += suffix;
     return p;
   };
-  // The picture (single-threaded: wireframe, circles, cairo) is made and written beside the data
-  // files.
-  std::exception_ptr picture_error;
-  std::thread painter;
-  if (formats.svg || formats.png) {
-    if (!picture.target) throw Error(ExitCode::internal_error, "sweep picture without a target shape");
-    painter = std::thread([&] {
-      try {
-        const plot::Drawing drawing = force_map_drawing(*picture.target, picture.centroid_m, r, picture.options);
-        if (formats.svg) plot::write_svg(with(".svg"), drawing);
-        if (formats.png) plot::write_png(with(".png"), drawing, picture.png_scale);
-      } catch (...) {
-        picture_error = std::current_exception();
-      }
-    });
+  if ((formats.svg || formats.png) && !picture.target) {
+    throw Error(ExitCode::internal_error, "sweep picture without a target shape");
   }
-  struct Joiner {
-    std::thread& t;
-    ~Joiner() {
-      if (t.joinable()) t.join();
-    }
-  } joiner{painter};
-
-  // Progress over the rows of every data file: CSV n, curves n, .pos n per view, .vtp n per array.
+  // One job per file, all at once on their own threads: each data file formats on the worker
+  // threads of its write_rows, and while one waits for the disk (its final flush before the
+  // rename) the others keep the cores busy; the picture (single-threaded: wireframe, circles,
+  // cairo) is one more job. The files and their order in the returned list do not change.
   const std::size_t n = r.points.size();
-  const std::size_t total = n * ((formats.csv ? 1 : 0) + (formats.curves ? 1 : 0) +
-                                 (formats.pos ? (r.sharp_count > 0 ? 4 : 3) : 0) + (formats.vtp ? 11 : 0));
-  std::size_t done = 0;
-  auto step = [&](std::size_t units) {
-    SweepWriteOptions o = options;
-    if (options.progress) o.progress = [&, units](std::size_t d, std::size_t t) {
-      options.progress(done + (t > 0 ? d * units / t : 0), total);
-    };
-    return o;
+  struct Job {
+    std::filesystem::path file;  // the first file of the job (the picture's second is added below)
+    std::size_t units = 0;       // progress units: rows (CSV n, .pos n per view, .vtp n per array)
+    std::function<void(const SweepWriteOptions&)> write;
   };
+  std::vector<Job> jobs;
+  if (formats.csv) jobs.push_back({with(".csv"), n, [&](const SweepWriteOptions& o) { write_sweep_csv(with(".csv"), r, meta, o); }});
+  if (formats.curves)
+    jobs.push_back({with("_curves.csv"), n, [&](const SweepWriteOptions& o) { write_sweep_curves_csv(with("_curves.csv"), r, meta, o); }});
+  if (formats.pos)
+    jobs.push_back({with(".pos"), n * (r.sharp_count > 0 ? 4 : 3), [&](const SweepWriteOptions& o) { write_sweep_pos(with(".pos"), r, meta, o); }});
+  if (formats.vtp) jobs.push_back({with(".vtp"), 11 * n, [&](const SweepWriteOptions& o) { write_sweep_vtp(with(".vtp"), r, meta, o); }});
+  if (formats.svg || formats.png) {
+    jobs.push_back({formats.svg ? with(".svg") : with(".png"), 0, [&](const SweepWriteOptions&) {
+                      const plot::Drawing drawing = force_map_drawing(*picture.target, picture.centroid_m, r, picture.options);
+                      if (formats.svg) plot::write_svg(with(".svg"), drawing);
+                      if (formats.png) plot::write_png(with(".png"), drawing, picture.png_scale);
+                    }});
+  }
+
+  // Progress: the sum over the jobs, reported under a lock (the jobs run on several threads).
+  std::size_t total = 0;
+  for (const Job& j : jobs) total += j.units;
+  std::mutex progress_lock;
+  std::vector<std::size_t> done(jobs.size(), 0);
+  std::vector<std::exception_ptr> errors(jobs.size());
+  auto run = [&](std::size_t k) {
+    SweepWriteOptions o = options;
+    if (options.progress) {
+      o.progress = [&, k](std::size_t d, std::size_t t) {
+        std::lock_guard<std::mutex> lock(progress_lock);
+        done[k] = t > 0 ? d * jobs[k].units / t : 0;
+        std::size_t sum = 0;
+        for (std::size_t x : done) sum += x;
+        options.progress(sum, total);
+      };
+    }
+    try {
+      jobs[k].write(o);
+    } catch (...) {
+      errors[k] = std::current_exception();
+    }
+  };
+  {
+    std::vector<std::thread> pool;
+    struct Joiner {
+      std::vector<std::thread>& pool;
+      ~Joiner() {
+        for (auto& t : pool)
+          if (t.joinable()) t.join();
+      }
+    } joiner{pool};
+    for (std::size_t k = 1; k < jobs.size(); ++k) pool.emplace_back(run, k);
+    if (!jobs.empty()) run(0);
+  }
+  for (const auto& e : errors)
+    if (e) std::rethrow_exception(e);  // the first file's error
   std::vector<std::filesystem::path> files;
-  if (formats.csv) {
-    write_sweep_csv(with(".csv"), r, meta, step(n));
-    files.push_back(with(".csv"));
-    done += n;
-  }
-  if (formats.curves) {
-    write_sweep_curves_csv(with("_curves.csv"), r, meta, step(n));
-    files.push_back(with("_curves.csv"));
-    done += n;
-  }
-  if (formats.pos) {
-    const std::size_t units = n * (r.sharp_count > 0 ? 4 : 3);
-    write_sweep_pos(with(".pos"), r, meta, step(units));
-    files.push_back(with(".pos"));
-    done += units;
-  }
-  if (formats.vtp) {
-    write_sweep_vtp(with(".vtp"), r, meta, step(11 * n));
-    files.push_back(with(".vtp"));
-    done += 11 * n;
-  }
-  if (painter.joinable()) painter.join();
-  if (picture_error) std::rethrow_exception(picture_error);
-  if (formats.svg) files.push_back(with(".svg"));
-  if (formats.png) files.push_back(with(".png"));
+  for (const Job& j : jobs) files.push_back(j.file);
+  if (formats.svg && formats.png) files.push_back(with(".png"));
   if (options.progress) options.progress(total, total);
   return files;
 }
