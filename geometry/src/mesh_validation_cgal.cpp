@@ -169,11 +169,18 @@ std::size_t count_self_intersections_direct(const TriangleMesh& m, unsigned thre
   std::vector<std::exception_ptr> errors(slabs);
   auto self_slab = [&](std::size_t s) {
     try {
+      // Back into memory order (the file's, spatially coherent), which nth_element scrambled: in
+      // a random order the box scans miss the cache and each slab took as long as the whole.
+      std::sort(ptr.begin() + cut[s], ptr.begin() + cut[s + 1]);
+      // A count of this thread's own (not counts[s]: neighbouring slots share a cache line, and
+      // the threads would pass it back and forth at every pair).
+      std::size_t count = 0;
       CGAL::box_self_intersection_d(ptr.begin() + cut[s], ptr.begin() + cut[s + 1],
                                     [&](const Box* x, const Box* y) {
-                                      counts[s] += triangles_intersect(m, int(x - base), int(y - base));
+                                      if (triangles_intersect(m, int(x - base), int(y - base))) ++count;
                                     },
                                     kCutoff);
+      counts[s] = count;
     } catch (...) {
       errors[s] = std::current_exception();
     }
