@@ -28,9 +28,11 @@ inline char* put_shortest(char* p, double v, const char* what) {
   if (!std::isfinite(v)) throw Error(ExitCode::internal_error, std::string(what) + ": non-finite value");
   return std::to_chars(p, p + kShortestMax, v + 0.0).ptr;
 }
+/// Appends the shortest text of `v` to `out`, formatted in place (no copy through a buffer).
 inline void append_shortest(std::string& out, double v, const char* what) {
-  char buf[kShortestMax];
-  out.append(buf, static_cast<std::size_t>(put_shortest(buf, v, what) - buf));
+  const std::size_t n = out.size();
+  out.resize(n + kShortestMax);
+  out.resize(static_cast<std::size_t>(put_shortest(&out[n], v, what) - out.data()));
 }
 inline std::string shortest(double v, const char* what) {
   char buf[kShortestMax];

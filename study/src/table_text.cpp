@@ -153,25 +153,40 @@ std::string CsvTable::header() const {
 
 RowsText CsvTable::rows(const char* what) const {
   return [this, what](std::size_t begin, std::size_t end, std::string& out) {
-    char buf[kShortestMax];
+    // Each row is formatted in place: the string grows by a bound of the row's length (numbers at
+    // most kShortestMax characters), the text is written through a pointer, then trimmed.
+    std::vector<std::string_view> texts(columns_.size());
     for (std::size_t i = begin; i < end; ++i) {
+      std::size_t bound = columns_.size();  // separators and the line end
       for (std::size_t k = 0; k < columns_.size(); ++k) {
-        if (k > 0) out.push_back(',');
         const Column& c = columns_[k];
-        if (c.number) {
-          append_shortest(out, c.number(i), what);
-        } else if (c.integer) {
-          out.append(buf, static_cast<std::size_t>(std::to_chars(buf, buf + sizeof buf, c.integer(i)).ptr - buf));
-        } else {
-          const std::string_view t = c.text(i);
-          if (t.find_first_of(",\"\r\n") != std::string_view::npos) {
+        if (c.text) {
+          texts[k] = c.text(i);
+          if (texts[k].find_first_of(",\"\r\n") != std::string_view::npos) {
             throw Error(ExitCode::internal_error, std::string(what) + ": column " + c.name + " holds '" +
-                                                      std::string(t) + "' (no comma, quote or line break)");
+                                                      std::string(texts[k]) + "' (no comma, quote or line break)");
           }
-          out.append(t);
+          bound += texts[k].size();
+        } else {
+          bound += kShortestMax;
         }
       }
-      out.push_back('\n');
+      const std::size_t start = out.size();
+      out.resize(start + bound);
+      char* p = &out[start];
+      for (std::size_t k = 0; k < columns_.size(); ++k) {
+        if (k > 0) *p++ = ',';
+        const Column& c = columns_[k];
+        if (c.number) {
+          p = put_shortest(p, c.number(i), what);
+        } else if (c.integer) {
+          p = std::to_chars(p, p + kShortestMax, c.integer(i)).ptr;
+        } else {
+          p = std::copy(texts[k].begin(), texts[k].end(), p);
+        }
+      }
+      *p++ = '\n';
+      out.resize(static_cast<std::size_t>(p - out.data()));
     }
   };
 }
