@@ -37,10 +37,11 @@ enum class CcxSolver {
   spooles,    ///< ccx's default sparse direct solver (SPOOLES)
   iterative,  ///< SOLVER=ITERATIVE SCALING (diagonally scaled conjugate gradients)
 };
-/// From this many nodes `automatic` takes the iterative solver (measured, bench/bench_ccx.cpp and
-/// docs/fem.md: below it SPOOLES is as fast or faster; above, the iterative solver wins by a factor
-/// growing with the size, with the same momentum).
-inline constexpr std::size_t kIterativeSolverMinNodes = 1000;
+/// From this many nodes `automatic` takes the iterative solver. Measured (bench/bench_ccx.cpp,
+/// docs/fem.md): on decks of 173 to 5,108 nodes it ran 2.5 to 22 times faster per increment than
+/// SPOOLES with the same momentum and probe stresses (to 4e-8); smaller decks, too coarse for
+/// stresses and cheap either way, keep the direct solver.
+inline constexpr std::size_t kIterativeSolverMinNodes = 150;
 const char* to_string(CcxSolver s);
 /// The solver a deck of `nodes` nodes is written with (`automatic` resolved).
 CcxSolver ccx_solver_for(CcxSolver requested, std::size_t nodes);
