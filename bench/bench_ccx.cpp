@@ -8,8 +8,8 @@
 //   2. Time step: the same deck with the refined and the main steps scaled, against the finest,
 //      so the step the accuracy needs is measured rather than assumed.
 //   3. Where the iterative solver starts to win, over mesh sizes.
-//   bench_ccx [--repeats N] [--quick] [--crossover]
-//   (--quick: a 10 mm mesh and one repeat; --crossover: table 3 alone)
+//   bench_ccx [--repeats N] [--quick] [--crossover | --steps]
+//   (--quick: a 10 mm mesh and one repeat; --crossover: table 3 alone; --steps: table 2 alone)
 // Needs ccx (calculix-ccx) and the Gmsh plugin (it meshes through `impactdeck run`'s pipeline).
 #include <algorithm>
 #include <chrono>
@@ -171,10 +171,11 @@ Outcome run_variant(const fs::path& deck, const fs::path& work, const Variant& v
 
 int main(int argc, char** argv) {
   int repeats = 3;
-  bool quick = false, crossover_only = false;
+  bool quick = false, crossover_only = false, steps_only = false;
   for (int i = 1; i < argc; ++i) {
     if (std::strcmp(argv[i], "--quick") == 0) quick = true;
     if (std::strcmp(argv[i], "--crossover") == 0) crossover_only = true;
+    if (std::strcmp(argv[i], "--steps") == 0) steps_only = true;
     if (std::strcmp(argv[i], "--repeats") == 0 && i + 1 < argc) repeats = std::atoi(argv[++i]);
   }
   if (quick) repeats = 1;
@@ -219,7 +220,7 @@ int main(int argc, char** argv) {
   const Variant chosen{"ITERATIVE SCALING, all cores (auto, default threads)", iterative, all, 1};
   std::vector<std::pair<Variant, Outcome>> rows;
   Outcome best_before, best_chosen;
-  for (int k = 0; k < repeats; ++k) {
+  for (int k = 0; k < (steps_only ? 0 : repeats); ++k) {
     for (const Variant* v : {&before, &chosen}) {
       const Outcome o = run_variant(deck.folder, dir / "run", *v);
       Outcome& best = v == &before ? best_before : best_chosen;
@@ -232,9 +233,10 @@ int main(int argc, char** argv) {
   for (const Variant& v : {Variant{"SPOOLES, all cores", spooles, all, 1},
                            Variant{"ITERATIVE SCALING, 1 thread", iterative, 1, 1},
                            Variant{"ITERATIVE CHOLESKY, all cores", cholesky, all, 1}}) {
-    if (quick) break;
+    if (quick || steps_only) break;
     rows.emplace_back(v, run_variant(deck.folder, dir / "run", v));
   }
+  if (!steps_only) {
   std::printf("\n| solver, threads | increments | ccx wall time, s | speed-up | ccx CPU time, s | linear momentum error | probe first-passage peak von Mises, MPa | at, us | peak vs SPOOLES 1 thread |\n");
   std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   for (const auto& [v, o] : rows) {
@@ -243,6 +245,7 @@ int main(int argc, char** argv) {
                 o.peak_mpa / best_before.peak_mpa - 1);
   }
   std::printf("(best of %d alternating runs for the first two rows, one run for the others)\n", repeats);
+  }
 
   // 2. Time step: the chosen solver and threads; steps scaled against the finest (scale 0.5).
   std::printf("\n| step scale (1 = 100 increments across the contact, 2.24 us after) | increments | ccx wall time, s | linear momentum error | probe first-passage peak von Mises, MPa | at, us | peak vs finest |\n");
@@ -252,7 +255,7 @@ int main(int argc, char** argv) {
   for (double s : scales) {
     Variant v = chosen;
     v.step_scale = s;
-    steps.emplace_back(s, s == 1 ? best_chosen : run_variant(deck.folder, dir / "run", v));
+    steps.emplace_back(s, s == 1 && !steps_only ? best_chosen : run_variant(deck.folder, dir / "run", v));
   }
   const Outcome& finest = steps.front().second;
   for (const auto& [s, o] : steps) {
@@ -263,7 +266,7 @@ int main(int argc, char** argv) {
 
   // 3. Where the iterative solver starts to win: both solvers, all cores, on the bar at several
   // mesh sizes, a quarter of the increments (the cost is per increment).
-  if (!quick) {
+  if (!quick && !steps_only) {
     std::printf("\n| mesh size, mm | nodes | SPOOLES, s per increment | ITERATIVE SCALING, s per increment | SPOOLES / iterative |\n");
     std::printf("|---:|---:|---:|---:|---:|\n");
     for (double size : {40.0, 30.0, 20.0, 12.0, 8.0, 6.5}) {
