@@ -37,7 +37,9 @@ void register_fem_check(CLI::App& app, Context& ctx) {
                   "Max relative error of the linear momentum (default: the deck's, 1e-3 unless the scene set it)")->check(positive_number());
   cmd->add_option("--angular-tolerance", args->options.angular_tolerance,
                   "Max relative error of the angular momentum (default: the deck's, 1e-2 unless the scene set it)")->check(positive_number());
-  cmd->add_option("--threads", args->options.threads, "Threads for ccx (default 1)")->check(positive_number());
+  cmd->add_option("--threads", args->options.threads,
+                  "Threads for ccx: OMP_NUM_THREADS, CCX_NPROC_EQUATION_SOLVER (default 0: all cores)")
+      ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--verbose", args->verbose, "Echo the settings on stderr");
   cmd->add_option("--solver-timeout-s", args->options.timeout_s,
                   "Wall-time limit of the ccx run (default: derived from the deck's size, stated in --json)")

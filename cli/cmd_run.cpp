@@ -1,4 +1,5 @@
 // `impactdeck run SCENE [--json] [--out DIR]`: compute what the scene asks for, nothing more.
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <memory>
@@ -18,6 +19,7 @@ void register_run(CLI::App& app, Context& ctx) {
     bool json = false;
     std::string out = ".";
     double solver_timeout_s = 0;
+    int threads = 0;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand("run", "Run a scene: impacts, force tables and decks it asks for");
@@ -28,13 +30,18 @@ void register_run(CLI::App& app, Context& ctx) {
   cmd->add_option("--solver-timeout-s", args->solver_timeout_s,
                   "Wall-time limit of each ccx run (default: derived from the deck's size, stated in --json)")
       ->check(positive_number());
+  cmd->add_option("--threads", args->threads,
+                  "Threads for ccx when [outputs.fem] run = \"calculix\" (default 0: all cores)")
+      ->check(CLI::NonNegativeNumber);
   cmd->callback([args, &ctx] {
     if (!std::isfinite(args->solver_timeout_s)) throw UsageError("--solver-timeout-s must be a finite number of seconds");
+    check_threads(static_cast<unsigned>(std::min(args->threads, 1 << 30)));
     const scene::Scene sc = scene::load_scene(args->scene);
     scene::RunOptions opt;
     opt.out_dir = args->out;
     opt.progress = &std::cerr;  // ccx progress when [outputs.fem] run = "calculix"
     opt.solver_timeout_s = args->solver_timeout_s;
+    opt.solver_threads = args->threads;
     const scene::RunReport rep = scene::run_scene(sc, opt);
     if (args->json) {
       std::cout << scene::to_json(sc, rep).dump(2) << "\n";

@@ -11,7 +11,6 @@
 #include "commands.hpp"
 #include "impactdeck/common/run_transaction.hpp"
 #include "impactdeck/common/error.hpp"
-#include "impactdeck/plot/drawing.hpp"
 #include "impactdeck/scene/scene.hpp"
 #include "impactdeck/study/cloud.hpp"
 #include "impactdeck/study/progress.hpp"
@@ -42,6 +41,7 @@ nlohmann::json point_json(std::size_t index, const study::PointResult& p) {
 void register_sweep(CLI::App& app, Context& ctx) {
   struct Args {
     std::string scene, impact, cloud = "auto", out = ".", prefix, azimuth, elevation, points;
+    std::string formats = "csv,vtp,pos,svg,png";
     int grid_steps = 8;
     std::size_t count = 2000;
     std::uint64_t seed = 1;
@@ -69,7 +69,9 @@ void register_sweep(CLI::App& app, Context& ctx) {
   cmd->add_option("--threads", a->threads, "Worker threads (default 0: all cores)");
   cmd->add_option("--out", a->out, "Output folder (created if missing; default: current folder)");
   cmd->add_option("--prefix", a->prefix, "File name prefix (default sweep_IMPACT)");
-  cmd->add_flag("--no-png", a->no_png, "Do not render the PNG picture");
+  cmd->add_option("--formats", a->formats,
+                  "Files to write, comma-separated: csv,vtp,pos,svg,png (default: all five)");
+  cmd->add_flag("--no-png", a->no_png, "Do not render the PNG picture (png left out of --formats)");
   cmd->add_flag("--json", a->json, "Print a JSON summary on stdout");
   cmd->add_flag("--quiet", a->quiet, "No progress bar");
   cmd->add_option("--max-points", a->max_points, "Most points a sweep may evaluate (default 1000000)")
@@ -79,6 +81,14 @@ void register_sweep(CLI::App& app, Context& ctx) {
       ->check(positive_number());
   cmd->callback([a, &ctx] {
     check_threads(a->threads);
+    study::SweepFormats formats;
+    try {
+      formats = study::parse_sweep_formats(a->formats);
+    } catch (const std::invalid_argument& e) {
+      throw UsageError("--formats '" + a->formats + "': " + e.what());
+    }
+    if (a->no_png) formats.png = false;
+    formats.curves = a->curves;
     const scene::Scene sc = scene::load_scene(a->scene);
     // One transaction: the sweep's files appear together when all are written, or not at all.
     RunTransaction txn(a->out);
@@ -111,10 +121,15 @@ void register_sweep(CLI::App& app, Context& ctx) {
         files.push_back(txn.public_path(staged));
         return staged;
       };
-      const fs::path csv_path = reserve(".csv");
-      const fs::path curves_path = a->curves ? reserve("_curves.csv") : fs::path();
-      const fs::path pos_path = reserve(".pos"), vtp_path = reserve(".vtp"), svg_path = reserve(".svg");
-      const fs::path png_path = a->no_png ? fs::path() : reserve(".png");
+      // The files --formats asks for, in write_sweep_files' order; all staged side by side.
+      fs::path staged_base;
+      for (const auto& [wanted, suffix] : {std::pair{formats.csv, ".csv"}, std::pair{formats.curves, "_curves.csv"},
+                                           std::pair{formats.pos, ".pos"}, std::pair{formats.vtp, ".vtp"},
+                                           std::pair{formats.svg, ".svg"}, std::pair{formats.png, ".png"}}) {
+        if (!wanted) continue;
+        const std::string staged = reserve(suffix).string();
+        staged_base = staged.substr(0, staged.size() - std::char_traits<char>::length(suffix));
+      }
 
       std::vector<geometry::SurfacePoint> cloud;
       if (!a->points.empty()) {
@@ -158,15 +173,16 @@ void register_sweep(CLI::App& app, Context& ctx) {
       if (a->points.empty() && (kind == study::CloudKind::area_uniform || kind == study::CloudKind::both))
         meta.cloud += ", " + std::to_string(a->count) + " area-uniform (seed " + std::to_string(a->seed) + ")";
 
-      study::write_sweep_csv(csv_path, r, meta);
-      if (a->curves) study::write_sweep_curves_csv(curves_path, r, meta);
-      study::write_sweep_pos(pos_path, r, meta);
-      study::write_sweep_vtp(vtp_path, r, meta);
-      study::ForceMapOptions fo;
-      fo.title = "Maximal collision force: " + imp.impactor + " hits " + imp.target + " (impact '" + imp.name + "')";
-      const plot::Drawing pic = study::force_map_drawing(*ss.setup.target.shape, ss.setup.target.volume.centroid_m, r, fo);
-      plot::write_svg(svg_path, pic);
-      if (!a->no_png) plot::write_png(png_path, pic, 1.5);
+      study::SweepPicture picture;
+      picture.target = ss.setup.target.shape.get();
+      picture.centroid_m = ss.setup.target.volume.centroid_m;
+      picture.options.title = "Maximal collision force: " + imp.impactor + " hits " + imp.target + " (impact '" + imp.name + "')";
+      study::ProgressBar write_bar("write", !a->quiet);
+      study::SweepWriteOptions wo;
+      wo.threads = a->threads;
+      wo.progress = [&write_bar](std::size_t done, std::size_t total) { write_bar.update(done, total); };
+      if (!staged_base.empty()) study::write_sweep_files(staged_base, formats, r, meta, picture, wo);
+      write_bar.finish();
       txn.commit();
       for (const auto& w : txn.warnings()) std::cerr << "impactdeck: warning: " << InputError::one_line(w) << "\n";
 

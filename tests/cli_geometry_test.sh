@@ -31,8 +31,22 @@ def walk(x):
     elif isinstance(x, dict): [walk(v) for v in x.values()]
     elif isinstance(x, list): [walk(v) for v in x]
 walk(d)
+assert d["stages_run"] == ["mesh_load", "mesh_validation", "mass_properties", "curvature_index"], d["stages_run"]
+assert d["stages_skipped"] == [] and set(d["stage_times_s"]) == set(d["stages_run"])
 PY
 passes=$((passes+1))
+# Without --at no surface index is built; the report is the same otherwise.
+"$bin" inspect "$tmp/e.stl" --length-unit mm --density-kg-m3 7850 --json >"$tmp/n.json" 2>/dev/null
+check "inspect without --at exit 0" test $? -eq 0
+check "no surface index without --at" python3 - "$tmp/e.json" "$tmp/n.json" <<'PY'
+import json, sys
+a, b = (json.load(open(f)) for f in sys.argv[1:3])
+assert b["stages_run"] == ["mesh_load", "mesh_validation", "mass_properties", "sharp_edges"], b["stages_run"]
+assert b["stages_skipped"] == ["curvature_index"], b["stages_skipped"]
+for k in ["volume_m3", "inertia_kg_m2", "sharp_edges", "mean_edge_length_m", "validation", "self_intersections"]:
+    assert a[k] == b[k], k
+assert b["points"] == []
+PY
 "$bin" inspect "$tmp/e.stl" --length-unit mm >"$tmp/h.txt" 2>&1
 check "readable report" grep -q "principal moments" "$tmp/h.txt"
 

@@ -3,7 +3,9 @@
 // size and content.
 #include <cmath>
 #include <filesystem>
+#include <cstring>
 #include <fstream>
+#include <map>
 #include <regex>
 #include <sstream>
 
@@ -200,34 +202,214 @@ TEST_F(SweepFiles, GmshPosViews) {
   EXPECT_EQ(std::count(pos.begin(), pos.end(), '{'), std::count(pos.begin(), pos.end(), '}'));
 }
 
-TEST_F(SweepFiles, VtpIsWellFormedPolyData) {
-  Xml x(*dir / "s.vtp");
-  const auto* root = x.doc.RootElement();
-  ASSERT_NE(root, nullptr);
-  EXPECT_STREQ(root->Name(), "VTKFile");
-  EXPECT_STREQ(root->Attribute("type"), "PolyData");
-  const auto pieces = all(root, "Piece");
-  ASSERT_EQ(pieces.size(), 1u);
-  const std::size_t n = result->points.size();
-  EXPECT_EQ(pieces[0]->UnsignedAttribute("NumberOfPoints"), n);
-  EXPECT_EQ(pieces[0]->UnsignedAttribute("NumberOfVerts"), n);
-  std::size_t arrays = 0;
+// A binary VTP split into its XML part (well-formed once the appended block is cut out) and its
+// arrays decoded from the appended raw data, by their offsets and the header_type's block sizes.
+struct Vtp {
+  tinyxml2::XMLDocument doc;
+  std::map<std::string, std::vector<double>> arrays;  // Float64 and Int64 values as doubles
+  std::string header_type;
+};
+void read_vtp(const fs::path& p, Vtp& v) {
+  const std::string text = slurp(p);
+  const std::string tag = "<AppendedData encoding=\"raw\">";
+  const std::size_t at = text.find(tag);
+  ASSERT_NE(at, std::string::npos);
+  const std::size_t underscore = text.find('_', at + tag.size());
+  ASSERT_NE(underscore, std::string::npos);
+  ASSERT_EQ(text.compare(at + tag.size(), underscore - at - tag.size(), "\n"), 0);  // only a newline before '_'
+  const std::string xml = text.substr(0, at) + "</VTKFile>\n";
+  ASSERT_EQ(v.doc.Parse(xml.c_str()), tinyxml2::XML_SUCCESS) << v.doc.ErrorStr();
+  const auto* root = v.doc.RootElement();
+  ASSERT_STREQ(root->Attribute("byte_order"), "LittleEndian");
+  v.header_type = root->Attribute("header_type");
+  ASSERT_TRUE(v.header_type == "UInt32" || v.header_type == "UInt64") << v.header_type;
+  const std::size_t size_bytes = v.header_type == "UInt64" ? 8 : 4;
+  const char* data = text.data() + underscore + 1;
+  std::size_t expected_offset = 0;
   for (const auto* a : all(root, "DataArray")) {
-    const int comps = a->IntAttribute("NumberOfComponents", 1);
-    const auto v = numbers(a->GetText());
-    const std::string name = a->Attribute("Name");
-    if (name == "offsets") {
-      ASSERT_EQ(v.size(), n);
-      EXPECT_EQ(v.back(), static_cast<double>(n));
-    } else {
-      EXPECT_EQ(v.size(), n * static_cast<std::size_t>(comps)) << name;
+    ASSERT_STREQ(a->Attribute("format"), "appended");
+    const std::size_t offset = std::stoull(a->Attribute("offset"));
+    EXPECT_EQ(offset, expected_offset) << a->Attribute("Name");  // blocks follow each other
+    std::uint64_t bytes = 0;
+    std::memcpy(&bytes, data + offset, size_bytes);
+    ASSERT_LE(underscore + 1 + offset + size_bytes + bytes, text.size());
+    ASSERT_EQ(bytes % 8, 0u);
+    std::vector<double>& out = v.arrays[a->Attribute("Name")];
+    for (std::size_t k = 0; k < bytes / 8; ++k) {
+      const char* at8 = data + offset + size_bytes + 8 * k;
+      if (std::string(a->Attribute("type")) == "Int64") {
+        std::int64_t x;
+        std::memcpy(&x, at8, 8);
+        out.push_back(static_cast<double>(x));
+      } else {
+        ASSERT_STREQ(a->Attribute("type"), "Float64");
+        double x;
+        std::memcpy(&x, at8, 8);
+        out.push_back(x);
+      }
     }
-    if (name == "max_force_N") {
-      EXPECT_EQ(v[result->max_index], result->points[result->max_index].max_force_N);  // 17 digits round-trip
-    }
-    ++arrays;
+    expected_offset = offset + size_bytes + bytes;
   }
-  EXPECT_EQ(arrays, 12u);  // 8 scalars (flag included) + normals + points + connectivity + offsets
+  // After the last block: the closing tags only.
+  EXPECT_EQ(text.substr(underscore + 1 + expected_offset), "\n</AppendedData>\n</VTKFile>\n");
+}
+
+TEST_F(SweepFiles, VtpIsBinaryPolyDataWithTheResultsArrays) {
+  for (bool wide : {false, true}) {
+    SCOPED_TRACE(wide ? "UInt64 block sizes" : "UInt32 block sizes");
+    SweepWriteOptions o;
+    o.vtp_uint64_headers = wide;
+    write_sweep_vtp(*dir / "w.vtp", *result, {}, o);
+    Vtp v;
+    read_vtp(*dir / "w.vtp", v);
+    EXPECT_EQ(v.header_type, wide ? "UInt64" : "UInt32");
+    const auto* root = v.doc.RootElement();
+    EXPECT_STREQ(root->Name(), "VTKFile");
+    EXPECT_STREQ(root->Attribute("type"), "PolyData");
+    const auto pieces = all(root, "Piece");
+    ASSERT_EQ(pieces.size(), 1u);
+    const std::size_t n = result->points.size();
+    EXPECT_EQ(pieces[0]->UnsignedAttribute("NumberOfPoints"), n);
+    EXPECT_EQ(pieces[0]->UnsignedAttribute("NumberOfVerts"), n);
+    EXPECT_EQ(v.arrays.size(), 12u);  // 8 scalars (flag included) + normals + points + connectivity + offsets
+    const double fmax = result->points[result->max_index].max_force_N;
+    for (std::size_t i = 0; i < n; ++i) {
+      const PointResult& p = result->points[i];
+      // The same doubles as the result (bitwise: == on finite values, and no -0 written).
+      ASSERT_EQ(v.arrays["max_force_N"].at(i), p.max_force_N);
+      ASSERT_EQ(v.arrays["force_ratio"].at(i), p.max_force_N / fmax);
+      ASSERT_EQ(v.arrays["reduced_mass_kg"].at(i), p.reduced_mass_kg);
+      ASSERT_EQ(v.arrays["effective_radius_m"].at(i), p.effective_radius_m);
+      ASSERT_EQ(v.arrays["target_radius_m"].at(i), p.target_radius_m);
+      ASSERT_EQ(v.arrays["contact_ellipse_axis_ratio"].at(i), p.contact_ellipse_axis_ratio);
+      ASSERT_EQ(v.arrays["sharp_feature"].at(i), 0.0);
+      ASSERT_EQ(v.arrays["flag"].at(i), static_cast<double>(p.flag));
+      for (int k = 0; k < 3; ++k) {
+        ASSERT_EQ(v.arrays["normal"].at(3 * i + k), p.normal[k]);
+        ASSERT_EQ(v.arrays["Points"].at(3 * i + k), p.point_m[k]);
+      }
+      ASSERT_EQ(v.arrays["connectivity"].at(i), static_cast<double>(i));
+      ASSERT_EQ(v.arrays["offsets"].at(i), static_cast<double>(i + 1));
+    }
+  }
+}
+
+// Every number of the CSV and the .pos reads back as the very double computed: the shortest
+// round-trip text (std::to_chars) loses nothing.
+TEST_F(SweepFiles, NumbersReadBackBitwise) {
+  std::istringstream s(slurp(*dir / "s.csv"));
+  std::string line;
+  std::vector<std::string> names;
+  std::size_t row = 0;
+  const double fmax = result->points[result->max_index].max_force_N;
+  while (std::getline(s, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::vector<std::string> cells;
+    std::stringstream ls(line);
+    for (std::string c; std::getline(ls, c, ',');) cells.push_back(c);
+    if (names.empty()) {
+      names = cells;
+      continue;
+    }
+    ASSERT_EQ(cells.size(), names.size());
+    const PointResult& p = result->points.at(row);
+    const double expected[] = {static_cast<double>(row), p.point_m.x(), p.point_m.y(), p.point_m.z(), p.normal.x(),
+                               p.normal.y(), p.normal.z(), p.target_radius_m, p.impactor_radius_m,
+                               p.effective_radius_m, p.reduced_mass_kg, p.hertz_constant, p.max_indentation_m,
+                               p.max_force_N, p.max_force_N / fmax, p.compression_time_s, p.restitution,
+                               p.contact_time_s, p.impulse_total_Ns, p.target_delta_velocity_m_s.x(),
+                               p.target_delta_velocity_m_s.y(), p.target_delta_velocity_m_s.z(),
+                               p.target_delta_angular_velocity_rad_s.x(), p.target_delta_angular_velocity_rad_s.y(),
+                               p.target_delta_angular_velocity_rad_s.z(), p.contact_ellipse_axis_ratio,
+                               p.sharp_feature ? 1.0 : 0.0};
+    ASSERT_EQ(cells.size(), std::size(expected));
+    for (std::size_t k = 0; k < cells.size(); ++k) {
+      char* end = nullptr;
+      const double x = std::strtod(cells[k].c_str(), &end);
+      ASSERT_EQ(*end, '\0') << cells[k];
+      const double want = expected[k] + 0.0;  // the writers never write "-0"
+      ASSERT_EQ(std::memcmp(&x, &want, sizeof x), 0) << names[k] << " row " << row << ": " << cells[k];
+    }
+    ++row;
+  }
+  EXPECT_EQ(row, result->points.size());
+
+  // .pos: SP(x,y,z){v} of the first view are the points and their F_max.
+  const std::string pos = slurp(*dir / "s.pos");
+  const std::regex sp(R"(SP\(([^,]+),([^,]+),([^)]+)\)\{([^}]+)\};)");
+  std::size_t i = 0;
+  for (auto it = std::sregex_iterator(pos.begin(), pos.end(), sp); it != std::sregex_iterator() && i < result->points.size();
+       ++it, ++i) {
+    const PointResult& p = result->points[i];
+    for (int k = 0; k < 3; ++k) ASSERT_EQ(std::stod((*it)[k + 1].str()), p.point_m[k]);
+    ASSERT_EQ(std::stod((*it)[4].str()), p.max_force_N);
+  }
+  EXPECT_EQ(i, result->points.size());
+}
+
+// The text is the same on one thread as on several (chunks are written in order).
+TEST_F(SweepFiles, FilesDoNotDependOnTheThreadCount) {
+  SweepMeta meta{"fig4_sweep.toml", "fig4", "ellipsoid", "ball", "both -- test"};
+  for (unsigned threads : {1u, 3u}) {
+    SweepWriteOptions o;
+    o.threads = threads;
+    // Per file: progress never goes back, stays within its total, and ends at it.
+    std::size_t last_done = 0, last_total = 0, calls = 0;
+    o.progress = [&](std::size_t done, std::size_t total) {
+      EXPECT_LE(done, total);
+      EXPECT_GE(done, last_done);
+      last_done = done;
+      last_total = total;
+      ++calls;
+    };
+    auto file = [&](auto&& write) {
+      last_done = last_total = calls = 0;
+      write();
+      EXPECT_GT(calls, 0u);
+      EXPECT_EQ(last_done, last_total);
+    };
+    const fs::path d = *dir / ("threads" + std::to_string(threads));
+    fs::create_directories(d);
+    file([&] { write_sweep_csv(d / "s.csv", *result, meta, o); });
+    file([&] { write_sweep_curves_csv(d / "s_curves.csv", *result, meta, o); });
+    file([&] { write_sweep_pos(d / "s.pos", *result, meta, o); });
+    file([&] { write_sweep_vtp(d / "s.vtp", *result, meta, o); });
+  }
+  for (const char* f : {"s.csv", "s_curves.csv", "s.pos", "s.vtp"}) {
+    EXPECT_TRUE(slurp(*dir / "threads1" / f) == slurp(*dir / "threads3" / f)) << f;
+    EXPECT_TRUE(slurp(*dir / "threads1" / f) == slurp(*dir / f)) << f;  // the default: all cores
+  }
+}
+
+// A non-finite number is a bug upstream: an internal error from whichever chunk holds it, on any
+// thread, and no file left behind.
+TEST_F(SweepFiles, NonFiniteValueIsAnInternalErrorAndNoFile) {
+  SweepResult big = *result;
+  big.points.assign(30000, result->points[result->max_index]);
+  big.min_index = big.max_index = 0;
+  big.points[21000].compression_time_s = std::nan("");
+  for (unsigned threads : {1u, 2u}) {
+    SweepWriteOptions o;
+    o.threads = threads;
+    try {
+      write_sweep_csv(*dir / "nan.csv", big, {}, o);
+      ADD_FAILURE() << "no error";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ExitCode::internal_error);
+      EXPECT_NE(std::string(e.what()).find("non-finite"), std::string::npos) << e.what();
+    }
+    EXPECT_FALSE(fs::exists(*dir / "nan.csv"));
+  }
+}
+
+TEST(SweepFormats, ParsesTheListAndRefusesUnknownOrRepeatedNames) {
+  const SweepFormats all = parse_sweep_formats("csv,vtp,pos,svg,png");
+  EXPECT_TRUE(all.csv && all.vtp && all.pos && all.svg && all.png && !all.curves);
+  const SweepFormats two = parse_sweep_formats("png,csv");
+  EXPECT_TRUE(two.csv && two.png && !two.vtp && !two.pos && !two.svg);
+  EXPECT_THROW(parse_sweep_formats("csv,xyz"), std::invalid_argument);
+  EXPECT_THROW(parse_sweep_formats("csv,csv"), std::invalid_argument);
+  EXPECT_THROW(parse_sweep_formats(""), std::invalid_argument);
 }
 
 TEST_F(SweepFiles, ForceMapSvgAndPng) {

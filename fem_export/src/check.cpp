@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <thread>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -235,6 +236,11 @@ DatFile read_dat(const fs::path& p) {
   return d;
 }
 
+int solver_threads(const CheckOptions& o) {
+  if (o.threads > 0) return o.threads;
+  return static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+}
+
 // First "*ERROR" line and last non-empty line of a ccx log; "No space left on device" anywhere
 // in it is reported in first_error's place when there is no *ERROR line.
 void scan_log(const fs::path& log, std::string& first_error, std::string& last_line) {
@@ -321,7 +327,7 @@ double run_ccx(const fs::path& work, const CheckOptions& o, double end_time_s, d
       last = s->text;
     }
   };
-  const std::string threads = std::to_string(std::max(1, o.threads));
+  const std::string threads = std::to_string(solver_threads(o));
   const fs::path log = work / (job + ".log");
   detail::SolverRun run;
   try {
@@ -400,6 +406,7 @@ CheckResult run_check(const fs::path& dir, const CheckOptions& o) {
       }
     }
     r.solver_wall_time_s = run_ccx(work, o, deck.end_time_s, r.solver_timeout_s, r.solver_timeout_source);
+    r.solver_threads = solver_threads(o);
     for (const char* ext : {".dat", ".frd", ".sta", ".cvg", ".12d", ".log"}) {
       const fs::path f = work / (std::string(kJobName) + ext);
       std::error_code ec;
@@ -642,6 +649,7 @@ json to_json(const CheckResult& r) {
             {"solver_wall_time_s", r.solver_wall_time_s},
             {"solver_timeout_s", r.solver_timeout_s},
             {"solver_timeout_source", r.solver_timeout_source},
+            {"solver_threads", r.solver_threads},
             {"momentum_time_s", r.momentum_time_s},
             {"linear_tolerance", r.linear_tolerance},
             {"angular_tolerance", r.angular_tolerance},
@@ -693,7 +701,7 @@ std::string format_check(const CheckResult& r) {
   }
   s << format_body(r.body);
   if (r.stress) s << format_stress(*r.stress);
-  s << "solver wall time " << r.solver_wall_time_s << " s; " << (r.passed ? "PASSED" : "FAILED") << "\n";
+  s << "solver wall time " << r.solver_wall_time_s << " s on " << r.solver_threads << " thread(s); " << (r.passed ? "PASSED" : "FAILED") << "\n";
   for (const auto& f : r.failures) s << "  " << f << "\n";
   return s.str();
 }

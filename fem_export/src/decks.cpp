@@ -232,6 +232,20 @@ std::string format_body(const BodyComparison& c) {
   return s.str();
 }
 
+const char* to_string(CcxSolver s) {
+  switch (s) {
+    case CcxSolver::automatic: return "auto";
+    case CcxSolver::spooles: return "spooles";
+    case CcxSolver::iterative: return "iterative";
+  }
+  return "?";
+}
+
+CcxSolver ccx_solver_for(CcxSolver requested, std::size_t nodes) {
+  if (requested != CcxSolver::automatic) return requested;
+  return nodes >= kIterativeSolverMinNodes ? CcxSolver::iterative : CcxSolver::spooles;
+}
+
 TimeSchedule time_schedule(const DeckOptions& o, double contact_end_s) {
   TimeSchedule t;
   double start = 0;
@@ -296,8 +310,12 @@ std::string calculix_inp(const DeckRequest& r, const TetMesh& m, const PatchLoad
       s << num(r.force.time_s[i]) << ", " << num(r.force.force_N[i]) << "\n";
     }
   }
+  // The equation solver by deck size (CcxSolver; bench/bench_ccx.cpp measured the choice).
+  const char* dynamic = ccx_solver_for(o.solver, m.nodes_m.size()) == CcxSolver::iterative
+                            ? "*DYNAMIC, DIRECT, SOLVER=ITERATIVE SCALING\n"
+                            : "*DYNAMIC, DIRECT\n";
   auto step = [&](std::size_t incs, double dt, double period, const std::string& what) {
-    s << "** " << what << "\n*STEP, INC=" << incs + 10 << "\n*DYNAMIC, DIRECT\n" << num(dt) << ", " << num(period) << "\n";
+    s << "** " << what << "\n*STEP, INC=" << incs + 10 << "\n" << dynamic << num(dt) << ", " << num(period) << "\n";
   };
   auto loads_and_output = [&](std::size_t frequency) {
     if (patch) {
@@ -322,7 +340,7 @@ std::string calculix_inp(const DeckRequest& r, const TetMesh& m, const PatchLoad
   }
   loads_and_output(every);
   s << "** Step 2: one increment printing all velocities and the mass (momentum check)\n";
-  s << "*STEP, INC=10\n*DYNAMIC, DIRECT\n" << num(ts.main_step_s) << ", " << num(ts.main_step_s) << "\n";
+  s << "*STEP, INC=10\n" << dynamic << num(ts.main_step_s) << ", " << num(ts.main_step_s) << "\n";
   s << "*NODE PRINT, NSET=BODYN, FREQUENCY=1\nV\n";
   s << "*EL PRINT, ELSET=BODY, TOTALS=ONLY, FREQUENCY=1\nEMAS\n";
   s << "*END STEP\n";
@@ -694,6 +712,7 @@ DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
                  {"yield_strength_Pa", r.yield_strength_Pa ? json(*r.yield_strength_Pa) : json(nullptr)},
                  {"probes", probes},
                  {"calculix", r.options.calculix},
+                 {"ccx_solver", to_string(ccx_solver_for(r.options.solver, m.nodes_m.size()))},
                  {"code_aster", r.options.code_aster},
                  {"model", {{"mass_kg", r.model.mass_kg},
                             {"volume_m3", r.model.volume_m3},

@@ -107,9 +107,9 @@ InspectReport inspect_part(const InspectOptions& a) {
     opt.accept_approximate_mass = args->approximate;
     opt.validation.check_self_intersections = !args->no_self;
     opt.shape.sharp_angle_deg = args->sharp_deg;
+    opt.build_surface_index = !points.empty();  // the index serves the --at queries only
     const Part part = load_part(args->part, opt);
-    const auto& shape = *part.shape;
-    const auto& vp = shape.volume_properties();
+    const auto& vp = part.mass.volume;
     const auto& rep = part.validation_after_repair ? *part.validation_after_repair : part.validation;
 
     std::optional<double> density;
@@ -154,10 +154,11 @@ InspectReport inspect_part(const InspectOptions& a) {
     j["principal_axes"] = mat(pa.axes);  // columns are the axes
     j["principal_moment_relative_gaps"] = {num(pa.relative_gaps[0]), num(pa.relative_gaps[1])};
     j["principal_axes_well_defined"] = pa.axes_well_defined();
-    j["sharp_edges"] = shape.sharp_edge_count();
-    j["mean_edge_length_m"] = num(shape.mean_edge_length_m());
+    j["sharp_edges"] = part.sharp_edges;
+    j["mean_edge_length_m"] = num(part.mean_edge_length_m);
     nlohmann::json queries = nlohmann::json::array();
     for (std::size_t i = 0; i < points.size(); ++i) {
+      const MeshShape& shape = *part.shape;
       const auto sp = shape.closest_point(points[i]);
       nlohmann::json q;
       q["query_m"] = vec(points[i]);
@@ -192,8 +193,13 @@ InspectReport inspect_part(const InspectOptions& a) {
       queries.push_back(q);
     }
     j["points"] = queries;
-    nlohmann::json stages = nlohmann::json::object();
-    for (const auto& s : part.stages) stages[s.name] = s.seconds;
+    nlohmann::json stages = nlohmann::json::object(), run = nlohmann::json::array();
+    for (const auto& s : part.stages) {
+      stages[s.name] = s.seconds;
+      run.push_back(s.name);
+    }
+    j["stages_run"] = run;
+    j["stages_skipped"] = part.stages_skipped;
     j["stage_times_s"] = stages;
     j["warnings"] = warnings;
 
@@ -218,7 +224,7 @@ InspectReport inspect_part(const InspectOptions& a) {
     o << "  principal moments " << text(pa.moments * density.value_or(1.0)) << ", gaps "
       << pa.relative_gaps[0] << ", " << pa.relative_gaps[1] << "\n";
     for (int k = 0; k < 3; ++k) o << "    axis " << k + 1 << " " << text(pa.axes.col(k)) << "\n";
-    o << "  sharp edges " << shape.sharp_edge_count() << ", mean edge length " << shape.mean_edge_length_m() << " m\n";
+    o << "  sharp edges " << part.sharp_edges << ", mean edge length " << part.mean_edge_length_m << " m\n";
     for (std::size_t i = 0; i < queries.size(); ++i) {
       const auto& q = queries[i];
       o << "  at " << args->at[i] << ": surface point " << q["surface_point_m"].dump() << " m, normal "

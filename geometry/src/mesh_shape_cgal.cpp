@@ -175,6 +175,24 @@ CPoint cp(const Eigen::Vector3d& v) { return CPoint(v.x(), v.y(), v.z()); }
 Eigen::Vector3d ev(const CPoint& p) { return {p.x(), p.y(), p.z()}; }
 Eigen::Vector3d ev(const K::Vector_3& p) { return {p.x(), p.y(), p.z()}; }
 
+// (b - a) × (c - a) of triangle f: twice its area times its unit normal.
+Eigen::Vector3d face_cross(const TriangleMesh& m, std::size_t f) {
+  const auto& V = m.vertices_m;
+  const auto& t = m.triangles[f];
+  return (V[t[1]] - V[t[0]]).cross(V[t[2]] - V[t[0]]);
+}
+Eigen::Vector3d unit_or_zero(const Eigen::Vector3d& c) {
+  const double n = c.norm();
+  return n > 0 ? Eigen::Vector3d(c / n) : Eigen::Vector3d::Zero();
+}
+
+// The undirected edge of the edge-table run [i, j) is sharp when it does not join exactly two
+// faces (boundary, non-manifold) or when their unit normals are further apart than the threshold.
+template <class Normal>
+bool run_is_sharp(const EdgeTable& e, std::size_t i, std::size_t j, double cos_sharp, Normal normal) {
+  return j - i != 2 || normal(e.face[i]).dot(normal(e.face[i + 1])) < cos_sharp;
+}
+
 double point_segment_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   const Eigen::Vector3d ab = b - a;
   const double l2 = ab.squaredNorm();
@@ -258,12 +276,10 @@ MeshShape::MeshShape(TriangleMesh mesh, const MeshMassProperties& mass, const Me
 
   double total = 0;
   for (std::size_t f = 0; f < nf; ++f) {
-    const auto& t = F[f];
-    const Eigen::Vector3d c = (V[t[1]] - V[t[0]]).cross(V[t[2]] - V[t[0]]);
-    const double n = c.norm();
-    ix.face_area[f] = 0.5 * n;
-    ix.face_normal[f] = n > 0 ? Eigen::Vector3d(c / n) : Eigen::Vector3d::Zero();
-    for (int v : t) ix.vertex_normal[v] += c;  // area weighting
+    const Eigen::Vector3d c = face_cross(mesh_, f);
+    ix.face_area[f] = 0.5 * c.norm();
+    ix.face_normal[f] = unit_or_zero(c);
+    for (int v : F[f]) ix.vertex_normal[v] += c;  // area weighting
     total += ix.face_area[f];
     ix.cumulative_area[f] = total;
   }
@@ -274,10 +290,7 @@ MeshShape::MeshShape(TriangleMesh mesh, const MeshMassProperties& mass, const Me
   // and non-manifold edges count as sharp: no smooth surface continues across them). One sorted
   // list of the 3F edge records gives every undirected edge's faces as a run.
   const EdgeTable records = build_edge_table(mesh_);
-  double edge_sum = 0;
-  for (std::size_t f = 0; f < nf; ++f)
-    for (int k = 0; k < 3; ++k) edge_sum += (V[F[f][k]] - V[F[f][(k + 1) % 3]]).norm();
-  ix.mean_edge = edge_sum / (3.0 * nf);
+  ix.mean_edge = mesh_.mean_edge_length_m();
   const double cos_sharp = std::cos(options_.sharp_angle_deg * M_PI / 180.0);
   ix.vertex_sharp.assign(nv, 0);
   ix.face_across.assign(nf, {-1, -1, -1});
@@ -287,9 +300,7 @@ MeshShape::MeshShape(TriangleMesh mesh, const MeshMassProperties& mass, const Me
     const std::uint64_t key = records.key[i];
     while (j < records.size() && records.key[j] == key) ++j;
     const int f0 = records.face[i];
-    bool sharp = j - i != 2;
-    if (!sharp) sharp = ix.face_normal[f0].dot(ix.face_normal[records.face[i + 1]]) < cos_sharp;
-    if (sharp) {
+    if (run_is_sharp(records, i, j, cos_sharp, [&](int f) -> const Eigen::Vector3d& { return ix.face_normal[f]; })) {
       ++ix.sharp_edge_count;
       ix.vertex_sharp[EdgeTable::lo(key)] = 1;
       ix.vertex_sharp[EdgeTable::hi(key)] = 1;
@@ -326,6 +337,22 @@ MeshShape::~MeshShape() = default;
 int MeshShape::closest_triangle(const Eigen::Vector3d& query_m) const {
   const auto hit = index_->tree.closest_point_and_primitive(cp(query_m));
   return static_cast<int>(hit.second - index_->triangles.begin());
+}
+
+std::size_t count_sharp_edges(const TriangleMesh& mesh, double sharp_angle_deg) {
+  return count_sharp_edges(mesh, build_edge_table(mesh), sharp_angle_deg);
+}
+
+std::size_t count_sharp_edges(const TriangleMesh& mesh, const EdgeTable& records, double sharp_angle_deg) {
+  const double cos_sharp = std::cos(sharp_angle_deg * M_PI / 180.0);
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < records.size();) {
+    std::size_t j = i;
+    while (j < records.size() && records.key[j] == records.key[i]) ++j;
+    count += run_is_sharp(records, i, j, cos_sharp, [&](int f) { return unit_or_zero(face_cross(mesh, f)); });
+    i = j;
+  }
+  return count;
 }
 
 double MeshShape::size_m() const { return (index_->hi - index_->lo).maxCoeff(); }

@@ -26,6 +26,12 @@ auto timed(std::vector<StageSeconds>& stages, const std::string& name, F&& f) {
 }
 }  // namespace
 
+const std::vector<std::string>& part_stages() {
+  static const std::vector<std::string> names{"mesh_load", "mesh_validation", "mass_properties", "sharp_edges",
+                                              "curvature_index"};
+  return names;
+}
+
 Part load_part(const std::filesystem::path& file, const PartOptions& opt) {
   Part part;
   part.file = file;
@@ -33,13 +39,17 @@ Part load_part(const std::filesystem::path& file, const PartOptions& opt) {
   part.loaded = timed(part.stages, "mesh_load", [&] { return load_mesh(file, opt.length_unit); });
   detail::check_part_extent(part.loaded, where);  // size range, memory for the stages below
   part.warnings = part.loaded.warnings;
-  TriangleMesh mesh = part.loaded.mesh;
+  TriangleMesh mesh = std::move(part.loaded.mesh);
+  part.loaded.mesh = TriangleMesh();
 
+  // The validation's shells and mass integrals are those of the mesh it validated (the repaired
+  // one after a repair): the mass_properties stage reuses them.
+  ValidationByproducts by;
   ValidationReport report = timed(part.stages, "mesh_validation", [&] {
-    part.validation = validate_mesh(mesh, opt.validation);
+    part.validation = validate_mesh(mesh, opt.validation, &by);
     if (!opt.repair) return part.validation;
     part.repairs = repair_mesh(mesh);
-    part.validation_after_repair = validate_mesh(mesh, opt.validation);
+    part.validation_after_repair = validate_mesh(mesh, opt.validation, &by);
     return *part.validation_after_repair;
   });
   if (mesh.triangles.empty()) throw InputError(where, "faces", "no triangle is left after repair");
@@ -78,8 +88,10 @@ Part load_part(const std::filesystem::path& file, const PartOptions& opt) {
   }
 
   MeshMassProperties mass = timed(part.stages, "mass_properties", [&] {
-    return compute_mass_properties(mesh, label_shells(mesh));
+    by.shells = ShellLabels();
+    return std::move(by.mass);
   });
+  if (opt.build_surface_index) by.edges = EdgeTable();  // the index builds its own
   if (part.approximate_mass && mass.volume.volume_m3 < 0) {
     // An open surface has no inside: a negative signed volume means its normals point the other
     // way. Accepted approximation: take the orientation as reversed, and say so.
@@ -93,9 +105,23 @@ Part load_part(const std::filesystem::path& file, const PartOptions& opt) {
     s << "the enclosed volume is not positive (" << mass.volume.volume_m3 << " m^3)";
     throw InputError(where, "mass properties", s.str());
   }
+  part.mass = mass;
+  if (!opt.build_surface_index) {
+    // Only what a report needs; the mesh is released with this function.
+    timed(part.stages, "sharp_edges", [&] {
+      // The validation's edge table (a reversal above keeps its undirected edges and their faces).
+      part.sharp_edges = count_sharp_edges(mesh, by.edges, opt.shape.sharp_angle_deg);
+      by.edges = EdgeTable();
+      part.mean_edge_length_m = mesh.mean_edge_length_m();
+    });
+    part.stages_skipped.push_back("curvature_index");
+    return part;
+  }
   part.shape = timed(part.stages, "curvature_index", [&] {
     return std::make_shared<const MeshShape>(std::move(mesh), mass, opt.shape);
   });
+  part.sharp_edges = part.shape->sharp_edge_count();
+  part.mean_edge_length_m = part.shape->mean_edge_length_m();
   return part;
 }
 

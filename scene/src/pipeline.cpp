@@ -294,6 +294,9 @@ fem_export::DeckRequest fem_request(const Scene& scene, const ImpactReport& ir, 
   r.options.time_step_s = f.time_step_s;
   r.options.code_aster = f.code_aster;
   r.options.calculix = f.calculix;
+  r.options.solver = f.solver == FemOutputs::Solver::spooles     ? fem_export::CcxSolver::spooles
+                     : f.solver == FemOutputs::Solver::iterative ? fem_export::CcxSolver::iterative
+                                                                 : fem_export::CcxSolver::automatic;
   r.options.mesh.mesh_size_m = f.mesh_size_m.value_or(
       b.shape == ShapeKind::mesh ? 0.25 * target.shape->size_m() : 0.5 * r.body.semi_axes_m.minCoeff());
   r.options.adapt_mesh_size = !f.mesh_size_m;
@@ -523,6 +526,7 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
           fem_export::CheckOptions co;
           co.progress = opt.progress;
           co.timeout_s = opt.solver_timeout_s;
+          co.threads = opt.solver_threads;
           ir.fem_check = fem_export::run_check(ir.fem_deck->folder, co);
         }
       });

@@ -386,7 +386,7 @@ FemOutputs read_fem(const toml::table& t, const std::string& file, double to_m) 
   r.allow({"mesh_size", "load_mesh_size", "end_time_s", "time_step_s", "probes", "code_aster", "calculix", "run",
            "load", "contact_elements", "contact_zone_factor", "linear_momentum_tolerance",
            "angular_momentum_tolerance", "model_linear_velocity_tolerance", "model_angular_velocity_tolerance",
-           "volume_tolerance", "mass_tolerance", "inertia_tolerance", "min_gamma"});
+           "volume_tolerance", "mass_tolerance", "inertia_tolerance", "min_gamma", "max_elements", "solver"});
   FemOutputs f;
   f.place = r.self();
   if (r.has("mesh_size")) f.mesh_size_m = r.positive("mesh_size") * to_m;
@@ -443,6 +443,11 @@ FemOutputs read_fem(const toml::table& t, const std::string& file, double to_m) 
     if (!(g >= 0.0 && g < 1.0)) r.fail("min_gamma", "must lie in [0, 1), got " + Reader::fmt(g));
     f.tolerances.min_gamma = g;
   }
+  f.solver = r.choice<FemOutputs::Solver>("solver",
+                                          {{"auto", FemOutputs::Solver::automatic},
+                                           {"spooles", FemOutputs::Solver::spooles},
+                                           {"iterative", FemOutputs::Solver::iterative}},
+                                          FemOutputs::Solver::automatic);
   if (!f.code_aster && !f.calculix) r.fail("calculix", "code_aster and calculix are both false: no deck to write");
   r.reject_unknown();
   return f;

@@ -12,9 +12,22 @@
 #include <limits>
 #include <mutex>
 #include <thread>
+#include <utility>
 #include <vector>
 
 namespace impactdeck::study::detail {
+
+/// The exception of the lowest failing chunk among those that failed (the caller holds its lock).
+struct FirstError {
+  std::exception_ptr error;
+  std::size_t chunk = std::numeric_limits<std::size_t>::max();
+  void keep(std::size_t c, std::exception_ptr e) {
+    if (c < chunk) {
+      chunk = c;
+      error = std::move(e);
+    }
+  }
+};
 
 inline unsigned resolve_threads(unsigned requested) {
   if (requested > 0) return requested;
@@ -34,8 +47,7 @@ unsigned parallel_for(std::size_t n, unsigned threads, std::size_t chunk, Body&&
   std::atomic<bool> stop{false};
   std::mutex m;
   std::condition_variable cv;
-  std::exception_ptr error;
-  std::size_t error_chunk = std::numeric_limits<std::size_t>::max();
+  FirstError first_error;
   unsigned running = threads;
 
   auto work = [&] {
@@ -48,10 +60,7 @@ unsigned parallel_for(std::size_t n, unsigned threads, std::size_t chunk, Body&&
         for (std::size_t i = begin; i < end; ++i) body(i);
       } catch (...) {
         std::lock_guard<std::mutex> lock(m);
-        if (c < error_chunk) {
-          error_chunk = c;
-          error = std::current_exception();
-        }
+        first_error.keep(c, std::current_exception());
         stop = true;
       }
       done.fetch_add(end - begin, std::memory_order_relaxed);
@@ -93,7 +102,7 @@ unsigned parallel_for(std::size_t n, unsigned threads, std::size_t chunk, Body&&
     }
   }
   for (auto& t : pool) t.join();
-  if (error) std::rethrow_exception(error);
+  if (first_error.error) std::rethrow_exception(first_error.error);
   if (progress) progress(done.load(), n);
   return threads;
 }

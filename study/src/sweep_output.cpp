@@ -3,18 +3,26 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <functional>
 #include <numeric>
 #include <sstream>
+#include <stdexcept>
+#include <mutex>
+#include <thread>
 
 #include "impactdeck/common/atomic_file.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/common/version.hpp"
 #include "number_text.hpp"
+#include "parallel.hpp"
+#include "table_text.hpp"
 
 namespace impactdeck::study {
 namespace {
 
-std::string g17(double v) { return detail::g17(v, "sweep output"); }
+constexpr const char* kWhat = "sweep output";
+std::string num(double v) { return detail::shortest(v, kWhat); }
 
 void header(std::ostream& o, const char* comment, const SweepMeta& m, const SweepResult& r) {
   o << comment << " impactdeck " << kVersion << " sweep: maximal Hertz contact force over the surface\n";
@@ -23,7 +31,7 @@ void header(std::ostream& o, const char* comment, const SweepMeta& m, const Swee
     o << comment << " impact: " << m.impact << " (" << m.impactor << " hits " << m.target << " along the inward normal)\n";
   if (!m.cloud.empty()) o << comment << " cloud: " << m.cloud << ", " << r.points.size() << " points\n";
   o << comment << " units: SI (m, kg, N, s); coordinates in the target's frame\n";
-  o << comment << " force ratio min/max = " << g17(r.force_ratio) << " (min at point " << r.min_index
+  o << comment << " force ratio min/max = " << num(r.force_ratio) << " (min at point " << r.min_index
     << ", max at point " << r.max_index << ")\n";
   o << comment << " flagged points: " << r.flagged_count << " (the contact model does not apply there: left out of "
     << "min/max; column flag names why";
@@ -39,37 +47,58 @@ double max_force(const SweepResult& r) { return r.points[r.max_index].max_force_
 // infinite radius, written as 0 (no real radius is 0), since the files hold no Inf.
 double radius_out(double r) { return std::isinf(r) ? 0.0 : r; }
 
+detail::RowWriteOptions row_options(const SweepWriteOptions& o) {
+  detail::RowWriteOptions w;
+  w.threads = o.threads;
+  w.progress = o.progress;
+  return w;
+}
+
 }  // namespace
 
-void write_sweep_csv(const std::filesystem::path& path, const SweepResult& r, const SweepMeta& meta) {
+void write_sweep_csv(const std::filesystem::path& path, const SweepResult& r, const SweepMeta& meta,
+                     const SweepWriteOptions& options) {
+  const auto& P = r.points;
+  const double fmax = max_force(r);
+  // Column by column (one more is one more line here).
+  detail::CsvTable t;
+  t.integer("index", [](std::size_t i) { return i; });
+  t.number("x_m", [&](std::size_t i) { return P[i].point_m.x(); });
+  t.number("y_m", [&](std::size_t i) { return P[i].point_m.y(); });
+  t.number("z_m", [&](std::size_t i) { return P[i].point_m.z(); });
+  t.number("nx", [&](std::size_t i) { return P[i].normal.x(); });
+  t.number("ny", [&](std::size_t i) { return P[i].normal.y(); });
+  t.number("nz", [&](std::size_t i) { return P[i].normal.z(); });
+  t.number("target_radius_m", [&](std::size_t i) { return radius_out(P[i].target_radius_m); });
+  t.number("impactor_radius_m", [&](std::size_t i) { return radius_out(P[i].impactor_radius_m); });
+  t.number("effective_radius_m", [&](std::size_t i) { return P[i].effective_radius_m; });
+  t.number("reduced_mass_kg", [&](std::size_t i) { return P[i].reduced_mass_kg; });
+  t.number("hertz_constant_N_per_m1_5", [&](std::size_t i) { return P[i].hertz_constant; });
+  t.number("max_indentation_m", [&](std::size_t i) { return P[i].max_indentation_m; });
+  t.number("max_force_N", [&](std::size_t i) { return P[i].max_force_N; });
+  t.number("force_ratio", [&](std::size_t i) { return P[i].max_force_N / fmax; });
+  t.number("compression_time_s", [&](std::size_t i) { return P[i].compression_time_s; });
+  t.number("restitution", [&](std::size_t i) { return P[i].restitution; });
+  t.number("contact_time_s", [&](std::size_t i) { return P[i].contact_time_s; });
+  t.number("impulse_total_Ns", [&](std::size_t i) { return P[i].impulse_total_Ns; });
+  t.number("target_dvx_m_s", [&](std::size_t i) { return P[i].target_delta_velocity_m_s.x(); });
+  t.number("target_dvy_m_s", [&](std::size_t i) { return P[i].target_delta_velocity_m_s.y(); });
+  t.number("target_dvz_m_s", [&](std::size_t i) { return P[i].target_delta_velocity_m_s.z(); });
+  t.number("target_dwx_rad_s", [&](std::size_t i) { return P[i].target_delta_angular_velocity_rad_s.x(); });
+  t.number("target_dwy_rad_s", [&](std::size_t i) { return P[i].target_delta_angular_velocity_rad_s.y(); });
+  t.number("target_dwz_rad_s", [&](std::size_t i) { return P[i].target_delta_angular_velocity_rad_s.z(); });
+  t.number("contact_ellipse_axis_ratio", [&](std::size_t i) { return P[i].contact_ellipse_axis_ratio; });
+  t.integer("sharp_feature", [&](std::size_t i) { return P[i].sharp_feature ? 1 : 0; });
+  t.text("flag", [&](std::size_t i) { return std::string_view(collision::flag_word(P[i].flag)); });
   write_file_atomically(path, [&](std::ostream& o) {
     header(o, "#", meta, r);
-    o << "index,x_m,y_m,z_m,nx,ny,nz,target_radius_m,impactor_radius_m,effective_radius_m,"
-         "reduced_mass_kg,hertz_constant_N_per_m1_5,max_indentation_m,max_force_N,force_ratio,"
-         "compression_time_s,restitution,contact_time_s,impulse_total_Ns,"
-         "target_dvx_m_s,target_dvy_m_s,target_dvz_m_s,target_dwx_rad_s,target_dwy_rad_s,target_dwz_rad_s,"
-         "contact_ellipse_axis_ratio,sharp_feature,flag\n";
-    const double fmax = max_force(r);
-    for (std::size_t i = 0; i < r.points.size(); ++i) {
-      const PointResult& p = r.points[i];
-      o << i;
-      for (double v : {p.point_m.x(), p.point_m.y(), p.point_m.z(), p.normal.x(), p.normal.y(), p.normal.z(),
-                       radius_out(p.target_radius_m), radius_out(p.impactor_radius_m), p.effective_radius_m,
-                       p.reduced_mass_kg,
-                       p.hertz_constant, p.max_indentation_m, p.max_force_N, p.max_force_N / fmax,
-                       p.compression_time_s, p.restitution, p.contact_time_s, p.impulse_total_Ns,
-                       p.target_delta_velocity_m_s.x(), p.target_delta_velocity_m_s.y(),
-                       p.target_delta_velocity_m_s.z(), p.target_delta_angular_velocity_rad_s.x(),
-                       p.target_delta_angular_velocity_rad_s.y(), p.target_delta_angular_velocity_rad_s.z(),
-                       p.contact_ellipse_axis_ratio}) {
-        o << ',' << g17(v);
-      }
-      o << ',' << (p.sharp_feature ? 1 : 0) << ',' << collision::flag_word(p.flag) << '\n';
-    }
+    o << t.header();
+    detail::write_rows(o, P.size(), t.rows(kWhat), row_options(options));
   });
 }
 
-void write_sweep_curves_csv(const std::filesystem::path& path, const SweepResult& r, const SweepMeta& meta) {
+void write_sweep_curves_csv(const std::filesystem::path& path, const SweepResult& r, const SweepMeta& meta,
+                            const SweepWriteOptions& options) {
   if (r.curves_N.empty() || r.curve_samples < 2) {
     throw InputError(path.string(), "curves", "the sweep was run without force curves");
   }
@@ -78,56 +107,178 @@ void write_sweep_curves_csv(const std::filesystem::path& path, const SweepResult
     o << "# F(t) at each point: " << r.curve_samples << " samples uniform over [0, contact time]\n";
     o << "point,time_s,force_N\n";
     const double last = static_cast<double>(r.curve_samples - 1);
-    for (std::size_t i = 0; i < r.points.size(); ++i) {
-      if (r.points[i].flagged()) continue;  // no curve where the model does not apply
-      const double tc = r.points[i].contact_time_s;
-      for (std::size_t k = 0; k < r.curve_samples; ++k) {
-        o << i << ',' << g17(tc * static_cast<double>(k) / last) << ','
-          << g17(r.curves_N[i * r.curve_samples + k]) << '\n';
+    // One unit of work per point: its curve_samples rows (none for a flagged point: the model does not apply there).
+    detail::write_rows(o, r.points.size(), [&](std::size_t begin, std::size_t end, std::string& out) {
+      for (std::size_t i = begin; i < end; ++i) {
+        if (r.points[i].flagged()) continue;  // no curve where the model does not apply
+        const double tc = r.points[i].contact_time_s;
+        char index[24];
+        const std::size_t index_size = static_cast<std::size_t>(std::to_chars(index, index + sizeof index, i).ptr - index);
+        for (std::size_t k = 0; k < r.curve_samples; ++k) {
+          out.append(index, index_size);
+          out.push_back(',');
+          detail::append_shortest(out, tc * static_cast<double>(k) / last, kWhat);
+          out.push_back(',');
+          detail::append_shortest(out, r.curves_N[i * r.curve_samples + k], kWhat);
+          out.push_back('\n');
+        }
       }
-    }
+    }, row_options(options));
   });
 }
 
-void write_sweep_pos(const std::filesystem::path& path, const SweepResult& r, const SweepMeta& meta) {
+void write_sweep_pos(const std::filesystem::path& path, const SweepResult& r, const SweepMeta& meta,
+                     const SweepWriteOptions& options) {
+  const double fmax = max_force(r);
+  const std::size_t n = r.points.size();
+  // "SP(x,y,z){" of every point, formatted once (in parallel, by chunks of points) for the three or
+  // four views; the text of point i is prefix[i / kChunk] from text_begin[i] to text_end[i].
+  constexpr std::size_t kChunk = 8192;
+  std::vector<std::string> prefix((n + kChunk - 1) / kChunk);
+  std::vector<std::uint32_t> text_begin(n), text_end(n);
+  detail::parallel_for(prefix.size(), options.threads, 1, [&](std::size_t c) {
+    std::string& out = prefix[c];
+    for (std::size_t i = c * kChunk; i < std::min(n, (c + 1) * kChunk); ++i) {
+      text_begin[i] = static_cast<std::uint32_t>(out.size());
+      const Eigen::Vector3d& x = r.points[i].point_m;
+      out.append("SP(", 3);
+      for (int k = 0; k < 3; ++k) {
+        if (k > 0) out.push_back(',');
+        detail::append_shortest(out, x[k], kWhat);
+      }
+      out.append("){", 2);
+      text_end[i] = static_cast<std::uint32_t>(out.size());
+    }
+  }, nullptr);
   write_file_atomically(path, [&](std::ostream& o) {
     header(o, "//", meta, r);
     o << "// open with: gmsh " << path.filename().string() << "\n";
-    const double fmax = max_force(r);
-    auto sp = [&](const PointResult& p, double v) {
-      o << "SP(" << g17(p.point_m.x()) << "," << g17(p.point_m.y()) << "," << g17(p.point_m.z()) << "){" << g17(v)
-        << "};\n";
+    // SP(x,y,z){v}; for the points of one view (chunks of points formatted in parallel). Progress
+    // runs over all views: view k of m reports k n + done of m n.
+    const std::size_t views = 3 + (r.sharp_count > 0 ? 1 : 0) + (r.flagged_count > r.sharp_count ? 1 : 0);
+    std::size_t views_done = 0;
+    auto view = [&](const char* name, auto in_view, auto value) {
+      detail::RowWriteOptions w = row_options(options);
+      if (options.progress)
+        w.progress = [&](std::size_t d, std::size_t) { options.progress(views_done * n + d, views * n); };
+      o << "View \"" << name << "\" {\n";
+      detail::write_rows(o, n, [&](std::size_t begin, std::size_t end, std::string& out) {
+        for (std::size_t i = begin; i < end; ++i) {
+          const PointResult& p = r.points[i];
+          if (!in_view(p)) continue;
+          out.append(prefix[i / kChunk], text_begin[i], text_end[i] - text_begin[i]);
+          detail::append_shortest(out, value(p), kWhat);
+          out.append("};\n", 3);
+        }
+      }, w);
+      o << "};\n";
+      ++views_done;
     };
     // The computed views hold the points not flagged; sharp points and the other flagged points get
     // views of their own (value: the flag's number, collision::ContactFlag).
-    const char* names[] = {"max_force_N", "force_ratio", "contact_ellipse_axis_ratio"};
-    for (int view = 0; view < 3; ++view) {
-      o << "View \"" << names[view] << "\" {\n";
-      for (const PointResult& p : r.points) {
-        if (p.flagged()) continue;
-        sp(p, view == 0 ? p.max_force_N : view == 1 ? p.max_force_N / fmax : p.contact_ellipse_axis_ratio);
-      }
-      o << "};\n";
-    }
+    view("max_force_N", [](const PointResult& p) { return !p.flagged(); }, [](const PointResult& p) { return p.max_force_N; });
+    view("force_ratio", [](const PointResult& p) { return !p.flagged(); }, [&](const PointResult& p) { return p.max_force_N / fmax; });
+    view("contact_ellipse_axis_ratio", [](const PointResult& p) { return !p.flagged(); },
+         [](const PointResult& p) { return p.contact_ellipse_axis_ratio; });
     if (r.sharp_count > 0) {
-      o << "View \"sharp_feature\" {\n";
-      for (const PointResult& p : r.points)
-        if (p.sharp_feature) sp(p, 1.0);
-      o << "};\n";
+      view("sharp_feature", [](const PointResult& p) { return p.sharp_feature; }, [](const PointResult&) { return 1.0; });
     }
     if (r.flagged_count > r.sharp_count) {
-      o << "View \"flag\" {\n";
-      for (const PointResult& p : r.points)
-        if (p.flagged() && !p.sharp_feature) sp(p, static_cast<double>(p.flag));
-      o << "};\n";
+      view("flag", [](const PointResult& p) { return p.flagged() && !p.sharp_feature; },
+           [](const PointResult& p) { return static_cast<double>(p.flag); });
     }
   });
 }
 
-void write_sweep_vtp(const std::filesystem::path& path, const SweepResult& r, const SweepMeta& meta) {
+namespace {
+
+// One array of a binary VTP file: its XML attributes and its raw values (host byte order).
+struct VtpArray {
+  std::string type;  // Float64, Int64
+  std::string name;
+  int components = 1;
+  std::function<void(std::size_t begin, std::size_t end, char* out)> fill;  // values of points [begin, end)
+  std::size_t value_bytes() const { return 8 * static_cast<std::size_t>(components); }
+};
+
+double finite(double v) {
+  if (!std::isfinite(v)) throw Error(ExitCode::internal_error, std::string(kWhat) + ": non-finite value");
+  return v + 0.0;
+}
+
+template <class Get>
+VtpArray scalar_array(const char* name, const std::vector<PointResult>& P, Get get) {
+  return {"Float64", name, 1, [&P, get](std::size_t begin, std::size_t end, char* out) {
+            for (std::size_t i = begin; i < end; ++i) {
+              const double v = finite(get(P[i]));
+              std::memcpy(out + 8 * (i - begin), &v, 8);
+            }
+          }};
+}
+
+template <class Get>
+VtpArray vector_array(const char* name, const std::vector<PointResult>& P, Get get) {
+  return {"Float64", name, 3, [&P, get](std::size_t begin, std::size_t end, char* out) {
+            for (std::size_t i = begin; i < end; ++i) {
+              const Eigen::Vector3d& x = get(P[i]);
+              for (int k = 0; k < 3; ++k) {
+                const double v = finite(x[k]);
+                std::memcpy(out + 24 * (i - begin) + 8 * k, &v, 8);
+              }
+            }
+          }};
+}
+
+VtpArray count_array(const char* name, std::int64_t first) {
+  return {"Int64", name, 1, [first](std::size_t begin, std::size_t end, char* out) {
+            for (std::size_t i = begin; i < end; ++i) {
+              const std::int64_t v = first + static_cast<std::int64_t>(i);
+              std::memcpy(out + 8 * (i - begin), &v, 8);
+            }
+          }};
+}
+
+bool little_endian() {
+  const std::uint16_t one = 1;
+  unsigned char b;
+  std::memcpy(&b, &one, 1);
+  return b == 1;
+}
+
+}  // namespace
+
+void write_sweep_vtp(const std::filesystem::path& path, const SweepResult& r, const SweepMeta& meta,
+                     const SweepWriteOptions& options) {
   const std::size_t n = r.points.size();
   const double fmax = max_force(r);
+  const auto& P = r.points;
+  const std::vector<VtpArray> point_data = {
+      scalar_array("max_force_N", P, [](const PointResult& p) { return p.max_force_N; }),
+      scalar_array("force_ratio", P, [fmax](const PointResult& p) { return p.max_force_N / fmax; }),
+      scalar_array("reduced_mass_kg", P, [](const PointResult& p) { return p.reduced_mass_kg; }),
+      scalar_array("effective_radius_m", P, [](const PointResult& p) { return p.effective_radius_m; }),
+      scalar_array("target_radius_m", P, [](const PointResult& p) { return radius_out(p.target_radius_m); }),
+      scalar_array("contact_ellipse_axis_ratio", P, [](const PointResult& p) { return p.contact_ellipse_axis_ratio; }),
+      scalar_array("sharp_feature", P, [](const PointResult& p) { return p.sharp_feature ? 1.0 : 0.0; }),
+      // collision::ContactFlag's number (0: valid)
+      scalar_array("flag", P, [](const PointResult& p) { return static_cast<double>(p.flag); }),
+      vector_array("normal", P, [](const PointResult& p) -> const Eigen::Vector3d& { return p.normal; })};
+  const VtpArray points = vector_array("Points", P, [](const PointResult& p) -> const Eigen::Vector3d& { return p.point_m; });
+  const VtpArray connectivity = count_array("connectivity", 0), offsets = count_array("offsets", 1);
+
+  // Appended raw data: per array a block size (UInt32, or UInt64 when a block needs it or when
+  // asked), then the values; each array's offset counts from the byte after the '_'.
+  const std::size_t largest = n * 24;
+  const bool wide = options.vtp_uint64_headers || largest > 0xffffffffull;
+  const std::size_t size_bytes = wide ? 8 : 4;
   write_file_atomically(path, [&](std::ostream& o) {
+    std::size_t offset = 0;
+    auto declare = [&](const VtpArray& a) {
+      o << "<DataArray type=\"" << a.type << "\" Name=\"" << a.name << "\"";
+      if (a.components != 1) o << " NumberOfComponents=\"" << a.components << "\"";
+      o << " format=\"appended\" offset=\"" << offset << "\"/>\n";
+      offset += size_bytes + n * a.value_bytes();
+    };
     o << "<?xml version=\"1.0\"?>\n";
     std::ostringstream h;
     header(h, "", meta, r);
@@ -135,37 +286,143 @@ void write_sweep_vtp(const std::filesystem::path& path, const SweepResult& r, co
     // "--" is not allowed inside an XML comment.
     for (std::size_t k; (k = comment.find("--")) != std::string::npos;) comment.replace(k, 2, "- -");
     o << "<!--\n" << comment << "-->\n";
-    o << "<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n<PolyData>\n"
+    o << "<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"" << (little_endian() ? "LittleEndian" : "BigEndian")
+      << "\" header_type=\"" << (wide ? "UInt64" : "UInt32") << "\">\n<PolyData>\n"
       << "<Piece NumberOfPoints=\"" << n << "\" NumberOfVerts=\"" << n
       << "\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n"
       << "<PointData Scalars=\"max_force_N\" Normals=\"normal\">\n";
-    auto scalar = [&](const char* name, auto get) {
-      o << "<DataArray type=\"Float64\" Name=\"" << name << "\" format=\"ascii\">\n";
-      for (std::size_t i = 0; i < n; ++i) o << g17(get(r.points[i])) << ((i + 1) % 6 == 0 || i + 1 == n ? "\n" : " ");
-      o << "</DataArray>\n";
-    };
-    scalar("max_force_N", [](const PointResult& p) { return p.max_force_N; });
-    scalar("force_ratio", [&](const PointResult& p) { return p.max_force_N / fmax; });
-    scalar("reduced_mass_kg", [](const PointResult& p) { return p.reduced_mass_kg; });
-    scalar("effective_radius_m", [](const PointResult& p) { return p.effective_radius_m; });
-    scalar("target_radius_m", [](const PointResult& p) { return radius_out(p.target_radius_m); });
-    scalar("contact_ellipse_axis_ratio", [](const PointResult& p) { return p.contact_ellipse_axis_ratio; });
-    scalar("sharp_feature", [](const PointResult& p) { return p.sharp_feature ? 1.0 : 0.0; });
-    scalar("flag", [](const PointResult& p) { return static_cast<double>(p.flag); });  // collision::ContactFlag
-    o << "<DataArray type=\"Float64\" Name=\"normal\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-    for (const PointResult& p : r.points)
-      o << g17(p.normal.x()) << ' ' << g17(p.normal.y()) << ' ' << g17(p.normal.z()) << '\n';
-    o << "</DataArray>\n</PointData>\n<Points>\n"
-      << "<DataArray type=\"Float64\" Name=\"Points\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-    for (const PointResult& p : r.points)
-      o << g17(p.point_m.x()) << ' ' << g17(p.point_m.y()) << ' ' << g17(p.point_m.z()) << '\n';
-    o << "</DataArray>\n</Points>\n<Verts>\n"
-      << "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
-    for (std::size_t i = 0; i < n; ++i) o << i << ((i + 1) % 16 == 0 || i + 1 == n ? "\n" : " ");
-    o << "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
-    for (std::size_t i = 0; i < n; ++i) o << i + 1 << ((i + 1) % 16 == 0 || i + 1 == n ? "\n" : " ");
-    o << "</DataArray>\n</Verts>\n</Piece>\n</PolyData>\n</VTKFile>\n";
+    for (const VtpArray& a : point_data) declare(a);
+    o << "</PointData>\n<Points>\n";
+    declare(points);
+    o << "</Points>\n<Verts>\n";
+    declare(connectivity);
+    declare(offsets);
+    o << "</Verts>\n</Piece>\n</PolyData>\n<AppendedData encoding=\"raw\">\n_";
+    std::vector<const VtpArray*> all;
+    for (const VtpArray& a : point_data) all.push_back(&a);
+    for (const VtpArray* a : {&points, &connectivity, &offsets}) all.push_back(a);
+    // Progress over all arrays' values.
+    std::size_t done = 0;
+    for (const VtpArray* a : all) {
+      const std::uint64_t bytes = n * a->value_bytes();
+      char size[8];
+      if (wide) {
+        std::memcpy(size, &bytes, 8);
+      } else {
+        const std::uint32_t b32 = static_cast<std::uint32_t>(bytes);
+        std::memcpy(size, &b32, 4);
+      }
+      o.write(size, static_cast<std::streamsize>(size_bytes));
+      detail::RowWriteOptions w = row_options(options);
+      w.chunk_rows = 65536;
+      if (options.progress)
+        w.progress = [&](std::size_t d, std::size_t) { options.progress(done + d, n * all.size()); };
+      detail::write_rows(o, n, [a](std::size_t begin, std::size_t end, std::string& out) {
+        out.resize((end - begin) * a->value_bytes());
+        a->fill(begin, end, out.data());
+      }, w);
+      done += n;
+    }
+    o << "\n</AppendedData>\n</VTKFile>\n";
   });
+}
+
+SweepFormats parse_sweep_formats(const std::string& list) {
+  SweepFormats f;
+  f.csv = f.vtp = f.pos = f.svg = f.png = false;
+  std::size_t start = 0;
+  for (;;) {
+    const std::size_t comma = list.find(',', start);
+    const std::string name = list.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    bool* flag = name == "csv" ? &f.csv : name == "vtp" ? &f.vtp : name == "pos" ? &f.pos
+               : name == "svg" ? &f.svg : name == "png" ? &f.png : nullptr;
+    if (!flag) throw std::invalid_argument("'" + name + "' is not one of csv, vtp, pos, svg, png");
+    if (*flag) throw std::invalid_argument("'" + name + "' is listed twice");
+    *flag = true;
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return f;
+}
+
+std::vector<std::filesystem::path> write_sweep_files(const std::filesystem::path& base, const SweepFormats& formats,
+                                                     const SweepResult& r, const SweepMeta& meta,
+                                                     const SweepPicture& picture, const SweepWriteOptions& options) {
+  auto with = [&](const char* suffix) {
+    std::filesystem::path p = base;
+    p += suffix;
+    return p;
+  };
+  if ((formats.svg || formats.png) && !picture.target) {
+    throw Error(ExitCode::internal_error, "sweep picture without a target shape");
+  }
+  // One job per file, all at once on their own threads: each data file formats on the worker
+  // threads of its write_rows, and while one waits for the disk (its final flush before the
+  // rename) the others keep the cores busy; the picture (single-threaded: wireframe, circles,
+  // cairo) is one more job. The files and their order in the returned list do not change.
+  const std::size_t n = r.points.size();
+  struct Job {
+    std::filesystem::path file;  // the first file of the job (the picture's second is added below)
+    std::size_t units = 0;       // progress units: rows (CSV n, .pos n per view, .vtp n per array)
+    std::function<void(const SweepWriteOptions&)> write;
+  };
+  std::vector<Job> jobs;
+  if (formats.csv) jobs.push_back({with(".csv"), n, [&](const SweepWriteOptions& o) { write_sweep_csv(with(".csv"), r, meta, o); }});
+  if (formats.curves)
+    jobs.push_back({with("_curves.csv"), n, [&](const SweepWriteOptions& o) { write_sweep_curves_csv(with("_curves.csv"), r, meta, o); }});
+  if (formats.pos)
+    jobs.push_back({with(".pos"), n * (3 + (r.sharp_count > 0 ? 1 : 0) + (r.flagged_count > r.sharp_count ? 1 : 0)), [&](const SweepWriteOptions& o) { write_sweep_pos(with(".pos"), r, meta, o); }});
+  if (formats.vtp) jobs.push_back({with(".vtp"), 12 * n, [&](const SweepWriteOptions& o) { write_sweep_vtp(with(".vtp"), r, meta, o); }});
+  if (formats.svg || formats.png) {
+    jobs.push_back({formats.svg ? with(".svg") : with(".png"), 0, [&](const SweepWriteOptions&) {
+                      const plot::Drawing drawing = force_map_drawing(*picture.target, picture.centroid_m, r, picture.options);
+                      if (formats.svg) plot::write_svg(with(".svg"), drawing);
+                      if (formats.png) plot::write_png(with(".png"), drawing, picture.png_scale);
+                    }});
+  }
+
+  // Progress: the sum over the jobs, reported under a lock (the jobs run on several threads).
+  std::size_t total = 0;
+  for (const Job& j : jobs) total += j.units;
+  std::mutex progress_lock;
+  std::vector<std::size_t> done(jobs.size(), 0);
+  std::vector<std::exception_ptr> errors(jobs.size());
+  auto run = [&](std::size_t k) {
+    SweepWriteOptions o = options;
+    if (options.progress) {
+      o.progress = [&, k](std::size_t d, std::size_t t) {
+        std::lock_guard<std::mutex> lock(progress_lock);
+        done[k] = t > 0 ? d * jobs[k].units / t : 0;
+        std::size_t sum = 0;
+        for (std::size_t x : done) sum += x;
+        options.progress(sum, total);
+      };
+    }
+    try {
+      jobs[k].write(o);
+    } catch (...) {
+      errors[k] = std::current_exception();
+    }
+  };
+  {
+    std::vector<std::thread> pool;
+    struct Joiner {
+      std::vector<std::thread>& pool;
+      ~Joiner() {
+        for (auto& t : pool)
+          if (t.joinable()) t.join();
+      }
+    } joiner{pool};
+    for (std::size_t k = 1; k < jobs.size(); ++k) pool.emplace_back(run, k);
+    if (!jobs.empty()) run(0);
+  }
+  for (const auto& e : errors)
+    if (e) std::rethrow_exception(e);  // the first file's error
+  std::vector<std::filesystem::path> files;
+  for (const Job& j : jobs) files.push_back(j.file);
+  if (formats.svg && formats.png) files.push_back(with(".png"));
+  if (options.progress) options.progress(total, total);
+  return files;
 }
 
 // ---------------------------------------------------------------------------------------------

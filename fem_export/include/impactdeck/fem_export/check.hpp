@@ -42,7 +42,8 @@ struct CheckOptions {
   double angular_tolerance = 0;
   bool stresses = true;              ///< read impact.frd back (when present) and write the stress files
   std::ostream* progress = nullptr;  ///< progress lines from the .sta file (e.g. &std::cerr)
-  int threads = 1;                   ///< OMP_NUM_THREADS for ccx
+  /// OMP_NUM_THREADS and CCX_NPROC_EQUATION_SOLVER for ccx; 0: all cores.
+  int threads = 0;
   /// Wall-time limit of the ccx run (--solver-timeout-s): past it ccx's process group is killed
   /// and the check fails with exit 3. 0: default_solver_timeout_s of the deck.
   double timeout_s = 0;
@@ -83,6 +84,7 @@ struct CheckResult {
   std::string solver_timeout_source;   ///< "--solver-timeout-s", or how the default was derived
   /// ccx's output files (impact.dat, .frd, .sta, .cvg, .log, ...) in the work folder.
   std::vector<std::filesystem::path> solver_files;
+  int solver_threads = 0;              ///< threads ccx was given
   double momentum_time_s = 0;          ///< time of the all-node velocity print
   double linear_tolerance = 0, angular_tolerance = 0;
   /// FE rigid-body motion against the rigid model (null when the deck carries no model, or the

@@ -86,6 +86,21 @@ struct FemTolerances {
   double min_gamma = 0.01; ///< floor of Gmsh's gamma over the tetrahedra, after optimisation
 };
 
+/// CalculiX's equation solver for the implicit dynamic steps (`*DYNAMIC, DIRECT[, SOLVER=...]`).
+enum class CcxSolver {
+  automatic,  ///< by deck size: `iterative` from kIterativeSolverMinNodes nodes, else `spooles`
+  spooles,    ///< ccx's default sparse direct solver (SPOOLES)
+  iterative,  ///< SOLVER=ITERATIVE SCALING (diagonally scaled conjugate gradients)
+};
+/// From this many nodes `automatic` takes the iterative solver. Measured (bench/bench_ccx.cpp,
+/// docs/fem.md): on decks of 173 to 5,108 nodes it ran 2.5 to 22 times faster per increment than
+/// SPOOLES with the same momentum and probe stresses (to 4e-8); smaller decks, too coarse for
+/// stresses and cheap either way, keep the direct solver.
+inline constexpr std::size_t kIterativeSolverMinNodes = 150;
+const char* to_string(CcxSolver s);
+/// The solver a deck of `nodes` nodes is written with (`automatic` resolved).
+CcxSolver ccx_solver_for(CcxSolver requested, std::size_t nodes);
+
 struct DeckOptions {
   double end_time_s = 0.02;    ///< simulated time (the paper: 0.02 s)
   double time_step_s = 1e-5;   ///< solver step after the contact (the paper: 1e-5 s)
@@ -102,6 +117,7 @@ struct DeckOptions {
   /// (151 000 in 118 s), so the default bounds meshing to minutes; ccx's implicit dynamics on
   /// such a mesh takes hours (its own limit: --solver-timeout-s).
   std::size_t max_elements = 500000;
+  CcxSolver solver = CcxSolver::automatic;  ///< impact.inp's equation solver
   MeshOptions mesh;
   /// The mesh size is a default, not the user's: while the FE body's volume or inertia (of the
   /// tetrahedra, or of ccx's mass matrix) differs from the part's by more than half its

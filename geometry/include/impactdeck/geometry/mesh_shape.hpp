@@ -108,4 +108,10 @@ class MeshShape final : public Shape {
   std::unique_ptr<Index> index_;
 };
 
+/// The sharp-edge count MeshShape reports (sharp_edge_count) for `sharp_angle_deg`, without
+/// building its index (O(F): one edge table and the face normals).
+std::size_t count_sharp_edges(const TriangleMesh& mesh, double sharp_angle_deg);
+/// The same on the mesh's edge table (build_edge_table) when the caller has it already.
+std::size_t count_sharp_edges(const TriangleMesh& mesh, const EdgeTable& edges, double sharp_angle_deg);
+
 }  // namespace impactdeck::geometry

@@ -4,12 +4,20 @@
 #include <string>
 #include <vector>
 
+#include "impactdeck/geometry/mass_properties.hpp"
 #include "impactdeck/geometry/triangle_mesh.hpp"
 
 namespace impactdeck::geometry {
 
 struct ValidationOptions {
   bool check_self_intersections = true;  ///< O(F log F) box intersection; can be off for huge parts
+  unsigned threads = 0;                  ///< self-intersection test; 0: all cores
+  /// Count self-intersections through CGAL's own route (orient the soup, build a Surface_mesh, run
+  /// PMP::self_intersections) instead of on the triangle array: slower, the reference the direct
+  /// test is checked against (tests, bench). Non-manifold, inconsistently oriented or degenerate
+  /// meshes take this route anyway (orienting the soup splits their vertices, which changes the
+  /// count).
+  bool self_intersections_via_surface_mesh = false;
 };
 
 struct ValidationReport {
@@ -36,6 +44,17 @@ struct ValidationReport {
 };
 
 ValidationReport validate_mesh(const TriangleMesh& mesh, const ValidationOptions& options = {});
+
+/// What validate_mesh computes on the way, for callers that need it next (load_part): the same
+/// values build_edge_table, label_shells and compute_mass_properties give for the mesh, not
+/// computed twice.
+struct ValidationByproducts {
+  EdgeTable edges;
+  ShellLabels shells;
+  MeshMassProperties mass;
+};
+ValidationReport validate_mesh(const TriangleMesh& mesh, const ValidationOptions& options,
+                               ValidationByproducts* byproducts);
 
 /// What `repair_mesh` did, one line per action ("merged 12 duplicate points", ...).
 struct RepairLog {

@@ -21,23 +21,36 @@ struct PartOptions {
   bool accept_approximate_mass = false;
   ValidationOptions validation;
   MeshShapeOptions shape;
+  /// Build the surface index (stage curvature_index: AABB tree, adjacency, normals; what
+  /// closest-point and curvature queries need). Without it `Part::shape` is null and only the
+  /// sharp-edge count is computed (stage sharp_edges); `inspect` without --at leaves it out.
+  bool build_surface_index = true;
 };
 
 struct StageSeconds {
-  std::string name;  ///< mesh_load, mesh_validation, mass_properties, curvature_index
+  std::string name;  ///< one of part_stages()
   double seconds = 0;
 };
 
+/// The stages of load_part in order: mesh_load, mesh_validation, mass_properties, sharp_edges
+/// (only without the surface index, which counts them itself), curvature_index.
+const std::vector<std::string>& part_stages();
+
 struct Part {
   std::filesystem::path file;
-  LoadedMesh loaded;                 ///< as read (its mesh is moved into `shape`)
+  LoadedMesh loaded;                 ///< as read; its mesh is moved on (into `shape`, or released)
   ValidationReport validation;       ///< of the mesh as read
   std::optional<ValidationReport> validation_after_repair;
   RepairLog repairs;
   bool approximate_mass = false;     ///< mass properties of a non-solid, accepted by the user
   std::string approximation_reason;  ///< why
+  MeshMassProperties mass;           ///< of the mesh as oriented for the shape
+  std::size_t sharp_edges = 0;       ///< edges sharper than options.shape.sharp_angle_deg
+  double mean_edge_length_m = 0;
+  /// The surface index; null when built without it (PartOptions::build_surface_index).
   std::shared_ptr<const MeshShape> shape;
-  std::vector<StageSeconds> stages;
+  std::vector<StageSeconds> stages;          ///< the stages that ran, in order
+  std::vector<std::string> stages_skipped;   ///< curvature_index when it was not built
   std::vector<std::string> warnings;
 };
 

@@ -48,6 +48,7 @@ struct RunOptions {
   std::ostream* progress = nullptr;     ///< solver progress lines (e.g. &std::cerr)
   /// ccx wall-time limit per deck (--solver-timeout-s); 0: derived from the deck's size.
   double solver_timeout_s = 0;
+  int solver_threads = 0;               ///< threads for ccx ([outputs.fem] run); 0: all cores
 };
 
 /// Builds the shape of a body (analytic or mesh). Throws InputError.

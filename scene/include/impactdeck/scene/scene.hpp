@@ -101,6 +101,8 @@ struct FemOutputs {
   /// `max_elements`: most tetrahedra a deck may have (estimated before meshing); default
   /// fem_export::DeckOptions::max_elements.
   std::optional<std::size_t> max_elements;
+  /// ccx's equation solver: "auto" (by deck size), "spooles", "iterative" (docs/fem.md).
+  enum class Solver { automatic, spooles, iterative } solver = Solver::automatic;
   Place place;
 };
 

@@ -6,6 +6,7 @@
 // atomically; no NaN or Inf is ever written (a non-finite value is an internal error).
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "impactdeck/geometry/shape.hpp"
 #include "impactdeck/plot/drawing.hpp"
@@ -22,6 +23,17 @@ struct SweepMeta {
   std::string cloud;     ///< e.g. "paper-grid (steps 8)"
 };
 
+/// How the large files are written: rows formatted in parallel chunks (numbers as the shortest
+/// text that reads back as the same double, std::to_chars), written in order in large writes.
+/// The content does not depend on the thread count.
+struct SweepWriteOptions {
+  unsigned threads = 0;  ///< formatting threads; 0: all cores
+  /// (rows written, rows in total) of the file being written, from the calling thread.
+  ProgressFn progress;
+  /// VTP block sizes as UInt64 even when every block fits UInt32 (they must above 4 GiB).
+  bool vtp_uint64_headers = false;
+};
+
 /// `# ...` comment lines (with the count of sharp points), then one row per point: index, x_m, y_m, z_m, nx, ny, nz,
 /// target_radius_m, impactor_radius_m, effective_radius_m, reduced_mass_kg,
 /// hertz_constant_N_per_m1_5, max_indentation_m, max_force_N, force_ratio (F / largest F),
@@ -30,21 +42,29 @@ struct SweepMeta {
 /// contact_ellipse_axis_ratio (a/b of the Hertz contact ellipse; 1 unless the elliptical rule) and
 /// sharp_feature (1: the point lies on a sharp edge/corner, every computed column is 0 and the
 /// point is left out of min/max). A radius column holds 0 where the body is flat there (infinite
-/// radius, e.g. a face of a box). 17 significant digits.
-void write_sweep_csv(const std::filesystem::path& path, const SweepResult& r, const SweepMeta& meta);
+/// radius, e.g. a face of a box). Numbers in their shortest round-trip text.
+void write_sweep_csv(const std::filesystem::path& path, const SweepResult& r, const SweepMeta& meta,
+                     const SweepWriteOptions& options = {});
 
 /// Long format `point,time_s,force_N`, one row per curve sample (needs r.curves_N).
-void write_sweep_curves_csv(const std::filesystem::path& path, const SweepResult& r, const SweepMeta& meta);
+void write_sweep_curves_csv(const std::filesystem::path& path, const SweepResult& r, const SweepMeta& meta,
+                            const SweepWriteOptions& options = {});
 
 /// Gmsh view file: views "max_force_N", "force_ratio" and "contact_ellipse_axis_ratio" as scalar
 /// points SP(x,y,z){v} over the points off sharp features, and, when there are any, a view
 /// "sharp_feature" (value 1) of the points on sharp edges/corners.
-void write_sweep_pos(const std::filesystem::path& path, const SweepResult& r, const SweepMeta& meta);
+void write_sweep_pos(const std::filesystem::path& path, const SweepResult& r, const SweepMeta& meta,
+                     const SweepWriteOptions& options = {});
 
-/// VTK XML PolyData (ASCII): one vertex per point; point data max_force_N, force_ratio,
-/// reduced_mass_kg, effective_radius_m, target_radius_m, contact_ellipse_axis_ratio,
-/// sharp_feature (0/1; the computed arrays are 0 there) and normals.
-void write_sweep_vtp(const std::filesystem::path& path, const SweepResult& r, const SweepMeta& meta);
+/// VTK XML PolyData, binary: the XML part declares every array `format="appended"` with its
+/// offset, and `<AppendedData encoding="raw">_` holds per array its byte count (UInt32, or UInt64,
+/// as the `header_type` attribute says) and the raw values in the host's byte order (the
+/// `byte_order` attribute): what ParaView's reader (vtkXMLPolyDataReader) expects. One vertex per
+/// point; point data max_force_N, force_ratio, reduced_mass_kg, effective_radius_m,
+/// target_radius_m, contact_ellipse_axis_ratio, sharp_feature (0/1; the computed arrays are 0
+/// there) and normals, all Float64 (the same doubles as the CSV); connectivity and offsets Int64.
+void write_sweep_vtp(const std::filesystem::path& path, const SweepResult& r, const SweepMeta& meta,
+                     const SweepWriteOptions& options = {});
 
 struct ForceMapOptions {
   std::string title;            ///< first line of the picture
@@ -63,5 +83,30 @@ struct ForceMapOptions {
 /// directions spread over the cloud's bounding box (exact parametric lines on an ellipsoid).
 plot::Drawing force_map_drawing(const geometry::Shape& target, const Eigen::Vector3d& centroid_m,
                                 const SweepResult& r, const ForceMapOptions& options = {});
+
+/// Which files a sweep writes (`impactdeck sweep --formats csv,vtp,pos,svg,png`; the curves CSV
+/// with --curves).
+struct SweepFormats {
+  bool csv = true, vtp = true, pos = true, svg = true, png = true;
+  bool curves = false;  ///< PREFIX_curves.csv (needs a sweep run with curves)
+};
+/// Parses a comma-separated list of csv, vtp, pos, svg and png (each at most once); the reason of
+/// a refusal is thrown as std::invalid_argument (the CLI makes it a usage error).
+SweepFormats parse_sweep_formats(const std::string& list);
+
+/// Everything a sweep writes, as `impactdeck sweep` does: BASE.csv, BASE_curves.csv, BASE.pos,
+/// BASE.vtp, BASE.svg, BASE.png (those asked for, in that order; BASE is a path prefix). The
+/// picture is drawn and rendered on a thread of its own while the data files are written;
+/// `options.progress` gets (done, total) over all the data files' rows. Returns the files written.
+struct SweepPicture {
+  const geometry::Shape* target = nullptr;
+  Eigen::Vector3d centroid_m = Eigen::Vector3d::Zero();
+  ForceMapOptions options;
+  double png_scale = 1.5;
+};
+std::vector<std::filesystem::path> write_sweep_files(const std::filesystem::path& base, const SweepFormats& formats,
+                                                     const SweepResult& r, const SweepMeta& meta,
+                                                     const SweepPicture& picture,
+                                                     const SweepWriteOptions& options = {});
 
 }  // namespace impactdeck::study

@@ -1,0 +1,185 @@
+// The speed goals of issue 15, end to end, as processes (what a user waits for), each row measured
+// in one run as best of N, the two sides of a ratio alternating:
+//   1. `impactdeck inspect` of a 1.31 M-triangle binary STL without the self-intersection test,
+//      against bench/direct_stl_reader (one fread, vertex merge, edge check, mass integrals);
+//   2. the same with all checks;
+//   3. the peak memory (max RSS) of those inspects against the file size;
+//   4. `impactdeck sweep` of 1 M area-uniform points with the default outputs on 2 threads, points
+//      per second end to end (--out on disk, and on tmpfs when /dev/shm exists: the difference is
+//      the disk);
+//   5. the sweep physics alone (the point loop of the same runs, its own clock: JSON `seconds`).
+// Row 6 (ccx) is bench/bench_ccx. Wall times are those of the whole process; CPU times (user +
+// system) are printed beside them, since a shared machine inflates wall times.
+//   bench_goals [--repeats N] [--subdivisions N] [--points N]      (Markdown on stdout)
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Run {
+  double wall_s = 0, cpu_s = 0;
+  long max_rss_kb = 0;
+  int status = 0;
+  std::string out;  // stdout
+};
+
+// Runs argv with stdout captured in `out_file`; wall time, CPU time and peak RSS from wait4.
+Run run(const std::vector<std::string>& argv, const fs::path& out_file) {
+  Run r;
+  const auto t0 = std::chrono::steady_clock::now();
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    const int fd = ::open(out_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const int null = ::open("/dev/null", O_WRONLY);
+    if (fd >= 0) ::dup2(fd, 1);
+    if (null >= 0) ::dup2(null, 2);
+    std::vector<char*> args;
+    for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+    args.push_back(nullptr);
+    ::execv(args[0], args.data());
+    ::_exit(127);
+  }
+  int status = 0;
+  rusage ru{};
+  ::wait4(pid, &status, 0, &ru);
+  r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  r.cpu_s = ru.ru_utime.tv_sec + 1e-6 * ru.ru_utime.tv_usec + ru.ru_stime.tv_sec + 1e-6 * ru.ru_stime.tv_usec;
+  r.max_rss_kb = ru.ru_maxrss;
+  r.status = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  std::ifstream f(out_file);
+  std::ostringstream s;
+  s << f.rdbuf();
+  r.out = s.str();
+  return r;
+}
+
+struct Best {
+  Run wall, cpu;  // the runs with the smallest wall and CPU time
+  long max_rss_kb = 0;
+  void add(const Run& r) {
+    if (wall.wall_s == 0 || r.wall_s < wall.wall_s) wall = r;
+    if (cpu.cpu_s == 0 || r.cpu_s < cpu.cpu_s) cpu = r;
+    max_rss_kb = std::max(max_rss_kb, r.max_rss_kb);
+  }
+};
+
+double json_number(const std::string& json, const std::string& key) {
+  const auto k = json.find("\"" + key + "\"");
+  if (k == std::string::npos) return 0;
+  return std::stod(json.substr(json.find(':', k) + 1));
+}
+
+std::string load_average() {
+  std::ifstream f("/proc/loadavg");
+  std::string a, b, c;
+  f >> a >> b >> c;
+  return a + " " + b + " " + c;
+}
+
+void check(const Run& r, const char* what) {
+  if (r.status != 0) {
+    std::fprintf(stderr, "bench_goals: %s exited with %d\n", what, r.status);
+    std::exit(1);
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int repeats = 3, subdivisions = 8;
+  long points = 1000000;
+  for (int i = 1; i + 1 < argc; ++i) {
+    if (std::strcmp(argv[i], "--repeats") == 0) repeats = std::atoi(argv[++i]);
+    else if (std::strcmp(argv[i], "--subdivisions") == 0) subdivisions = std::atoi(argv[++i]);
+    else if (std::strcmp(argv[i], "--points") == 0) points = std::atol(argv[++i]);
+  }
+  const std::string tool = IMPACTDECK_EXE, direct = DIRECT_READER_EXE, src = IMPACTDECK_SOURCE_DIR;
+  const fs::path dir = fs::temp_directory_path() / ("impactdeck_bench_goals_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const fs::path stl = dir / "ellipsoid.stl", out = dir / "stdout.txt";
+  check(run({tool, "mesh-ellipsoid", "3", "2", "1", "--subdivisions", std::to_string(subdivisions), "-o", stl.string()}, out),
+        "mesh-ellipsoid");
+  const double file_mb = fs::file_size(stl) / 1e6;
+  std::printf("Measured by `bench/bench_goals` (%d runs per side, alternating); load average %s at the start.\n\n",
+              repeats, load_average().c_str());
+
+  // Rows 1-3: inspect against the direct reader.
+  Best direct_best, no_si, all_checks;
+  for (int k = 0; k < repeats; ++k) {
+    Run d = run({direct, stl.string()}, out);
+    check(d, "direct_stl_reader");
+    direct_best.add(d);
+    Run a = run({tool, "inspect", stl.string(), "--length-unit", "m", "--no-self-intersections", "--json"}, out);
+    check(a, "inspect --no-self-intersections");
+    no_si.add(a);
+    Run b = run({tool, "inspect", stl.string(), "--length-unit", "m", "--json"}, out);
+    check(b, "inspect");
+    all_checks.add(b);
+  }
+  const double triangles = json_number(all_checks.wall.out, "triangles");
+  std::printf("| goal | measured | ratio | goal met |\n|---|---|---:|---|\n");
+  auto ratio_row = [&](const char* name, const Best& b, double goal) {
+    const double r = b.wall.wall_s / direct_best.wall.wall_s;
+    std::printf("| %s | %.3f s against %.3f s (CPU %.3f s against %.3f s: %.2fx) | %.2fx | %s (<= %gx) |\n", name,
+                b.wall.wall_s, direct_best.wall.wall_s, b.cpu.cpu_s, direct_best.cpu.cpu_s,
+                b.cpu.cpu_s / direct_best.cpu.cpu_s, r, r <= goal ? "yes" : "NO", goal);
+  };
+  char what[160];
+  std::snprintf(what, sizeof what, "`inspect` %.0f triangles (%.1f MB), no self-intersection test", triangles, file_mb);
+  ratio_row(what, no_si, 2);
+  std::snprintf(what, sizeof what, "`inspect` %.0f triangles, all checks", triangles);
+  ratio_row(what, all_checks, 5);
+  for (const auto* b : {&no_si, &all_checks}) {
+    const double r = b->max_rss_kb * 1024.0 / 1e6 / file_mb;
+    std::printf("| peak memory of `inspect`%s | %.1f MB (%.0f bytes per triangle; direct reader %.1f MB) | %.2fx file size | %s (<= 4x) |\n",
+                b == &no_si ? " (no self-intersection test)" : " (all checks)", b->max_rss_kb * 1024.0 / 1e6,
+                b->max_rss_kb * 1024.0 / triangles, direct_best.max_rss_kb * 1024.0 / 1e6, r, r <= 4 ? "yes" : "NO");
+  }
+
+  // Rows 4-5: the sweep.
+  const std::string scene = src + "/samples/fig4_sweep.toml";
+  std::vector<std::pair<std::string, fs::path>> outs = {{"disk", dir / "sweep"}};
+  if (fs::is_directory("/dev/shm")) outs.emplace_back("tmpfs", fs::path("/dev/shm") / dir.filename());
+  for (const auto& [where, folder] : outs) {
+    Best b;
+    double physics_best = 0;
+    for (int k = 0; k < repeats; ++k) {
+      fs::remove_all(folder);
+      Run r = run({tool, "sweep", scene, "--cloud", "uniform", "--count", std::to_string(points), "--threads", "2",
+                   "--out", folder.string(), "--quiet", "--json"},
+                  out);
+      check(r, "sweep");
+      b.add(r);
+      const double s = json_number(r.out, "seconds");
+      if (physics_best == 0 || s < physics_best) physics_best = s;
+    }
+    std::uintmax_t bytes = 0;
+    for (const auto& e : fs::directory_iterator(folder)) bytes += e.file_size();
+    fs::remove_all(folder);
+    const double rate = points / b.wall.wall_s;
+    std::printf("| %ld-point sweep, default outputs (%.0f MB), 2 threads, --out on %s | %.2f s end to end (CPU %.2f s), %.0f k points/s | | %s (>= 500 k points/s) |\n",
+                points, bytes / 1e6, where.c_str(), b.wall.wall_s, b.cpu.cpu_s, rate / 1e3, rate >= 5e5 ? "yes" : "NO");
+    if (where == "disk") {
+      const double prate = points / physics_best;
+      std::printf("| sweep physics alone (the point loop of those runs), 2 threads | %.3f s, %.2f M points/s | | %s (>= 10 M points/s) |\n",
+                  physics_best, prate / 1e6, prate >= 1e7 ? "yes" : "NO");
+    }
+  }
+  std::printf("\nLoad average at the end: %s.\n", load_average().c_str());
+  fs::remove_all(dir);
+  return 0;
+}

@@ -1,0 +1,80 @@
+"""The binary VTP files of a sweep, read by VTK's own XML reader (vtkXMLPolyDataReader, what
+ParaView uses; Debian python3-vtk9), hold exactly the CSV's numbers: every point-data array, the
+points and the vertex cells, for UInt32 and UInt64 block sizes.
+usage: vtk_reader_test.py DIR (written by sweep_files_fixture)"""
+import csv
+import os
+import sys
+
+try:
+    from vtkmodules.vtkIOXML import vtkXMLPolyDataReader
+    from vtkmodules.vtkCommonCore import vtkLogger
+except ImportError as e:
+    sys.exit(f"FAILED: VTK's Python modules are missing ({e}): install the Debian package python3-vtk9")
+
+vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_OFF)
+folder = sys.argv[1]
+failures = 0
+
+
+def rows(path):
+    with open(path) as f:
+        lines = [line for line in f if not line.startswith("#")]
+    table = list(csv.reader(lines))
+    return table[0], table[1:]
+
+
+for name in ["ellipsoid", "cube"]:
+    head, body = rows(os.path.join(folder, name + ".csv"))
+    col = {h: i for i, h in enumerate(head)}
+    # CSV column(s) of each VTP array; the CSV holds the shortest round-trip text of each double.
+    expected = {
+        "max_force_N": ["max_force_N"], "force_ratio": ["force_ratio"], "reduced_mass_kg": ["reduced_mass_kg"],
+        "effective_radius_m": ["effective_radius_m"], "target_radius_m": ["target_radius_m"],
+        "contact_ellipse_axis_ratio": ["contact_ellipse_axis_ratio"], "sharp_feature": ["sharp_feature"],
+        "normal": ["nx", "ny", "nz"],
+    }
+    for header in ["u32", "u64"]:
+        path = os.path.join(folder, f"{name}_{header}.vtp")
+        reader = vtkXMLPolyDataReader()
+        reader.SetFileName(path)
+        reader.Update()
+        pd = reader.GetOutput()
+        problems = []
+        if reader.GetErrorCode() != 0:
+            problems.append(f"reader error code {reader.GetErrorCode()}")
+        n = len(body)
+        if pd.GetNumberOfPoints() != n or pd.GetNumberOfVerts() != n:
+            problems.append(f"{pd.GetNumberOfPoints()} points, {pd.GetNumberOfVerts()} verts, CSV has {n} rows")
+        data = pd.GetPointData()
+        names = sorted(data.GetArrayName(i) for i in range(data.GetNumberOfArrays()))
+        if names != sorted(expected):
+            problems.append(f"arrays {names}")
+        for array, columns in expected.items():
+            a = data.GetArray(array)
+            if a is None or a.GetNumberOfTuples() != n or a.GetNumberOfComponents() != len(columns):
+                problems.append(f"array {array}: missing or wrong shape")
+                continue
+            bad = [i for i in range(n) if list(a.GetTuple(i)) != [float(body[i][col[c]]) for c in columns]]
+            if bad:
+                problems.append(f"array {array}: {len(bad)} points differ from the CSV, first {bad[0]}")
+        points = pd.GetPoints()
+        bad = [i for i in range(n)
+               if points is None or list(points.GetPoint(i)) != [float(body[i][col[c]]) for c in ["x_m", "y_m", "z_m"]]]
+        if bad:
+            problems.append(f"points: {len(bad)} differ from the CSV")
+        verts = pd.GetVerts()
+        cells = [verts.GetOffsetsArray().GetValue(i) for i in range(n + 1)] if verts else []
+        ids = [verts.GetConnectivityArray().GetValue(i) for i in range(n)] if verts else []
+        if cells != list(range(n + 1)) or ids != list(range(n)):
+            problems.append("vertex cells are not one per point")
+        sharp = sum(float(r[col["sharp_feature"]]) for r in body)
+        if (name == "cube") != (sharp > 0):
+            problems.append(f"{sharp} sharp points")
+        if problems:
+            failures += 1
+            print(f"FAILED: {path}: " + "; ".join(problems))
+        else:
+            print(f"ok: {path}: {n} points, {len(expected)} arrays equal to the CSV")
+
+sys.exit(1 if failures else 0)
