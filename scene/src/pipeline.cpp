@@ -346,7 +346,7 @@ RunReport run_scene(const Scene& scene, const RunOptions& opt) {
 
   for (const auto& s : scene.impacts) {
     ImpactReport ir;
-    ir.spec = &s;
+    ir.spec = std::make_shared<const ImpactSpec>(s);
     const PreparedBody& target = bodies.at(s.target);
     const PreparedBody& impactor = bodies.at(s.impactor);
     const ContactModel model = in_impact(scene, s, [&] {
