@@ -18,7 +18,8 @@
 namespace impactdeck::scene {
 
 struct ImpactReport {
-  const ImpactSpec* spec = nullptr;
+  /// A copy of the scene's impact: the report stays valid after the Scene it came from is gone.
+  std::shared_ptr<const ImpactSpec> spec;
   ContactEvaluation contact;         ///< where the bodies touch, both surfaces, the kernel's input
   collision::ImpactResult result;
   collision::ValidityReport validity;  ///< of the Hertz model at this impact
