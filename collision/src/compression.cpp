@@ -189,6 +189,11 @@ CompressionPhase compression_phase(double m_w, double v_w, double k_h) noexcept 
   c.max_force_N = std::exp(std::log(k_h) + kHertzExponent * log_xmax);
   c.compression_time_s = compression_time_factor() * std::exp(log_xmax - std::log(v_w));
   c.impulse_Ns = m_w * v_w;
+  return c;
+}
+
+void check_compression_range(const CompressionPhase& c) {
+  const double m_w = c.reduced_mass_kg, v_w = c.approach_velocity_m_s, k_h = c.hertz_constant;
   // Every number of the solve within [1e-100, 1e100] (numeric.hpp): beyond, the self-checks'
   // products under- or overflow and would print NaN or fail as "physics".
   const std::pair<const char*, double> values[] = {
@@ -204,7 +209,6 @@ CompressionPhase compression_phase(double m_w, double v_w, double k_h) noexcept 
       << " m/s, Hertz constant " << k_h << " N/m^1.5) are too extreme";
     throw InputError("", "numeric range", s.str());
   }
-  return c;
 }
 
 CompressionPhase solve_compression(double m_w, double v_w, double k_h) {
@@ -218,7 +222,9 @@ CompressionPhase solve_compression(double m_w, double v_w, double k_h) {
   require_positive(m_w, "reduced mass", "kg");
   require_positive(v_w, "approach velocity", "m/s");
   require_positive(k_h, "Hertz constant", "N/m^1.5");
-  return compression_phase(m_w, v_w, k_h);
+  const CompressionPhase c = compression_phase(m_w, v_w, k_h);
+  check_compression_range(c);
+  return c;
 }
 
 }  // namespace impactdeck::collision
