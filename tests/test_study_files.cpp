@@ -307,11 +307,16 @@ TEST_F(SweepFiles, NumbersReadBackBitwise) {
     std::vector<std::string> cells;
     std::stringstream ls(line);
     for (std::string c; std::getline(ls, c, ',');) cells.push_back(c);
+    if (!line.empty() && line.back() == ',') cells.emplace_back();  // an empty last cell (flag)
     if (names.empty()) {
       names = cells;
       continue;
     }
     ASSERT_EQ(cells.size(), names.size());
+    // The last column is the flag word (empty: the model applies), the rest are numbers.
+    ASSERT_EQ(names.back(), "flag");
+    EXPECT_EQ(cells.back(), collision::flag_word(result->points.at(row).flag));
+    cells.pop_back();
     const PointResult& p = result->points.at(row);
     const double expected[] = {static_cast<double>(row), p.point_m.x(), p.point_m.y(), p.point_m.z(), p.normal.x(),
                                p.normal.y(), p.normal.z(), p.target_radius_m, p.impactor_radius_m,

@@ -48,7 +48,7 @@ for name in ["ellipsoid", "cube"]:
             problems.append(f"{pd.GetNumberOfPoints()} points, {pd.GetNumberOfVerts()} verts, CSV has {n} rows")
         data = pd.GetPointData()
         names = sorted(data.GetArrayName(i) for i in range(data.GetNumberOfArrays()))
-        if names != sorted(expected):
+        if names != sorted(list(expected) + ["flag"]):
             problems.append(f"arrays {names}")
         for array, columns in expected.items():
             a = data.GetArray(array)
@@ -58,6 +58,16 @@ for name in ["ellipsoid", "cube"]:
             bad = [i for i in range(n) if list(a.GetTuple(i)) != [float(body[i][col[c]]) for c in columns]]
             if bad:
                 problems.append(f"array {array}: {len(bad)} points differ from the CSV, first {bad[0]}")
+        # flag: collision::ContactFlag's number, 0 where the CSV's flag word is empty, 1 for "sharp".
+        fl = data.GetArray("flag")
+        if fl is None or fl.GetNumberOfTuples() != n:
+            problems.append("array flag: missing or wrong shape")
+        else:
+            words = [body[i][col["flag"]] for i in range(n)]
+            bad = [i for i in range(n) if (fl.GetValue(i) == 0) != (words[i] == "")
+                   or (fl.GetValue(i) == 1) != (words[i] == "sharp")]
+            if bad:
+                problems.append(f"array flag: {len(bad)} points disagree with the CSV's flag words, first {bad[0]}")
         points = pd.GetPoints()
         bad = [i for i in range(n)
                if points is None or list(points.GetPoint(i)) != [float(body[i][col[c]]) for c in ["x_m", "y_m", "z_m"]]]

@@ -1,11 +1,10 @@
 #include "impactdeck/collision/elliptical.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
-#include <gsl/gsl_errno.h>
-#include <gsl/gsl_mode.h>
-#include <gsl/gsl_sf_ellint.h>
 
 #include "impactdeck/common/error.hpp"
 
@@ -15,46 +14,44 @@ namespace {
 // With m = e^2, the two combinations of complete elliptic integrals that appear, each divided by
 // m so that the circular limit m -> 0 has no 0/0:
 //   s1(m) = (K - E)/m,   s2(m) = (E - (1 - m) K)/m.
-// For m < 0.5 from their power series (K = pi/2 sum c_n^2 m^n, E = pi/2 sum c_n^2 m^n/(1 - 2n),
-// c_n = (2n)!/(4^n n!^2)), else from GSL's complete integrals.
+// Both from the arithmetic-geometric mean (Abramowitz & Stegun 17.6): a_0 = 1, b_0 = sqrt(1 - m),
+// c_0 = sqrt(m); a_{n+1} = (a_n + b_n)/2, b_{n+1} = sqrt(a_n b_n), c_{n+1} = c_n^2 / (4 a_{n+1})
+// (= (a_n - b_n)/2 without its cancellation); K = pi / (2 a_N), E/K = 1 - sum_n 2^(n-1) c_n^2.
+// With S' = sum_{n>=1} 2^(n-1) c_n^2 (the n = 0 term is m/2):
+//   s1 = K (1/2 + S'/m),   s2 = K (1/2 - S'/m),
+// free of cancellation for every m (S'/m ~ m/16 as m -> 0). Quadratic convergence: 4 to 6 steps
+// up to m = 1 - 1e-12. `one_minus_m` is passed apart so that slender contacts keep their digits.
 struct S {
   double s1, s2, K;
 };
 
-S integrals(double m) {
-  S r{};
-  if (m < 0.5) {
-    double c_prev = 1.0;  // c_0
-    double s1 = 0, s2 = 0, K = M_PI_2, mp = 1.0;  // mp = m^(n-1)
-    for (int n = 1; n < 400; ++n) {
-      const double c = c_prev * (2.0 * n - 1.0) / (2.0 * n);
-      const double t1 = c * c * (2.0 * n) / (2.0 * n - 1.0) * mp;
-      const double t2 = (c_prev * c_prev - c * c * (2.0 * n) / (2.0 * n - 1.0)) * mp;
-      s1 += t1;
-      s2 += t2;
-      K += M_PI_2 * c * c * mp * m;
-      c_prev = c;
-      mp *= m;
-      if (std::abs(t1) < 1e-18 * std::abs(s1) && std::abs(t2) < 1e-18 * std::abs(s2)) break;
-    }
-    r.s1 = M_PI_2 * s1;
-    r.s2 = M_PI_2 * s2;
-    r.K = K;
-    return r;
+S integrals(double m, double one_minus_m) {
+  double a = 1.0, b = std::sqrt(one_minus_m), c = std::sqrt(m);
+  double sum = 0.0, weight = 0.5;  // 2^(n-1), n = 0 (its term m/2 is not summed)
+  for (int n = 1; n < 64; ++n) {
+    const double a_next = 0.5 * (a + b);
+    const double c_next = c * c / (4.0 * a_next);
+    b = std::sqrt(a * b);
+    a = a_next;
+    c = c_next;
+    weight *= 2.0;  // 2^(n-1)
+    const double term = weight * c * c;
+    sum += term;
+    if (term <= 1e-17 * (0.5 * m + sum) || c == 0.0) break;
   }
-  const double k = std::sqrt(m);
-  const double K = gsl_sf_ellint_Kcomp(k, GSL_PREC_DOUBLE);
-  const double E = gsl_sf_ellint_Ecomp(k, GSL_PREC_DOUBLE);
-  r.s1 = (K - E) / m;
-  r.s2 = (E - (1.0 - m) * K) / m;
-  r.K = K;
+  S r{};
+  r.K = M_PI / (2.0 * a);
+  const double rest = m > 0.0 ? sum / m : 0.0;
+  r.s1 = r.K * (0.5 + rest);
+  r.s2 = r.K * (0.5 - rest);
   return r;
 }
 
-// B/A as a function of m = e^2: s2 / ((1 - m) s1), increasing from 1 at m = 0 to infinity.
-double ratio(double m) {
-  const S s = integrals(m);
-  return s.s2 / ((1.0 - m) * s.s1);
+// B/A as a function of q = -ln(1 - m): s2 / ((1 - m) s1), increasing from 1 at q = 0 to infinity.
+double log_ratio(double q) {
+  const double one_minus_m = std::exp(-q), m = -std::expm1(-q);
+  const S s = integrals(m, one_minus_m);
+  return std::log(s.s2 / s.s1) + q;
 }
 
 }  // namespace
@@ -92,25 +89,58 @@ EllipticalContact elliptical_contact(const RelativeCurvatures& c) {
     throw InputError("", "contact curvature", s.str());
   }
   const double target = B / A;
-  double m = 0.0;
+  double m = 0.0, one_minus_m = 1.0;
   if (target > 1.0) {
-    // Bisection in q = -ln(1 - m), which spreads the slender contacts (m -> 1) evenly.
-    double lo = 0.0, hi = 1.0;
-    while (ratio(-std::expm1(-hi)) < target) hi *= 2.0;  // ratio ~ exp(q)-like growth: few steps
-    for (int i = 0; i < 200; ++i) {
-      const double mid = 0.5 * (lo + hi);
-      if (mid == lo || mid == hi) break;
-      if (ratio(-std::expm1(-mid)) < target) lo = mid; else hi = mid;
+    // Solve ln(B/A)(q) = ln(target) for q = -ln(1 - m), a smooth, increasing, nearly linear
+    // function (slender contacts spread evenly): bracketed, from the Hamrock-Brewe estimate
+    // a/b ~ 1.0339 (B/A)^0.636 (q = 2 ln(a/b)), by the Illinois variant of regula falsi, which
+    // converges superlinearly (6 to 10 evaluations to the last bit, against 60 by bisection).
+    const double goal = std::log(target);
+    auto f = [&](double q) { return log_ratio(q) - goal; };
+    double lo = 0.0, f_lo = -goal;  // ratio(0) = 1
+    double hi = std::max(2.0 * std::log(1.0339) + 1.272 * goal, 1e-3 * goal);
+    double f_hi = f(hi);
+    while (f_hi < 0.0) {  // the estimate is low: step up (rare, and a few steps)
+      lo = hi;
+      f_lo = f_hi;
+      hi *= 2.0;
+      f_hi = f(hi);
     }
-    m = -std::expm1(-0.5 * (lo + hi));
+    int side = 0;
+    double q = hi;
+    for (int i = 0; i < 200 && f_hi != 0.0; ++i) {
+      q = (lo * f_hi - hi * f_lo) / (f_hi - f_lo);
+      if (!(q > lo && q < hi)) q = 0.5 * (lo + hi);  // round-off at the bracket's ends
+      if (q == lo || q == hi) break;
+      const double fq = f(q);
+      if (fq == 0.0) {
+        lo = hi = q;
+        break;
+      }
+      if (fq < 0.0) {
+        lo = q;
+        f_lo = fq;
+        if (side == -1) f_hi *= 0.5;
+        side = -1;
+      } else {
+        hi = q;
+        f_hi = fq;
+        if (side == 1) f_lo *= 0.5;
+        side = 1;
+      }
+      if (hi - lo <= 4.0 * std::numeric_limits<double>::epsilon() * hi) break;
+    }
+    q = 0.5 * (lo + hi);
+    m = -std::expm1(-q);
+    one_minus_m = std::exp(-q);
   }
-  const S s = integrals(m);
+  const S s = integrals(m, one_minus_m);
   EllipticalContact r;
   r.eccentricity = std::sqrt(m);
-  r.axis_ratio = 1.0 / std::sqrt(1.0 - m);
+  r.axis_ratio = 1.0 / std::sqrt(one_minus_m);
   r.equivalent_radius_m = (M_PI * M_PI / 4.0) * s.s1 / (A * s.K * s.K * s.K);
   r.m = std::cbrt((2.0 / M_PI) * (1.0 + target) * s.s1);
-  r.n = r.m * std::sqrt(1.0 - m);
+  r.n = r.m * std::sqrt(one_minus_m);
   return r;
 }
 
