@@ -268,6 +268,8 @@ double run_ccx(const fs::path& dir, const CheckOptions& o, double end_time_s) {
 
 }  // namespace
 
+double run_ccx_job(const fs::path& dir, const CheckOptions& o, double end_time_s) { return run_ccx(dir, o, end_time_s); }
+
 CheckResult run_check(const fs::path& dir, const CheckOptions& o) {
   if (!fs::is_directory(dir)) throw InputError(dir.string(), "deck folder", "does not exist");
   const Deck deck = read_deck(dir);

@@ -89,6 +89,11 @@ struct CheckResult {
 /// output is incomplete; a check above its tolerance is reported in `passed`/`failures`.
 CheckResult run_check(const std::filesystem::path& deck_dir, const CheckOptions& options = {});
 
+/// Runs ccx on `dir`/impact.inp (cwd = dir, output in impact.log, progress from impact.sta up to
+/// `end_time_s`); returns the wall time in s. Throws InputError when ccx is missing or fails.
+/// run_check uses it; so does the full-contact model (contact_model.hpp).
+double run_ccx_job(const std::filesystem::path& dir, const CheckOptions& options, double end_time_s);
+
 /// JSON of a check (keys documented in docs/fem.md).
 nlohmann::json to_json(const CheckResult& r);
 
