@@ -59,7 +59,9 @@ struct ContactModelOptions {
   double penalty_factor = 20;  ///< K = penalty_factor E* / h_c (see above)
   int contact_increments = 40;  ///< increments across the analytic (elastic) contact duration 2 t_m
   double end_time_factor = 1.3;  ///< simulated time: this times 2 t_m (past the separation)
-  bool iterative_solver = false;  ///< *DYNAMIC, SOLVER=ITERATIVE SCALING (default: SPOOLES)
+  /// *DYNAMIC, SOLVER=ITERATIVE SCALING; false: SPOOLES. Measured on two spheres, 6,882 nodes, 22
+  /// increments: 49 s against 225 s, the same force to 4 digits.
+  bool iterative_solver = true;
 };
 
 struct ContactModelRequest {
