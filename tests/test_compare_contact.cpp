@@ -29,9 +29,16 @@ constexpr double kContactForceRel = 0.03;
 // Impulse and duration of the contact run against 2 m_w v: the trapezoidal force history at 12
 // increments across the pulse, and the penalty layer (measured 5e-5 at 20 increments).
 constexpr double kContactImpulseRel = 0.01;
-// ccx's implicit solver conserves the momentum of both free bodies to its equation tolerance
-// (measured 5e-10 linear, 3e-6 angular about the contact point per impulse x body size).
-constexpr double kMomentumRel = 1e-4;
+// ccx's implicit solver conserves the momentum of both free bodies to its equation tolerance:
+// the linear momentum (exact row sums of the mass matrix) measured 5e-10. The angular momentum
+// uses the same nodal weights (exact for a rigid field only; the vibration's share is not), per
+// impulse x body size: measured 3e-6 on two spheres, 3.1e-4 on the ringing ellipsoid.
+constexpr double kLinearMomentumRel = 1e-6;
+constexpr double kAngularMomentumRel = 1e-3;
+// Vibration energy left in the bodies, as a fraction of the impact energy 1/2 m_w v^2: small for
+// compact bodies (measured 1.2e-5 for two spheres), a few % for the slender ellipsoid hit off its
+// centre (measured 3.4 %); a negative value beyond round-off would mean a wrong rigid part.
+constexpr double kVibrationFractionMax = 0.10;
 
 // Two bodies: the target rotated and far from the origin, the impactor placed to touch.
 std::string scene_text(const std::string& target_body, double speed_m_s) {
@@ -71,14 +78,15 @@ void expect_hertz(const scene::CompareReport& r, const std::string& what) {
   EXPECT_LT(std::abs(L.max_force_relative_difference), kContactForceRel) << what;
   EXPECT_NEAR(L.run.impulse_Ns / r.analytic_impulse_Ns, 1.0, kContactImpulseRel) << what;
   // Momentum of the two free bodies: conserved by the solver, and the jumps are the impulse's.
-  EXPECT_LT(L.run.linear_momentum_relative_error, kMomentumRel) << what;
-  EXPECT_LT(L.run.angular_momentum_relative_error, kMomentumRel) << what;
+  EXPECT_LT(L.run.linear_momentum_relative_error, kLinearMomentumRel) << what;
+  EXPECT_LT(L.run.angular_momentum_relative_error, kAngularMomentumRel) << what;
   EXPECT_NEAR((L.run.impactor.delta_velocity_m_s - r.analytic_impactor_dv).norm() / r.analytic_impactor_dv.norm(), 0.0,
               kContactImpulseRel)
       << what;
-  // An elastic impact of compact bodies leaves little vibration (the paper's assumption).
+  // The vibration the hybrid model ignores: non-negative, a small share of the impact energy.
+  ::testing::Test::RecordProperty("vibration_energy_fraction", test::sci(L.run.vibration_energy_J / r.impact_energy_J));
   EXPECT_GE(L.run.vibration_energy_J, -1e-3 * r.impact_energy_J);
-  EXPECT_LT(L.run.vibration_energy_J, 0.01 * r.impact_energy_J);
+  EXPECT_LT(L.run.vibration_energy_J, kVibrationFractionMax * r.impact_energy_J);
 }
 
 }  // namespace
@@ -145,6 +153,7 @@ orientation_angle_deg = 37
   // Two equal spheres, central: the target takes the impactor's whole velocity.
   const auto& L = *r.finest();
   EXPECT_NEAR(L.run.target.delta_velocity_m_s.norm(), 5.0, 5.0 * kContactImpulseRel);
+  EXPECT_LT(L.run.vibration_energy_J, 1e-3 * r.impact_energy_J);  // compact bodies: almost none
   // The JSON contract of issue 16.
   const auto j = scene::to_json(r);
   for (const char* run : {"contact_run", "hybrid_run"}) {

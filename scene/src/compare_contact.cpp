@@ -169,6 +169,9 @@ CompareReport compare_contact(const Scene& scene_in, const CompareOptions& o) {
     for (double f : ir.table->force_N) rep.hybrid_max_force_N = std::max(rep.hybrid_max_force_N, f);
     if (o.progress) *o.progress << "compare-contact: running the hybrid deck (" << rep.hybrid_deck->node_count << " nodes)\n";
     rep.hybrid_check = fem_export::run_check(rep.hybrid_deck->folder, check_options);
+    // The deck's frame is the target's own: rotate its jumps into the world.
+    rep.hybrid_target_dv = target.pose.rotation * rep.hybrid_check->fe_rigid_velocity_m_s;
+    rep.hybrid_target_dw = target.pose.rotation * rep.hybrid_check->angular_velocity_fe_rad_s;
     for (const auto& f : rep.hybrid_check->failures) rep.warnings.push_back("hybrid deck check: " + f);
   }
 
@@ -324,8 +327,8 @@ json to_json(const CompareReport& r) {
                        {"wall_time_s", c.solver_wall_time_s},
                        {"node_count", r.hybrid_deck->node_count},
                        {"increments", r.hybrid_increments},
-                       {"delta_velocity_m_s", {{"target", v3(c.fe_rigid_velocity_m_s)}}},
-                       {"delta_angular_velocity_rad_s", {{"target", v3(c.angular_velocity_fe_rad_s)}}},
+                       {"delta_velocity_m_s", {{"target", v3(r.hybrid_target_dv)}}},
+                       {"delta_angular_velocity_rad_s", {{"target", v3(r.hybrid_target_dw)}}},
                        {"probes", probes},
                        {"checks_passed", c.passed},
                        {"folder", r.hybrid_deck->folder.string()}};

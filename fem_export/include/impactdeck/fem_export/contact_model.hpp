@@ -57,7 +57,8 @@ struct ContactModelOptions {
   /// (at least 4 h_c); the rest of the surface never touches.
   double surface_zone_factor = 4.0;
   double penalty_factor = 20;  ///< K = penalty_factor E* / h_c (see above)
-  int contact_increments = 40;  ///< increments across the analytic (elastic) contact duration 2 t_m
+  /// Largest step: the analytic (elastic) contact duration 2 t_m / this (ccx may cut it back).
+  int contact_increments = 40;
   double end_time_factor = 1.3;  ///< simulated time: this times 2 t_m (past the separation)
   /// *DYNAMIC, SOLVER=ITERATIVE SCALING; false: SPOOLES. Measured on two spheres, 6,882 nodes, 22
   /// increments: 49 s against 225 s, the same force to 4 digits.
@@ -114,7 +115,7 @@ struct ContactRunResult {
   double max_force_N = 0, max_force_time_s = 0;
   double impulse_Ns = 0;          ///< trapezoidal integral of the force
   double contact_duration_s = 0;  ///< first to last increment with a force above 1e-3 F_max
-  std::size_t increments = 0;
+  std::size_t increments = 0;  ///< increments ccx took (both steps)
   double wall_time_s = 0;
   ContactBodyMotion target, impactor;
   double initial_kinetic_energy_J = 0;  ///< of the initial (rigid) velocity field, FE masses

@@ -59,6 +59,8 @@ struct CompareReport {
   std::optional<fem_export::CheckResult> hybrid_check;
   double hybrid_max_force_N = 0;  ///< the applied table's maximum
   std::size_t hybrid_increments = 0;
+  /// The hybrid FE target's rigid-body jumps (momentum / FE mass, I_FE^-1 L_FE), world frame.
+  Eigen::Vector3d hybrid_target_dv = Eigen::Vector3d::Zero(), hybrid_target_dw = Eigen::Vector3d::Zero();
   std::vector<std::string> warnings;
   std::vector<std::filesystem::path> files;
   std::vector<double> analytic_time_s, analytic_force_N;  ///< elastic curve sampled for the plot
