@@ -41,6 +41,9 @@ void register_compare_contact(CLI::App& app, Context& ctx) {
   cmd->add_option("--penalty-factor", args->options.contact.penalty_factor,
                   "Penalty slope K = factor E* / h_c (default 20)")
       ->check(CLI::PositiveNumber);
+  cmd->add_option("--solver-timeout-s", args->options.solver_timeout_s,
+                  "Wall-time limit of each ccx run (default: from each deck's size)")
+      ->check(CLI::PositiveNumber);
   cmd->add_flag("--no-hybrid", [args](std::int64_t) { args->options.run_hybrid = false; },
                 "Run the full-contact model only");
   cmd->callback([args, &ctx] {

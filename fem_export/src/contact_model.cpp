@@ -444,7 +444,12 @@ ContactRunResult run_contact_model(const fs::path& folder, const CheckOptions& o
   }
   ContactRunResult r;
   const double end = cj.at("end_time_s");
-  if (options.run_solver) r.wall_time_s = run_ccx_job(folder, options, end);
+  if (options.run_solver) {
+    // Contact: a few equation solves per increment (3-6 seen), and cutbacks: 8 per nominal one.
+    std::size_t nodes = 0;
+    for (const auto& b : cj.at("bodies")) nodes += b.at("node_count").get<std::size_t>();
+    r.wall_time_s = run_ccx_job(folder, options, end, nodes, 8 * cj.at("increments").get<std::size_t>());
+  }
   const ContactDat d = read_contact_dat(folder / (std::string(kJobName) + ".dat"));
   const Eigen::Vector3d n = vec3(cj.at("normal"));
   r.increments = d.time_s.size();

@@ -155,6 +155,7 @@ CompareReport compare_contact(const Scene& scene_in, const CompareOptions& o) {
   double target_far = scene.outputs.fem->mesh_size_m.value_or(default_mesh_size(*target.spec, target));
   fem_export::CheckOptions check_options;
   check_options.progress = o.progress;
+  check_options.timeout_s = o.solver_timeout_s;
   const fem_export::DeckRequest target_req = hybrid_deck_request(scene, ir, target);
   if (o.run_hybrid) {
     fem_export::DeckRequest req = target_req;

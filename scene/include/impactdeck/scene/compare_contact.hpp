@@ -27,6 +27,7 @@ struct CompareOptions {
   int refine = 0;                        ///< extra contact runs, each with sqrt(2) x contact_elements
   fem_export::ContactModelOptions contact;
   bool run_hybrid = true;                ///< false: the contact model only (tests)
+  double solver_timeout_s = 0;           ///< per ccx run; 0: derived from each deck's size
   std::ostream* progress = nullptr;
 };
 
