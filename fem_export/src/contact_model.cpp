@@ -379,9 +379,12 @@ ContactDat read_contact_dat(const fs::path& p) {
   int energy_set = -1;
   std::string energy_kind;
   std::string l;
-  auto time_of = [](const std::string& s) {
+  auto time_of = [&](const std::string& s) {
     const auto k = s.rfind("time");
-    return k == std::string::npos ? 0.0 : std::stod(s.substr(k + 4));
+    double t = 0;
+    std::istringstream ts(k == std::string::npos ? std::string() : s.substr(k + 4));
+    if (!(ts >> t) || !std::isfinite(t)) throw InputError(p.string(), "contact force", "unreadable time in '" + s + "'");
+    return t;
   };
   while (std::getline(in, l)) {
     if (l.find("statistics for slave set") != std::string::npos) {
