@@ -372,6 +372,13 @@ double run_ccx(const fs::path& work, const CheckOptions& o, double end_time_s, d
 
 }  // namespace
 
+double run_ccx_job(const fs::path& dir, const CheckOptions& o, double end_time_s, std::size_t nodes,
+                   std::size_t solves) {
+  if (o.timeout_s > 0) return run_ccx(dir, o, end_time_s, o.timeout_s, "--solver-timeout-s");
+  return run_ccx(dir, o, end_time_s, default_solver_timeout_s(nodes, solves),
+                 "default for " + std::to_string(nodes) + " nodes and " + std::to_string(solves) + " solves");
+}
+
 CheckResult run_check(const fs::path& dir, const CheckOptions& o) {
   if (!fs::is_directory(dir)) throw InputError(dir.string(), "deck folder", "does not exist");
   const Deck deck = read_deck(dir);

@@ -34,8 +34,8 @@ Drawing stress_time_drawing(const std::vector<StressSeries>& series, const Stres
 
   const double tf = t_max < 1e-3 ? 1e6 : 1e3;
   const char* tu = t_max < 1e-3 ? "\xC2\xB5s" : "ms";
-  const double sf = s_max >= 1e6 ? 1e-6 : 1e-3;
-  const char* su = s_max >= 1e6 ? "MPa" : "kPa";
+  const double sf = opt.force_N ? (s_max >= 1e4 ? 1e-3 : 1.0) : s_max >= 1e6 ? 1e-6 : 1e-3;
+  const char* su = opt.force_N ? (s_max >= 1e4 ? "kN" : "N") : s_max >= 1e6 ? "MPa" : "kPa";
 
   Drawing d(opt.width_px, opt.height_px);
   const double left = 84, top = 56, right = opt.width_px - 250, bottom = opt.height_px - 62;
@@ -67,7 +67,7 @@ Drawing stress_time_drawing(const std::vector<StressSeries>& series, const Stres
                   log ? format_number(std::pow(10.0, v)) : format_number(v)});
   }
   chart_frame(d, left, top, right, bottom, xt, yt, std::string("time t [") + tu + "]",
-              std::string("von Mises stress [") + su + "]" + (log ? " (log scale)" : ""));
+              opt.quantity + " [" + su + "]" + (log ? " (log scale)" : ""));
   d.text({left, 30}, opt.title.empty() ? "Von Mises stress against time" : opt.title, 15, Anchor::start, kBlack, true);
 
   Style mark;

@@ -325,6 +325,14 @@ fem_export::DeckRequest fem_request(const Scene& scene, const ImpactReport& ir, 
 
 }  // namespace
 
+ContactEvaluation locate_impact_contact(const Scene& scene, const ImpactSpec& s, const ContactModel& model) {
+  return locate_contact(scene, s, model);
+}
+
+fem_export::DeckRequest hybrid_deck_request(const Scene& scene, const ImpactReport& ir, const PreparedBody& body) {
+  return fem_request(scene, ir, body);
+}
+
 namespace {
 
 // Where each output of the scene goes, reserved in the run's transaction before any work (a bad

@@ -108,6 +108,13 @@ struct CheckResult {
 /// tolerance is reported in `passed`/`failures`.
 CheckResult run_check(const std::filesystem::path& deck_dir, const CheckOptions& options = {});
 
+/// Runs ccx on `dir`/impact.inp (cwd = dir, output in impact.log, progress from impact.sta up to
+/// `end_time_s`) with options.timeout_s, or default_solver_timeout_s(nodes, solves); returns the
+/// wall time in s. Throws InputError when ccx is missing, fails or times out. The runner of
+/// run_check, for the full-contact model (contact_model.hpp).
+double run_ccx_job(const std::filesystem::path& dir, const CheckOptions& options, double end_time_s,
+                   std::size_t nodes, std::size_t solves);
+
 /// JSON of a check (keys documented in docs/fem.md).
 nlohmann::json to_json(const CheckResult& r);
 

@@ -31,6 +31,10 @@ struct StressPlotOptions {
   std::optional<double> yield_strength_Pa;  ///< dashed horizontal line
   std::optional<double> contact_end_s;      ///< dotted vertical line
   bool log_scale = false;                   ///< logarithmic stress axis (a point load's node dwarfs the probes)
+  /// Other quantities on the same chart: the axis name, and forces (values in N, axis in N or kN)
+  /// instead of stresses (compare-contact's F(t) overlay).
+  std::string quantity = "von Mises stress";
+  bool force_N = false;
 };
 
 /// Builds the picture; time in ms or us, stress in MPa or kPa (named on the axes). Throws

@@ -67,6 +67,14 @@ PreparedBody prepare_body(const BodySpec& body, const Scene& scene, RunReport* r
 /// published only when every stage and check passed; after any failure nothing is visible.
 RunReport run_scene(const Scene& scene, const RunOptions& options = {});
 
+/// Where the bodies of impact `s` touch, as `run` finds it (point mode: the projected point, else
+/// the first contact); a point where Hertz does not apply comes back flagged. Throws InputError.
+ContactEvaluation locate_impact_contact(const Scene& scene, const ImpactSpec& s, const ContactModel& model);
+
+/// The hybrid deck request `run` builds for an impact (scene.outputs.fem must be set; `ir.table`
+/// sampled): the body `body` alone in its own frame with the force on the target. Throws InputError.
+fem_export::DeckRequest hybrid_deck_request(const Scene& scene, const ImpactReport& ir, const PreparedBody& body);
+
 /// Every stage the tool knows, in pipeline order (for stages_run / stages_skipped).
 const std::vector<std::string>& all_stages();
 

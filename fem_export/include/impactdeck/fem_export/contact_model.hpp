@@ -1,0 +1,137 @@
+#pragma once
+// The full-contact model of an impact, for CalculiX: both bodies meshed with quadratic tetrahedra
+// (C3D10) refined around the contact point, surface-to-surface penalty contact between them, the
+// bodies' translations and spins as initial velocities, implicit dynamics through the contact and
+// past the separation. It is what the hybrid deck (decks.hpp) replaces by the analytic Hertz force:
+// `impactdeck compare-contact` runs both and compares them (docs/contact-vs-hybrid.md).
+//
+// Frame: the deck's coordinates are the world's, translated so that the contact point is the
+// origin (mm in the deck; SI in every struct here). Each body is meshed in its own frame by the
+// Gmsh plugin (mesh.hpp, with the contact point as the load point, so a node lies on it exactly),
+// then placed by its pose.
+//
+// Quadratic elements: the plugin's linear tetrahedra get a node at the middle of every edge; on an
+// analytic body (ellipsoid, sphere) the middle nodes of boundary edges are moved onto the exact
+// surface, so that the contact surface is curved as the body is (a faceted surface concentrates the
+// curvature on its edges, and the contact patch spans only a few elements). Mesh parts keep straight
+// edges (their surface is faceted anyway).
+//
+// Penalty (PRESSURE-OVERCLOSURE=LINEAR): slope K = penalty_factor * E* / h_c (N/m^3), h_c the
+// contact element size. The overclosure at the peak pressure p0 is p0 / K; Hertz gives
+// p0 = 2 E* a / (pi R) and x_max = a^2 / R, so overclosure / x_max = 2 h_c / (pi penalty_factor a):
+// 1 % for a / h_c = 3 and the default factor 20, which softens the contact and lowers F_max by
+// roughly 0.6 of that (F ~ x^(3/2), the penalty layer in series).
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+#include <nlohmann/json.hpp>
+
+#include "impactdeck/fem_export/check.hpp"
+#include "impactdeck/fem_export/decks.hpp"
+
+namespace impactdeck::fem_export {
+
+/// One body of the contact model.
+struct ContactBody {
+  std::string name;  ///< named in messages and the deck
+  DeckBody body;     ///< shape in its own frame (ellipsoid / part / cad)
+  DeckMaterial material;
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();  ///< own frame -> world
+  Eigen::Vector3d position_m = Eigen::Vector3d::Zero();    ///< world position of the own origin
+  Eigen::Vector3d contact_point_own_m = Eigen::Vector3d::Zero();  ///< on its surface, own frame
+  Eigen::Vector3d velocity_m_s = Eigen::Vector3d::Zero();           ///< world, of its centroid
+  Eigen::Vector3d angular_velocity_rad_s = Eigen::Vector3d::Zero();  ///< world
+  Eigen::Vector3d centroid_own_m = Eigen::Vector3d::Zero();  ///< the spin's centre (exact body)
+  double far_mesh_size_m = 0;  ///< element size away from the contact
+};
+
+struct ContactModelOptions {
+  /// The smaller Hertz contact semi-axis at F_max spans this many elements (h_c = b / this).
+  double contact_elements = 3;
+  /// The element size stays h_c within this many larger semi-axes a of the contact point.
+  double refined_zone_factor = 2.0;
+  /// Contact surfaces: boundary faces within this many larger semi-axes of the contact point
+  /// (at least 4 h_c); the rest of the surface never touches.
+  double surface_zone_factor = 4.0;
+  double penalty_factor = 20;  ///< K = penalty_factor E* / h_c (see above)
+  /// Largest step: the analytic (elastic) contact duration 2 t_m / this (ccx may cut it back).
+  int contact_increments = 40;
+  double end_time_factor = 1.3;  ///< simulated time: this times 2 t_m (past the separation)
+  /// *DYNAMIC, SOLVER=ITERATIVE SCALING; false: SPOOLES. Measured on two spheres, 6,882 nodes, 22
+  /// increments: 49 s against 225 s, the same force to 4 digits.
+  bool iterative_solver = true;
+};
+
+struct ContactModelRequest {
+  std::string source, impact;
+  ContactBody target, impactor;
+  Eigen::Vector3d contact_point_m = Eigen::Vector3d::Zero();  ///< world
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  ///< world, the target's outward normal
+  double effective_modulus_Pa = 0;                    ///< E* (with the Poisson terms)
+  /// The analytic Hertz impact (elastic): contact semi-axes at F_max (a >= b) and t_m.
+  double semi_axis_a_m = 0, semi_axis_b_m = 0;
+  double compression_time_s = 0;
+  ContactModelOptions options;
+};
+
+struct ContactBodyMesh {
+  std::size_t node_count = 0, element_count = 0, contact_faces = 0;
+  double contact_mesh_size_m = 0, far_mesh_size_m = 0;
+  double fe_mass_kg = 0;
+  Eigen::Vector3d fe_centroid_m = Eigen::Vector3d::Zero();  ///< deck frame
+  Eigen::Matrix3d fe_inertia_kg_m2 = Eigen::Matrix3d::Zero();  ///< world axes, about the centroid
+  std::size_t first_node = 0;  ///< 0-based: this body's nodes in the deck are [first, first + count)
+};
+
+struct ContactDeck {
+  std::filesystem::path folder;
+  ContactBodyMesh target, impactor;
+  std::size_t node_count = 0;
+  double contact_mesh_size_m = 0, penalty_N_m3 = 0;
+  double time_step_s = 0, end_time_s = 0;
+  std::size_t increments = 0;
+  double mesh_seconds = 0;
+};
+
+/// Meshes both bodies and writes `folder`/impact.inp (+ contact.json with what the reader needs),
+/// staged in a hidden sibling folder renamed at the end. Throws InputError on bad input or a
+/// meshing failure.
+ContactDeck write_contact_deck(const ContactModelRequest& request, const std::filesystem::path& folder);
+
+/// A body's motion after the contact, from the FE velocities (rigid part of the field).
+struct ContactBodyMotion {
+  Eigen::Vector3d delta_velocity_m_s = Eigen::Vector3d::Zero();
+  Eigen::Vector3d delta_angular_velocity_rad_s = Eigen::Vector3d::Zero();
+  double kinetic_energy_J = 0, strain_energy_J = 0;  ///< ccx's ELKE and ELSE totals at the end
+  double rigid_kinetic_energy_J = 0;                  ///< 1/2 P^2 / M + 1/2 L . I^-1 L at the end
+  double vibration_energy_J = 0;                      ///< kinetic + strain - rigid
+};
+
+struct ContactRunResult {
+  std::vector<double> time_s, force_N;  ///< contact force on the impactor along n, per increment
+  double max_force_N = 0, max_force_time_s = 0;
+  double impulse_Ns = 0;          ///< trapezoidal integral of the force
+  double contact_duration_s = 0;  ///< first to last increment with a force above 1e-3 F_max
+  std::size_t increments = 0;  ///< increments ccx took (both steps)
+  double wall_time_s = 0;
+  ContactBodyMotion target, impactor;
+  double initial_kinetic_energy_J = 0;  ///< of the initial (rigid) velocity field, FE masses
+  /// |P_after - P_before| / |impulse| over both bodies, and the same for the angular momentum
+  /// about the contact point (the solver's conservation check).
+  double linear_momentum_relative_error = 0, angular_momentum_relative_error = 0;
+  double vibration_energy_J = 0;      ///< both bodies
+  double final_total_energy_J = 0;    ///< kinetic + strain of both bodies at the end
+};
+
+/// Runs ccx on the deck folder (check.hpp's runner) and reads the contact force history and the
+/// final state. Throws InputError when ccx fails or its output is incomplete.
+ContactRunResult run_contact_model(const std::filesystem::path& folder, const CheckOptions& options = {});
+
+/// Exposed for tests: the C3D10 edge-middle node of the ccx ordering (5: 1-2, 6: 2-3, 7: 3-1,
+/// 8: 1-4, 9: 2-4, 10: 3-4), 0-based corner pairs.
+inline constexpr int kTet10Edges[6][2] = {{0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3}};
+
+}  // namespace impactdeck::fem_export

@@ -1,0 +1,79 @@
+#pragma once
+// `impactdeck compare-contact`: one impact of a scene run twice in CalculiX, as the hybrid deck
+// (the target alone, loaded by the analytic Hertz force: decks.hpp) and as a full-contact model
+// (both bodies meshed, penalty contact: contact_model.hpp), both compared with the analytic force
+// (docs/contact-vs-hybrid.md). The full-contact model is purely elastic, so its reference is the
+// elastic Hertz impact (R = 1): F_max and t_m are the analytic model's, the duration 2 t_m, the
+// impulse 2 m_w v_w, the jumps the model's times 2 / (1 + R).
+#include <filesystem>
+#include <optional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "impactdeck/fem_export/check.hpp"
+#include "impactdeck/fem_export/contact_model.hpp"
+#include "impactdeck/fem_export/decks.hpp"
+#include "impactdeck/scene/scene.hpp"
+
+namespace impactdeck::scene {
+
+struct CompareOptions {
+  std::string impact;                    ///< empty: the scene's only (or first) impact
+  std::filesystem::path out_dir = ".";   ///< must exist; folders hybrid/, contact_L<k>/ and files go here
+  double threshold = 0.03;               ///< |F_max contact / analytic - 1| above it: exit 4
+  int refine = 0;                        ///< extra contact runs, each with sqrt(2) x contact_elements
+  fem_export::ContactModelOptions contact;
+  bool run_hybrid = true;                ///< false: the contact model only (tests)
+  double solver_timeout_s = 0;           ///< per ccx run; 0: derived from each deck's size
+  std::ostream* progress = nullptr;
+};
+
+/// One rung of the refinement ladder.
+struct ContactLevel {
+  double contact_elements = 0;
+  fem_export::ContactDeck deck;
+  fem_export::ContactRunResult run;
+  double max_force_relative_difference = 0;  ///< F_max / analytic - 1
+};
+
+enum class CompareVerdict { agree, disagree, non_hertzian };
+const char* to_string(CompareVerdict v);
+
+struct CompareReport {
+  std::string impact, target, impactor;
+  CompareVerdict verdict = CompareVerdict::agree;
+  std::string non_hertzian_reason;  ///< the kernel's flag explained
+  std::string in_doubt;             ///< disagree: "contact mesh" or "hybrid assumptions"
+  std::string explanation;          ///< one sentence saying why
+  // The analytic (elastic) impact.
+  double analytic_max_force_N = 0, analytic_compression_time_s = 0, analytic_duration_s = 0;
+  double analytic_impulse_Ns = 0, impact_energy_J = 0;  ///< 2 m_w v_w, 1/2 m_w v_w^2
+  double restitution = 1, assumed_loss_fraction = 0;    ///< the scene's R and 1 - R^2
+  double semi_axis_a_m = 0, semi_axis_b_m = 0;
+  Eigen::Vector3d analytic_target_dv = Eigen::Vector3d::Zero(), analytic_target_dw = Eigen::Vector3d::Zero();
+  Eigen::Vector3d analytic_impactor_dv = Eigen::Vector3d::Zero(), analytic_impactor_dw = Eigen::Vector3d::Zero();
+  std::vector<ContactLevel> ladder;  ///< coarse to fine; the last one is compared
+  std::optional<fem_export::DeckResult> hybrid_deck;
+  std::optional<fem_export::CheckResult> hybrid_check;
+  double hybrid_max_force_N = 0;  ///< the applied table's maximum
+  std::size_t hybrid_increments = 0;
+  /// The hybrid FE target's rigid-body jumps (momentum / FE mass, I_FE^-1 L_FE), world frame.
+  Eigen::Vector3d hybrid_target_dv = Eigen::Vector3d::Zero(), hybrid_target_dw = Eigen::Vector3d::Zero();
+  std::vector<std::string> warnings;
+  std::vector<std::filesystem::path> files;
+  std::vector<double> analytic_time_s, analytic_force_N;  ///< elastic curve sampled for the plot
+
+  const ContactLevel* finest() const { return ladder.empty() ? nullptr : &ladder.back(); }
+};
+
+/// Runs the comparison. Throws InputError (exit 3) on bad input: an unknown impact, a plane or a
+/// fixed body (the full-contact model meshes both bodies and needs their masses).
+CompareReport compare_contact(const Scene& scene, const CompareOptions& options);
+
+nlohmann::json to_json(const CompareReport& r);
+std::string format_compare(const CompareReport& r);
+
+}  // namespace impactdeck::scene

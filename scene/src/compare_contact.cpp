@@ -1,0 +1,386 @@
+// compare-contact: the hybrid deck and the full-contact model of one impact (compare_contact.hpp).
+#include "impactdeck/scene/compare_contact.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "impactdeck/collision/hertz.hpp"
+#include "impactdeck/common/atomic_file.hpp"
+#include "impactdeck/common/error.hpp"
+#include "impactdeck/plot/stress_plot.hpp"
+#include "impactdeck/scene/contact.hpp"
+#include "impactdeck/scene/pipeline.hpp"
+
+namespace impactdeck::scene {
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+const char* to_string(CompareVerdict v) {
+  switch (v) {
+    case CompareVerdict::agree: return "agree";
+    case CompareVerdict::disagree: return "disagree";
+    case CompareVerdict::non_hertzian: return "non-hertzian";
+  }
+  return "?";
+}
+
+namespace {
+
+json v3(const Eigen::Vector3d& v) { return json::array({v.x() + 0.0, v.y() + 0.0, v.z() + 0.0}); }
+
+double rel(double value, double reference) { return reference != 0 ? value / reference - 1.0 : 0.0; }
+
+// The part's default far-field size, as the hybrid deck picks it (pipeline.cpp fem_request).
+double default_mesh_size(const BodySpec& b, const PreparedBody& p) {
+  if (b.shape == ShapeKind::mesh) return 0.25 * p.shape->size_m();
+  const Eigen::Vector3d ax = b.shape == ShapeKind::sphere ? Eigen::Vector3d::Constant(b.radius_m) : b.semi_axes_m;
+  return 0.5 * ax.minCoeff();
+}
+
+fem_export::ContactBody contact_body(const fem_export::DeckRequest& own, const PreparedBody& p,
+                                     const geometry::SurfacePoint& point, const collision::KernelBody& k,
+                                     const Eigen::Vector3d& translation_m, double far_size_m) {
+  fem_export::ContactBody b;
+  b.name = p.name;
+  b.body = own.body;
+  b.material = own.material;
+  b.rotation = p.pose.rotation;
+  b.position_m = p.pose.position_m + translation_m;
+  b.contact_point_own_m = point.point_m;
+  b.velocity_m_s = k.velocity_m_s;
+  b.angular_velocity_rad_s = k.angular_velocity_rad_s;
+  b.centroid_own_m = p.volume.centroid_m;
+  b.far_mesh_size_m = far_size_m;
+  return b;
+}
+
+}  // namespace
+
+CompareReport compare_contact(const Scene& scene_in, const CompareOptions& o) {
+  const std::string file = scene_in.file.string();
+  if (scene_in.impacts.empty()) throw InputError(file, "impacts", "the scene has no impact");
+  const ImpactSpec* spec = &scene_in.impacts.front();
+  if (!o.impact.empty()) {
+    spec = nullptr;
+    for (const auto& s : scene_in.impacts)
+      if (s.name == o.impact) spec = &s;
+    if (!spec) throw InputError(file, "--impact", "no impact named '" + o.impact + "' in the scene");
+  }
+  if (!(o.threshold > 0) || o.refine < 0 || o.refine > 6) {
+    throw InputError(file, "options", "--threshold must be > 0 and --refine within 0..6");
+  }
+  // The scene reduced to this impact, with the hybrid deck's settings (the scene's, or defaults).
+  Scene scene = scene_in;
+  scene.impacts = {*spec};
+  scene.outputs = Outputs{};
+  scene.outputs.force_table = scene_in.outputs.force_table;
+  const ImpactSpec& s = scene.impacts.front();
+  for (const std::string* name : {&s.target, &s.impactor}) {
+    const BodySpec& b = scene.body(*name);
+    if (b.shape == ShapeKind::plane) {
+      throw InputError(file, b.place.describe(),
+                       "impact '" + s.name + "': body '" + b.name +
+                           "' is an infinite plane: the full-contact model meshes both bodies and a plane cannot be "
+                           "meshed (give the floor as a finite part)");
+    }
+    if (b.fixed) {
+      throw InputError(file, b.place.describe(),
+                       "impact '" + s.name + "': body '" + b.name +
+                           "' is fixed: the full-contact model needs both bodies free, with their masses");
+    }
+  }
+  CompareReport rep;
+  rep.impact = s.name;
+  rep.target = s.target;
+  rep.impactor = s.impactor;
+  if (scene.modulus_convention != collision::ModulusConvention::hertz) {
+    rep.warnings.push_back("modulus_convention is not \"hertz\": the analytic force leaves out the Poisson terms "
+                           "that the FE models contain, so they differ by design");
+  }
+
+  const PreparedBody target = prepare_body(scene.body(s.target), scene);
+  const PreparedBody impactor = prepare_body(scene.body(s.impactor), scene);
+  const double e_star = collision::effective_modulus_Pa(target.material, impactor.material, scene.modulus_convention);
+  const ContactModel model(target, impactor, s.contact_radius, e_star, s.restitution);
+  const ContactEvaluation ev = locate_impact_contact(scene, s, model);
+  if (ev.result.flag != collision::ContactFlag::none) {
+    rep.verdict = CompareVerdict::non_hertzian;
+    rep.non_hertzian_reason = collision::explain_flag(ev.input, ev.result, "'" + s.target + "'", "'" + s.impactor + "'");
+    rep.explanation = std::string("the contact is not Hertzian (") + collision::flag_word(ev.result.flag) +
+                      "): there is no analytic force to compare with and no hybrid deck to build";
+    return rep;
+  }
+
+  // The analytic impact (run's own pipeline, no output files).
+  RunOptions ro;
+  ro.out_dir = o.out_dir;
+  RunReport run = run_scene(scene, ro);
+  ImpactReport& ir = run.impacts.front();
+  for (const auto& w : run.warnings) rep.warnings.push_back(w);
+  const collision::KernelResult& k = ir.result.kernel;
+  const double R = k.restitution.coefficient;
+  rep.restitution = R;
+  rep.assumed_loss_fraction = 1.0 - R * R;
+  rep.analytic_max_force_N = k.max_force_N;
+  rep.analytic_compression_time_s = k.compression_time_s;
+  rep.analytic_duration_s = 2.0 * k.compression_time_s;
+  rep.analytic_impulse_Ns = 2.0 * k.impulse_compression_Ns;
+  rep.impact_energy_J = 0.5 * k.reduced_mass_kg * k.approach_velocity_m_s * k.approach_velocity_m_s;
+  rep.semi_axis_a_m = std::max(k.contact_semi_axis_a_m, k.contact_semi_axis_b_m);
+  rep.semi_axis_b_m = std::min(k.contact_semi_axis_a_m, k.contact_semi_axis_b_m);
+  const double elastic = 2.0 / (1.0 + R);
+  rep.analytic_target_dv = elastic * ir.result.target_jump.delta_velocity_m_s;
+  rep.analytic_target_dw = elastic * ir.result.target_jump.delta_angular_velocity_rad_s;
+  rep.analytic_impactor_dv = elastic * ir.result.impactor_jump.delta_velocity_m_s;
+  rep.analytic_impactor_dw = elastic * ir.result.impactor_jump.delta_angular_velocity_rad_s;
+  {
+    const double tm = k.compression_time_s;
+    const int n = 200;
+    for (int i = 0; i <= n; ++i) {
+      const double t = 2.0 * tm * i / n;
+      rep.analytic_time_s.push_back(t);
+      rep.analytic_force_N.push_back(ir.result.history.force_N(t <= tm ? t : 2.0 * tm - t));
+    }
+  }
+
+  // Time stepping shared by both models: the contact model's.
+  const fem_export::ContactModelOptions& co = o.contact;
+  const double dt = rep.analytic_duration_s / co.contact_increments;
+  const std::size_t increments = static_cast<std::size_t>(std::ceil(co.end_time_factor * co.contact_increments - 1e-9));
+  const double end_time = increments * dt;
+
+  scene.outputs.fem = scene_in.outputs.fem ? *scene_in.outputs.fem : FemOutputs{};
+  ir.table = collision::sample_force_table(ir.result.history, scene.outputs.force_table);
+  double target_far = scene.outputs.fem->mesh_size_m.value_or(default_mesh_size(*target.spec, target));
+  fem_export::CheckOptions check_options;
+  check_options.progress = o.progress;
+  check_options.timeout_s = o.solver_timeout_s;
+  const fem_export::DeckRequest target_req = hybrid_deck_request(scene, ir, target);
+  if (o.run_hybrid) {
+    fem_export::DeckRequest req = target_req;
+    req.options.code_aster = false;
+    req.options.end_time_s = end_time;
+    req.options.time_step_s = dt;
+    req.options.pulse_increments = static_cast<int>(std::ceil(ir.table->time_s.back() / dt - 1e-9));
+    rep.hybrid_deck = fem_export::write_decks(req, o.out_dir / "hybrid");
+    target_far = rep.hybrid_deck->quality.mesh_size_m;  // after any adaptive refinement
+    const fem_export::TimeSchedule ts = fem_export::time_schedule(req.options, ir.table->time_s.back());
+    rep.hybrid_increments = ts.pulse_increments + ts.main_increments;
+    for (double f : ir.table->force_N) rep.hybrid_max_force_N = std::max(rep.hybrid_max_force_N, f);
+    if (o.progress) *o.progress << "compare-contact: running the hybrid deck (" << rep.hybrid_deck->node_count << " nodes)\n";
+    rep.hybrid_check = fem_export::run_check(rep.hybrid_deck->folder, check_options);
+    // The deck's frame is the target's own: rotate its jumps into the world.
+    rep.hybrid_target_dv = target.pose.rotation * rep.hybrid_check->fe_rigid_velocity_m_s;
+    rep.hybrid_target_dw = target.pose.rotation * rep.hybrid_check->angular_velocity_fe_rad_s;
+    for (const auto& f : rep.hybrid_check->failures) rep.warnings.push_back("hybrid deck check: " + f);
+  }
+
+  // The full-contact model: the impactor's own deck request gives its body and material.
+  const fem_export::DeckRequest impactor_req = hybrid_deck_request(scene, ir, impactor);
+  fem_export::ContactModelRequest cr;
+  cr.source = scene.file.string();
+  cr.impact = s.name;
+  cr.target = contact_body(target_req, target, ev.target_point, ev.input.target, Eigen::Vector3d::Zero(), target_far);
+  cr.impactor = contact_body(impactor_req, impactor, ev.impactor_point, ev.input.impactor, ev.impactor_translation_m,
+                             default_mesh_size(*impactor.spec, impactor));
+  cr.contact_point_m = ev.point_m;
+  cr.normal = ev.normal;
+  cr.effective_modulus_Pa = collision::effective_modulus_Pa(target.material, impactor.material,
+                                                            collision::ModulusConvention::hertz);
+  cr.semi_axis_a_m = rep.semi_axis_a_m;
+  cr.semi_axis_b_m = rep.semi_axis_b_m;
+  cr.compression_time_s = k.compression_time_s;
+  for (int level = 0; level <= o.refine; ++level) {
+    cr.options = co;
+    cr.options.contact_elements = co.contact_elements * std::pow(std::sqrt(2.0), level);
+    ContactLevel L;
+    L.contact_elements = cr.options.contact_elements;
+    const fs::path folder = o.out_dir / (o.refine == 0 ? std::string("contact") : "contact_L" + std::to_string(level));
+    L.deck = fem_export::write_contact_deck(cr, folder);
+    if (o.progress) {
+      *o.progress << "compare-contact: running the full-contact model, " << L.contact_elements
+                  << " elements across the contact semi-axis (" << L.deck.node_count << " nodes)\n";
+    }
+    L.run = fem_export::run_contact_model(folder, check_options);
+    L.max_force_relative_difference = rel(L.run.max_force_N, rep.analytic_max_force_N);
+    rep.ladder.push_back(std::move(L));
+  }
+
+  // Verdict.
+  const ContactLevel& fine = rep.ladder.back();
+  const double d = fine.max_force_relative_difference;
+  const double vib = rep.impact_energy_J > 0 ? fine.run.vibration_energy_J / rep.impact_energy_J : 0;
+  if (std::abs(d) <= o.threshold) {
+    rep.verdict = CompareVerdict::agree;
+  } else {
+    rep.verdict = CompareVerdict::disagree;
+    std::ostringstream m;
+    if (rep.ladder.size() >= 2) {
+      const double d0 = rep.ladder.front().max_force_relative_difference;
+      if (std::abs(d) < 0.75 * std::abs(d0)) {
+        rep.in_doubt = "contact mesh";
+        m << "refining moved F_max toward the analytic value (" << 100 * d0 << " % -> " << 100 * d
+          << " %): the contact mesh is not converged";
+      } else {
+        rep.in_doubt = "hybrid assumptions";
+        m << "refining did not move F_max toward the analytic value (" << 100 * d0 << " % -> " << 100 * d
+          << " %): the Hertz assumptions (elastic half-spaces, no vibration; here " << 100 * vib
+          << " % of the impact energy is left as vibration) are in doubt";
+      }
+    } else if (vib > 0.05) {
+      rep.in_doubt = "hybrid assumptions";
+      m << 100 * vib << " % of the impact energy is left as elastic vibration, which the rigid-body Hertz model "
+        << "ignores; run with --refine 2 to rule out the contact mesh";
+    } else {
+      rep.in_doubt = "contact mesh";
+      m << "little vibration energy (" << 100 * vib << " %): the contact mesh is the likelier cause; run with "
+        << "--refine 2 to see F_max converge";
+    }
+    rep.explanation = m.str();
+  }
+
+  // The F(t) overlay.
+  std::vector<plot::StressSeries> series;
+  series.push_back({"analytic Hertz (elastic)", rep.analytic_time_s, rep.analytic_force_N, 0, true});
+  for (const auto& L : rep.ladder) {
+    std::ostringstream lab;
+    lab << "full contact, " << L.contact_elements << " el./b";
+    series.push_back({lab.str(), L.run.time_s, L.run.force_N, -1, false});
+    series.back().colour = 1 + static_cast<int>(&L - &rep.ladder.front()) % 4;
+  }
+  if (o.run_hybrid) series.push_back({"hybrid applied load", ir.table->time_s, ir.table->force_N, plot::kVermilion, false});
+  plot::StressPlotOptions po;
+  po.title = "Contact force, impact '" + s.name + "': full contact against the hybrid load";
+  po.quantity = "contact force";
+  po.force_N = true;
+  const fs::path svg = o.out_dir / "compare_force.svg";
+  write_file_atomically(svg, plot::to_svg(plot::stress_time_drawing(series, po)));
+  rep.files.push_back(svg);
+  return rep;
+}
+
+json to_json(const CompareReport& r) {
+  json j = {{"impact", r.impact}, {"target", r.target}, {"impactor", r.impactor}, {"verdict", to_string(r.verdict)}};
+  if (r.verdict == CompareVerdict::non_hertzian) {
+    j["hertzian"] = false;
+    j["non_hertzian_reason"] = r.non_hertzian_reason;
+    j["explanation"] = r.explanation;
+    j["contact_run"] = nullptr;
+    j["hybrid_run"] = nullptr;
+    return j;
+  }
+  j["hertzian"] = true;
+  j["analytic"] = {{"max_force_N", r.analytic_max_force_N},
+                   {"compression_time_s", r.analytic_compression_time_s},
+                   {"contact_duration_s", r.analytic_duration_s},
+                   {"impulse_Ns", r.analytic_impulse_Ns},
+                   {"impact_energy_J", r.impact_energy_J},
+                   {"contact_semi_axes_m", {r.semi_axis_a_m, r.semi_axis_b_m}},
+                   {"restitution", r.restitution},
+                   {"delta_velocity_m_s", {{"target", v3(r.analytic_target_dv)}, {"impactor", v3(r.analytic_impactor_dv)}}},
+                   {"delta_angular_velocity_rad_s",
+                    {{"target", v3(r.analytic_target_dw)}, {"impactor", v3(r.analytic_impactor_dw)}}}};
+  auto level_json = [&](const ContactLevel& L) {
+    const auto& run = L.run;
+    return json{{"contact_elements", L.contact_elements},
+                {"contact_mesh_size_m", L.deck.contact_mesh_size_m},
+                {"max_force_N", run.max_force_N},
+                {"max_force_time_s", run.max_force_time_s},
+                {"max_force_relative_difference", L.max_force_relative_difference},
+                {"wall_time_s", run.wall_time_s},
+                {"node_count", L.deck.node_count},
+                {"node_count_target", L.deck.target.node_count},
+                {"node_count_impactor", L.deck.impactor.node_count},
+                {"increments", run.increments},
+                {"time_step_s", L.deck.time_step_s},
+                {"penalty_N_m3", L.deck.penalty_N_m3},
+                {"contact_duration_s", run.contact_duration_s},
+                {"impulse_Ns", run.impulse_Ns},
+                {"delta_velocity_m_s", {{"target", v3(run.target.delta_velocity_m_s)}, {"impactor", v3(run.impactor.delta_velocity_m_s)}}},
+                {"delta_angular_velocity_rad_s",
+                 {{"target", v3(run.target.delta_angular_velocity_rad_s)}, {"impactor", v3(run.impactor.delta_angular_velocity_rad_s)}}},
+                {"vibration_energy_J", run.vibration_energy_J},
+                {"linear_momentum_relative_error", run.linear_momentum_relative_error},
+                {"angular_momentum_relative_error", run.angular_momentum_relative_error},
+                {"numerical_energy_loss_fraction",
+                 run.initial_kinetic_energy_J > 0 ? 1.0 - run.final_total_energy_J / run.initial_kinetic_energy_J : 0.0},
+                {"folder", L.deck.folder.string()}};
+  };
+  const ContactLevel& fine = r.ladder.back();
+  j["contact_run"] = level_json(fine);
+  json ladder = json::array();
+  for (const auto& L : r.ladder) ladder.push_back(level_json(L));
+  j["refinement"] = ladder;
+  j["max_force_relative_difference"] = fine.max_force_relative_difference;
+  j["contact_duration_relative_difference"] = rel(fine.run.contact_duration_s, r.analytic_duration_s);
+  j["impulse_relative_difference"] = rel(fine.run.impulse_Ns, r.analytic_impulse_Ns);
+  j["vibration_energy_fraction"] = r.impact_energy_J > 0 ? fine.run.vibration_energy_J / r.impact_energy_J : 0.0;
+  j["restitution_assumed_loss_fraction"] = r.assumed_loss_fraction;
+  if (r.hybrid_deck && r.hybrid_check) {
+    const auto& c = *r.hybrid_check;
+    json probes = json::array();
+    if (c.stress) {
+      for (const auto& p : c.stress->probes)
+        probes.push_back({{"name", p.name}, {"point_m", v3(p.point_m)}, {"max_von_mises_Pa", p.max_von_mises_Pa}});
+    }
+    j["hybrid_run"] = {{"max_force_N", r.hybrid_max_force_N},
+                       {"wall_time_s", c.solver_wall_time_s},
+                       {"node_count", r.hybrid_deck->node_count},
+                       {"increments", r.hybrid_increments},
+                       {"delta_velocity_m_s", {{"target", v3(r.hybrid_target_dv)}}},
+                       {"delta_angular_velocity_rad_s", {{"target", v3(r.hybrid_target_dw)}}},
+                       {"probes", probes},
+                       {"checks_passed", c.passed},
+                       {"folder", r.hybrid_deck->folder.string()}};
+    j["wall_time_ratio_full_over_hybrid"] =
+        c.solver_wall_time_s > 0 ? json(fine.run.wall_time_s / c.solver_wall_time_s) : json(nullptr);
+  } else {
+    j["hybrid_run"] = nullptr;
+    j["wall_time_ratio_full_over_hybrid"] = nullptr;
+  }
+  if (r.verdict == CompareVerdict::disagree) {
+    j["in_doubt"] = r.in_doubt;
+    j["explanation"] = r.explanation;
+  }
+  json files = json::array();
+  for (const auto& f : r.files) files.push_back(f.string());
+  j["files"] = files;
+  j["warnings"] = r.warnings;
+  return j;
+}
+
+std::string format_compare(const CompareReport& r) {
+  std::ostringstream o;
+  o << "impact '" << r.impact << "': '" << r.impactor << "' hits '" << r.target << "'\n";
+  if (r.verdict == CompareVerdict::non_hertzian) {
+    o << "  not a Hertzian contact: " << r.non_hertzian_reason << "\n  " << r.explanation << "\n";
+    return o.str();
+  }
+  o << "  analytic (elastic Hertz): F_max " << r.analytic_max_force_N << " N, duration " << r.analytic_duration_s * 1e6
+    << " us, impulse " << r.analytic_impulse_Ns << " N s\n";
+  o << "  refinement (elements across the contact semi-axis b, F_max, difference, nodes, wall time):\n";
+  for (const auto& L : r.ladder) {
+    o << "    " << L.contact_elements << "  " << L.run.max_force_N << " N  " << 100 * L.max_force_relative_difference
+      << " %  " << L.deck.node_count << " nodes  " << L.run.wall_time_s << " s\n";
+  }
+  const ContactLevel& f = r.ladder.back();
+  o << "  full contact: duration " << f.run.contact_duration_s * 1e6 << " us ("
+    << 100 * rel(f.run.contact_duration_s, r.analytic_duration_s) << " %), impulse " << f.run.impulse_Ns << " N s ("
+    << 100 * rel(f.run.impulse_Ns, r.analytic_impulse_Ns) << " %), momentum error "
+    << f.run.linear_momentum_relative_error << "\n";
+  o << "  vibration energy left: " << 100 * (r.impact_energy_J > 0 ? f.run.vibration_energy_J / r.impact_energy_J : 0)
+    << " % of the impact energy; the restitution model assumes a loss of " << 100 * r.assumed_loss_fraction << " %\n";
+  if (r.hybrid_check) {
+    o << "  hybrid: F_max applied " << r.hybrid_max_force_N << " N, " << r.hybrid_deck->node_count << " nodes, "
+      << r.hybrid_check->solver_wall_time_s << " s; full/hybrid wall time "
+      << f.run.wall_time_s / std::max(r.hybrid_check->solver_wall_time_s, 1e-9) << "\n";
+  }
+  o << "  verdict: " << to_string(r.verdict);
+  if (r.verdict == CompareVerdict::disagree) o << " (in doubt: " << r.in_doubt << "): " << r.explanation;
+  o << "\n";
+  for (const auto& w : r.warnings) o << "  warning: " << w << "\n";
+  return o.str();
+}
+
+}  // namespace impactdeck::scene
