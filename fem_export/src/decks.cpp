@@ -531,9 +531,9 @@ DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
       mo.load_zone_radius_m = std::max(mo.load_zone_radius_m, 1.25 * r.patch.a_max_m);
     }
     const auto t_mesh = std::chrono::steady_clock::now();
-    // A CAD part is meshed from its B-rep with Gmsh's 2D algorithms 6, 1 and 5 in turn; when all
-    // fail (e.g. "overlapping facets" on a face), from its search triangulation through the part
-    // route, with that route's own fallbacks. Every try is recorded.
+    // A CAD part is meshed from its B-rep with Gmsh's 2D algorithms 6, 1 and 5 in turn (a face
+    // one algorithm cannot mesh, e.g. "overlapping facets", another often can). Every try is
+    // recorded. (The B-rep's search triangulation is no fallback: its faces are not sewn.)
     auto mesh_cad_with_fallback = [&] {
       std::vector<MeshAttempt> failed;
       for (int alg : {6, 1, 5}) {
@@ -545,15 +545,10 @@ DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
           return res;
         } catch (const InputError& e) {
           failed.push_back({"cad", m.algorithm_2d, m.algorithm_3d, m.mesh_size_m, m.load_mesh_size_m, e.reason()});
-          if (mo.algorithm_2d) break;  // the user's algorithm only
+          if (mo.algorithm_2d || alg == 5) throw;  // the user's algorithm only, or the last one
         }
       }
-      if (r.body.surface.triangles.empty()) {
-        throw InputError(r.body.cad.string(), "gmsh mesh", "every try on the B-rep failed: " + failed.back().outcome);
-      }
-      MeshResult res = mesh_part(r.body.surface, r.load_point_m, mo, stage, "mesh", r.body.cad.string());
-      res.quality.attempts.insert(res.quality.attempts.begin(), failed.begin(), failed.end());
-      return res;
+      throw InputError(r.body.cad.string(), "gmsh mesh", "every try on the B-rep failed");
     };
     auto mesh_once = [&] {
       switch (r.body.kind) {

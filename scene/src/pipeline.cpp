@@ -262,8 +262,6 @@ fem_export::DeckRequest fem_request(const Scene& scene, const ImpactReport& ir, 
         r.body.cad = b.mesh_path;
         // STEP/IGES: OpenCASCADE reads them in mm; a BREP is in the scene's unit.
         r.body.cad_unit_m = cad->file_unit() ? 1e-3 : metres_per(scene.length_unit);
-        r.body.surface.vertices_m = cad->triangulation().mesh().vertices_m;  // the fallback
-        r.body.surface.triangles = cad->triangulation().mesh().triangles;
         break;
       }
       const auto* part = dynamic_cast<const geometry::MeshShape*>(target.shape.get());

@@ -40,9 +40,7 @@ struct DeckBody {
   Eigen::Vector3d semi_axes_m = Eigen::Vector3d::Zero();  ///< ellipsoid, centred at the origin
   std::filesystem::path cad;  ///< cad: the part file
   double cad_unit_m = 1e-3;   ///< cad: metres per file coordinate unit (a BREP; STEP/IGES state theirs)
-  /// part: the loaded, validated (and repaired) triangulation, target frame; cad: the B-rep's
-  /// search triangulation, the fallback when Gmsh cannot mesh the B-rep itself.
-  PartSurface surface;
+  PartSurface surface;  ///< part: the loaded, validated (and repaired) triangulation, target frame
   std::string name;     ///< part: its file, named in messages
   /// Volume of the body, m^3, for the element-count estimate; 0: from the semi-axes (ellipsoid).
   double volume_m3 = 0;
