@@ -4,6 +4,7 @@
 #include <memory>
 
 #include "commands.hpp"
+#include "set_option.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/scene/pipeline.hpp"
 #include "impactdeck/scene/report.hpp"
@@ -17,14 +18,19 @@ void register_run(CLI::App& app, Context& ctx) {
     std::string scene;
     bool json = false;
     std::string out = ".";
+    std::vector<std::string> set;
+    int threads = 1;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand("run", "Run a scene: impacts, force tables and decks it asks for");
   cmd->add_option("scene", args->scene, "Scene file (TOML, docs/scene-format.md)")->required();
   cmd->add_flag("--json", args->json, "Print one JSON document on stdout (keys: docs/cli.md)");
   cmd->add_option("--out", args->out, "Output folder (created if missing; default: current folder)");
+  add_set_option(cmd, args->set);
+  cmd->add_option("--threads", args->threads, "ccx threads when the scene runs calculix (default 1)")
+      ->check(CLI::Range(1, 1024));
   cmd->callback([args, &ctx] {
-    const scene::Scene sc = scene::load_scene(args->scene);
+    const scene::Scene sc = scene::load_scene(args->scene, overrides_from(args->set));
     std::error_code ec;
     fs::create_directories(args->out, ec);
     if (!fs::is_directory(args->out)) {
@@ -32,6 +38,7 @@ void register_run(CLI::App& app, Context& ctx) {
     }
     scene::RunOptions opt;
     opt.out_dir = args->out;
+    opt.ccx_threads = args->threads;
     opt.progress = &std::cerr;  // ccx progress when [outputs.fem] run = "calculix"
     const scene::RunReport rep = scene::run_scene(sc, opt);
     if (args->json) {

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "commands.hpp"
+#include "set_option.hpp"
 #include "impactdeck/common/atomic_file.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/geometry/ellipsoid.hpp"
@@ -50,6 +51,7 @@ void register_study(CLI::App& app, Context& ctx) {
     std::uint64_t seed = 1;
     unsigned threads = 0;
     bool json = false, quiet = false, no_png = false;
+    std::vector<std::string> set;  // --set, with --scene
   };
   auto a = std::make_shared<Args>();
   CLI::App* study = app.add_subcommand("study", "Configuration studies");
@@ -61,6 +63,7 @@ void register_study(CLI::App& app, Context& ctx) {
   cmd->add_option("--mass-ratios", a->mu, "Comma-separated m1/m2 values (columns)");
   cmd->add_option("--size-ratio", a->size_ratio, "Smaller semi-axis / sphere radius (paper preset: 20)");
   cmd->add_option("--radius-rule", a->rule, "Local radius rule: paper (Eq. 26, the sphere's radius) | mean (mean curvature) | elliptical (both curvature tensors)");
+  add_set_option(cmd, a->set);
   cmd->add_option("--scene", a->scene,
                   "Scene file (TOML) giving the target, impactor, materials and speed instead of the paper's "
                   "ellipsoid and sphere (docs/study.md)");
@@ -105,13 +108,14 @@ void register_study(CLI::App& app, Context& ctx) {
       else if (a->cloud == "vertices") o.cloud = study::CloudKind::vertices;
       else throw UsageError("--cloud: expected grid, uniform, both or vertices, got \"" + a->cloud + "\"");
     }
+    if (!a->set.empty() && a->scene.empty()) throw UsageError("--set needs --scene");
     if (!a->scene.empty()) {
       int axis;
       if (a->stretch_axis.empty() || a->stretch_axis == "x") axis = 0;
       else if (a->stretch_axis == "y") axis = 1;
       else if (a->stretch_axis == "z") axis = 2;
       else throw UsageError("--stretch-axis: expected x, y or z, got \"" + a->stretch_axis + "\"");
-      study::Table1Scene ts = study::table1_scene_from(scene::load_scene(a->scene), a->impact, axis);
+      study::Table1Scene ts = study::table1_scene_from(scene::load_scene(a->scene, overrides_from(a->set)), a->impact, axis);
       const bool analytic = dynamic_cast<const geometry::Ellipsoid*>(ts.setup.target.shape.get()) != nullptr;
       if (a->cloud.empty()) o.cloud = analytic ? study::CloudKind::paper_grid : study::CloudKind::area_uniform;
       o.scene = std::move(ts);

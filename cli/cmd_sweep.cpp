@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
+#include "set_option.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/plot/drawing.hpp"
 #include "impactdeck/scene/scene.hpp"
@@ -46,6 +47,7 @@ void register_sweep(CLI::App& app, Context& ctx) {
     bool curves = false, json = false, quiet = false, no_png = false;
     std::size_t curve_samples = 201;
     unsigned threads = 0;
+    std::vector<std::string> set;
   };
   auto a = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
@@ -69,8 +71,9 @@ void register_sweep(CLI::App& app, Context& ctx) {
   cmd->add_flag("--no-png", a->no_png, "Do not render the PNG picture");
   cmd->add_flag("--json", a->json, "Print a JSON summary on stdout");
   cmd->add_flag("--quiet", a->quiet, "No progress bar");
+  add_set_option(cmd, a->set);
   cmd->callback([a, &ctx] {
-    const scene::Scene sc = scene::load_scene(a->scene);
+    const scene::Scene sc = scene::load_scene(a->scene, overrides_from(a->set));
     const study::SceneSweep ss = study::sweep_from_scene(sc, a->impact);
     const scene::ImpactSpec& imp = *ss.impact;
 

@@ -291,6 +291,8 @@ fem_export::DeckRequest fem_request(const Scene& scene, const ImpactReport& ir, 
   r.options.time_step_s = f.time_step_s;
   r.options.code_aster = f.code_aster;
   r.options.calculix = f.calculix;
+  r.options.aster_cpus = f.aster_cpus;
+  r.options.aster_mpi_processes = f.aster_mpi_processes;
   r.options.mesh.mesh_size_m = f.mesh_size_m.value_or(
       b.shape == ShapeKind::mesh ? 0.25 * target.shape->size_m() : 0.5 * r.body.semi_axes_m.minCoeff());
   r.options.adapt_mesh_size = !f.mesh_size_m;
@@ -449,6 +451,7 @@ RunReport run_scene(const Scene& scene, const RunOptions& opt) {
             }
             fem_export::CheckOptions co;
             co.progress = opt.progress;
+            co.threads = opt.ccx_threads;
             ir.fem_check = fem_export::run_check(ir.fem_deck->folder, co);
           }
         });

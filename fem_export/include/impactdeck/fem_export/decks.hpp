@@ -94,6 +94,8 @@ struct DeckOptions {
   int pulse_increments = 100;
   bool code_aster = true;      ///< write impact.comm, impact.export and mesh.med
   bool calculix = true;        ///< write impact.inp and mesh.inp
+  int aster_cpus = 1;           ///< impact.export `P ncpus` (OpenMP threads of each Code_Aster process)
+  int aster_mpi_processes = 1;  ///< impact.export `P mpi_nbcpu` (MPI processes)
   MeshOptions mesh;
   /// The mesh size is a default, not the user's: while the FE body's volume or inertia (of the
   /// tetrahedra, or of ccx's mass matrix) differs from the part's by more than half its

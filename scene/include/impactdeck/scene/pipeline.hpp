@@ -46,6 +46,7 @@ struct RunReport {
 struct RunOptions {
   std::filesystem::path out_dir = ".";  ///< outputs are written here (must exist)
   std::ostream* progress = nullptr;     ///< solver progress lines (e.g. &std::cerr)
+  int ccx_threads = 1;                  ///< [outputs.fem] run = "calculix": OMP threads of ccx
 };
 
 /// Builds the shape of a body (analytic or mesh). Throws InputError.

@@ -1,0 +1,204 @@
+#include "impactdeck/scene/overrides.hpp"
+
+#include <cctype>
+#include <fstream>
+#include <sstream>
+
+#include "impactdeck/common/error.hpp"
+#include "overrides_toml.hpp"
+#include "toml_ascii.hpp"
+
+namespace impactdeck::scene {
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Segment {
+  std::string name;
+  std::vector<std::size_t> indices;  ///< `name[i][j]`
+};
+
+[[noreturn]] void bad_key(const std::string& where, const std::string& key, const std::string& reason) {
+  throw InputError(where, "--set " + key, reason);
+}
+
+bool bare_key_char(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-'; }
+
+// "a.b[1].c" -> {a}, {b,[1]}, {c}. Bare TOML keys only (letters, digits, '_' and '-').
+std::vector<Segment> split_key(const std::string& key, const std::string& where) {
+  std::vector<Segment> out;
+  std::size_t i = 0;
+  const std::string expect = "a dotted key path such as bodies[1].velocity_m_s";
+  while (true) {
+    Segment s;
+    while (i < key.size() && bare_key_char(key[i])) s.name += key[i++];
+    if (s.name.empty()) bad_key(where, key, "malformed key (expected " + expect + ")");
+    while (i < key.size() && key[i] == '[') {
+      const std::size_t close = key.find(']', i);
+      const std::string digits = close == std::string::npos ? "" : key.substr(i + 1, close - i - 1);
+      if (digits.empty() || digits.size() > 6 ||
+          digits.find_first_not_of("0123456789") != std::string::npos) {
+        bad_key(where, key, "malformed array index (expected [0], [1], ...)");
+      }
+      s.indices.push_back(static_cast<std::size_t>(std::stoul(digits)));
+      i = close + 1;
+    }
+    out.push_back(std::move(s));
+    if (i == key.size()) return out;
+    if (key[i] != '.') bad_key(where, key, "malformed key (expected " + expect + ")");
+    ++i;
+  }
+}
+
+std::string describe(const std::vector<Segment>& segs, std::size_t upto, std::size_t indices) {
+  std::string s;
+  for (std::size_t k = 0; k <= upto && k < segs.size(); ++k) {
+    if (k) s += '.';
+    s += segs[k].name;
+    const std::size_t n = k == upto ? indices : segs[k].indices.size();
+    for (std::size_t j = 0; j < n; ++j) s += "[" + std::to_string(segs[k].indices[j]) + "]";
+  }
+  return s;
+}
+
+// The value text parsed as TOML: `v = VALUE`.
+toml::table parse_value(const Override& o, const std::string& where) {
+  const std::string doc = "v = " + o.value + "\n";
+  try {
+    toml::table t = toml::parse(detail::toml_ascii(doc, "--set " + o.key), "--set " + o.key);
+    if (t.size() != 1 || !t.contains("v")) throw InputError("", "", "");
+    return t;
+  } catch (const toml::parse_error& e) {
+    bad_key(where, o.key, "value '" + o.value + "' is not a TOML value (" + std::string(e.description()) +
+                              "; strings need quotes: KEY='\"text\"')");
+  } catch (const InputError&) {
+    bad_key(where, o.key, "value '" + o.value + "' is not one TOML value (strings need quotes: KEY='\"text\"')");
+  }
+}
+
+void apply_one(toml::table& root, const Override& o, const std::string& where) {
+  const std::vector<Segment> segs = split_key(o.key, where);
+  toml::table value_doc = parse_value(o, where);
+  toml::node& value = *value_doc.get("v");
+  toml::node* cur = &root;
+  for (std::size_t k = 0; k < segs.size(); ++k) {
+    const Segment& s = segs[k];
+    toml::table* t = cur->as_table();
+    if (!t) bad_key(where, o.key, "'" + describe(segs, k - 1, segs[k - 1].indices.size()) + "' is not a table");
+    const bool last = k + 1 == segs.size();
+    if (last && s.indices.empty()) {
+      value.visit([&](auto&& v) { t->insert_or_assign(s.name, std::move(v)); });
+      return;
+    }
+    toml::node* child = t->get(s.name);
+    if (!child) {
+      if (!s.indices.empty()) bad_key(where, o.key, "there is no array '" + describe(segs, k, 0) + "'");
+      child = &t->insert_or_assign(s.name, toml::table{}).first->second;
+    }
+    for (std::size_t j = 0; j < s.indices.size(); ++j) {
+      toml::array* a = child->as_array();
+      if (!a) bad_key(where, o.key, "'" + describe(segs, k, j) + "' is not an array");
+      const std::size_t idx = s.indices[j];
+      if (idx >= a->size()) {
+        bad_key(where, o.key, "index " + std::to_string(idx) + " out of range: '" + describe(segs, k, j) + "' has " +
+                                  std::to_string(a->size()) + " element" + (a->size() == 1 ? "" : "s"));
+      }
+      if (last && j + 1 == s.indices.size()) {
+        value.visit([&](auto&& v) { a->replace(a->cbegin() + static_cast<std::ptrdiff_t>(idx), std::move(v)); });
+        return;
+      }
+      child = a->get(idx);
+    }
+    cur = child;
+  }
+}
+
+// The key named by an InputError's place ("line 3, key 'bodies[0].radius'"), or "".
+std::string error_key(const std::string& place) {
+  const std::string tag = "key '";
+  const std::size_t b = place.find(tag);
+  if (b == std::string::npos) return "";
+  const std::size_t e = place.find('\'', b + tag.size());
+  return e == std::string::npos ? "" : place.substr(b + tag.size(), e - b - tag.size());
+}
+
+bool under(const std::string& key, const std::string& root) {
+  if (key.size() < root.size() || key.compare(0, root.size(), root) != 0) return false;
+  return key.size() == root.size() || key[root.size()] == '.' || key[root.size()] == '[';
+}
+
+}  // namespace
+
+Override parse_override(const std::string& text) {
+  const std::size_t eq = text.find('=');
+  if (eq == std::string::npos) throw InputError("--set", text, "expected KEY=VALUE");
+  Override o{text.substr(0, eq), text.substr(eq + 1)};
+  while (!o.key.empty() && std::isspace(static_cast<unsigned char>(o.key.back()))) o.key.pop_back();
+  while (!o.key.empty() && std::isspace(static_cast<unsigned char>(o.key.front()))) o.key.erase(0, 1);
+  if (o.key.empty()) throw InputError("--set", text, "the key before '=' is empty");
+  split_key(o.key, "--set");  // syntax check now, where the message can name the flag
+  return o;
+}
+
+namespace detail {
+
+void apply_overrides(toml::table& root, const std::vector<Override>& overrides, const std::string& file) {
+  for (const Override& o : overrides) apply_one(root, o, file);
+}
+
+void rethrow_naming_override(const std::vector<Override>& overrides) {
+  try {
+    throw;
+  } catch (const InputError& e) {
+    const std::string key = error_key(e.place());
+    // The last override wins, so it is the one to name.
+    for (auto o = overrides.rbegin(); !key.empty() && o != overrides.rend(); ++o) {
+      if (!under(key, o->key)) continue;
+      std::string place = "--set " + o->key;
+      if (key != o->key) place += " (key '" + key + "')";
+      throw InputError(e.where(), place, e.reason());
+    }
+    throw;
+  }
+}
+
+}  // namespace detail
+
+std::string resolved_scene_text(const fs::path& file, const std::vector<Override>& overrides) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in || fs::is_directory(file)) throw InputError(file.string(), "file", "cannot be opened (missing or unreadable)");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  toml::table root;
+  try {
+    root = toml::parse(detail::toml_ascii(ss.str(), file.string()), file.string());
+  } catch (const toml::parse_error& e) {
+    std::ostringstream place;
+    place << "line " << e.source().begin.line << ", column " << e.source().begin.column;
+    throw InputError(file.string(), place.str(), "TOML syntax error: " + std::string(e.description()));
+  }
+  detail::apply_overrides(root, overrides, file.string());
+  // Part paths are relative to the scene file: make them absolute so the text stands alone.
+  const fs::path base = fs::absolute(file).parent_path();
+  if (toml::array* bodies = root["bodies"].as_array()) {
+    for (toml::node& b : *bodies) {
+      toml::table* t = b.as_table();
+      if (!t) continue;
+      if (const auto* mesh = t->get_as<std::string>("mesh")) {
+        const fs::path p(mesh->get());
+        if (!p.empty() && p.is_relative()) t->insert_or_assign("mesh", (base / p).lexically_normal().string());
+      }
+    }
+  }
+  std::ostringstream out;
+  out << "# " << file.filename().string() << " resolved by impactdeck";
+  for (const Override& o : overrides) {
+    std::string v = o.value;
+    for (char& c : v) c = (c == '\n' || c == '\r') ? ' ' : c;
+    out << "\n#   --set " << o.key << "=" << v;
+  }
+  out << "\n" << root << "\n";
+  return out.str();
+}
+
+}  // namespace impactdeck::scene
