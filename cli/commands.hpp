@@ -15,5 +15,6 @@ void register_study(CLI::App& app, Context& ctx);
 void register_inspect(CLI::App& app, Context& ctx);
 void register_mesh_ellipsoid(CLI::App& app, Context& ctx);
 void register_fem_check(CLI::App& app, Context& ctx);
+void register_campaign(CLI::App& app, Context& ctx);
 
 }  // namespace impactdeck::cli
