@@ -131,7 +131,7 @@ class FileReader {
       if (std::none_of(keys.begin(), keys.end(), [&](const char* a) { return key == a; })) {
         std::string list;
         for (const char* a : keys) list += (list.empty() ? "" : ", ") + std::string(a);
-        fail(&v, table + "." + key, "unknown key (allowed here: " + list + ")");
+        fail(&v, table.empty() ? key : table + "." + key, "unknown key (allowed here: " + list + ")");
       }
     }
   }
@@ -182,6 +182,7 @@ Campaign read_campaign(const fs::path& file) {
   if (!sn->is_string() || sn->as_string()->get().empty()) fr.fail(sn, "scene", "must be a file name (string)");
   const fs::path base_dir = fs::absolute(file).parent_path();
   c.scene = (base_dir / sn->as_string()->get()).lexically_normal();
+  if (!fs::is_regular_file(c.scene, ec)) fr.fail(sn, "scene", "no scene file " + c.scene.string());
   const scene::Scene base = scene::load_scene(c.scene);  // its own errors name the scene file
 
   std::size_t impact = 0;
