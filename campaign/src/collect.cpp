@@ -68,8 +68,9 @@ const std::vector<std::pair<std::string, std::string>>& result_columns() {
       {"fem_linear_momentum_relative_error", "/fem/check/linear_momentum_relative_error"},
       {"fem_angular_momentum_relative_error", "/fem/check/angular_momentum_relative_error"},
       {"fem_check_passed", "/fem/check/passed"},
-      {"peak_von_mises_Pa", "/fem/check/stress/verdict/governing/von_mises_Pa"},
+      {"peak_von_mises_Pa", "/fem/check/stress/verdict/governing/max_von_mises_Pa"},
       {"verdict", "/fem/check/stress/verdict/result"},
+      {"safety_factor", "/fem/check/stress/verdict/safety_factor"},
   };
   return c;
 }
@@ -234,9 +235,9 @@ CollectResult collect(const fs::path& dir_in) {
   // The worst case: the largest peak von Mises where every done case has one, else max force.
   bool all_stress = out.done > 0;
   for (const Row& r : rows)
-    if (r.state == CaseState::done && !at(r.impact, "/fem/check/stress/verdict/governing/von_mises_Pa").is_number())
+    if (r.state == CaseState::done && !at(r.impact, "/fem/check/stress/verdict/governing/max_von_mises_Pa").is_number())
       all_stress = false;
-  const char* worst_key = all_stress ? "/fem/check/stress/verdict/governing/von_mises_Pa" : "/max_force_N";
+  const char* worst_key = all_stress ? "/fem/check/stress/verdict/governing/max_von_mises_Pa" : "/max_force_N";
   double worst = -1;
   for (const Row& r : rows) {
     const json v = at(r.impact, worst_key);
