@@ -18,7 +18,7 @@
 #include "impactdeck/scene/pipeline.hpp"
 #include "impactdeck/scene/report.hpp"
 #include "impactdeck/scene/scene.hpp"
-#include "lock.hpp"
+#include "detail.hpp"
 
 namespace impactdeck::campaign {
 namespace fs = std::filesystem;

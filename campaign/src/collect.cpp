@@ -15,7 +15,7 @@
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/plot/drawing.hpp"
 #include "impactdeck/scene/scene.hpp"
-#include "lock.hpp"
+#include "detail.hpp"
 
 namespace impactdeck::campaign {
 namespace fs = std::filesystem;

@@ -18,7 +18,7 @@
 #include "impactdeck/common/atomic_file.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/study/progress.hpp"
-#include "lock.hpp"
+#include "detail.hpp"
 
 extern char** environ;
 
@@ -100,8 +100,7 @@ bool on_path(const std::string& program) {
 }  // namespace
 
 int RunSummary::exit_code() const {
-  if (failed > 0) return static_cast<int>(ExitCode::invalid_input);
-  if (other > 0) return static_cast<int>(ExitCode::internal_error);
+  if (failed > 0 || other > 0) return static_cast<int>(ExitCode::invalid_input);  // other: refused (locked)
   if (checks_failed > 0) return static_cast<int>(ExitCode::check_failed);
   return 0;
 }

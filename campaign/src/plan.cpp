@@ -1,5 +1,4 @@
 // `campaign plan`: case folders with their resolved scenes, and campaign.json.
-#include <fstream>
 #include <iomanip>
 #include <set>
 #include <sstream>
@@ -11,21 +10,10 @@
 #include "impactdeck/common/atomic_file.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/scene/scene.hpp"
+#include "detail.hpp"
 
 namespace impactdeck::campaign {
 namespace fs = std::filesystem;
-
-namespace {
-
-std::string read_bytes(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  if (!in) throw InputError(p.string(), "file", "cannot be opened (missing or unreadable)");
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-}  // namespace
 
 std::string fnv1a64_hex(const std::string& bytes, std::uint64_t h) {
   for (unsigned char c : bytes) {
@@ -53,11 +41,11 @@ PlanResult plan_campaign(const Campaign& c, const fs::path& dir_in) {
   std::vector<std::string> texts;
   texts.reserve(c.cases.size());
   for (const Case& k : c.cases) texts.push_back(scene::resolved_scene_text(c.scene, k.overrides));
-  std::string all = read_bytes(c.file) + '\0' + read_bytes(c.scene);
+  std::string all = detail::read_text(c.file) + '\0' + detail::read_text(c.scene);
   std::set<fs::path> parts;
   for (const auto& b : scene::load_scene(c.scene).bodies)
     if (!b.mesh_path.empty()) parts.insert(b.mesh_path);
-  for (const auto& p : parts) all += '\0' + read_bytes(p);
+  for (const auto& p : parts) all += '\0' + detail::read_text(p);
   std::vector<std::string> case_hashes;
   for (const auto& t : texts) {
     case_hashes.push_back(fnv1a64_hex(t));
@@ -71,7 +59,7 @@ PlanResult plan_campaign(const Campaign& c, const fs::path& dir_in) {
   if (fs::exists(dir / "campaign.json", ec)) {
     nlohmann::json old;
     try {
-      old = nlohmann::json::parse(read_bytes(dir / "campaign.json"));
+      old = nlohmann::json::parse(detail::read_text(dir / "campaign.json"));
     } catch (const nlohmann::json::exception&) {
       throw InputError((dir / "campaign.json").string(), "file", "is not valid JSON");
     }

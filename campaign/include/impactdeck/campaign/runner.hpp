@@ -43,7 +43,7 @@ struct LocalOptions {
 
 struct RunSummary {
   std::size_t total = 0, done = 0, failed = 0, skipped = 0, checks_failed = 0, other = 0;
-  int exit_code() const;  ///< 3 if a case failed, 4 if a check failed, else 0 (1: a case not run)
+  int exit_code() const;  ///< 3 if a case failed or was refused (locked elsewhere), 4 if a check failed, else 0
 };
 
 /// Runs every case that is not done, `jobs` at a time, each as a child process
