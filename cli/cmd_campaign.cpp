@@ -58,10 +58,10 @@ void register_campaign(CLI::App& app, Context& ctx) {
       ->allow_extra_args(false);
   run->add_flag("--dry-run", a->dry_run, "slurm: write campaign.sbatch, do not submit");
   run->add_flag("--quiet", a->quiet, "No progress bar");
-  run->callback([a, &ctx] {
+  run->callback([a, run, &ctx] {
     if (a->executor == "slurm") {
       campaign::SlurmOptions o;
-      o.max_parallel = a->jobs > 1 ? a->jobs : 0;
+      o.max_parallel = run->count("--jobs") > 0 ? a->jobs : 0;  // no --jobs: no %K limit
       o.cpus_per_task = a->cpus_per_task > 0 ? a->cpus_per_task : a->threads;
       o.sbatch_lines = a->sbatch;
       o.executable = self_executable();

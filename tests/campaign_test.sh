@@ -74,7 +74,8 @@ check "the worst case is copied with its files" '[ -f clean/collect/worst_case/r
 out=$("$bin" campaign run-case killed 4)
 check "run-case of a done case does nothing" '[ "$out" = "case 4: already done" ]'
 "$bin" campaign run-case killed 12 >/dev/null 2>err.txt
-check "run-case of an unknown id exits 3 naming it" '[ $? = 3 ] || true; grep -q "case 12: no such case (the campaign has 12" err.txt'
+rc=$?
+check "run-case of an unknown id exits 3 naming it" '[ $rc = 3 ] && grep -q "case 12: no such case (the campaign has 12" err.txt'
 
 # A failing case: published as failed with its reason, the others run.
 cat >f.toml <<'TOML'
@@ -85,7 +86,8 @@ TOML
 "$bin" campaign plan f.toml --out failing >/dev/null
 rm failing/cases/0/scene.toml
 "$bin" campaign run failing --quiet >/dev/null 2>&1
-check "a failed case makes run exit 3" '[ $? = 3 ]'
+rc=$?
+check "a failed case makes run exit 3" '[ $rc = 3 ]'
 "$bin" campaign collect failing >/dev/null
 check "the table gives the failure's reason" 'grep -q "^0,failed,.*scene.toml: file: cannot be opened" failing/collect/cases.csv'
 
