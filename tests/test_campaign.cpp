@@ -115,6 +115,23 @@ TEST(Overrides, ResolvedTextStandsAloneAndReadsBackTheSame) {
   }
 }
 
+TEST(Overrides, ResolvedTextKeepsStringsAndNumbersExactly) {
+  TempDir tmp;
+  // Quotes, a backslash, a tab, non-ASCII; floats that need 17 digits, tiny and huge ones.
+  const std::string name = "hit \"one\" \\ \xc3\xa9\t";
+  const std::vector<scene::Override> o = {{"impacts[0].name", "\"hit \\\"one\\\" \\\\ \xc3\xa9\\t\""},
+                                          {"bodies[1].velocity_m_s", "[-0.1, 1e-300, 0.30000000000000004]"},
+                                          {"bodies[0].radius", "12345678.9"}};
+  write(tmp.path / "scene.toml", scene::resolved_scene_text(kTwoSpheres, o));
+  const scene::Scene a = scene::load_scene(tmp.path / "scene.toml");
+  const scene::Scene b = scene::load_scene(kTwoSpheres, o);
+  EXPECT_EQ(a.impacts[0].name, name);
+  EXPECT_EQ(b.impacts[0].name, name);
+  EXPECT_EQ(a.bodies[1].velocity_m_s, b.bodies[1].velocity_m_s);  // bit for bit
+  EXPECT_EQ(a.bodies[1].velocity_m_s.z(), 0.30000000000000004);
+  EXPECT_EQ(a.bodies[0].radius_m, b.bodies[0].radius_m);
+}
+
 TEST(CampaignFile, ProductIsRowMajorWithTheLastKeyFastest) {
   TempDir tmp;
   fs::copy_file(kTwoSpheres, tmp.path / "base.toml");

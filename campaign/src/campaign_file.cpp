@@ -15,6 +15,7 @@
 #include "impactdeck/scene/pipeline.hpp"
 #include "impactdeck/scene/scene.hpp"
 #include "impactdeck/study/cloud.hpp"
+#include "overrides_toml.hpp"  // scene/src: the TOML value writer
 #include "toml_ascii.hpp"  // scene/src: toml++ never sees non-ASCII text (why: that header)
 
 namespace impactdeck::campaign {
@@ -39,47 +40,8 @@ std::string place(const toml::node* n, const std::string& key) {
   return s.str();
 }
 
-bool bare(const std::string& k) {
-  return !k.empty() && std::all_of(k.begin(), k.end(), [](char c) {
-    return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-';
-  });
-}
-
-// The shortest text that reads back as exactly v (0.8, not 0.80000000000000004).
-std::string number_text(double v) {
-  std::string t;
-  for (int digits = 15; digits <= 17; ++digits) {
-    std::ostringstream s;
-    s << std::setprecision(digits) << v;
-    t = s.str();
-    if (std::strtod(t.c_str(), nullptr) == v) break;
-  }
-  if (t.find_first_of(".eEn") == std::string::npos) t += ".0";  // a TOML float, not an integer
-  return t;
-}
-
-// A TOML value as one line of text (what `--set KEY=VALUE` takes).
-std::string value_text(const toml::node& n) {
-  if (const toml::table* t = n.as_table()) {
-    std::string s = "{ ";
-    bool first = true;
-    for (const auto& [k, v] : *t) {
-      const std::string key(k.str());
-      s += (first ? "" : ", ") + (bare(key) ? key : "\"" + key + "\"") + " = " + value_text(v);
-      first = false;
-    }
-    return s + " }";
-  }
-  if (const toml::array* a = n.as_array()) {
-    std::string s = "[";
-    for (std::size_t i = 0; i < a->size(); ++i) s += (i ? ", " : "") + value_text(*a->get(i));
-    return s + "]";
-  }
-  if (const auto* d = n.as_floating_point()) return number_text(d->get());
-  std::ostringstream s;
-  n.visit([&](const auto& v) { s << v; });
-  return s.str();
-}
+std::string number_text(double v) { return scene::detail::toml_float_text(v); }
+std::string value_text(const toml::node& n) { return scene::detail::toml_value_text(n); }
 
 std::string vec_text(const Eigen::Vector3d& v) {
   return "[" + number_text(v.x() + 0.0) + ", " + number_text(v.y() + 0.0) + ", " + number_text(v.z() + 0.0) + "]";

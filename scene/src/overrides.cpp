@@ -1,6 +1,11 @@
 #include "impactdeck/scene/overrides.hpp"
 
+#include <algorithm>
 #include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <iomanip>
 #include <fstream>
 #include <sstream>
 
@@ -127,7 +132,102 @@ bool under(const std::string& key, const std::string& root) {
   return key.size() == root.size() || key[root.size()] == '.' || key[root.size()] == '[';
 }
 
+bool bare_key(const std::string& k) {
+  return !k.empty() && std::all_of(k.begin(), k.end(), bare_key_char);
+}
+
+std::string key_text(const std::string& k) {
+  return bare_key(k) ? k : detail::toml_value_text(toml::value<std::string>(k));
+}
+
+bool is_table_array(const toml::node& n) {
+  const toml::array* a = n.as_array();
+  return a && !a->empty() && a->is_array_of_tables();
+}
+
+void write_table(std::ostringstream& out, const toml::table& t, const std::string& path) {
+  for (const auto& [k, v] : t) {
+    if (v.is_table() || is_table_array(v)) continue;
+    out << key_text(std::string(k.str())) << " = " << detail::toml_value_text(v) << "\n";
+  }
+  for (const auto& [k, v] : t) {
+    const std::string sub = (path.empty() ? "" : path + ".") + key_text(std::string(k.str()));
+    if (const toml::table* st = v.as_table()) {
+      out << "\n[" << sub << "]\n";
+      write_table(out, *st, sub);
+    } else if (is_table_array(v)) {
+      for (const toml::node& e : *v.as_array()) {
+        out << "\n[[" << sub << "]]\n";
+        write_table(out, *e.as_table(), sub);
+      }
+    }
+  }
+}
+
 }  // namespace
+
+namespace detail {
+
+std::string toml_float_text(double v) {
+  if (std::isnan(v)) return "nan";
+  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  std::string t;
+  for (int digits = 15; digits <= 17; ++digits) {
+    std::ostringstream s;
+    s << std::setprecision(digits) << v;
+    t = s.str();
+    if (std::strtod(t.c_str(), nullptr) == v) break;
+  }
+  if (t.find_first_of(".eE") == std::string::npos) t += ".0";  // a TOML float, not an integer
+  return t;
+}
+
+std::string toml_value_text(const toml::node& n) {
+  if (const toml::table* t = n.as_table()) {
+    std::string s = "{ ";
+    bool first = true;
+    for (const auto& [k, v] : *t) {
+      s += (first ? "" : ", ") + key_text(std::string(k.str())) + " = " + toml_value_text(v);
+      first = false;
+    }
+    return first ? "{}" : s + " }";
+  }
+  if (const toml::array* a = n.as_array()) {
+    std::string s = "[";
+    for (std::size_t i = 0; i < a->size(); ++i) s += (i ? ", " : "") + toml_value_text(*a->get(i));
+    return s + "]";
+  }
+  if (const auto* d = n.as_floating_point()) return toml_float_text(d->get());
+  if (const auto* i = n.as_integer()) return std::to_string(i->get());
+  if (const auto* b = n.as_boolean()) return b->get() ? "true" : "false";
+  if (const auto* str = n.as_string()) {
+    std::string s = "\"";
+    for (unsigned char c : str->get()) {
+      if (c == '"' || c == '\\') {
+        s += '\\';
+        s += static_cast<char>(c);
+      } else if (c < 0x20 || c == 0x7f) {
+        char buf[8];
+        std::snprintf(buf, sizeof buf, "\\u%04x", c);
+        s += buf;
+      } else {
+        s += static_cast<char>(c);  // UTF-8 passes through
+      }
+    }
+    return s + "\"";
+  }
+  std::ostringstream s;  // dates and times: toml++ prints a single value without the column count
+  n.visit([&](const auto& v) { s << v; });
+  return s.str();
+}
+
+std::string toml_document_text(const toml::table& root) {
+  std::ostringstream out;
+  write_table(out, root, "");
+  return out.str();
+}
+
+}  // namespace detail
 
 Override parse_override(const std::string& text) {
   const std::size_t eq = text.find('=');
@@ -197,7 +297,7 @@ std::string resolved_scene_text(const fs::path& file, const std::vector<Override
     for (char& c : v) c = (c == '\n' || c == '\r') ? ' ' : c;
     out << "\n#   --set " << o.key << "=" << v;
   }
-  out << "\n" << root << "\n";
+  out << "\n" << detail::toml_document_text(root);
   return out.str();
 }
 
