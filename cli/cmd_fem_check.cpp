@@ -1,14 +1,22 @@
 // `impactdeck fem-check DIR [--json] [--ccx PATH] [--no-run] [--linear-tolerance X]
 // [--angular-tolerance X]`: run CalculiX on a deck folder written by `run` ([outputs.fem]) and
 // check that the body carries the impulse as linear and angular momentum (docs/fem.md).
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
 #include <iostream>
 #include <memory>
+#include <optional>
+#include <sstream>
 
+#include "cli_limits.hpp"
 #include "commands.hpp"
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/common/run_transaction.hpp"
 #include "impactdeck/fem_export/check.hpp"
 
 namespace impactdeck::cli {
+namespace fs = std::filesystem;
 
 void register_fem_check(CLI::App& app, Context& ctx) {
   struct Args {
@@ -26,14 +34,17 @@ void register_fem_check(CLI::App& app, Context& ctx) {
   cmd->add_option("--ccx", args->options.ccx, "CalculiX executable (default: ccx from PATH)");
   cmd->add_flag("--no-run", args->no_run, "Do not run ccx; check the existing impact.dat");
   cmd->add_option("--linear-tolerance", args->options.linear_tolerance,
-                  "Max relative error of the linear momentum (default: the deck's, 1e-3 unless the scene set it)")
-      ->check(CLI::PositiveNumber);
+                  "Max relative error of the linear momentum (default: the deck's, 1e-3 unless the scene set it)")->check(positive_number());
   cmd->add_option("--angular-tolerance", args->options.angular_tolerance,
-                  "Max relative error of the angular momentum (default: the deck's, 1e-2 unless the scene set it)")
-      ->check(CLI::PositiveNumber);
-  cmd->add_option("--threads", args->options.threads, "Threads for ccx (default 1)")->check(CLI::PositiveNumber);
+                  "Max relative error of the angular momentum (default: the deck's, 1e-2 unless the scene set it)")->check(positive_number());
+  cmd->add_option("--threads", args->options.threads, "Threads for ccx (default 1)")->check(positive_number());
   cmd->add_flag("--verbose", args->verbose, "Echo the settings on stderr");
+  cmd->add_option("--solver-timeout-s", args->options.timeout_s,
+                  "Wall-time limit of the ccx run (default: derived from the deck's size, stated in --json)")
+      ->check(positive_number());
   cmd->callback([args, &ctx] {
+    check_threads(static_cast<unsigned>(std::min(args->options.threads, 1 << 30)));
+    if (!std::isfinite(args->options.timeout_s)) throw UsageError("--solver-timeout-s must be a finite number of seconds");
     fem_export::CheckOptions o = args->options;
     o.run_solver = !args->no_run;
     o.progress = &std::cerr;
@@ -42,15 +53,56 @@ void register_fem_check(CLI::App& app, Context& ctx) {
                 << ", linear tolerance " << o.linear_tolerance << ", angular tolerance "
                 << o.angular_tolerance << ", threads " << o.threads << "\n";
     }
-    const fem_export::CheckResult r = fem_export::run_check(args->dir, o);
+    std::error_code ec;
+    if (!fs::is_directory(args->dir, ec)) throw InputError(args->dir, "deck folder", "does not exist");
+    // ccx runs in a private folder of a transaction on the deck folder: its results replace the
+    // folder's previous ones only when the run and the checks passed; otherwise nothing changes.
+    std::optional<RunTransaction> txn;
+    if (o.run_solver) {
+      txn.emplace(args->dir, "deck folder");
+      o.work_dir = txn->scratch("ccx");
+    }
+    fem_export::CheckResult r;
+    try {
+      r = fem_export::run_check(args->dir, o);
+    } catch (const InputError& e) {
+      if (txn) throw txn->public_error(e);
+      throw;
+    }
+    if (!r.passed) {
+      std::ostringstream m;
+      m << (fs::path(args->dir) / "impact.dat").string() << ": FEM check failed: ";
+      for (std::size_t i = 0; i < r.failures.size(); ++i) m << (i ? "; " : "") << r.failures[i];
+      m << (txn ? " (the deck folder was left as it was)" : "");
+      if (args->json) {
+        std::cout << fem_export::to_json(r).dump(2) << "\n";
+      } else {
+        std::cout << fem_export::format_check(r);
+      }
+      std::cerr << "impactdeck: error: " << m.str() << "\n";
+      ctx.exit_code = static_cast<int>(ExitCode::check_failed);
+      return;
+    }
+    if (txn) {
+      try {
+        for (const auto& f : r.solver_files) {
+          const fs::path staged = txn->file(f.filename().string(), args->dir, "ccx results");
+          fs::rename(f, staged);
+        }
+        txn->commit();
+      } catch (const InputError& e) {
+        throw txn->public_error(e);
+      }
+      for (auto& f : r.solver_files) f = fs::path(args->dir) / f.filename();
+      if (r.stress) {
+        for (auto& f : r.stress->files) f = fs::path(args->dir) / f.filename();
+      }
+      for (const auto& w : txn->warnings()) std::cerr << "impactdeck: warning: " << InputError::one_line(w) << "\n";
+    }
     if (args->json) {
       std::cout << fem_export::to_json(r).dump(2) << "\n";
     } else {
       std::cout << fem_export::format_check(r);
-    }
-    if (!r.passed) {
-      std::cerr << "impactdeck: error: FEM check failed: " << r.failures.front() << "\n";
-      ctx.exit_code = static_cast<int>(ExitCode::check_failed);
     }
   });
 }

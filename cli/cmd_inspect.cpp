@@ -7,6 +7,7 @@
 
 #include "commands.hpp"
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/common/numeric.hpp"
 #include "impactdeck/geometry/inspect.hpp"
 
 namespace impactdeck::cli {
@@ -38,6 +39,12 @@ void register_inspect(CLI::App& app, Context& /*ctx*/) {
   cmd->callback([args] {
     auto unit = parse_length_unit(args->unit);
     if (!unit) throw UsageError("--length-unit '" + args->unit + "': expected m, cm, mm or in");
+    // > 0 and within [1e-100, 1e100] (numeric.hpp): mass and inertia then stay finite.
+    if (args->density && !(*args->density > 0 && within_magnitude_range(*args->density)))
+      throw UsageError("--density-kg-m3 must be > 0 and within 1e-100 .. 1e+100");
+    if (args->mass && !(*args->mass > 0 && within_magnitude_range(*args->mass)))
+      throw UsageError("--mass-kg must be > 0 and within 1e-100 .. 1e+100");
+    if (!(args->sharp_deg > 0 && args->sharp_deg < 180)) throw UsageError("--sharp-angle-deg must lie in (0, 180)");
     const double to_m = metres_per(*unit);
     std::vector<Eigen::Vector3d> points;
     for (const auto& s : args->at) points.push_back(geometry::parse_point(s, to_m));
@@ -56,7 +63,7 @@ void register_inspect(CLI::App& app, Context& /*ctx*/) {
     const geometry::InspectReport rep = geometry::inspect_part(opt);
     if (args->json) {
       std::cout << rep.document.dump(2) << "\n";
-      for (const auto& w : rep.warnings) std::cerr << "impactdeck: warning: " << w << "\n";
+      for (const auto& w : rep.warnings) std::cerr << "impactdeck: warning: " << InputError::one_line(w) << "\n";
       return;
     }
     std::cout << rep.text;

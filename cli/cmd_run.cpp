@@ -1,8 +1,9 @@
 // `impactdeck run SCENE [--json] [--out DIR]`: compute what the scene asks for, nothing more.
-#include <filesystem>
+#include <cmath>
 #include <iostream>
 #include <memory>
 
+#include "cli_limits.hpp"
 #include "commands.hpp"
 #include "set_option.hpp"
 #include "impactdeck/common/error.hpp"
@@ -11,7 +12,6 @@
 #include "impactdeck/scene/scene.hpp"
 
 namespace impactdeck::cli {
-namespace fs = std::filesystem;
 
 void register_run(CLI::App& app, Context& ctx) {
   struct Args {
@@ -20,26 +20,28 @@ void register_run(CLI::App& app, Context& ctx) {
     std::string out = ".";
     std::vector<std::string> set;
     int threads = 1;
+    double solver_timeout_s = 0;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand("run", "Run a scene: impacts, force tables and decks it asks for");
   cmd->add_option("scene", args->scene, "Scene file (TOML, docs/scene-format.md)")->required();
   cmd->add_flag("--json", args->json, "Print one JSON document on stdout (keys: docs/cli.md)");
-  cmd->add_option("--out", args->out, "Output folder (created if missing; default: current folder)");
+  cmd->add_option("--out", args->out, "Output folder (created if missing; default: current folder). Everything "
+                  "a run writes appears there only when every stage and check passed (docs/reliability.md)");
+  cmd->add_option("--solver-timeout-s", args->solver_timeout_s,
+                  "Wall-time limit of each ccx run (default: derived from the deck's size, stated in --json)")
+      ->check(positive_number());
   add_set_option(cmd, args->set);
   cmd->add_option("--threads", args->threads, "ccx threads when the scene runs calculix (default 1)")
       ->check(CLI::Range(1, 1024));
   cmd->callback([args, &ctx] {
+    if (!std::isfinite(args->solver_timeout_s)) throw UsageError("--solver-timeout-s must be a finite number of seconds");
     const scene::Scene sc = scene::load_scene(args->scene, overrides_from(args->set));
-    std::error_code ec;
-    fs::create_directories(args->out, ec);
-    if (!fs::is_directory(args->out)) {
-      throw InputError(args->out, "--out", "cannot create the output folder");
-    }
     scene::RunOptions opt;
     opt.out_dir = args->out;
     opt.ccx_threads = args->threads;
     opt.progress = &std::cerr;  // ccx progress when [outputs.fem] run = "calculix"
+    opt.solver_timeout_s = args->solver_timeout_s;
     const scene::RunReport rep = scene::run_scene(sc, opt);
     if (args->json) {
       std::cout << scene::to_json(sc, rep).dump(2) << "\n";
@@ -47,9 +49,9 @@ void register_run(CLI::App& app, Context& ctx) {
       std::cout << scene::format_summary(sc, rep);
     }
     if (args->json)
-      for (const auto& w : rep.warnings) std::cerr << "impactdeck: warning: " << w << "\n";
+      for (const auto& w : rep.warnings) std::cerr << "impactdeck: warning: " << InputError::one_line(w) << "\n";
     if (!rep.all_checks_passed()) {
-      std::cerr << "impactdeck: error: a physics self-check failed (see checks above)\n";
+      std::cerr << "impactdeck: error: " << scene::failed_checks_summary(sc, rep) << "\n";
       ctx.exit_code = static_cast<int>(ExitCode::check_failed);
     }
   });

@@ -5,10 +5,13 @@
 #include <memory>
 #include <sstream>
 
+#include "cli_limits.hpp"
 #include "commands.hpp"
 #include "set_option.hpp"
+#include "impactdeck/common/run_transaction.hpp"
 #include "impactdeck/common/atomic_file.hpp"
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/common/numeric.hpp"
 #include "impactdeck/geometry/ellipsoid.hpp"
 #include "impactdeck/plot/drawing.hpp"
 #include "impactdeck/scene/scene.hpp"
@@ -37,6 +40,13 @@ std::vector<double> parse_list(const std::string& text, const char* option) {
     }
   }
   if (v.empty()) throw UsageError(std::string(option) + ": give a comma-separated list of numbers");
+  for (double x : v) {  // > 0 and within [1e-100, 1e100] (numeric.hpp): masses and sizes stay in range
+    if (!(x > 0) || !within_magnitude_range(x)) {
+      std::ostringstream m;
+      m << option << ": every value must be > 0 and within 1e-100 .. 1e+100, got " << x;
+      throw UsageError(m.str());
+    }
+  }
   return v;
 }
 
@@ -51,6 +61,7 @@ void register_study(CLI::App& app, Context& ctx) {
     std::uint64_t seed = 1;
     unsigned threads = 0;
     bool json = false, quiet = false, no_png = false;
+    std::size_t max_points = kDefaultMaxPoints;
     std::vector<std::string> set;  // --set, with --scene
   };
   auto a = std::make_shared<Args>();
@@ -63,7 +74,6 @@ void register_study(CLI::App& app, Context& ctx) {
   cmd->add_option("--mass-ratios", a->mu, "Comma-separated m1/m2 values (columns)");
   cmd->add_option("--size-ratio", a->size_ratio, "Smaller semi-axis / sphere radius (paper preset: 20)");
   cmd->add_option("--radius-rule", a->rule, "Local radius rule: paper (Eq. 26, the sphere's radius) | mean (mean curvature) | elliptical (both curvature tensors)");
-  add_set_option(cmd, a->set);
   cmd->add_option("--scene", a->scene,
                   "Scene file (TOML) giving the target, impactor, materials and speed instead of the paper's "
                   "ellipsoid and sphere (docs/study.md)");
@@ -82,7 +92,12 @@ void register_study(CLI::App& app, Context& ctx) {
   cmd->add_flag("--no-png", a->no_png, "Do not render the PNG heat map");
   cmd->add_flag("--json", a->json, "Print the JSON document on stdout");
   cmd->add_flag("--quiet", a->quiet, "No progress bar");
+  cmd->add_option("--max-points", a->max_points,
+                  "Most impact evaluations (cells x points per cell) of the study (default 1000000)")
+      ->check(positive_number());
+  add_set_option(cmd, a->set);
   cmd->callback([a, &ctx] {
+    check_threads(a->threads);
     study::Table1Options o = study::table1_preset(a->preset);
     if (!a->g.empty()) o.geometric_ratios = parse_list(a->g, "--geometric-ratios");
     if (!a->mu.empty()) o.mass_ratios = parse_list(a->mu, "--mass-ratios");
@@ -94,7 +109,12 @@ void register_study(CLI::App& app, Context& ctx) {
                        " applies to the paper's setting only: with --scene, sizes come from the scene and the "
                        "radius rule from its impact's contact_radius");
     }
-    if (a->size_ratio != 0) o.size_ratio = a->size_ratio;
+    if (a->size_ratio != 0) {
+      if (!(a->size_ratio > 0) || !within_magnitude_range(a->size_ratio)) {
+        throw UsageError("--size-ratio must be > 0 and within 1e-100 .. 1e+100");
+      }
+      o.size_ratio = a->size_ratio;
+    }
     if (!a->rule.empty()) {
       if (a->rule == "paper") o.rule = collision::ContactRule::paper;
       else if (a->rule == "mean") o.rule = collision::ContactRule::mean;
@@ -124,20 +144,39 @@ void register_study(CLI::App& app, Context& ctx) {
     if (a->count != 0) o.uniform_count = a->count;
     o.seed = a->seed;
     o.threads = a->threads;
+    {
+      // Bounded work: cells x points per cell, known before any is computed.
+      const geometry::Ellipsoid unit(1, 1, 1);
+      const geometry::Shape& target = o.scene ? *o.scene->setup.target.shape : unit;
+      const double cells = static_cast<double>(o.geometric_ratios.size()) * static_cast<double>(o.mass_ratios.size());
+      const double evaluations = cells * cloud_size(target, o.cloud, o.grid_steps, o.uniform_count);
+      check_points(evaluations, a->max_points, a->scene.empty() ? "study table1" : a->scene,
+                   o.cloud == study::CloudKind::paper_grid ? "--grid-steps" : "--count",
+                   std::to_string(static_cast<long long>(cells)) + " cells with their clouds");
+    }
+    // One transaction: the study's four files appear together, or none of them.
+    RunTransaction txn(a->out);
+    const std::string where = txn.out_dir().string();
+    const fs::path csv = txn.file("table1.csv", where, "--out"), md = txn.file("table1.md", where, "--out");
+    const fs::path svg = txn.file("table1_heatmap.svg", where, "--out");
+    const fs::path png = a->no_png ? fs::path() : txn.file("table1_heatmap.png", where, "--out");
     study::ProgressBar bar("table1", !a->quiet);
     o.progress = [&bar](std::size_t done, std::size_t total) { bar.update(done, total); };
     const study::Table1Result r = study::run_table1(o);
     bar.finish();
 
-    std::error_code ec;
-    fs::create_directories(a->out, ec);
-    if (!fs::is_directory(a->out)) throw InputError(a->out, "--out", "cannot create the output folder");
     const fs::path out(a->out);
-    study::write_table1_csv(out / "table1.csv", r);
-    write_file_atomically(out / "table1.md", "# Table 1 study (impactdeck study table1)\n\n" + study::table1_markdown(r));
-    const plot::Drawing heat = study::table1_heatmap(r);
-    plot::write_svg(out / "table1_heatmap.svg", heat);
-    if (!a->no_png) plot::write_png(out / "table1_heatmap.png", heat, 1.25);
+    try {
+      study::write_table1_csv(csv, r);
+      write_file_atomically(md, "# Table 1 study (impactdeck study table1)\n\n" + study::table1_markdown(r));
+      const plot::Drawing heat = study::table1_heatmap(r);
+      plot::write_svg(svg, heat);
+      if (!a->no_png) plot::write_png(png, heat, 1.25);
+      txn.commit();
+    } catch (const InputError& e) {
+      throw txn.public_error(e);
+    }
+    for (const auto& w : txn.warnings()) std::cerr << "impactdeck: warning: " << InputError::one_line(w) << "\n";
 
     if (a->json) {
       std::cout << study::table1_json(r).dump(2) << "\n";

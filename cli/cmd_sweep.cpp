@@ -7,8 +7,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cli_limits.hpp"
 #include "commands.hpp"
 #include "set_option.hpp"
+#include "impactdeck/common/run_transaction.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/plot/drawing.hpp"
 #include "impactdeck/scene/scene.hpp"
@@ -47,6 +49,7 @@ void register_sweep(CLI::App& app, Context& ctx) {
     bool curves = false, json = false, quiet = false, no_png = false;
     std::size_t curve_samples = 201;
     unsigned threads = 0;
+    std::size_t max_points = kDefaultMaxPoints, max_curve_samples = kDefaultMaxCurveSamples;
     std::vector<std::string> set;
   };
   auto a = std::make_shared<Args>();
@@ -71,143 +74,169 @@ void register_sweep(CLI::App& app, Context& ctx) {
   cmd->add_flag("--no-png", a->no_png, "Do not render the PNG picture");
   cmd->add_flag("--json", a->json, "Print a JSON summary on stdout");
   cmd->add_flag("--quiet", a->quiet, "No progress bar");
+  cmd->add_option("--max-points", a->max_points, "Most points a sweep may evaluate (default 1000000)")
+      ->check(positive_number());
+  cmd->add_option("--max-curve-samples", a->max_curve_samples,
+                  "With --curves: most samples over all curves (default 20000000, 160 MB)")
+      ->check(positive_number());
   add_set_option(cmd, a->set);
   cmd->callback([a, &ctx] {
+    check_threads(a->threads);
     const scene::Scene sc = scene::load_scene(a->scene, overrides_from(a->set));
-    const study::SceneSweep ss = study::sweep_from_scene(sc, a->impact);
-    const scene::ImpactSpec& imp = *ss.impact;
-
-    study::CloudKind kind;
-    const bool analytic = dynamic_cast<const geometry::Ellipsoid*>(ss.setup.target.shape.get()) != nullptr;
-    if (a->cloud == "auto") kind = analytic ? study::CloudKind::paper_grid : study::CloudKind::area_uniform;
-    else if (a->cloud == "grid") kind = study::CloudKind::paper_grid;
-    else if (a->cloud == "uniform") kind = study::CloudKind::area_uniform;
-    else if (a->cloud == "both") kind = study::CloudKind::both;
-    else if (a->cloud == "vertices") kind = study::CloudKind::vertices;
-    else throw UsageError("--cloud: expected grid, uniform, both, vertices or auto, got \"" + a->cloud + "\"");
-    std::vector<geometry::SurfacePoint> cloud;
-    if (!a->points.empty()) {
-      // Projected as `run` projects an impact point, with the same distance limit.
-      const double tol = imp.max_projection_distance_m.value_or(0.01 * ss.setup.target.shape->size_m());
-      cloud = study::csv_point_cloud(*ss.setup.target.shape, a->points, metres_per(sc.length_unit), tol);
-    } else {
-      try {
-        cloud = study::make_cloud(*ss.setup.target.shape, kind, a->grid_steps, a->count, a->seed);
-      } catch (const InputError& e) {
-        throw InputError(sc.file.string(), e.place(), "target '" + imp.target + "': " + e.reason());
-      }
-    }
-
-    std::error_code ec;
-    fs::create_directories(a->out, ec);
-    if (!fs::is_directory(a->out)) throw InputError(a->out, "--out", "cannot create the output folder");
-
-    study::ProgressBar bar("sweep", !a->quiet);
-    study::SweepOptions opt;
-    opt.threads = a->threads;
-    opt.curves = a->curves;
-    opt.curve_samples = a->curve_samples;
-    opt.progress = [&bar](std::size_t done, std::size_t total) { bar.update(done, total); };
-    study::SweepResult r;
+    // One transaction: the sweep's files appear together when all are written, or not at all.
+    RunTransaction txn(a->out);
     try {
-      r = study::run_sweep(ss.setup, cloud, opt);
-    } catch (const InputError& e) {
-      bar.finish();
-      throw InputError(sc.file.string(), "impact '" + imp.name + "': " + e.place(), e.reason());
-    }
-    bar.finish();
+      const study::SceneSweep ss = study::sweep_from_scene(sc, a->impact);
+      const scene::ImpactSpec& imp = *ss.impact;
 
-    study::SweepMeta meta;
-    meta.source = sc.file.string();
-    meta.impact = imp.name;
-    meta.target = imp.target;
-    meta.impactor = imp.impactor;
-    meta.cloud = a->points.empty() ? study::to_string(kind) : "points of " + a->points;
-    if (a->points.empty() && (kind == study::CloudKind::paper_grid || kind == study::CloudKind::both))
-      meta.cloud += ", grid step 1/" + std::to_string(a->grid_steps);
-    if (a->points.empty() && (kind == study::CloudKind::area_uniform || kind == study::CloudKind::both))
-      meta.cloud += ", " + std::to_string(a->count) + " area-uniform (seed " + std::to_string(a->seed) + ")";
-
-    const std::string prefix = a->prefix.empty() ? "sweep_" + imp.name : a->prefix;
-    const fs::path base = fs::path(a->out) / prefix;
-    std::vector<fs::path> files;
-    auto with = [&](const std::string& suffix) {
-      fs::path p = base;
-      p += suffix;
-      files.push_back(p);
-      return p;
-    };
-    study::write_sweep_csv(with(".csv"), r, meta);
-    if (a->curves) study::write_sweep_curves_csv(with("_curves.csv"), r, meta);
-    study::write_sweep_pos(with(".pos"), r, meta);
-    study::write_sweep_vtp(with(".vtp"), r, meta);
-    study::ForceMapOptions fo;
-    fo.title = "Maximal collision force: " + imp.impactor + " hits " + imp.target + " (impact '" + imp.name + "')";
-    const plot::Drawing pic = study::force_map_drawing(*ss.setup.target.shape, ss.setup.target.volume.centroid_m, r, fo);
-    plot::write_svg(with(".svg"), pic);
-    if (!a->no_png) plot::write_png(with(".png"), pic, 1.5);
-
-    const auto& pmin = r.points[r.min_index];
-    const auto& pmax = r.points[r.max_index];
-    const double rate = r.seconds > 0 ? r.points.size() / r.seconds : 0.0;
-    if (a->json) {
-      nlohmann::json j;
-      j["scene"] = sc.file.string();
-      j["impact"] = imp.name;
-      j["cloud"] = meta.cloud;
-      j["points"] = r.points.size();
-      j["force_ratio"] = r.force_ratio;
-      j["mass_only_ratio"] = r.mass_only_ratio;
-      j["min"] = point_json(r.min_index, pmin);
-      j["max"] = point_json(r.max_index, pmax);
-      j["approach_speed_m_s"] = ss.setup.approach_speed_m_s;
-      j["restitution_clamped_points"] = r.restitution_clamped_count;
-      j["sharp_points"] = r.sharp_count;
-      j["flagged_points"] = r.flagged_count;
-      nlohmann::json flags = nlohmann::json::object();
-      for (int f = 1; f < collision::kContactFlagCount; ++f) {
-        flags[collision::flag_word(static_cast<collision::ContactFlag>(f))] = r.flag_counts[f];
+      study::CloudKind kind;
+      const bool analytic = dynamic_cast<const geometry::Ellipsoid*>(ss.setup.target.shape.get()) != nullptr;
+      if (a->cloud == "auto") kind = analytic ? study::CloudKind::paper_grid : study::CloudKind::area_uniform;
+      else if (a->cloud == "grid") kind = study::CloudKind::paper_grid;
+      else if (a->cloud == "uniform") kind = study::CloudKind::area_uniform;
+      else if (a->cloud == "both") kind = study::CloudKind::both;
+      else if (a->cloud == "vertices") kind = study::CloudKind::vertices;
+      else throw UsageError("--cloud: expected grid, uniform, both, vertices or auto, got \"" + a->cloud + "\"");
+      const std::string where = sc.file.string();
+      if (a->points.empty()) {
+        const double points = cloud_size(*ss.setup.target.shape, kind, a->grid_steps, a->count);
+        check_points(points, a->max_points, where, kind == study::CloudKind::paper_grid ? "--grid-steps" : "--count",
+                     "the cloud's points");
+        if (a->curves) check_curve_samples(points, a->curve_samples, a->max_curve_samples, where);
       }
-      j["flag_counts"] = flags;
-      j["threads"] = r.threads_used;
-      j["seconds"] = r.seconds;
-      nlohmann::json fl = nlohmann::json::array();
-      for (const auto& f : files) fl.push_back(f.string());
-      j["files_written"] = fl;
-      std::cout << j.dump(2) << "\n";
-    } else {
-      auto pt = [](const study::PointResult& p) {
-        std::ostringstream s;
-        s << std::setprecision(6) << "(" << p.point_m.x() + 0.0 << ", " << p.point_m.y() + 0.0 << ", "
-          << p.point_m.z() + 0.0 << ") m";
-        return s.str();
+
+      // Every output name is reserved (checked: relative, inside --out, no duplicate) before the work.
+      const std::string prefix = a->prefix.empty() ? "sweep_" + imp.name : a->prefix;
+      const std::string prefix_place = a->prefix.empty() ? "--prefix (default sweep_<impact name>)" : "--prefix";
+      std::vector<fs::path> files;
+      auto reserve = [&](const std::string& suffix) {
+        const fs::path staged = txn.file(prefix + suffix, txn.out_dir().string(), prefix_place);
+        files.push_back(txn.public_path(staged));
+        return staged;
       };
-      std::cout << "sweep of impact '" << imp.name << "': " << imp.impactor << " hits " << imp.target << " at "
-                << r.points.size() << " points (" << meta.cloud << "), " << ss.setup.approach_speed_m_s
-                << " m/s along the inward normal\n"
-                << "  force ratio min/max   " << std::setprecision(6) << r.force_ratio << "\n"
-                << "  reduced-mass part     " << r.mass_only_ratio << "\n"
-                << "  min F_max             " << pmin.max_force_N << " N at " << pt(pmin) << " (point " << r.min_index
-                << ")\n"
-                << "  max F_max             " << pmax.max_force_N << " N at " << pt(pmax) << " (point " << r.max_index
-                << ")\n"
-                << "  time                  " << r.seconds << " s on " << r.threads_used << " threads ("
-                << std::setprecision(3) << rate << " points/s)\n";
-      if (r.flagged_count > 0) {
-        std::cout << "  flagged points        " << r.flagged_count << " (";
-        bool any = false;
-        for (int f = 1; f < collision::kContactFlagCount; ++f) {
-          if (r.flag_counts[f] == 0) continue;
-          std::cout << (any ? ", " : "") << r.flag_counts[f] << " " << collision::flag_word(static_cast<collision::ContactFlag>(f));
-          any = true;
+      const fs::path csv_path = reserve(".csv");
+      const fs::path curves_path = a->curves ? reserve("_curves.csv") : fs::path();
+      const fs::path pos_path = reserve(".pos"), vtp_path = reserve(".vtp"), svg_path = reserve(".svg");
+      const fs::path png_path = a->no_png ? fs::path() : reserve(".png");
+
+      std::vector<geometry::SurfacePoint> cloud;
+      if (!a->points.empty()) {
+        // Projected as `run` projects an impact point, with the same distance limit.
+        const double tol = imp.max_projection_distance_m.value_or(0.01 * ss.setup.target.shape->size_m());
+        cloud = study::csv_point_cloud(*ss.setup.target.shape, a->points, metres_per(sc.length_unit), tol);
+        const double points = static_cast<double>(cloud.size());
+        check_points(points, a->max_points, a->points, "--points", "its rows");
+        if (a->curves) check_curve_samples(points, a->curve_samples, a->max_curve_samples, where);
+      } else {
+        try {
+          cloud = study::make_cloud(*ss.setup.target.shape, kind, a->grid_steps, a->count, a->seed);
+        } catch (const InputError& e) {
+          throw InputError(sc.file.string(), e.place(), "target '" + imp.target + "': " + e.reason());
         }
-        std::cout << "): the model does not apply there; left out of min/max, `flag` column in the files\n";
       }
-      if (r.restitution_clamped_count > 0) {
-        std::cout << "  warning: ln(Phi) clamped into Eq. 30's range at " << r.restitution_clamped_count
-                  << " points\n";
+
+      study::ProgressBar bar("sweep", !a->quiet);
+      study::SweepOptions opt;
+      opt.threads = a->threads;
+      opt.curves = a->curves;
+      opt.curve_samples = a->curve_samples;
+      opt.progress = [&bar](std::size_t done, std::size_t total) { bar.update(done, total); };
+      study::SweepResult r;
+      try {
+        r = study::run_sweep(ss.setup, cloud, opt);
+      } catch (const InputError& e) {
+        bar.finish();
+        throw InputError(sc.file.string(), "impact '" + imp.name + "': " + e.place(), e.reason());
       }
-      for (const auto& f : files) std::cout << "  wrote " << f.string() << "\n";
+      bar.finish();
+
+      study::SweepMeta meta;
+      meta.source = sc.file.string();
+      meta.impact = imp.name;
+      meta.target = imp.target;
+      meta.impactor = imp.impactor;
+      meta.cloud = a->points.empty() ? study::to_string(kind) : "points of " + a->points;
+      if (a->points.empty() && (kind == study::CloudKind::paper_grid || kind == study::CloudKind::both))
+        meta.cloud += ", grid step 1/" + std::to_string(a->grid_steps);
+      if (a->points.empty() && (kind == study::CloudKind::area_uniform || kind == study::CloudKind::both))
+        meta.cloud += ", " + std::to_string(a->count) + " area-uniform (seed " + std::to_string(a->seed) + ")";
+
+      study::write_sweep_csv(csv_path, r, meta);
+      if (a->curves) study::write_sweep_curves_csv(curves_path, r, meta);
+      study::write_sweep_pos(pos_path, r, meta);
+      study::write_sweep_vtp(vtp_path, r, meta);
+      study::ForceMapOptions fo;
+      fo.title = "Maximal collision force: " + imp.impactor + " hits " + imp.target + " (impact '" + imp.name + "')";
+      const plot::Drawing pic = study::force_map_drawing(*ss.setup.target.shape, ss.setup.target.volume.centroid_m, r, fo);
+      plot::write_svg(svg_path, pic);
+      if (!a->no_png) plot::write_png(png_path, pic, 1.5);
+      txn.commit();
+      for (const auto& w : txn.warnings()) std::cerr << "impactdeck: warning: " << InputError::one_line(w) << "\n";
+
+      const auto& pmin = r.points[r.min_index];
+      const auto& pmax = r.points[r.max_index];
+      const double rate = r.seconds > 0 ? r.points.size() / r.seconds : 0.0;
+      if (a->json) {
+        nlohmann::json j;
+        j["scene"] = sc.file.string();
+        j["impact"] = imp.name;
+        j["cloud"] = meta.cloud;
+        j["points"] = r.points.size();
+        j["force_ratio"] = r.force_ratio;
+        j["mass_only_ratio"] = r.mass_only_ratio;
+        j["min"] = point_json(r.min_index, pmin);
+        j["max"] = point_json(r.max_index, pmax);
+        j["approach_speed_m_s"] = ss.setup.approach_speed_m_s;
+        j["restitution_clamped_points"] = r.restitution_clamped_count;
+        j["sharp_points"] = r.sharp_count;
+        j["flagged_points"] = r.flagged_count;
+        nlohmann::json flags = nlohmann::json::object();
+        for (int f = 1; f < collision::kContactFlagCount; ++f) {
+          flags[collision::flag_word(static_cast<collision::ContactFlag>(f))] = r.flag_counts[f];
+        }
+        j["flag_counts"] = flags;
+        j["threads"] = r.threads_used;
+        j["seconds"] = r.seconds;
+        nlohmann::json fl = nlohmann::json::array();
+        for (const auto& f : files) fl.push_back(f.string());
+        j["files_written"] = fl;
+        std::cout << j.dump(2) << "\n";
+      } else {
+        auto pt = [](const study::PointResult& p) {
+          std::ostringstream s;
+          s << std::setprecision(6) << "(" << p.point_m.x() + 0.0 << ", " << p.point_m.y() + 0.0 << ", "
+            << p.point_m.z() + 0.0 << ") m";
+          return s.str();
+        };
+        std::cout << "sweep of impact '" << imp.name << "': " << imp.impactor << " hits " << imp.target << " at "
+                  << r.points.size() << " points (" << meta.cloud << "), " << ss.setup.approach_speed_m_s
+                  << " m/s along the inward normal\n"
+                  << "  force ratio min/max   " << std::setprecision(6) << r.force_ratio << "\n"
+                  << "  reduced-mass part     " << r.mass_only_ratio << "\n"
+                  << "  min F_max             " << pmin.max_force_N << " N at " << pt(pmin) << " (point " << r.min_index
+                  << ")\n"
+                  << "  max F_max             " << pmax.max_force_N << " N at " << pt(pmax) << " (point " << r.max_index
+                  << ")\n"
+                  << "  time                  " << r.seconds << " s on " << r.threads_used << " threads ("
+                  << std::setprecision(3) << rate << " points/s)\n";
+        if (r.flagged_count > 0) {
+          std::cout << "  flagged points        " << r.flagged_count << " (";
+          bool any = false;
+          for (int f = 1; f < collision::kContactFlagCount; ++f) {
+            if (r.flag_counts[f] == 0) continue;
+            std::cout << (any ? ", " : "") << r.flag_counts[f] << " " << collision::flag_word(static_cast<collision::ContactFlag>(f));
+            any = true;
+          }
+          std::cout << "): the model does not apply there; left out of min/max, `flag` column in the files\n";
+        }
+        if (r.restitution_clamped_count > 0) {
+          std::cout << "  warning: ln(Phi) clamped into Eq. 30's range at " << r.restitution_clamped_count
+                    << " points\n";
+        }
+        for (const auto& f : files) std::cout << "  wrote " << f.string() << "\n";
+      }
+    } catch (const InputError& e) {
+      throw txn.public_error(e);  // name the final paths, not the staging folder
     }
     (void)ctx;
   });

@@ -1,4 +1,7 @@
 // impactdeck — eccentric Hertz impacts to FEM decks. Exit codes: docs/cli.md.
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <exception>
 #include <iostream>
 
@@ -28,14 +31,23 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::cerr << "impactdeck: usage error: " << e.what() << "\n(run 'impactdeck --help')\n";
+    std::cerr << "impactdeck: usage error: " << impactdeck::InputError::one_line(e.what()) << " (run 'impactdeck --help')\n";  // one line, as every error
     return static_cast<int>(ExitCode::usage);
   } catch (const impactdeck::Error& e) {
-    std::cerr << "impactdeck: error: " << e.what() << "\n";
+    std::cerr << "impactdeck: error: " << impactdeck::InputError::one_line(e.what()) << "\n";
     return static_cast<int>(e.code());
   } catch (const std::exception& e) {
-    std::cerr << "impactdeck: internal error: " << e.what() << "\n";
+    std::cerr << "impactdeck: internal error: " << impactdeck::InputError::one_line(e.what()) << "\n";
     return static_cast<int>(ExitCode::internal_error);
+  }
+  // Every write is checked, stdout included: `impactdeck run ... > /dev/full` must not exit 0.
+  errno = 0;
+  std::cout.flush();
+  if (std::fflush(stdout) != 0 || std::ferror(stdout) || !std::cout) {
+    const int e = errno;
+    std::cerr << "impactdeck: error: stdout: write failed: " << (e ? std::strerror(e) : "disk full, or the output was closed")
+              << "\n";
+    return static_cast<int>(ExitCode::invalid_input);
   }
   return ctx.exit_code;
 }

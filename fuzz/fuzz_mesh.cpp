@@ -68,9 +68,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         const CurvatureFit f = s.curvature_fit(c.point_m);
         require(std::isfinite(f.curvature.k1_per_m) && std::isfinite(f.curvature.k2_per_m), "finite curvatures");
         if (!f.curvature.sharp_feature) {
-          // A flat spot (a face of a box) has an infinite radius: a correct answer, not a NaN.
+          // A flat spot (a face of a box) has an infinite radius, a concave one a negative radius:
+          // correct answers, not a NaN or a 0.
           const double r = s.paper_radius_m(c);
-          require(r > 0 && !std::isnan(r), "Eq. 26 radius > 0 (possibly infinite)");
+          require(r != 0 && !std::isnan(r), "Eq. 26 radius not 0 and not NaN (possibly infinite or negative)");
         }
       } catch (const InputError&) {
         // too coarse, sharp, degenerate: a correct answer for this point

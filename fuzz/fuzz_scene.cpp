@@ -28,6 +28,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   try {
     impactdeck::scene::Scene s = impactdeck::scene::parse_scene(text, "fuzz.toml");
     s.outputs.force_table_csv.reset();  // no files: the fuzzer must not write
+    s.outputs.force_plot_svg.reset();
+    s.outputs.fem.reset();               // nor mesh (Gmsh) or run ccx
     for (auto& b : s.bodies)
       if (b.shape == impactdeck::scene::ShapeKind::mesh) return 0;  // the mesh fuzzer covers meshes
     const auto report = impactdeck::scene::run_scene(s);

@@ -2,7 +2,9 @@
 # Runs every case of tests/data/bad/cases.tsv through the CLI: the exit code must match, stderr
 # must be exactly one line matching the case's pattern, and the output folder must stay empty.
 # A case expecting exit 0 (a tricky input that must be read correctly) must print nothing on
-# stderr instead, and its pattern must match a line of stdout.
+# stderr instead, and its pattern must match a line of stdout. {DECK} is a fresh copy of the
+# one-tetrahedron deck tests/data/bad/fem/deck, which must come back unchanged (fem-check leaves a
+# deck folder as it was after any failure); {FEM} is tests/data/bad/fem (fake solvers).
 # usage: bad_inputs.sh IMPACTDECK SOURCE_DIR
 set -u
 bin=$1; src=$2
@@ -14,6 +16,10 @@ while IFS=$'\t' read -r name args code pattern; do
   a=${args//\{BAD\}/$bad}
   a=${a//\{OUT\}/$out}
   a=${a//\{SRC\}/$src}
+  deck="$out.d/deck"
+  case "$args" in *'{DECK}'*) mkdir -p "$out.d" && cp -r "$bad/fem/deck" "$deck" ;; esac
+  a=${a//\{DECK\}/$deck}
+  a=${a//\{FEM\}/$bad/fem}
   # shellcheck disable=SC2086
   "$bin" $a >"$out.stdout" 2>"$out.stderr" </dev/null
   rc=$?
@@ -29,6 +35,10 @@ while IFS=$'\t' read -r name args code pattern; do
     printf '%s' "$msg" | grep -Eq -- "$pattern" || problems="$problems message does not match /$pattern/;"
   fi
   [ -z "$(ls -A "$out" 2>/dev/null)" ] || problems="$problems output folder not empty: $(ls -A "$out");"
+  if [ -d "$deck" ]; then
+    changed=$(diff -rq "$bad/fem/deck" "$deck" 2>&1)
+    [ -z "$changed" ] || problems="$problems the deck folder changed: $changed;"
+  fi
   if [ -n "$problems" ]; then
     echo "FAILED $name:$problems"
     echo "  message: $msg"
@@ -36,7 +46,7 @@ while IFS=$'\t' read -r name args code pattern; do
   else
     pass=$((pass+1))
   fi
-  rm -rf "$out" "$out.stdout" "$out.stderr"
+  rm -rf "$out" "$out.d" "$out.stdout" "$out.stderr"
 done <"$bad/cases.tsv"
 echo "bad_inputs: $pass passed, $fail failed"
 [ "$fail" -eq 0 ] && [ "$pass" -ge 1 ]

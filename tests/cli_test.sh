@@ -55,7 +55,7 @@ check "no output written" test ! -e "$tmp/out3/force_table2.csv"
 "$bin" run "$tmp/does-not-exist.toml" >/dev/null 2>&1; check "missing file exit 3" test $? -eq 3
 
 # 5. A failing self-check: exit 4 and no output file (threshold set impossibly low).
-sed 's/^restitution_range_policy = "warn"/restitution_range_policy = "warn"\n[checks]\nimpulse_relative = 1e-300/' \
+sed 's/^restitution_range_policy = "warn"/restitution_range_policy = "warn"\n[checks]\nimpulse_relative = 1e-30/' \
   "$src/samples/paper_table2.toml" >"$tmp/strict.toml"
 "$bin" run "$tmp/strict.toml" --out "$tmp/out4" >/dev/null 2>"$tmp/strict.err"
 rc=$?

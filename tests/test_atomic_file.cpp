@@ -9,24 +9,13 @@
 
 #include "impactdeck/common/atomic_file.hpp"
 #include "impactdeck/common/error.hpp"
+#include "scratch_files.hpp"
 
 namespace fs = std::filesystem;
 using namespace impactdeck;
 
-namespace {
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-fs::path fresh_dir(const char* name) {
-  const fs::path d = fs::temp_directory_path() / name;
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
-}  // namespace
+using test::fresh_dir;
+using test::slurp;
 
 TEST(AtomicFile, FailedFillLeavesPreviousFile) {
   const fs::path d = fresh_dir("impactdeck_atomic_1");

@@ -120,7 +120,7 @@ TEST(Overrides, ResolvedTextKeepsStringsAndNumbersExactly) {
   // Quotes, a backslash, a tab, non-ASCII; floats that need 17 digits, tiny and huge ones.
   const std::string name = "hit \"one\" \\ \xc3\xa9\t";
   const std::vector<scene::Override> o = {{"impacts[0].name", "\"hit \\\"one\\\" \\\\ \xc3\xa9\\t\""},
-                                          {"bodies[1].velocity_m_s", "[-0.1, 1e-300, 0.30000000000000004]"},
+                                          {"bodies[1].velocity_m_s", "[-0.1, 1.0000000000000002e-90, 0.30000000000000004]"},
                                           {"bodies[0].radius", "12345678.9"}};
   write(tmp.path / "scene.toml", scene::resolved_scene_text(kTwoSpheres, o));
   const scene::Scene a = scene::load_scene(tmp.path / "scene.toml");

@@ -47,6 +47,9 @@ inline constexpr double kCurvature20kRel = 2e-2;
 inline constexpr double kPaperRadius20kRel = 2e-2;
 /// Coordinates that went through float32 (STL) on both sides: identical meshes give identical sums.
 inline constexpr double kSameFileRel = 1e-12;
+/// A float32 printed with 9 significant digits (ASCII STL) read back in double: within half a
+/// unit of the 9th digit, 5e-9 relative, of the float itself (plus the unit conversion's rounding).
+inline constexpr double kNineDigitsRel = 6e-9;
 }  // namespace impactdeck::test
 
 namespace impactdeck::test {

@@ -10,6 +10,7 @@
 #include <gsl/gsl_sf_gamma.h>
 
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/common/numeric.hpp"
 
 namespace impactdeck::collision {
 namespace {
@@ -191,6 +192,25 @@ CompressionPhase compression_phase(double m_w, double v_w, double k_h) noexcept 
   return c;
 }
 
+void check_compression_range(const CompressionPhase& c) {
+  const double m_w = c.reduced_mass_kg, v_w = c.approach_velocity_m_s, k_h = c.hertz_constant;
+  // Every number of the solve within [1e-100, 1e100] (numeric.hpp): beyond, the self-checks'
+  // products under- or overflow and would print NaN or fail as "physics".
+  const std::pair<const char*, double> values[] = {
+      {"reduced mass (kg)", m_w},          {"approach velocity (m/s)", v_w},
+      {"Hertz constant (N/m^1.5)", k_h},   {"maximal indentation (m)", c.max_indentation_m},
+      {"maximal force (N)", c.max_force_N}, {"compression time (s)", c.compression_time_s},
+      {"compression impulse (N s)", c.impulse_Ns}};
+  for (const auto& [name, value] : values) {
+    if (std::isfinite(value) && value > 0.0 && within_magnitude_range(value)) continue;
+    std::ostringstream s;
+    s << "the " << name << " is " << value << ", outside the magnitudes impactdeck computes with (1e-100 to "
+      << "1e+100, SI): the inputs (reduced mass " << m_w << " kg, approach velocity " << v_w
+      << " m/s, Hertz constant " << k_h << " N/m^1.5) are too extreme";
+    throw InputError("", "numeric range", s.str());
+  }
+}
+
 CompressionPhase solve_compression(double m_w, double v_w, double k_h) {
   auto require_positive = [](double value, const char* name, const char* unit) {
     if (!(value > 0.0) || !std::isfinite(value)) {
@@ -202,7 +222,9 @@ CompressionPhase solve_compression(double m_w, double v_w, double k_h) {
   require_positive(m_w, "reduced mass", "kg");
   require_positive(v_w, "approach velocity", "m/s");
   require_positive(k_h, "Hertz constant", "N/m^1.5");
-  return compression_phase(m_w, v_w, k_h);
+  const CompressionPhase c = compression_phase(m_w, v_w, k_h);
+  check_compression_range(c);
+  return c;
 }
 
 }  // namespace impactdeck::collision

@@ -97,16 +97,26 @@ ForceTable sample_force_table(const ForceHistory& h, const ForceTableOptions& o)
   const double tm = h.compression.compression_time_s;
   const double tr = h.restitution * tm;
   if (o.time_step_s > 0.0) {
-    auto count = [&](double span) {
-      const double n = std::ceil(span / o.time_step_s - 1e-9);
-      return static_cast<std::size_t>(std::clamp(n, 1.0, double(o.max_intervals_per_phase)));
-    };
-    fill_uniform(h, count(tm), tr > 0.0 ? count(tr) : 1, t);
+    auto count = [&](double span) { return std::max(1.0, std::ceil(span / o.time_step_s - 1e-9)); };
+    const double n_comp = count(tm), n_rest = tr > 0.0 ? count(tr) : 1.0;
+    const double samples = n_comp + n_rest + 1.0;
+    if (!(samples <= static_cast<double>(o.max_samples))) {
+      std::ostringstream m;
+      m << "a step of " << o.time_step_s << " s gives " << samples << " samples over the " << h.contact_time_s()
+        << " s contact, more than the limit of " << o.max_samples
+        << " (force_table_max_samples in [outputs]: raise it, or use a larger step)";
+      throw InputError("", "force_table_time_step_s", m.str());
+    }
+    fill_uniform(h, static_cast<std::size_t>(n_comp), static_cast<std::size_t>(n_rest), t);
   } else {
     std::size_t n = 8;
+    if (2 * n + 1 > o.max_samples) {
+      throw InputError("", "force_table_max_samples",
+                       "is " + std::to_string(o.max_samples) + ", below the 17 samples of the coarsest table");
+    }
     for (;;) {
       fill_uniform(h, n, n, t);
-      if (t.impulse_relative_error <= o.impulse_tolerance || 2 * n > o.max_intervals_per_phase) break;
+      if (t.impulse_relative_error <= o.impulse_tolerance || 4 * n + 1 > o.max_samples) break;
       n *= 2;
     }
   }

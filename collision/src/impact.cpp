@@ -131,6 +131,7 @@ ImpactResult solve_impact(const ImpactInput& in) {
   r.impactor_jump = kr.impactor_jump;
 
   r.history.compression = compression_phase(kr.reduced_mass_kg, kr.approach_velocity_m_s, kr.hertz_constant);
+  check_compression_range(r.history.compression);
   r.history.restitution = kr.restitution.coefficient;
 
   // Self-check 1 (Eq. 31): compression impulse by quadrature of the curve vs m_w v_w.

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include <fcntl.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include "impactdeck/common/error.hpp"
@@ -44,7 +45,14 @@ fs::path write_temporary(const fs::path& path, const std::function<void(std::ost
   if (!fs::is_directory(dir, ec)) {
     throw InputError(path.string(), "output", "folder '" + dir.string() + "' does not exist");
   }
-  const fs::path tmp = dir / ("." + path.filename().string() + ".tmp-" + random_suffix());
+  // Only a file (or a symbolic link, itself replaced) is replaced: never a folder, a device or a
+  // FIFO (`-o /dev/full` must not replace the device node).
+  const fs::file_status st = fs::symlink_status(path, ec);
+  if (!ec && fs::exists(st) && !fs::is_regular_file(st) && !fs::is_symlink(st)) {
+    throw InputError(path.string(), "output", "exists and is not a regular file: not replaced");
+  }
+  // A fixed-length temporary name, whatever the target's: a legal 255-byte name stays legal.
+  const fs::path tmp = dir / (".impactdeck-tmp-" + random_suffix());
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
     if (!out) {
@@ -52,9 +60,20 @@ fs::path write_temporary(const fs::path& path, const std::function<void(std::ost
                        "cannot write in folder '" + dir.string() + "': " + std::strerror(errno));
     }
     try {
+      errno = 0;
       fill(out);
-      out.flush();
-      if (!out) throw InputError(path.string(), "output", "write failed (disk full?)");
+      int e = errno;  // the first failed write's reason (a bad stream writes nothing more)
+      if (out) {
+        errno = 0;
+        out.flush();
+        e = errno;
+      }
+      if (!out) {
+        struct statvfs fs_st {};
+        if (e == 0 && ::statvfs(dir.c_str(), &fs_st) == 0 && fs_st.f_bavail == 0) e = ENOSPC;
+        throw InputError(path.string(), "output",
+                         std::string("write failed: ") + (e ? std::strerror(e) : "I/O error"));
+      }
     } catch (...) {
       out.close();
       fs::remove(tmp, ec);
@@ -69,8 +88,9 @@ void rename_into_place(const fs::path& tmp, const fs::path& path) {
   std::error_code ec;
   fs::rename(tmp, path, ec);
   if (ec) {
+    const std::string why = ec.message();
     fs::remove(tmp, ec);
-    throw InputError(path.string(), "output", "cannot rename temporary file into place");
+    throw InputError(path.string(), "output", "cannot rename temporary file into place: " + why);
   }
 }
 

@@ -1,22 +1,20 @@
 // The CalculiX momentum check (see check.hpp).
 #include "impactdeck/fem_export/check.hpp"
 
-#include <fcntl.h>
-#include <signal.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <sstream>
-#include <thread>
 
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/common/input_file.hpp"
+#include "impactdeck/common/numeric.hpp"
 #include "impactdeck/fem_export/decks.hpp"
 #include "impactdeck/fem_export/mesh.hpp"
+#include "solver_process.hpp"
 
 namespace impactdeck::fem_export {
 namespace fs = std::filesystem;
@@ -26,20 +24,19 @@ namespace {
 
 constexpr double kMm = 1000.0;
 
+// Deck and result files: regular files only, bounded by the memory left (a .dat of a big deck
+// is large, but never larger than what the check can hold).
 std::string read_text(const fs::path& p, const std::string& what) {
-  std::ifstream in(p, std::ios::binary);
-  if (!in) throw InputError(p.string(), "file", what + " cannot be opened (missing or unreadable)");
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
+  std::error_code ec;
+  if (!fs::exists(p, ec)) throw InputError(p.string(), "file", what + " does not exist");
+  return read_input_file(p, what, available_memory_bytes() / 4, "a quarter of the free memory");
 }
 
-Eigen::Vector3d vec3(const json& j) { return Eigen::Vector3d(j.at(0), j.at(1), j.at(2)); }
-
 struct Deck {
-  double impulse_Ns = 0, density_kg_m3 = 0, contact_end_s = 0, end_time_s = 0;
+  double impulse_Ns = 0, density_kg_m3 = 0, contact_end_s = 0, end_time_s = 0, time_step_s = 0;
+  std::size_t pulse_increments = 0;
   Eigen::Vector3d direction = Eigen::Vector3d::Zero();
-  int load_node = 0;  // 1-based
+  std::size_t load_node = 0;  // 1-based
   std::vector<std::string> probes;
   std::vector<int> probe_nodes;  // 1-based
   TetMesh mesh;       // node i has ccx id i + 1
@@ -53,6 +50,8 @@ struct Deck {
   std::string impact;
 };
 
+Eigen::Vector3d vec3(const json& j) { return Eigen::Vector3d(j.at(0), j.at(1), j.at(2)); }
+
 Eigen::Matrix3d mat3(const json& j) {
   Eigen::Matrix3d m;
   for (int r = 0; r < 3; ++r) m.row(r) = vec3(j.at(r)).transpose();
@@ -62,17 +61,48 @@ Eigen::Matrix3d mat3(const json& j) {
 Deck read_deck(const fs::path& dir) {
   Deck d;
   const fs::path jp = dir / "deck.json";
+  const std::string where = jp.string();
   json j;
   try {
     j = json::parse(read_text(jp, "deck description"));
-    d.impulse_Ns = j.at("impulse_Ns");
-    d.density_kg_m3 = j.at("density_kg_m3");
-    d.contact_end_s = j.at("contact_end_s");
-    d.end_time_s = j.at("end_time_s");
-    d.direction = vec3(j.at("direction"));
-    d.load_node = j.at("load_node");
+    // Every number checked: a hand-edited deck.json is input like any other.
+    auto number = [&](const char* key, bool positive) {
+      const json& v = j.at(key);
+      const double x = v.is_number() ? v.get<double>() : NAN;
+      if (!std::isfinite(x) || (positive ? !(x > 0) : !(x >= 0))) {
+        throw InputError(where, key, std::string("must be a finite number ") + (positive ? "> 0" : ">= 0") +
+                                         ", got " + v.dump());
+      }
+      return x;
+    };
+    auto whole = [&](const char* key) {
+      const double x = number(key, false);
+      if (x != std::floor(x) || x > 1e12) throw InputError(where, key, "must be a whole number, got " + j.at(key).dump());
+      return static_cast<std::size_t>(x);
+    };
+    d.impulse_Ns = number("impulse_Ns", true);
+    d.density_kg_m3 = number("density_kg_m3", true);
+    d.contact_end_s = number("contact_end_s", false);
+    d.end_time_s = number("end_time_s", true);
+    d.time_step_s = j.contains("time_step_s") ? number("time_step_s", true) : d.end_time_s;
+    d.pulse_increments = j.contains("pulse_increments") ? whole("pulse_increments") : 0;
+    const json& dir_j = j.at("direction");
+    if (!dir_j.is_array() || dir_j.size() != 3 || !dir_j[0].is_number() || !dir_j[1].is_number() ||
+        !dir_j[2].is_number()) {
+      throw InputError(where, "direction", "must be an array of 3 numbers");
+    }
+    d.direction = Eigen::Vector3d(dir_j[0].get<double>(), dir_j[1].get<double>(), dir_j[2].get<double>());
+    if (!d.direction.allFinite() || std::abs(d.direction.norm() - 1.0) > 1e-6) {
+      throw InputError(where, "direction", "must be a unit vector, got " + dir_j.dump());
+    }
+    d.load_node = whole("load_node");
     for (const auto& p : j.at("probes")) {
-      d.probes.push_back(p.at("name"));
+      const std::string name = p.at("name");
+      if (name.empty() || name.size() > 8 || name.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") !=
+                                                  std::string::npos) {
+        throw InputError(where, "probes", "probe name '" + name + "' is not a node set name ([A-Z0-9_], 8 characters)");
+      }
+      d.probes.push_back(name);
       d.probe_nodes.push_back(p.at("node"));
     }
     d.impact = j.value("impact", std::string());
@@ -104,10 +134,10 @@ Deck read_deck(const fs::path& dir) {
       d.yield_strength_Pa = j.at("yield_strength_Pa").get<double>();
     }
     if (!j.at("calculix").get<bool>()) {
-      throw InputError(jp.string(), "calculix", "the deck has no CalculiX input (calculix = false)");
+      throw InputError(where, "calculix", "the deck has no CalculiX input (calculix = false)");
     }
   } catch (const json::exception& e) {
-    throw InputError(jp.string(), "json", std::string("not a deck description: ") + e.what());
+    throw InputError(where, "json", std::string("not a deck description: ") + e.what());
   }
   // mesh.inp: *NODE, *ELEMENT and *NSET blocks as calculix_mesh_inp writes them.
   const fs::path mp = dir / "mesh.inp";
@@ -146,6 +176,13 @@ Deck read_deck(const fs::path& dir) {
     }
   }
   if (d.mesh.tets.empty()) throw InputError(mp.string(), "*ELEMENT", "no tetrahedra");
+  for (const auto& x : d.mesh.nodes_m) {
+    if (!x.allFinite()) throw InputError(mp.string(), "*NODE", "a coordinate is not a finite number");
+  }
+  if (d.load_node < 1 || d.load_node > d.mesh.nodes_m.size()) {
+    throw InputError(where, "load_node", "node " + std::to_string(d.load_node) + " is not in mesh.inp (" +
+                                             std::to_string(d.mesh.nodes_m.size()) + " nodes)");
+  }
   return d;
 }
 
@@ -166,8 +203,12 @@ DatFile read_dat(const fs::path& p) {
     const auto set_pos = line.find(" for set ");
     if (set_pos != std::string::npos) {
       const auto and_pos = line.find(" and time ", set_pos);
+      char* end = nullptr;
+      const double t = and_pos == std::string::npos ? NAN : std::strtod(line.c_str() + and_pos + 10, &end);
+      if (!std::isfinite(t)) {
+        throw InputError(p.string(), "line '" + line.substr(0, 80) + "'", "a print header without a time");
+      }
       const std::string set = line.substr(set_pos + 9, and_pos - set_pos - 9);
-      const double t = std::stod(line.substr(and_pos + 10));
       if (line.find("velocities (vx,vy,vz)") != std::string::npos) {
         auto& v = d.velocities[set];
         v.emplace_back(t, std::map<int, Eigen::Vector3d>{});
@@ -194,76 +235,133 @@ DatFile read_dat(const fs::path& p) {
   return d;
 }
 
-// Runs ccx in `dir`, output to impact.log; progress from impact.sta. Returns wall time.
-double run_ccx(const fs::path& dir, const CheckOptions& o, double end_time_s) {
+// First "*ERROR" line and last non-empty line of a ccx log; "No space left on device" anywhere
+// in it is reported in first_error's place when there is no *ERROR line.
+void scan_log(const fs::path& log, std::string& first_error, std::string& last_line) {
+  std::ifstream in(log);
+  std::string no_space;
+  for (std::string l; std::getline(in, l);) {
+    if (!l.empty() && l.back() == '\r') l.pop_back();
+    if (first_error.empty() && l.find("*ERROR") != std::string::npos) first_error = l;
+    if (no_space.empty() && l.find("No space left") != std::string::npos) no_space = l;
+    if (l.find_first_not_of(" \t") != std::string::npos) last_line = l;
+  }
+  if (first_error.empty()) first_error = no_space;
+  auto trim = [](std::string& t) {
+    t.erase(0, t.find_first_not_of(" \t"));
+    if (t.size() > 200) t = t.substr(0, 200) + "...";
+  };
+  trim(first_error);
+  trim(last_line);
+}
+
+// The last line of ccx's .sta file: step, increment and total time (nullopt when there is none).
+struct StaLine {
+  int step = 0, increment = 0;
+  double time_s = 0;
+  std::string text;
+};
+std::optional<StaLine> last_sta_line(const fs::path& sta) {
+  std::ifstream in(sta);
+  std::string l, tail;
+  while (std::getline(in, l))
+    if (!l.empty()) tail = l;
+  std::istringstream ls(tail);
+  StaLine s;
+  int attempts, iterations;
+  if (!(ls >> s.step >> s.increment >> attempts >> iterations >> s.time_s)) return std::nullopt;
+  s.text = tail;
+  return s;
+}
+
+// How far ccx got ("" when unknown).
+std::string sta_progress(const fs::path& sta, double end_time_s) {
+  const auto s = last_sta_line(sta);
+  if (!s || !(s->time_s >= 0 && s->time_s <= 1.01 * end_time_s)) return "";  // none, or a line cut short
+  std::ostringstream m;
+  m << "ccx reached t = " << s->time_s << " s of " << end_time_s << " s (step " << s->step << ", increment "
+    << s->increment << ")";
+  return m.str();
+}
+
+// "the disk is full (...)" when the work folder's file system has (almost) no room left or the log
+// says so: the usual reason for cut-short results.
+std::string disk_full_note(const fs::path& work, const std::string& log_text) {
+  const long long free = detail::free_bytes(work);
+  const bool said = log_text.find("No space left") != std::string::npos;
+  const bool full_now = free >= 0 && free < (1 << 20);
+  if (!said && !full_now) return "";
+  std::string note = "the disk is full";
+  if (full_now) note += " (" + std::to_string(free) + " bytes free on the file system of '" + work.string() + "')";
+  else note += " (ccx's log says so; " + std::to_string(free) + " bytes are free now)";
+  return note;
+}
+
+// Runs ccx in `work` (output to impact.log; progress from impact.sta). Returns the wall time.
+double run_ccx(const fs::path& work, const CheckOptions& o, double end_time_s, double timeout_s,
+               const std::string& timeout_source) {
   const std::string job = kJobName;
-  for (const char* ext : {".dat", ".sta", ".frd", ".cvg", ".12d"}) {
+  for (const char* ext : {".dat", ".sta", ".frd", ".cvg", ".12d", ".log"}) {
     std::error_code ec;
-    fs::remove(dir / (job + ext), ec);
+    fs::remove(work / (job + ext), ec);
   }
   const auto t0 = std::chrono::steady_clock::now();
-  const pid_t pid = ::fork();
-  if (pid < 0) throw Error(ExitCode::internal_error, "fork failed");
-  if (pid == 0) {
-    if (::chdir(dir.c_str()) != 0) ::_exit(126);
-    const int fd = ::open((job + ".log").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    if (fd >= 0) {
-      ::dup2(fd, 1);
-      ::dup2(fd, 2);
-      ::close(fd);
-    }
-    const std::string threads = std::to_string(std::max(1, o.threads));
-    ::setenv("OMP_NUM_THREADS", threads.c_str(), 1);
-    ::setenv("CCX_NPROC_EQUATION_SOLVER", threads.c_str(), 1);
-    ::execlp(o.ccx.c_str(), o.ccx.c_str(), "-i", job.c_str(), static_cast<char*>(nullptr));
-    ::_exit(127);
-  }
-  int status = 0;
   std::string last;
-  auto last_print = std::chrono::steady_clock::now();
-  for (;;) {
-    const pid_t w = ::waitpid(pid, &status, WNOHANG);
-    if (w == pid) break;
-    if (w < 0) throw Error(ExitCode::internal_error, "waitpid failed");
-    std::this_thread::sleep_for(std::chrono::milliseconds(200));
-    if (o.progress && std::chrono::steady_clock::now() - last_print > std::chrono::seconds(2)) {
-      std::ifstream sta(dir / (job + ".sta"));
-      std::string l, tail;
-      while (std::getline(sta, l))
-        if (!l.empty()) tail = l;
-      std::istringstream ls(tail);
-      int step, inc, att, it;
-      double tot;
-      if (ls >> step >> inc >> att >> it >> tot && tail != last) {
-        const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        *o.progress << "ccx: step " << step << ", increment " << inc << ", time " << tot << " s of "
-                    << end_time_s << " s (" << static_cast<int>(100.0 * std::min(1.0, tot / end_time_s))
-                    << " %), " << static_cast<int>(el) << " s elapsed\n";
-        o.progress->flush();
-        last = tail;
-      }
-      last_print = std::chrono::steady_clock::now();
+  auto last_print = t0;
+  auto poll = [&] {
+    if (!o.progress || std::chrono::steady_clock::now() - last_print < std::chrono::seconds(2)) return;
+    last_print = std::chrono::steady_clock::now();
+    const auto s = last_sta_line(work / (job + ".sta"));
+    if (s && s->text != last) {
+      const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      *o.progress << "ccx: step " << s->step << ", increment " << s->increment << ", time " << s->time_s << " s of "
+                  << end_time_s << " s (" << static_cast<int>(100.0 * std::min(1.0, s->time_s / end_time_s)) << " %), "
+                  << static_cast<int>(el) << " s elapsed\n";
+      o.progress->flush();
+      last = s->text;
     }
+  };
+  const std::string threads = std::to_string(std::max(1, o.threads));
+  const fs::path log = work / (job + ".log");
+  detail::SolverRun run;
+  try {
+    run = detail::run_solver({o.ccx, "-i", job}, work, log,
+                             {"OMP_NUM_THREADS=" + threads, "CCX_NPROC_EQUATION_SOLVER=" + threads}, timeout_s, poll);
+  } catch (const InputError& e) {
+    if (e.reason().rfind("cannot run", 0) != 0) throw;
+    throw InputError(e.where(), e.place(), e.reason() + " (install the Debian package calculix-ccx, or name the "
+                                                        "solver with --ccx)");
   }
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  const std::string where = (dir / (job + ".log")).string();
-  if (WIFEXITED(status) && WEXITSTATUS(status) == 127) {
-    throw InputError(o.ccx, "solver", "cannot run '" + o.ccx + "' (install the Debian package calculix-ccx)");
-  }
-  std::ifstream log(dir / (job + ".log"));
-  std::string l, first_error;
-  while (std::getline(log, l)) {
-    if (first_error.empty() && l.find("*ERROR") != std::string::npos) first_error = l;
-  }
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || !first_error.empty()) {
+  const std::string where = log.string();
+  std::string first_error, last_line;
+  scan_log(log, first_error, last_line);
+  const std::string progress = sta_progress(work / (job + ".sta"), end_time_s);
+  const std::string disk = disk_full_note(work, first_error + "\n" + last_line);
+  auto detail_text = [&] {
+    std::string d;
+    if (!disk.empty()) d += "; " + disk;
+    if (!first_error.empty()) d += ": " + first_error;
+    else if (!last_line.empty()) d += "; last line of the log: '" + last_line + "'";
+    else d += "; the log is empty";
+    return d;
+  };
+  if (run.timed_out) {
     std::ostringstream m;
-    m << "ccx failed (";
-    if (WIFSIGNALED(status)) m << "signal " << WTERMSIG(status);
-    else m << "exit code " << WEXITSTATUS(status);
-    m << ")" << (first_error.empty() ? "" : ": " + first_error);
-    throw InputError(where, "ccx", m.str());
+    m << "ccx ran longer than the solver timeout of " << timeout_s << " s (" << timeout_source
+      << ") and was stopped (its process group killed)" << (progress.empty() ? "" : "; " + progress)
+      << "; raise --solver-timeout-s, or coarsen the deck";
+    throw InputError(where, "ccx run", m.str());
   }
-  return wall;
+  if (run.signal != 0) {
+    throw InputError(where, "ccx run", "ccx was killed by " + detail::describe_signal(run.signal) +
+                                           (progress.empty() ? "" : " when " + progress) + detail_text());
+  }
+  if (run.exit_code != 0 || !first_error.empty()) {
+    throw InputError(where, "ccx run", "ccx failed (exit code " + std::to_string(run.exit_code) + ")" +
+                                           (first_error.empty() ? detail_text() : (disk.empty() ? "" : " (" + disk + ")") +
+                                                                                    ": " + first_error));
+  }
+  return run.wall_s;
 }
 
 }  // namespace
@@ -277,9 +375,56 @@ CheckResult run_check(const fs::path& dir, const CheckOptions& o) {
   r.model_linear_velocity_tolerance = deck.tolerances.model_linear_velocity;
   r.model_angular_velocity_tolerance = deck.tolerances.model_angular_velocity;
   r.impulse_Ns = deck.impulse_Ns;
-  if (o.run_solver) r.solver_wall_time_s = run_ccx(dir, o, deck.end_time_s);
-  const fs::path dat_path = dir / (std::string(kJobName) + ".dat");
-  const DatFile dat = read_dat(dat_path);
+  // The time limit: given, or from the deck's size.
+  DeckOptions schedule;
+  schedule.end_time_s = deck.end_time_s;
+  schedule.time_step_s = std::min(deck.time_step_s, deck.end_time_s);
+  schedule.pulse_increments = static_cast<int>(std::min<std::size_t>(deck.pulse_increments, 1000000));
+  const TimeSchedule ts = time_schedule(schedule, deck.contact_end_s);
+  const std::size_t increments = ts.pulse_increments + ts.main_increments + 1;
+  if (o.timeout_s > 0) {
+    r.solver_timeout_s = o.timeout_s;
+    r.solver_timeout_source = "--solver-timeout-s";
+  } else {
+    r.solver_timeout_s = default_solver_timeout_s(deck.mesh.nodes_m.size(), increments);
+    r.solver_timeout_source = "default for " + std::to_string(deck.mesh.nodes_m.size()) + " nodes and " +
+                              std::to_string(increments) + " increments";
+  }
+  const fs::path work = o.run_solver && !o.work_dir.empty() ? o.work_dir : dir;
+  if (o.run_solver) {
+    if (work != dir) {
+      for (const std::string f : {std::string(kJobName) + ".inp", std::string("mesh.inp")}) {
+        std::error_code ec;
+        fs::copy_file(dir / f, work / f, fs::copy_options::overwrite_existing, ec);
+        if (ec) throw InputError((dir / f).string(), "copy for the ccx run", ec.message());
+      }
+    }
+    r.solver_wall_time_s = run_ccx(work, o, deck.end_time_s, r.solver_timeout_s, r.solver_timeout_source);
+    for (const char* ext : {".dat", ".frd", ".sta", ".cvg", ".12d", ".log"}) {
+      const fs::path f = work / (std::string(kJobName) + ext);
+      std::error_code ec;
+      if (fs::is_regular_file(f, ec)) r.solver_files.push_back(f);
+    }
+  }
+  const fs::path dat_path = work / (std::string(kJobName) + ".dat");
+  if (std::error_code ec; !fs::exists(dat_path, ec)) {
+    std::string first_error, last_line;
+    scan_log(work / (std::string(kJobName) + ".log"), first_error, last_line);
+    if (!o.run_solver) throw InputError(dat_path.string(), "ccx results", "missing: run without --no-run to make them");
+    throw InputError(dat_path.string(), "ccx results",
+                     "ccx ended without writing impact.dat" +
+                         (last_line.empty() ? std::string("; its log is empty") : "; last line of impact.log: '" + last_line + "'"));
+  }
+  DatFile dat;
+  try {
+    dat = read_dat(dat_path);
+  } catch (const InputError& e) {
+    std::string first_error, last_line;
+    if (o.run_solver) scan_log(work / (std::string(kJobName) + ".log"), first_error, last_line);
+    const std::string disk = o.run_solver ? disk_full_note(work, first_error + "\n" + last_line) : "";
+    if (disk.empty()) throw;
+    throw InputError(e.where(), e.place(), e.reason() + "; " + disk);
+  }
 
   // FE mass, centroid and inertia of the mesh (exact for linear tetrahedra).
   const TetMesh& m = deck.mesh;
@@ -298,15 +443,41 @@ CheckResult run_check(const fs::path& dir, const CheckOptions& o) {
 
   // Momentum from the all-node print of step 2.
   auto all = dat.velocities.find("BODYN");
-  if (all == dat.velocities.end() || all->second.empty() ||
-      all->second.back().second.size() != m.nodes_m.size() || dat.total_mass_kg <= 0) {
-    throw InputError(dat_path.string(), "step 2", "missing the all-node velocity or total mass print "
-                     "(did ccx finish? see impact.log)");
+  const bool have_velocities = all != dat.velocities.end() && !all->second.empty() &&
+                               all->second.back().second.size() == m.nodes_m.size();
+  if (!have_velocities || !(dat.total_mass_kg > 0)) {
+    std::string why;
+    if (all == dat.velocities.end() || all->second.empty()) {
+      why = "the all-node velocity print of step 2 (*NODE PRINT, NSET=BODYN) is missing";
+    } else if (!have_velocities) {
+      why = "the all-node velocity print of step 2 has " + std::to_string(all->second.back().second.size()) +
+            " of the mesh's " + std::to_string(m.nodes_m.size()) + " nodes (cut short)";
+    } else {
+      why = "the total mass print of step 2 (*EL PRINT, EMAS) is missing";
+    }
+    if (o.run_solver) {
+      std::string first_error, last_line;
+      scan_log(work / (std::string(kJobName) + ".log"), first_error, last_line);
+      const std::string disk = disk_full_note(work, first_error + "\n" + last_line);
+      const std::string progress = sta_progress(work / (std::string(kJobName) + ".sta"), deck.end_time_s);
+      if (!disk.empty()) why += "; " + disk;
+      if (!progress.empty()) why += "; " + progress;
+      if (disk.empty() && !last_line.empty()) why += "; last line of impact.log: '" + last_line + "'";
+    } else {
+      why += " (run without --no-run to make it)";
+    }
+    throw InputError(dat_path.string(), "step 2", why);
   }
   const auto& [t_all, v_all] = all->second.back();
   r.momentum_time_s = t_all;
   std::vector<Eigen::Vector3d> v(m.nodes_m.size());
-  for (const auto& [node, vel] : v_all) v.at(static_cast<std::size_t>(node - 1)) = vel;
+  for (const auto& [node, vel] : v_all) {
+    if (node < 1 || static_cast<std::size_t>(node) > v.size() || !vel.allFinite()) {
+      throw InputError(dat_path.string(), "step 2", "velocity of node " + std::to_string(node) +
+                                                        ": not a node of the mesh, or not a finite number");
+    }
+    v[static_cast<std::size_t>(node - 1)] = vel;
+  }
   Eigen::Vector3d P = Eigen::Vector3d::Zero();
   for (std::size_t i = 0; i < v.size(); ++i) P += node_mass[i] * v[i];
   // ccx 2.20 integrates the C3D4 mass matrix at one point: M_e = m_e / 16 (1 1^T) (x) I_3, so
@@ -327,7 +498,7 @@ CheckResult run_check(const fs::path& dir, const CheckOptions& o) {
   r.fe_velocity_m_s = P.dot(d) / r.fe_mass_kg;
   r.linear_momentum_relative_error = (P - Pi).norm() / deck.impulse_Ns;
 
-  const Eigen::Vector3d arm = m.nodes_m.at(static_cast<std::size_t>(deck.load_node - 1)) - c;
+  const Eigen::Vector3d arm = m.nodes_m[deck.load_node - 1] - c;
   const Eigen::Vector3d Lref = arm.cross(Pi);
   const Eigen::Matrix3d Iinv = inertia.inverse();
   r.angular_velocity_fe_rad_s = Iinv * L;
@@ -356,7 +527,10 @@ CheckResult run_check(const fs::path& dir, const CheckOptions& o) {
       if (t > deck.contact_end_s && t <= deck.end_time_s * (1 + 1e-9)) vals.push_back(nv.begin()->second.dot(d));
     }
     if (vals.empty()) throw InputError(dat_path.string(), name, "no velocity after the pulse");
-    pr.point_m = m.nodes_m.at(static_cast<std::size_t>(node - 1));
+    if (node < 1 || static_cast<std::size_t>(node) > m.nodes_m.size()) {
+      throw InputError(dat_path.string(), name, "node " + std::to_string(node) + " is not a node of the mesh");
+    }
+    pr.point_m = m.nodes_m[static_cast<std::size_t>(node - 1)];
     pr.samples = vals.size();
     double sum = 0;
     for (double x : vals) sum += x;
@@ -396,7 +570,7 @@ CheckResult run_check(const fs::path& dir, const CheckOptions& o) {
   }
 
   // Stresses, when this run wrote them.
-  const fs::path frd = dir / (std::string(kJobName) + ".frd");
+  const fs::path frd = work / (std::string(kJobName) + ".frd");
   if (o.stresses && fs::exists(frd)) {
     StressInputs si;
     si.load_node = deck.load_node - 1;
@@ -406,8 +580,10 @@ CheckResult run_check(const fs::path& dir, const CheckOptions& o) {
     si.yield_strength_Pa = deck.yield_strength_Pa;
     si.end_time_s = deck.end_time_s;
     r.stress = read_stresses(frd, m, si);
-    write_stress_files(dir, m, *r.stress,
+    write_stress_files(work, m, *r.stress,
                        "Von Mises stress, impact '" + deck.impact + "' (" + (deck.patch_load ? "Hertz-patch" : "point") + " load)");
+    // Published with the solver's own results (fem-check moves solver_files into the deck folder).
+    if (work != dir) r.solver_files.insert(r.solver_files.end(), r.stress->files.begin(), r.stress->files.end());
   }
 
   // One line per missed threshold (a null error is not checked).
@@ -425,7 +601,20 @@ CheckResult run_check(const fs::path& dir, const CheckOptions& o) {
        r.model_angular_velocity_tolerance);
   for (const auto& b : r.body.failures) r.failures.push_back(b);
   r.passed = r.failures.empty();
+  // A degenerate mesh (zero FE mass or inertia) must not print NaN as a result.
+  if (!is_finite_all(r.fe_mass_kg, r.expected_velocity_m_s, r.fe_velocity_m_s, r.linear_momentum_relative_error,
+                     r.angular_momentum_relative_error.value_or(0.0)) ||
+      !(r.fe_mass_kg > 0) || !r.angular_velocity_fe_rad_s.allFinite() || !r.angular_velocity_expected_rad_s.allFinite()) {
+    throw InputError((dir / "mesh.inp").string(), "momentum check",
+                     "the mesh's mass or inertia is zero or not finite (degenerate tetrahedra): no momentum to check");
+  }
   return r;
+}
+
+double default_solver_timeout_s(std::size_t nodes, std::size_t increments) {
+  const double n = static_cast<double>(nodes);
+  const double estimate = 2e-4 * n * static_cast<double>(increments) * std::max(1.0, std::sqrt(n / 1000.0));
+  return std::max(300.0, 10.0 * estimate);
 }
 
 json to_json(const CheckResult& r) {
@@ -451,6 +640,8 @@ json to_json(const CheckResult& r) {
             {"angular_velocity_expected_rad_s", v3(r.angular_velocity_expected_rad_s)},
             {"probes", probes},
             {"solver_wall_time_s", r.solver_wall_time_s},
+            {"solver_timeout_s", r.solver_timeout_s},
+            {"solver_timeout_source", r.solver_timeout_source},
             {"momentum_time_s", r.momentum_time_s},
             {"linear_tolerance", r.linear_tolerance},
             {"angular_tolerance", r.angular_tolerance},

@@ -13,6 +13,7 @@
 
 #include "impactdeck/common/atomic_file.hpp"
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/common/run_transaction.hpp"
 #include "impactdeck/common/version.hpp"
 #include "impactdeck/fem_export/force_table.hpp"
 
@@ -457,15 +458,50 @@ std::string code_aster_export(const DeckRequest& r, const TetMesh& m) {
   return s.str();
 }
 
+namespace {
+
+// The element count before meshing (estimate) and after it (real), against options.max_elements.
+void check_element_count(const DeckRequest& r, const std::string& where) {
+  const double volume = r.body.volume_m3 > 0                  ? r.body.volume_m3
+                        : r.model.volume_m3 > 0              ? r.model.volume_m3
+                        : r.body.kind == BodyKind::ellipsoid ? 4.0 / 3.0 * M_PI * r.body.semi_axes_m.prod()
+                                                             : 0.0;  // unknown: only the real count is checked
+  const double est = estimate_tet_count(volume, r.options.mesh.mesh_size_m, r.options.mesh.load_mesh_size_m);
+  if (est > static_cast<double>(r.options.max_elements)) {
+    std::ostringstream m;
+    m << "about " << std::setprecision(3) << est << " tetrahedra (estimated from the body's volume " << volume
+      << " m^3 at mesh_size " << r.options.mesh.mesh_size_m << " m), more than max_elements = "
+      << r.options.max_elements << ": use a larger mesh_size, or raise outputs.fem.max_elements";
+    throw InputError(where, "mesh_size", m.str());
+  }
+}
+
+}  // namespace
+
 DeckResult write_decks(const DeckRequest& r, const fs::path& folder) {
+  const fs::path parent = folder.has_parent_path() ? folder.parent_path() : fs::path(".");
+  if (!fs::is_directory(parent)) throw InputError(folder.string(), "output folder", "parent folder does not exist");
+  RunTransaction txn(parent, "deck folder");
+  try {
+    DeckResult out = write_deck_files(r, txn.folder(folder.filename().string(), folder.string(), "deck folder"));
+    txn.commit();
+    out.folder = folder;
+    for (auto& f : out.files) f = txn.public_path(f);
+    return out;
+  } catch (const InputError& e) {
+    throw txn.public_error(e);
+  }
+}
+
+DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
   const std::string where = folder.string();
   validate(r, where);
-  const fs::path parent = folder.has_parent_path() ? folder.parent_path() : fs::path(".");
-  if (!fs::is_directory(parent)) throw InputError(where, "output folder", "parent folder does not exist");
-  const fs::path stage = parent / ("." + folder.filename().string() + ".partial-" + std::to_string(::getpid()));
+  check_element_count(r, where);
+  const fs::path stage = folder;
   std::error_code ec;
-  fs::remove_all(stage, ec);
-  if (!fs::create_directory(stage, ec)) throw InputError(where, "output folder", "cannot create " + stage.string());
+  if (!fs::create_directory(stage, ec)) {
+    throw InputError(where, "output folder", "cannot create it: " + (ec ? ec.message() : "it exists already"));
+  }
 
   DeckResult out;
   try {
@@ -519,6 +555,12 @@ DeckResult write_decks(const DeckRequest& r, const fs::path& folder) {
     }
     out.mesh_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_mesh).count();
     TetMesh& m = mr.mesh;
+    if (m.tets.size() > r.options.max_elements) {
+      throw InputError(where, "mesh", "Gmsh made " + std::to_string(m.tets.size()) +
+                                          " tetrahedra, more than max_elements = " +
+                                          std::to_string(r.options.max_elements) +
+                                          ": use a larger mesh_size, or raise outputs.fem.max_elements");
+    }
     const MeshQuality& q = mr.quality;
     out.load = r.options.load;
     std::optional<PatchLoad> patch;
@@ -674,24 +716,11 @@ DeckResult write_decks(const DeckRequest& r, const fs::path& folder) {
                  {"files", names}};
     write_file_atomically(stage / "deck.json", deck.dump(2) + "\n");
 
-    // Publish: move an old folder aside, rename the stage, drop the old one.
-    const fs::path old = parent / ("." + folder.filename().string() + ".old-" + std::to_string(::getpid()));
-    fs::remove_all(old, ec);
-    if (fs::exists(folder)) fs::rename(folder, old);
-    fs::rename(stage, folder);
-    fs::remove_all(old, ec);
-
     out.folder = folder;
     for (const auto& n : names) out.files.push_back(folder / n);
     out.quality = q;
     out.node_count = q.node_count;
     out.tet_count = q.tet_count;
-  } catch (const InputError& e) {
-    fs::remove_all(stage, ec);
-    // Name the deck folder, not the hidden staging folder that no longer exists.
-    std::string w = e.where();
-    if (w.rfind(stage.string(), 0) == 0) w = (folder / fs::path(w).lexically_relative(stage)).string();
-    throw InputError(w, e.place(), e.reason());
   } catch (...) {
     fs::remove_all(stage, ec);
     throw;

@@ -40,9 +40,10 @@ Eigen::Vector3d parse_point(const std::string& s, double to_m, const std::string
     try {
       std::size_t used = 0;
       p[k] = std::stod(item, &used);
-      if (used != item.size() || !std::isfinite(p[k])) throw std::invalid_argument("");
+      // Within 1e20 m of the origin, as the parts are (text_mesh_readers.hpp): squared distances stay finite.
+      if (used != item.size() || !std::isfinite(p[k]) || std::abs(p[k] * to_m) > 1e20) throw std::invalid_argument("");
     } catch (const std::exception&) {
-      throw UsageError(flag + " '" + s + "': expected three numbers x,y,z");
+      throw UsageError(flag + " '" + s + "': expected three numbers x,y,z, each within 1e20 m of the origin");
     }
     ++k;
   }

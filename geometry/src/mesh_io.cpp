@@ -6,6 +6,7 @@
 #include <cstring>
 #include <fstream>
 #include <iomanip>
+#include <limits>
 #include <sstream>
 
 #include <assimp/Importer.hpp>
@@ -14,6 +15,7 @@
 
 #include "impactdeck/common/atomic_file.hpp"
 #include "impactdeck/common/error.hpp"
+#include "text_mesh_readers.hpp"
 
 namespace impactdeck::geometry {
 namespace fs = std::filesystem;
@@ -76,148 +78,21 @@ class VertexIndex {
 
 bool is_identity(const aiMatrix4x4& m) { return m.IsIdentity(); }
 
-// An OFF header declaring more vertices and faces than the file can hold (each needs at least two
-// bytes: a digit and a separator) is refused before assimp reserves memory for them: assimp's
-// `models/invalid/OutOfMemory.off` (353535235358 vertices in 309 bytes) otherwise runs for minutes.
-std::string count_text(long double n) {
-  std::ostringstream o;
-  o << std::fixed << std::setprecision(0) << n;
-  return o.str();
-}
-
-void check_off_header(const fs::path& file, const std::string& where, std::uintmax_t bytes) {
-  std::ifstream in(file, std::ios::binary);
-  std::string line;
-  int line_no = 0, seen = 0;
-  while (seen < 2 && std::getline(in, line)) {
-    ++line_no;
-    const auto hash = line.find('#');
-    if (hash != std::string::npos) line.erase(hash);
-    std::istringstream ls(line);
-    std::string first;
-    if (!(ls >> first)) continue;
-    if (seen == 0) {
-      ++seen;
-      if (first.size() >= 3 && first.compare(first.size() - 3, 3, "OFF") == 0) {
-        if (!(ls >> first)) continue;  // counts on the next line
-      }
-    }
-    ++seen;
-    long double nv = 0, nf = 0;
-    std::string rest;
-    std::getline(ls, rest);
-    std::istringstream cs(first + " " + rest);
-    if (!(cs >> nv >> nf)) return;  // malformed counts: assimp reports them
-    if (nv < 0 || nf < 0 || 2.0L * (nv + nf) > static_cast<long double>(bytes)) {
-      throw InputError(where, "line " + std::to_string(line_no),
-                       "the OFF header declares " + count_text(nv) + " vertices and " +
-                           count_text(nf) + " faces, more than a file of " +
-                           std::to_string(bytes) + " bytes can hold");
-    }
-    return;
-  }
-}
-
-// A PLY header is checked before assimp reads the body: assimp 5.2.5 reads past its buffer (a
-// SEGV, found by fuzz_mesh) on a binary PLY whose property has an unknown type ("fl}oat"), and
-// trusts element counts as the OFF reader does. Refused here: a first line other than "ply", an
-// unknown format, a property type PLY does not define, a header with no end_header, and
-// counts whose minimal size (binary: the scalar properties plus the count of each list; ASCII:
-// two characters per value) exceeds what follows the header.
-std::size_t ply_type_size(const std::string& t) {
-  static const std::pair<const char*, std::size_t> kTypes[] = {
-      {"char", 1},  {"uchar", 1},  {"int8", 1},   {"uint8", 1},  {"short", 2},   {"ushort", 2},
-      {"int16", 2}, {"uint16", 2}, {"int", 4},    {"uint", 4},   {"int32", 4},   {"uint32", 4},
-      {"float", 4}, {"float32", 4}, {"double", 8}, {"float64", 8}};
-  for (const auto& [name, size] : kTypes)
-    if (t == name) return size;
-  return 0;
-}
-
-void check_ply_header(const fs::path& file, const std::string& where, std::uintmax_t bytes) {
-  std::ifstream in(file, std::ios::binary);
-  std::string line;
-  int line_no = 0;
-  bool binary = false;
-  long double minimal = 0, element_count = 0, element_size = 0;
-  auto fail = [&](const std::string& reason) { throw InputError(where, "line " + std::to_string(line_no), reason); };
-  auto close_element = [&] { minimal += element_count * element_size; };
-  std::uintmax_t header_bytes = 0;
-  while (std::getline(in, line)) {
-    ++line_no;
-    header_bytes += line.size() + 1;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    std::istringstream ls(line);
-    std::string word;
-    ls >> word;
-    if (line_no == 1) {
-      if (word != "ply") fail("not a PLY file (the first line must be 'ply')");
-      continue;
-    }
-    if (word.empty() || word == "comment" || word == "obj_info") continue;
-    if (word == "format") {
-      std::string kind;
-      ls >> kind;
-      if (kind == "ascii") binary = false;
-      else if (kind == "binary_little_endian" || kind == "binary_big_endian") binary = true;
-      else fail("unknown PLY format '" + kind + "'");
-    } else if (word == "element") {
-      close_element();
-      std::string name;
-      element_count = -1;
-      if (!(ls >> name >> element_count) || element_count < 0) fail("an element needs a name and a count >= 0");
-      element_size = 0;
-    } else if (word == "property") {
-      std::string type;
-      ls >> type;
-      if (type == "list") {
-        std::string count_type, item_type;
-        ls >> count_type >> item_type;
-        const std::size_t c = ply_type_size(count_type);
-        if (c == 0 || count_type.find("float") != std::string::npos || count_type == "double" ||
-            ply_type_size(item_type) == 0) {
-          fail("property list '" + count_type + " " + item_type + "': not PLY types (an integer count, then any type)");
-        }
-        element_size += binary ? static_cast<long double>(c) : 2.0L;
-      } else {
-        const std::size_t z = ply_type_size(type);
-        if (z == 0) fail("property type '" + type + "' is not a PLY type");
-        element_size += binary ? static_cast<long double>(z) : 2.0L;
-      }
-    } else if (word == "end_header") {
-      close_element();
-      const long double body = static_cast<long double>(bytes) - static_cast<long double>(header_bytes);
-      if (minimal > body) {
-        fail("the PLY header declares elements needing at least " + count_text(minimal) + " bytes, but " +
-             count_text(std::max<long double>(body, 0)) + " follow the header");
-      }
-      return;
-    }  // any other line is free text, as assimp (and Blender's exporter) take it
-    if (line_no > 10000) break;
-  }
-  fail("no end_header: the PLY header is incomplete");
-}
-
 }  // namespace
 
 LoadedMesh load_mesh(const fs::path& file, LengthUnit unit) {
   const std::string where = file.string();
-  std::error_code ec;
-  if (!fs::exists(file, ec)) throw InputError(where, "file", "does not exist");
-  if (fs::is_directory(file, ec)) throw InputError(where, "file", "is a directory, not a part file");
-  {
-    std::ifstream probe(file, std::ios::binary);
-    if (!probe) throw InputError(where, "file", "cannot be opened (unreadable)");
-  }
-  if (fs::file_size(file, ec) == 0) throw InputError(where, "file", "is empty (0 bytes): no triangles");
+  // A regular file (a FIFO or a device is refused before it is opened) that fits in memory.
+  const std::uintmax_t bytes = detail::check_part_file(file);
+  if (bytes == 0) throw InputError(where, "file", "is empty (0 bytes): no triangles");
   std::string ext = file.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
   if (ext != ".stl" && ext != ".obj" && ext != ".ply" && ext != ".off") {
     throw InputError(where, "file", "unsupported format '" + ext + "' (expected .stl, .obj, .ply or .off)");
   }
-
-  if (ext == ".off") check_off_header(file, where, fs::file_size(file, ec));
-  if (ext == ".ply") check_ply_header(file, where, fs::file_size(file, ec));
+  // OFF, OBJ, PLY and ASCII STL: own readers in double precision (text_mesh_readers.hpp); assimp
+  // (float32) reads binary STL only, which is float32 anyway.
+  if (auto own = detail::read_own_format(file, ext, unit, bytes)) return std::move(*own);
 
   LoadedMesh out;
   out.format = ext.substr(1);
@@ -325,23 +200,27 @@ LoadedMesh load_mesh(const fs::path& file, LengthUnit unit) {
   }
   // Vertices of skipped points/lines never get an id (vertex_id runs for triangle corners only),
   // and ids are given in order of first use: every vertex is a triangle corner, no remap needed.
-  if (out.lines_ignored + out.points_ignored > 0) {
-    out.warnings.push_back(where + ": ignored " + std::to_string(out.lines_ignored) + " line(s) and " +
-                           std::to_string(out.points_ignored) +
-                           " point(s): only triangles and polygons describe a surface");
-  }
-  if (out.mesh.triangles.empty()) {
-    std::string detail;
-    if (out.lines_ignored + out.points_ignored > 0) {
-      detail = " (only " + std::to_string(out.points_ignored) + " point(s) and " +
-               std::to_string(out.lines_ignored) + " line(s))";
-    }
-    throw InputError(where, "faces", "the file contains no triangles" + detail);
-  }
+  detail::finish_loaded(out, where);
   return out;
 }
 
 namespace {
+// STL holds float32 coordinates: every one must be finite and, unless 0, a normal float (a part
+// 1e39 or 1e-60 units across would be written as Inf or as zeros).
+void check_float32(const fs::path& file, const TriangleMesh& mesh, double scale) {
+  for (std::size_t v = 0; v < mesh.vertices_m.size(); ++v)
+    for (int i = 0; i < 3; ++i) {
+      const double x = mesh.vertices_m[v][i] * scale;
+      const float f = static_cast<float>(x);
+      if (x != 0.0 && (!std::isfinite(f) || std::abs(f) < std::numeric_limits<float>::min())) {
+        std::ostringstream m;
+        m << "vertex " << v << " has the coordinate " << x << ", which float32, the STL coordinate type, cannot "
+          << "hold (finite and normal: 1.2e-38 to 3.4e+38 in magnitude, or 0); nothing was written";
+        throw InputError(file.string(), "coordinates", m.str());
+      }
+    }
+}
+
 void put_f32(std::ostream& o, float x) {
   char b[4];
   std::memcpy(b, &x, 4);
@@ -352,6 +231,7 @@ void put_f32(std::ostream& o, float x) {
 void write_stl_binary(const fs::path& file, const TriangleMesh& mesh, LengthUnit unit,
                       const std::string& header) {
   const double s = 1.0 / metres_per(unit);
+  check_float32(file, mesh, s);
   write_file_atomically(file, [&](std::ostream& o) {
     char h[80] = {};
     std::string text = header;
@@ -377,6 +257,7 @@ void write_stl_binary(const fs::path& file, const TriangleMesh& mesh, LengthUnit
 void write_stl_ascii(const fs::path& file, const TriangleMesh& mesh, LengthUnit unit,
                      const std::string& name) {
   const double s = 1.0 / metres_per(unit);
+  check_float32(file, mesh, s);
   write_file_atomically(file, [&](std::ostream& o) {
     o << std::setprecision(9) << "solid " << name << "\n";
     for (const auto& t : mesh.triangles) {

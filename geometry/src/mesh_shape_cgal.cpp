@@ -478,7 +478,9 @@ CurvatureFit MeshShape::fit_curvature(const Eigen::Vector3d& point, bool with_co
     // Too few points for a quadric: exact zero when they are coplanar (a flat facet region).
     double dev = 0;
     for (std::size_t i = 0; i < hood_size; ++i) dev = std::max(dev, std::abs((V[pts[i]] - p).dot(ix.face_normal[f])));
-    if (dev <= 1e-9 * std::max(size_m(), 1e-300)) {
+    // Flat to 1e-9 of the part's size, or to the rounding of positions this far from the origin
+    // (a 1 m cube 1e9 m away has coordinates rounded to 1e-7 m: still flat).
+    if (dev <= 1e-9 * std::max(size_m(), 1e-300) + 64.0 * std::numeric_limits<double>::epsilon() * p.norm()) {
       out.planar = true;
       out.neighbourhood_points = static_cast<int>(hood_size);
       out.curvature.k1_per_m = out.curvature.k2_per_m = 0;

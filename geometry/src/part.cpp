@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "impactdeck/common/error.hpp"
+#include "text_mesh_readers.hpp"
 
 namespace impactdeck::geometry {
 
@@ -30,6 +31,7 @@ Part load_part(const std::filesystem::path& file, const PartOptions& opt) {
   part.file = file;
   const std::string where = file.string();
   part.loaded = timed(part.stages, "mesh_load", [&] { return load_mesh(file, opt.length_unit); });
+  detail::check_part_extent(part.loaded, where);  // size range, memory for the stages below
   part.warnings = part.loaded.warnings;
   TriangleMesh mesh = part.loaded.mesh;
 

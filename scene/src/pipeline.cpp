@@ -8,6 +8,7 @@
 #include "impactdeck/collision/elliptical.hpp"
 #include "impactdeck/collision/hertz.hpp"
 #include "impactdeck/common/atomic_file.hpp"
+#include "impactdeck/common/run_transaction.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/fem_export/force_table.hpp"
 #include "impactdeck/geometry/cad_shape.hpp"
@@ -16,6 +17,7 @@
 #include "impactdeck/geometry/part.hpp"
 #include "impactdeck/geometry/plane.hpp"
 #include "impactdeck/plot/force_plot.hpp"
+#include "numeric_checks.hpp"
 
 namespace impactdeck::scene {
 namespace fs = std::filesystem;
@@ -146,6 +148,7 @@ PreparedBody prepare_body(const BodySpec& b, const Scene& scene, RunReport* repo
   const double density = b.mass_kg ? *b.mass_kg / p.volume.volume_m3 : *m.density_kg_m3;
   p.mass_kg = density * p.volume.volume_m3;
   p.inertia_kg_m2 = density * p.volume.inertia_per_density_m5;
+  detail::check_body_magnitudes(scene, b, p);
   return p;
 }
 
@@ -312,21 +315,81 @@ fem_export::DeckRequest fem_request(const Scene& scene, const ImpactReport& ir, 
   t.mass = u.mass.value_or(t.mass);
   t.inertia = u.inertia.value_or(t.inertia);
   t.min_gamma = u.min_gamma.value_or(t.min_gamma);
+  r.body.volume_m3 = target.volume.volume_m3;
+  if (f.max_elements) r.options.max_elements = *f.max_elements;
   return r;
 }
 
 }  // namespace
 
-RunReport run_scene(const Scene& scene, const RunOptions& opt) {
-  RunReport report;
-  StageClock clock(report);
-  report.stages_run.push_back({"scene", 0.0});
-  if (const auto left = AtomicFileSet::interrupted_commit(opt.out_dir); !left.empty()) {
-    report.warnings.push_back("a previous run was killed while replacing its " + std::to_string(left.size()) +
-                              " output files in '" + opt.out_dir.string() +
-                              "': they may mix two runs until this run replaces them (see " +
-                              AtomicFileSet::kMarker + ")");
+namespace {
+
+// Where each output of the scene goes, reserved in the run's transaction before any work (a bad
+// name fails at once): staged paths, one per impact.
+struct StagedOutputs {
+  std::vector<fs::path> table, plot, fem;
+};
+
+StagedOutputs reserve_outputs(const Scene& scene, RunTransaction& txn) {
+  StagedOutputs st;
+  const std::string file = where(scene);
+  const std::size_t n = scene.impacts.size();
+  auto place_of = [&](const char* key) {
+    const auto it = scene.outputs.places.find(key);
+    return (it != scene.outputs.places.end() ? it->second : Place{0, std::string("outputs.") + key}).describe();
+  };
+  // One file per impact; with several impacts the impact's name is appended to the stem.
+  auto per_impact = [&](const fs::path& base, const ImpactSpec& s, const char* key) {
+    if (n == 1) return base.string();
+    RunTransaction::check_name(base.string(), file, place_of(key));  // before the name is changed
+    return (base.parent_path() / (base.stem().string() + "_" + s.name + base.extension().string())).string();
+  };
+  auto name_in_file_names = [&](const ImpactSpec& s) {
+    if (s.name.find('/') != std::string::npos) {
+      throw InputError(file, Place{s.place.line, s.place.key + ".name"}.describe(),
+                       "impact '" + s.name + "': the name is part of output file names, so it must not contain '/'");
+    }
+  };
+  // No output may replace the run's own inputs (the scene, a part), however named: checked on the
+  // final path before anything is staged.
+  std::vector<fs::path> inputs = {scene.file};
+  for (const auto& b : scene.bodies)
+    if (b.shape == ShapeKind::mesh) inputs.push_back(b.mesh_path);
+  auto reserve = [&](const std::string& name, const std::string& place, bool folder) {
+    const fs::path target_path = txn.out_dir() / RunTransaction::check_name(name, file, place);
+    std::error_code ec;
+    const fs::path target = fs::weakly_canonical(target_path, ec);
+    for (const fs::path& in : inputs) {
+      std::error_code ec2;
+      const fs::path c = fs::weakly_canonical(in, ec2);
+      const bool inside = c.string().rfind(target.string() + "/", 0) == 0;  // a part inside a deck folder
+      if (!ec && !ec2 && !in.empty() && (c == target || inside)) {
+        throw InputError(file, place, "the output '" + target_path.string() + "' would replace the run's own input '" +
+                                          in.string() + "'");
+      }
+    }
+    return folder ? txn.folder(name, file, place) : txn.file(name, file, place);
+  };
+  for (const auto& s : scene.impacts) {
+    if (scene.outputs.fem || (n > 1 && (scene.outputs.force_table_csv || scene.outputs.force_plot_svg))) {
+      name_in_file_names(s);
+    }
+    if (scene.outputs.fem) {
+      st.fem.push_back(reserve("fem_" + s.name,
+                               Place{s.place.line, s.place.key + ".name"}.describe() + " (deck folder of [outputs.fem])", true));
+    }
+    if (scene.outputs.force_table_csv) {
+      st.table.push_back(reserve(per_impact(*scene.outputs.force_table_csv, s, "force_table_csv"), place_of("force_table_csv"), false));
+    }
+    if (scene.outputs.force_plot_svg) {
+      st.plot.push_back(reserve(per_impact(*scene.outputs.force_plot_svg, s, "force_plot_svg"), place_of("force_plot_svg"), false));
+    }
   }
+  return st;
+}
+
+void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, RunReport& report, StageClock& clock) {
+  const StagedOutputs staged = reserve_outputs(scene, txn);
 
   // Bodies that take part in an impact (others are not even built).
   std::map<std::string, PreparedBody> bodies;
@@ -348,7 +411,7 @@ RunReport run_scene(const Scene& scene, const RunOptions& opt) {
 
   for (const auto& s : scene.impacts) {
     ImpactReport ir;
-    ir.spec = &s;
+    ir.spec = std::make_shared<const ImpactSpec>(s);
     const PreparedBody& target = bodies.at(s.target);
     const PreparedBody& impactor = bodies.at(s.impactor);
     const ContactModel model = in_impact(scene, s, [&] {
@@ -358,7 +421,7 @@ RunReport run_scene(const Scene& scene, const RunOptions& opt) {
     });
     ir.contact = clock.run("contact_geometry", [&] { return locate_contact(scene, s, model); });
     if (ir.contact.result.flag != collision::ContactFlag::none) {
-      const Place place{s.place.line, s.place.key + (s.first_contact ? ".point" : ".point")};
+      const Place place{s.place.line, s.place.key + ".point"};
       throw InputError(where(scene), place.describe(),
                        "impact '" + s.name + "': at " + text(ir.contact.point_m) + " m (normal " +
                            text(ir.contact.normal) + "): " + collision::explain_flag(ir.contact.input, ir.contact.result, "'" + s.target + "'", "'" + s.impactor + "'") +
@@ -374,7 +437,16 @@ RunReport run_scene(const Scene& scene, const RunOptions& opt) {
       }
     }
     ir.result = clock.run("impact", [&] {
-      return in_impact(scene, s, [&] { return collision::solve_impact(impact_input(scene, s, model, ir.contact)); });
+      return in_impact(scene, s, [&] {
+        const collision::ImpactInput in = impact_input(scene, s, model, ir.contact);
+        detail::check_impact_magnitudes(scene, s, in, ir.contact.result.effective_radius_m);
+        try {
+          return collision::solve_impact(in);
+        } catch (const InputError& e) {
+          if (e.place() != "numeric range") throw;
+          throw InputError("", e.place(), e.reason() + "; check " + detail::impact_input_keys(scene, s));
+        }
+      });
     });
     ir.validity = collision::assess_validity(ir.contact.input, ir.result.kernel, target.yield_strength_Pa,
                                              impactor.yield_strength_Pa, scene.validity);
@@ -382,108 +454,152 @@ RunReport run_scene(const Scene& scene, const RunOptions& opt) {
       report.warnings.push_back("impact '" + s.name + "': validity of the Hertz model: " + w);
     }
     for (const auto& w : ir.result.warnings) report.warnings.push_back("impact '" + s.name + "': " + w);
+    if (const std::string w = detail::indentation_warning(scene, s, ir.result); !w.empty()) {
+      report.warnings.push_back("impact '" + s.name + "': " + w);
+    }
     report.impacts.push_back(std::move(ir));
   }
 
   const bool want_fem = scene.outputs.fem.has_value();
   if (!report.all_checks_passed()) {
     report.warnings.push_back("a self-check failed: no output file was written");
-  } else {
-    // One file per impact; with several impacts the impact's name is appended to the stem.
-    auto per_impact = [&](const fs::path& base, const ImpactReport& ir) {
-      fs::path p = base;
-      if (report.impacts.size() > 1) {
-        p = base.parent_path() / (base.stem().string() + "_" + ir.spec->name + base.extension().string());
-      }
-      return p.is_absolute() ? p : opt.out_dir / p;
-    };
-    if (scene.outputs.force_table_csv || want_fem) {
-      clock.run("force_table", [&] {
-        for (auto& ir : report.impacts) {
-          ir.table = collision::sample_force_table(ir.result.history, scene.outputs.force_table);
-          if (!ir.table->tolerance_met) {
-            std::ostringstream m;
-            m << "impact '" << ir.spec->name << "': force table impulse error "
-              << ir.table->impulse_relative_error << " exceeds the tolerance "
-              << ir.table->impulse_tolerance;
-            report.warnings.push_back(m.str());
-          }
-        }
-      });
-    }
-    // FEM decks first: a meshing failure then leaves no CSV behind either. Each deck folder is
-    // staged and renamed whole (fem_export::write_decks).
-    if (want_fem) {
+    return;
+  }
+  if (scene.outputs.force_table_csv || want_fem) {
+    clock.run("force_table", [&] {
       for (auto& ir : report.impacts) {
-        fem_export::DeckRequest req = fem_request(scene, ir, bodies.at(ir.spec->target));
-        const fs::path folder = opt.out_dir / ("fem_" + ir.spec->name);
-        const auto t0 = std::chrono::steady_clock::now();
         try {
-          ir.fem_deck = fem_export::write_decks(req, folder);
+          ir.table = collision::sample_force_table(ir.result.history, scene.outputs.force_table);
         } catch (const InputError& e) {
-          // One line naming the scene, the [outputs.fem] table, and what failed where.
-          std::string what = "impact '" + ir.spec->name + "': FEM deck " + e.where() + ": ";
-          if (!e.place().empty()) what += e.place() + ": ";
-          throw InputError(where(scene), Place{scene.outputs.fem->place.line, "outputs.fem"}.describe(),
-                           what + e.reason());
+          const auto it = scene.outputs.places.find(e.place());
+          const Place place = it != scene.outputs.places.end() ? it->second : Place{0, "outputs." + e.place()};
+          throw InputError(where(scene), place.describe(), "impact '" + ir.spec->name + "': " + e.reason());
         }
-        const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        const auto& patch = ir.fem_deck->patch;
-        if (ir.fem_deck->load == fem_export::LoadKind::hertz_patch &&
-            patch.largest_ellipse_elements < scene.outputs.fem->contact_elements) {
+        if (!ir.table->tolerance_met) {
           std::ostringstream m;
-          m << "impact '" << ir.spec->name << "': the largest contact ellipse spans " << patch.largest_ellipse_elements
-            << " elements, fewer than contact_elements = " << scene.outputs.fem->contact_elements
-            << " (the mesher kept the part's own triangles, or a coarser load size was asked for)";
+          m << "impact '" << ir.spec->name << "': force table impulse error "
+            << ir.table->impulse_relative_error << " exceeds the tolerance "
+            << ir.table->impulse_tolerance;
           report.warnings.push_back(m.str());
         }
-        add_stage(report, "fem_mesh", ir.fem_deck->mesh_seconds);
-        add_stage(report, "fem_decks", total - ir.fem_deck->mesh_seconds);
-        for (const auto& f : ir.fem_deck->files) report.files_written.push_back(f);
       }
-      if (scene.outputs.fem->run == FemOutputs::Run::calculix) {
-        clock.run("fem_run", [&] {
-          for (auto& ir : report.impacts) {
-            // A mesh that misses the body checks is not worth a solver run (it fails anyway).
-            if (!ir.fem_deck->body_check.passed) {
-              report.warnings.push_back("impact '" + ir.spec->name + "': FEM deck fails its body checks: ccx not run");
-              continue;
-            }
-            fem_export::CheckOptions co;
-            co.progress = opt.progress;
-            co.threads = opt.ccx_threads;
-            ir.fem_check = fem_export::run_check(ir.fem_deck->folder, co);
-          }
-        });
+    });
+  }
+  // FEM decks first (the slow part), written into the run's staging folder with the solver's
+  // results: they appear in --out only with everything else, after every check passed.
+  if (want_fem) {
+    for (std::size_t k = 0; k < report.impacts.size(); ++k) {
+      auto& ir = report.impacts[k];
+      fem_export::DeckRequest req = fem_request(scene, ir, bodies.at(ir.spec->target));
+      const auto t0 = std::chrono::steady_clock::now();
+      try {
+        ir.fem_deck = fem_export::write_deck_files(req, staged.fem[k]);
+      } catch (const InputError& e) {
+        // One line naming the scene, the [outputs.fem] table, and what failed where.
+        std::string what = "impact '" + ir.spec->name + "': FEM deck " + txn.public_text(e.where()) + ": ";
+        if (!e.place().empty()) what += e.place() + ": ";
+        throw InputError(where(scene), Place{scene.outputs.fem->place.line, "outputs.fem"}.describe(),
+                         what + e.reason());
       }
+      const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      const auto& patch = ir.fem_deck->patch;
+      if (ir.fem_deck->load == fem_export::LoadKind::hertz_patch &&
+          patch.largest_ellipse_elements < scene.outputs.fem->contact_elements) {
+        std::ostringstream m;
+        m << "impact '" << ir.spec->name << "': the largest contact ellipse spans " << patch.largest_ellipse_elements
+          << " elements, fewer than contact_elements = " << scene.outputs.fem->contact_elements
+          << " (the mesher kept the part's own triangles, or a coarser load size was asked for)";
+        report.warnings.push_back(m.str());
+      }
+      add_stage(report, "fem_mesh", ir.fem_deck->mesh_seconds);
+      add_stage(report, "fem_decks", total - ir.fem_deck->mesh_seconds);
     }
-    if (scene.outputs.force_table_csv || scene.outputs.force_plot_svg) {
-      clock.run("write_outputs", [&] {
-        AtomicFileSet files;  // all or nothing: a failure leaves the previous outputs as they were
+    if (scene.outputs.fem->run == FemOutputs::Run::calculix) {
+      clock.run("fem_run", [&] {
         for (auto& ir : report.impacts) {
-          if (scene.outputs.force_table_csv) {
-            const fs::path full = per_impact(*scene.outputs.force_table_csv, ir);
-            fem_export::ForceTableHeader h;
-            h.source = scene.file.string();
-            h.impact = ir.spec->name;
-            h.direction = -ir.contact.normal;  // force on the target: along -n (world)
-            files.add(full, [&](std::ostream& out) { fem_export::write_force_table_csv(out, *ir.table, h); });
-            ir.table_path = full;
+          // A mesh that misses the body checks is not worth a solver run (it fails anyway).
+          if (!ir.fem_deck->body_check.passed) {
+            report.warnings.push_back("impact '" + ir.spec->name + "': FEM deck fails its body checks: ccx not run");
+            continue;
           }
-          if (scene.outputs.force_plot_svg) {
-            const fs::path full = per_impact(*scene.outputs.force_plot_svg, ir);
-            plot::ForcePlotOptions po;
-            po.title = "Contact force, impact '" + ir.spec->name + "': " + ir.spec->impactor + " hits " +
-                       ir.spec->target;
-            files.add(full, plot::to_svg(plot::force_time_drawing(ir.result.history, po)));
-            ir.plot_path = full;
-          }
+          fem_export::CheckOptions co;
+          co.progress = opt.progress;
+          co.threads = opt.ccx_threads;
+          co.timeout_s = opt.solver_timeout_s;
+          ir.fem_check = fem_export::run_check(ir.fem_deck->folder, co);
         }
-        for (const auto& f : files.commit()) report.files_written.push_back(f);
       });
     }
   }
+  if (scene.outputs.force_table_csv || scene.outputs.force_plot_svg) {
+    clock.run("write_outputs", [&] {
+      for (std::size_t k = 0; k < report.impacts.size(); ++k) {
+        auto& ir = report.impacts[k];
+        if (scene.outputs.force_table_csv) {
+          fem_export::ForceTableHeader h;
+          h.source = scene.file.string();
+          h.impact = ir.spec->name;
+          h.direction = -ir.contact.normal;  // force on the target: along -n (world)
+          write_file_atomically(staged.table[k], [&](std::ostream& out) {
+            fem_export::write_force_table_csv(out, *ir.table, h);
+          });
+          ir.table_path = txn.public_path(staged.table[k]);
+        }
+        if (scene.outputs.force_plot_svg) {
+          plot::ForcePlotOptions po;
+          po.title = "Contact force, impact '" + ir.spec->name + "': " + ir.spec->impactor + " hits " +
+                     ir.spec->target;
+          write_file_atomically(staged.plot[k], plot::to_svg(plot::force_time_drawing(ir.result.history, po)));
+          ir.plot_path = txn.public_path(staged.plot[k]);
+        }
+      }
+    });
+  }
+  if (!report.all_checks_passed()) {
+    report.warnings.push_back("a self-check failed: no output file was written");
+    return;  // the transaction is rolled back: nothing of this run is visible
+  }
+  if (scene.outputs.force_table_csv || scene.outputs.force_plot_svg) {
+    clock.run("write_outputs", [&] { txn.commit(); });
+  } else {
+    txn.commit();
+  }
+  for (auto& ir : report.impacts) {
+    if (ir.fem_deck) {
+      ir.fem_deck->folder = txn.public_path(ir.fem_deck->folder);
+      for (auto& f : ir.fem_deck->files) {
+        f = txn.public_path(f);
+        report.files_written.push_back(f);
+      }
+    }
+    if (ir.fem_check) {
+      for (auto& f : ir.fem_check->solver_files) f = txn.public_path(f);
+      if (ir.fem_check->stress) {
+        for (auto& f : ir.fem_check->stress->files) f = txn.public_path(f);
+      }
+    }
+  }
+  for (const auto& ir : report.impacts) {
+    if (ir.table_path) report.files_written.push_back(*ir.table_path);
+    if (ir.plot_path) report.files_written.push_back(*ir.plot_path);
+  }
+}
 
+}  // namespace
+
+RunReport run_scene(const Scene& scene, const RunOptions& opt) {
+  RunReport report;
+  StageClock clock(report);
+  report.stages_run.push_back({"scene", 0.0});
+  RunTransaction txn(opt.out_dir);
+  for (const auto& w : txn.warnings()) report.warnings.push_back(w);
+  try {
+    run_stages(scene, opt, txn, report, clock);
+  } catch (const InputError& e) {
+    throw txn.public_error(e);  // name the final paths, not the staging folder
+  } catch (const Error& e) {
+    throw Error(e.code(), txn.public_text(e.what()));
+  }
   for (const auto& st : all_stages()) {
     bool ran = false;
     for (const auto& r : report.stages_run) ran = ran || r.name == st;

@@ -259,4 +259,22 @@ std::string format_summary(const Scene& scene, const RunReport& rep) {
   return o.str();
 }
 
+std::string failed_checks_summary(const Scene& scene, const RunReport& rep) {
+  std::ostringstream o;
+  o << std::setprecision(3);
+  for (const auto& ir : rep.impacts) {
+    const auto& k = ir.result.checks;
+    if (!k.passed) {
+      o << "; impact '" << ir.spec->name << "': impulse check (Eq. 31) relative error " << k.impulse_relative_error
+        << " (limit " << k.thresholds.impulse_relative << "), Carnot energy check (Eq. 32) relative error "
+        << k.energy_relative_error << " (limit " << k.thresholds.energy_relative << ")";
+    }
+    if (ir.fem_check && !ir.fem_check->passed) {
+      o << "; impact '" << ir.spec->name << "': FEM momentum check of deck 'fem_" << ir.spec->name << "'";
+      for (const auto& f : ir.fem_check->failures) o << ": " << f;
+    }
+  }
+  return scene.file.string() + ": physics self-check failed" + o.str() + "; nothing was written";
+}
+
 }  // namespace impactdeck::scene

@@ -1,7 +1,6 @@
 #include "impactdeck/scene/scene.hpp"
 
 #include <cmath>
-#include <fstream>
 #include <set>
 #include <sstream>
 
@@ -9,6 +8,8 @@
 
 #include "impactdeck/common/error.hpp"
 #include "overrides_toml.hpp"
+#include "impactdeck/common/input_file.hpp"
+#include "impactdeck/common/numeric.hpp"
 #include "toml_ascii.hpp"
 
 namespace impactdeck::scene {
@@ -70,9 +71,17 @@ class Reader {
     const toml::node* n = get(k);
     if (!n) return std::nullopt;
     if (!n->is_number()) fail(k, "must be a number, got " + type_name(*n));
-    const double v = n->value<double>().value();
-    if (!std::isfinite(v)) fail(k, "must be finite");
+    const double v = n->value<double>().value() + 0.0;  // + 0.0: -0 is 0
+    check_magnitude(k, v);
     return v;
+  }
+  /// Finite, and 0 or within [1e-100, 1e100] in magnitude (numeric.hpp says why).
+  void check_magnitude(const std::string& k, double v, const std::string& what = "") const {
+    if (!std::isfinite(v)) fail(k, what + "must be finite");
+    if (!within_magnitude_range(v)) {
+      fail(k, what + "must be 0 or between 1e-100 and 1e+100 in magnitude, got " + fmt(v) +
+                  " (beyond, products of the inputs leave double precision's range)");
+    }
   }
   double required_number(const std::string& k) {
     auto v = number(k);
@@ -83,6 +92,12 @@ class Reader {
     const double v = required_number(k);
     if (!(v > 0.0)) fail(k, "must be > 0, got " + fmt(v));
     return v;
+  }
+  /// A limit: a whole number in [1, 1e15].
+  std::size_t count(const std::string& k) {
+    const double v = required_number(k);
+    if (!(v >= 1.0 && v <= 1e15 && v == std::floor(v))) fail(k, "must be a whole number in [1, 1e15], got " + fmt(v));
+    return static_cast<std::size_t>(v);
   }
   std::optional<std::string> string(const std::string& k) {
     const toml::node* n = get(k);
@@ -111,8 +126,8 @@ class Reader {
     for (int i = 0; i < 3; ++i) {
       const toml::node& e = *a->get(static_cast<std::size_t>(i));
       if (!e.is_number()) fail(k, "must be an array of 3 numbers, element " + std::to_string(i) + " is " + type_name(e));
-      v[i] = e.value<double>().value();
-      if (!std::isfinite(v[i])) fail(k, "must be finite");
+      v[i] = e.value<double>().value() + 0.0;
+      check_magnitude(k, v[i]);
     }
     return v;
   }
@@ -218,6 +233,8 @@ BodySpec read_body(std::size_t index, const toml::table& t, const std::string& f
     }
     case ShapeKind::mesh: {
       const std::string p = r.required_string("mesh");
+      for (const char c : p)  // a NUL would cut the path short where the system reads it
+        if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) r.fail("mesh", "the path contains a control character");
       b.mesh_path = fs::path(p).is_absolute() ? fs::path(p) : base_dir / p;
       b.mesh_repair = r.boolean("repair").value_or(false);
       b.mesh_approximate_mass = r.boolean("approximate_mass_properties").value_or(false);
@@ -329,7 +346,7 @@ ImpactSpec read_impact(std::size_t index, const toml::table& t, const std::strin
       }
       s.restitution.kind = collision::RestitutionModel::Kind::energy_flux;
     } else if (n->is_number()) {
-      const double R = n->value<double>().value();
+      const double R = n->value<double>().value() + 0.0;
       if (!(R >= 0.0 && R <= 1.0)) r.fail("restitution", "must lie in [0, 1], got " + Reader::fmt(R));
       s.restitution.kind = collision::RestitutionModel::Kind::constant;
       s.restitution.constant = R;
@@ -380,6 +397,7 @@ FemOutputs read_fem(const toml::table& t, const std::string& file, double to_m) 
   if (r.has("time_step_s")) f.time_step_s = r.positive("time_step_s");
   if (!(f.time_step_s < f.end_time_s)) r.fail("time_step_s", "must be smaller than end_time_s");
   if (f.end_time_s / f.time_step_s > 2e6) r.fail("time_step_s", "more than 2e6 increments");
+  if (r.has("max_elements")) f.max_elements = r.count("max_elements");
   if (const toml::node* n = r.get("probes")) {
     const toml::array* a = n->as_array();
     if (!a) r.fail("probes", "must be an array of points [[x, y, z], ...]");
@@ -390,7 +408,9 @@ FemOutputs read_fem(const toml::table& t, const std::string& file, double to_m) 
       for (int k = 0; k < 3; ++k) {
         const toml::node* e = p->get(static_cast<std::size_t>(k));
         if (!e->is_number()) r.fail("probes", "element " + std::to_string(i) + " must hold 3 numbers");
-        v[k] = e->value<double>().value() * to_m;
+        v[k] = e->value<double>().value() + 0.0;
+        r.check_magnitude("probes", v[k], "element " + std::to_string(i) + ": ");
+        v[k] *= to_m;
       }
       f.probes_m.push_back(v);
     }
@@ -438,8 +458,11 @@ FemOutputs read_fem(const toml::table& t, const std::string& file, double to_m) 
 
 Outputs read_outputs(const toml::table& t, const std::string& file, double to_m) {
   Reader r(t, "outputs", file);
-  r.allow({"force_table_csv", "force_table_impulse_tolerance", "force_table_time_step_s"});
+  r.allow({"force_table_csv", "force_table_impulse_tolerance", "force_table_time_step_s", "force_table_max_samples"});
   Outputs o;
+  for (const char* k : {"force_table_csv", "force_plot_svg", "force_table_time_step_s", "force_table_impulse_tolerance",
+                        "force_table_max_samples"})
+    if (r.has(k)) o.places[k] = r.place(k);
   if (auto s = r.string("force_table_csv")) {
     if (s->empty()) r.fail("force_table_csv", "must not be empty");
     o.force_table_csv = fs::path(*s);
@@ -456,6 +479,7 @@ Outputs read_outputs(const toml::table& t, const std::string& file, double to_m)
     }
   }
   if (r.has("force_table_time_step_s")) o.force_table.time_step_s = r.positive("force_table_time_step_s");
+  if (r.has("force_table_max_samples")) o.force_table.max_samples = r.count("force_table_max_samples");
   if (const toml::node* n = r.get("fem")) o.fem = read_fem(sub_table(n, "outputs.fem", file), file, to_m);
   r.reject_unknown();
   return o;
@@ -618,14 +642,10 @@ Scene parse_scene(const std::string& text, const std::string& name, const fs::pa
 }
 
 Scene load_scene(const fs::path& file, const std::vector<Override>& overrides) {
-  std::error_code ec;
-  if (fs::is_directory(file, ec)) throw InputError(file.string(), "file", "is a directory, not a scene file");
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(file.string(), "file", "cannot be opened (missing or unreadable)");
-  std::ostringstream ss;
-  ss << in.rdbuf();
+  // A regular file of at most 16 MiB: a FIFO, a device or a huge file is refused before reading.
+  const std::string text = read_input_file(file, "scene file", kMaxSceneBytes);
   const fs::path base = file.has_parent_path() ? file.parent_path() : fs::path(".");
-  Scene s = parse_scene(ss.str(), file.string(), base, overrides);
+  Scene s = parse_scene(text, file.string(), base, overrides);
   s.file = file;
   return s;
 }

@@ -57,6 +57,11 @@ struct CompressionPhase {
 CompressionPhase compression_phase(double reduced_mass_kg, double approach_velocity_m_s,
                                    double hertz_constant) noexcept;
 
+/// Throws InputError (place "numeric range") when a number of `phase` lies outside
+/// [1e-100, 1e100] (common/numeric.hpp): beyond, the self-checks' products under- or overflow.
+/// compression_phase itself never throws (the kernel flags such a point instead).
+void check_compression_range(const CompressionPhase& phase);
+
 /// Closed-form compression phase. Throws InputError unless m_w > 0, v_w > 0, k_H > 0 (finite).
 CompressionPhase solve_compression(double reduced_mass_kg, double approach_velocity_m_s,
                                    double hertz_constant);

@@ -34,8 +34,10 @@ struct ForceTableOptions {
   double impulse_tolerance = 1e-4;
   /// If > 0, use this spacing instead (the impulse error is then only reported).
   double time_step_s = 0;
-  /// Upper bound on samples per phase.
-  std::size_t max_intervals_per_phase = std::size_t{1} << 22;
+  /// Most samples a table may have (scene key `force_table_max_samples`): a time_step_s needing
+  /// more is refused (InputError naming force_table_time_step_s, never silently coarsened); the
+  /// tolerance-driven doubling stops there (the table then reports tolerance_met = false).
+  std::size_t max_samples = 1000000;
 };
 
 /// Piecewise-linear force table: uniform spacing in each phase, t_m always a node, first and last
@@ -49,6 +51,7 @@ struct ForceTable {
   bool tolerance_met = false;
 };
 
+/// Throws InputError("", "force_table_time_step_s", ...) when the step needs more than max_samples.
 ForceTable sample_force_table(const ForceHistory& h, const ForceTableOptions& options = {});
 
 }  // namespace impactdeck::collision

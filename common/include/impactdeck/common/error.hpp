@@ -42,6 +42,25 @@ class InputError : public Error {
     if (!where.empty()) s += where + ": ";
     if (!place.empty()) s += place + ": ";
     s += reason;
+    return one_line(s);
+  }
+
+  /// The text with every control character (a newline in a scene's string, a NUL in a file name)
+  /// written as \xNN: a message stays one line whatever the input held.
+  static std::string one_line(const std::string& text) {
+    static const char* const hex = "0123456789ABCDEF";
+    std::string s;
+    s.reserve(text.size());
+    for (const char ch : text) {
+      const unsigned char c = static_cast<unsigned char>(ch);
+      if (c < 0x20 || c == 0x7f) {
+        s += "\\x";
+        s += hex[c >> 4];
+        s += hex[c & 15];
+      } else {
+        s += ch;
+      }
+    }
     return s;
   }
 

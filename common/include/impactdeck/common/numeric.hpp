@@ -11,6 +11,16 @@ inline double relative_difference(double a, double b, double floor = 1e-300) {
   return std::abs(a - b) / std::max(std::abs(b), floor);
 }
 
+/// Every number a user gives, and every physical quantity derived from them (SI units), must be 0
+/// or lie within [kMinMagnitude, kMaxMagnitude] in magnitude: products of three such numbers
+/// (energies, volumes, inertias) then stay inside double precision's range (about 1e-308 to
+/// 1e308), so no result silently underflows to 0 or overflows to Inf (docs/reliability.md).
+inline constexpr double kMinMagnitude = 1e-100;
+inline constexpr double kMaxMagnitude = 1e100;
+inline bool within_magnitude_range(double x) {
+  return x == 0.0 || (std::abs(x) >= kMinMagnitude && std::abs(x) <= kMaxMagnitude);
+}
+
 inline bool is_finite_all() { return true; }
 template <class... T>
 bool is_finite_all(double x, T... rest) {

@@ -43,7 +43,18 @@ struct CheckOptions {
   bool stresses = true;              ///< read impact.frd back (when present) and write the stress files
   std::ostream* progress = nullptr;  ///< progress lines from the .sta file (e.g. &std::cerr)
   int threads = 1;                   ///< OMP_NUM_THREADS for ccx
+  /// Wall-time limit of the ccx run (--solver-timeout-s): past it ccx's process group is killed
+  /// and the check fails with exit 3. 0: default_solver_timeout_s of the deck.
+  double timeout_s = 0;
+  /// Where ccx runs and writes its results (the deck's impact.inp and mesh.inp are copied there);
+  /// empty: the deck folder itself. `fem-check` uses a private folder of its run transaction.
+  std::filesystem::path work_dir;
 };
+
+/// The default ccx time limit of a deck: 10 times an estimate of its run time (2e-4 s per node and
+/// increment, times sqrt(nodes / 1000) above 1000 nodes; DECKS.md's measured runs take 0.4 to 0.9
+/// of the estimate), and at least 300 s.
+double default_solver_timeout_s(std::size_t nodes, std::size_t increments);
 
 struct ProbeResult {
   std::string name;
@@ -68,6 +79,10 @@ struct CheckResult {
   Eigen::Vector3d angular_velocity_expected_rad_s = Eigen::Vector3d::Zero();
   std::vector<ProbeResult> probes;
   double solver_wall_time_s = 0;
+  double solver_timeout_s = 0;         ///< the limit the run had
+  std::string solver_timeout_source;   ///< "--solver-timeout-s", or how the default was derived
+  /// ccx's output files (impact.dat, .frd, .sta, .cvg, .log, ...) in the work folder.
+  std::vector<std::filesystem::path> solver_files;
   double momentum_time_s = 0;          ///< time of the all-node velocity print
   double linear_tolerance = 0, angular_tolerance = 0;
   /// FE rigid-body motion against the rigid model (null when the deck carries no model, or the
@@ -84,9 +99,11 @@ struct CheckResult {
   std::vector<std::string> failures;   ///< one line per failed check
 };
 
-/// Runs ccx on `deck_dir`/impact.inp (cwd = deck_dir, output in impact.log), then parses
-/// impact.dat. Throws InputError when the folder is not a deck, ccx is missing or fails, or the
-/// output is incomplete; a check above its tolerance is reported in `passed`/`failures`.
+/// Runs ccx on `deck_dir`/impact.inp (in options.work_dir or the deck folder, output in
+/// impact.log), then parses impact.dat. Throws InputError naming the file, the step and the reason
+/// when the folder is not a deck, ccx is missing, fails, is killed by a signal, runs past its
+/// timeout, or its output is incomplete (a missing print, a full disk); a check above its
+/// tolerance is reported in `passed`/`failures`.
 CheckResult run_check(const std::filesystem::path& deck_dir, const CheckOptions& options = {});
 
 /// JSON of a check (keys documented in docs/fem.md).

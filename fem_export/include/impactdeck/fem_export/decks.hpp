@@ -42,6 +42,8 @@ struct DeckBody {
   double cad_unit_m = 1e-3;   ///< cad: metres per file coordinate unit (a BREP; STEP/IGES state theirs)
   PartSurface surface;  ///< part: the loaded, validated (and repaired) triangulation, target frame
   std::string name;     ///< part: its file, named in messages
+  /// Volume of the body, m^3, for the element-count estimate; 0: from the semi-axes (ellipsoid).
+  double volume_m3 = 0;
 };
 
 /// How the force enters the deck.
@@ -96,6 +98,12 @@ struct DeckOptions {
   bool calculix = true;        ///< write impact.inp and mesh.inp
   int aster_cpus = 1;           ///< impact.export `P ncpus` (OpenMP threads of each Code_Aster process)
   int aster_mpi_processes = 1;  ///< impact.export `P mpi_nbcpu` (MPI processes)
+  /// Most tetrahedra a deck may have (scene key outputs.fem.max_elements). Checked before meshing
+  /// against estimate_tet_count (a mesh size too small for the body would run Gmsh for hours) and
+  /// after it against the real count. Measured here: Gmsh makes about 1300 tetrahedra per second
+  /// (151 000 in 118 s), so the default bounds meshing to minutes; ccx's implicit dynamics on
+  /// such a mesh takes hours (its own limit: --solver-timeout-s).
+  std::size_t max_elements = 500000;
   MeshOptions mesh;
   /// The mesh size is a default, not the user's: while the FE body's volume or inertia (of the
   /// tetrahedra, or of ccx's mass matrix) differs from the part's by more than half its
@@ -199,10 +207,20 @@ struct TimeSchedule {
 };
 TimeSchedule time_schedule(const DeckOptions& options, double contact_end_s);
 
-/// Meshes the body and writes the decks into `folder` (created; its parent must exist). The files
-/// are first written into a hidden sibling folder which is renamed to `folder` only when all
-/// succeeded; a previous `folder` is replaced then. Throws InputError on bad input or a meshing
-/// failure, leaving `folder` as it was.
+/// Tetrahedra Gmsh makes for a body of `volume_m3` at the global size `mesh_size_m`, refined to
+/// `load_mesh_size_m` (0: a third) around a surface load point as the decks' size field does.
+/// Calibrated on Gmsh 4.8.4 meshes (docs/reliability.md: real counts 0.78 to 1.07 times the
+/// estimate from 700 to 150 000 tetrahedra); used to refuse hopeless meshes before meshing.
+double estimate_tet_count(double volume_m3, double mesh_size_m, double load_mesh_size_m);
+
+/// Meshes the body and writes the decks into the staging folder `folder` (created here; its parent
+/// must exist): the caller publishes it (a RunTransaction). On failure the folder is removed.
+/// Throws InputError on bad input, a meshing failure, or an estimated or real element count
+/// above options.max_elements.
+DeckResult write_deck_files(const DeckRequest& request, const std::filesystem::path& folder);
+
+/// write_deck_files in a transaction of its own on folder's parent (common/run_transaction.hpp):
+/// `folder` appears complete or not at all, and a previous `folder` is replaced only on success.
 DeckResult write_decks(const DeckRequest& request, const std::filesystem::path& folder);
 
 /// Text of the Code_Aster command file (exposed for tests). `patch`: the hertz-patch nodal forces

@@ -18,7 +18,8 @@
 namespace impactdeck::scene {
 
 struct ImpactReport {
-  const ImpactSpec* spec = nullptr;
+  /// A copy of the scene's impact: the report stays valid after the Scene it came from is gone.
+  std::shared_ptr<const ImpactSpec> spec;
   ContactEvaluation contact;         ///< where the bodies touch, both surfaces, the kernel's input
   collision::ImpactResult result;
   collision::ValidityReport validity;  ///< of the Hertz model at this impact
@@ -44,9 +45,11 @@ struct RunReport {
 };
 
 struct RunOptions {
-  std::filesystem::path out_dir = ".";  ///< outputs are written here (must exist)
+  std::filesystem::path out_dir = ".";  ///< outputs are written here (created if missing)
   std::ostream* progress = nullptr;     ///< solver progress lines (e.g. &std::cerr)
   int ccx_threads = 1;                  ///< [outputs.fem] run = "calculix": OMP threads of ccx
+  /// ccx wall-time limit per deck (--solver-timeout-s); 0: derived from the deck's size.
+  double solver_timeout_s = 0;
 };
 
 /// Builds the shape of a body (analytic or mesh). Throws InputError.
@@ -59,8 +62,9 @@ std::shared_ptr<const geometry::Shape> make_shape(const BodySpec& body, const Sc
 PreparedBody prepare_body(const BodySpec& body, const Scene& scene, RunReport* report = nullptr);
 
 /// Runs everything the scene asks for. Throws InputError on bad input; a failed self-check is
-/// reported (see all_checks_passed), not thrown. Outputs are written atomically after all impacts
-/// are solved, so a failure leaves no partial file set.
+/// reported (see all_checks_passed), not thrown. One transaction (common/run_transaction.hpp):
+/// every output, deck folders and solver results included, is staged inside `out_dir` and
+/// published only when every stage and check passed; after any failure nothing is visible.
 RunReport run_scene(const Scene& scene, const RunOptions& options = {});
 
 /// Every stage the tool knows, in pipeline order (for stages_run / stages_skipped).

@@ -101,6 +101,9 @@ struct FemOutputs {
     std::optional<double> linear_momentum, angular_momentum, model_linear_velocity, model_angular_velocity,
         volume, mass, inertia, min_gamma;
   } tolerances;
+  /// `max_elements`: most tetrahedra a deck may have (estimated before meshing); default
+  /// fem_export::DeckOptions::max_elements.
+  std::optional<std::size_t> max_elements;
   Place place;
 };
 
@@ -109,6 +112,7 @@ struct Outputs {
   std::optional<std::filesystem::path> force_plot_svg;   ///< F(t) picture, relative to the output folder
   collision::ForceTableOptions force_table;
   std::optional<FemOutputs> fem;
+  std::map<std::string, Place> places;  ///< line and key of the [outputs] keys given (messages)
 };
 
 struct Scene {

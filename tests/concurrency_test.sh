@@ -1,0 +1,42 @@
+#!/usr/bin/env bash
+# Concurrent runs into one --out (issue 14): each stages into its own folder and publishes under
+# flock(2), so both succeed and never corrupt each other: two FEM runs with ccx into one folder
+# (they used to crash ccx with signal 11 and leave .fem_*.old-PID folders), then ten pairs of
+# plain runs racing on the same file names.
+# usage: concurrency_test.sh IMPACTDECK SOURCE_DIR
+set -u
+bin=$1; src=$2
+. "$(dirname "$0")/check_lib.sh"
+out="$tmp/out"
+
+# 1. Two FEM runs with ccx at once (the eccentric sample, shortened): both exit 0, the deck that
+# stays is complete and its results pass the momentum check again, nothing else is left.
+sed -e 's/^end_time_s = .*/end_time_s = 5e-4/' "$src/samples/eccentric_fem.toml" >"$tmp/fem.toml"
+"$bin" run "$tmp/fem.toml" --out "$out" >"$tmp/a.out" 2>"$tmp/a.err" &
+a=$!
+"$bin" run "$tmp/fem.toml" --out "$out" >"$tmp/b.out" 2>"$tmp/b.err" &
+b=$!
+wait "$a"; ra=$?
+wait "$b"; rb=$?
+check "first FEM run exit 0 (got $ra: $(tail -2 "$tmp/a.err"))" test "$ra" -eq 0
+check "second FEM run exit 0 (got $rb: $(tail -2 "$tmp/b.err"))" test "$rb" -eq 0
+check "one deck folder, nothing else: $(ls -A "$out" | tr '\n' ' ')" test "$(ls -A "$out")" = "fem_eccentric"
+check "the deck holds ccx's results" test -s "$out/fem_eccentric/impact.dat" -a -s "$out/fem_eccentric/deck.json"
+"$bin" fem-check "$out/fem_eccentric" --no-run >/dev/null 2>"$tmp/check.err"
+check "the published deck's results pass the momentum check ($(cat "$tmp/check.err"))" test $? -eq 0
+
+# 2. Ten pairs of runs writing the same force table: each file is one run's, whole.
+plain="$tmp/plain"
+for i in $(seq 1 10); do
+  "$bin" run "$src/samples/two_spheres.toml" --out "$plain" >/dev/null 2>&1 &
+  p1=$!
+  "$bin" run "$src/samples/two_spheres.toml" --out "$plain" >/dev/null 2>&1 &
+  p2=$!
+  wait "$p1"; r1=$?
+  wait "$p2"; r2=$?
+  [ "$r1" -eq 0 ] && [ "$r2" -eq 0 ] || { echo "FAILED: pair $i exit $r1 $r2"; fails=$((fails+1)); }
+done
+check "only the force table is left: $(ls -A "$plain" | tr '\n' ' ')" test "$(ls -A "$plain")" = "force_two_spheres.csv"
+"$bin" run "$src/samples/two_spheres.toml" --out "$tmp/alone" >/dev/null 2>&1
+check "the raced file equals a lone run's byte for byte" cmp -s "$plain/force_two_spheres.csv" "$tmp/alone/force_two_spheres.csv"
+finish concurrency_test
