@@ -11,6 +11,7 @@
 #include "impactdeck/campaign/campaign.hpp"
 #include "impactdeck/campaign/orientations.hpp"
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/common/input_file.hpp"
 #include "impactdeck/common/units.hpp"
 #include "impactdeck/scene/pipeline.hpp"
 #include "impactdeck/scene/scene.hpp"
@@ -123,13 +124,10 @@ std::size_t body_index(const scene::Scene& sc, const std::string& name) {
 Campaign read_campaign(const fs::path& file) {
   FileReader fr(file);
   std::error_code ec;
-  std::ifstream in(file, std::ios::binary);
-  if (!in || fs::is_directory(file, ec)) throw InputError(fr.name(), "file", "cannot be opened (missing or unreadable)");
-  std::ostringstream text;
-  text << in.rdbuf();
+  const std::string text = read_input_file(file, "campaign file", kMaxSceneBytes);  // regular files only
   toml::table root;
   try {
-    root = toml::parse(scene::detail::toml_ascii(text.str(), fr.name()), fr.name());
+    root = toml::parse(scene::detail::toml_ascii(text, fr.name()), fr.name());
   } catch (const toml::parse_error& e) {
     std::ostringstream p;
     p << "line " << e.source().begin.line << ", column " << e.source().begin.column;

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/common/input_file.hpp"
 #include "overrides_toml.hpp"
 #include "toml_ascii.hpp"
 
@@ -265,13 +266,10 @@ void rethrow_naming_override(const std::vector<Override>& overrides) {
 }  // namespace detail
 
 std::string resolved_scene_text(const fs::path& file, const std::vector<Override>& overrides) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in || fs::is_directory(file)) throw InputError(file.string(), "file", "cannot be opened (missing or unreadable)");
-  std::ostringstream ss;
-  ss << in.rdbuf();
+  const std::string text = read_input_file(file, "scene file", kMaxSceneBytes);
   toml::table root;
   try {
-    root = toml::parse(detail::toml_ascii(ss.str(), file.string()), file.string());
+    root = toml::parse(detail::toml_ascii(text, file.string()), file.string());
   } catch (const toml::parse_error& e) {
     std::ostringstream place;
     place << "line " << e.source().begin.line << ", column " << e.source().begin.column;
