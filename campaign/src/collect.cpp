@@ -131,7 +131,6 @@ std::string map_svg(const std::vector<Eigen::Vector3d>& pts, const std::vector<d
                     const std::string& title) {
   const double W = 720, H = 480, margin = 60;
   plot::Drawing d(W, H);
-  d.rect(0, 0, W, H, plot::Style{plot::kWhite, -1, 1, plot::kWhite, 1});
   const double fmin = *std::min_element(force.begin(), force.end());
   const double fmax = *std::max_element(force.begin(), force.end());
   std::vector<plot::Point2> xy;
