@@ -6,6 +6,8 @@
 #include <iostream>
 #include <memory>
 
+#include "cli_limits.hpp"
+#include "set_option.hpp"
 #include "commands.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/scene/compare_contact.hpp"
@@ -16,38 +18,40 @@ namespace impactdeck::cli {
 void register_compare_contact(CLI::App& app, Context& ctx) {
   struct Args {
     std::string scene, out = ".";
+    std::vector<std::string> set;
     bool json = false;
     scene::CompareOptions options;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
       "compare-contact", "Run an impact as the hybrid deck and as a full-contact CalculiX model; compare with Hertz");
-  cmd->add_option("scene", args->scene, "Scene file (TOML)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("scene", args->scene, "Scene file (TOML)")->required();
+  add_set_option(cmd, args->set);
   cmd->add_option("--impact", args->options.impact, "Impact name (default: the scene's first)");
   cmd->add_option("--out", args->out, "Output folder (created): hybrid/, contact*/, compare_force.svg");
   cmd->add_flag("--json", args->json, "Print one JSON document on stdout (keys: docs/cli.md)");
   cmd->add_option("--threshold", args->options.threshold,
                   "Max |F_max contact / analytic - 1| before exit 4 (default 0.03)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   cmd->add_option("--refine", args->options.refine,
                   "Extra contact runs, each with sqrt(2) times more elements across the contact (default 0)")
       ->check(CLI::Range(0, 6));
   cmd->add_option("--contact-elements", args->options.contact.contact_elements,
                   "Elements across the smaller Hertz contact semi-axis, coarsest run (default 3)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   cmd->add_option("--contact-increments", args->options.contact.contact_increments,
                   "Increments across the analytic contact duration (default 40)")
       ->check(CLI::Range(4, 100000));
   cmd->add_option("--penalty-factor", args->options.contact.penalty_factor,
                   "Penalty slope K = factor E* / h_c (default 20)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   cmd->add_option("--solver-timeout-s", args->options.solver_timeout_s,
                   "Wall-time limit of each ccx run (default: from each deck's size)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   cmd->add_flag("--no-hybrid", [args](std::int64_t) { args->options.run_hybrid = false; },
                 "Run the full-contact model only");
   cmd->callback([args, &ctx] {
-    const scene::Scene sc = scene::load_scene(args->scene);
+    const scene::Scene sc = scene::load_scene(args->scene, overrides_from(args->set));
     std::error_code ec;
     std::filesystem::create_directories(args->out, ec);
     if (ec) throw InputError(args->out, "--out", "cannot create the folder: " + ec.message());

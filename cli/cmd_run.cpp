@@ -6,6 +6,7 @@
 
 #include "cli_limits.hpp"
 #include "commands.hpp"
+#include "set_option.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/scene/pipeline.hpp"
 #include "impactdeck/scene/report.hpp"
@@ -18,6 +19,7 @@ void register_run(CLI::App& app, Context& ctx) {
     std::string scene;
     bool json = false;
     std::string out = ".";
+    std::vector<std::string> set;
     double solver_timeout_s = 0;
     int threads = 0;
   };
@@ -30,13 +32,14 @@ void register_run(CLI::App& app, Context& ctx) {
   cmd->add_option("--solver-timeout-s", args->solver_timeout_s,
                   "Wall-time limit of each ccx run (default: derived from the deck's size, stated in --json)")
       ->check(positive_number());
+  add_set_option(cmd, args->set);
   cmd->add_option("--threads", args->threads,
                   "Threads for ccx when [outputs.fem] run = \"calculix\" (default 0: all cores)")
       ->check(CLI::NonNegativeNumber);
   cmd->callback([args, &ctx] {
     if (!std::isfinite(args->solver_timeout_s)) throw UsageError("--solver-timeout-s must be a finite number of seconds");
     check_threads(static_cast<unsigned>(std::min(args->threads, 1 << 30)));
-    const scene::Scene sc = scene::load_scene(args->scene);
+    const scene::Scene sc = scene::load_scene(args->scene, overrides_from(args->set));
     scene::RunOptions opt;
     opt.out_dir = args->out;
     opt.progress = &std::cerr;  // ccx progress when [outputs.fem] run = "calculix"

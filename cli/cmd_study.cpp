@@ -7,6 +7,7 @@
 
 #include "cli_limits.hpp"
 #include "commands.hpp"
+#include "set_option.hpp"
 #include "impactdeck/common/run_transaction.hpp"
 #include "impactdeck/common/atomic_file.hpp"
 #include "impactdeck/common/error.hpp"
@@ -61,6 +62,7 @@ void register_study(CLI::App& app, Context& ctx) {
     unsigned threads = 0;
     bool json = false, quiet = false, no_png = false;
     std::size_t max_points = kDefaultMaxPoints;
+    std::vector<std::string> set;  // --set, with --scene
   };
   auto a = std::make_shared<Args>();
   CLI::App* study = app.add_subcommand("study", "Configuration studies");
@@ -93,6 +95,7 @@ void register_study(CLI::App& app, Context& ctx) {
   cmd->add_option("--max-points", a->max_points,
                   "Most impact evaluations (cells x points per cell) of the study (default 1000000)")
       ->check(positive_number());
+  add_set_option(cmd, a->set);
   cmd->callback([a, &ctx] {
     check_threads(a->threads);
     study::Table1Options o = study::table1_preset(a->preset);
@@ -125,13 +128,14 @@ void register_study(CLI::App& app, Context& ctx) {
       else if (a->cloud == "vertices") o.cloud = study::CloudKind::vertices;
       else throw UsageError("--cloud: expected grid, uniform, both or vertices, got \"" + a->cloud + "\"");
     }
+    if (!a->set.empty() && a->scene.empty()) throw UsageError("--set needs --scene");
     if (!a->scene.empty()) {
       int axis;
       if (a->stretch_axis.empty() || a->stretch_axis == "x") axis = 0;
       else if (a->stretch_axis == "y") axis = 1;
       else if (a->stretch_axis == "z") axis = 2;
       else throw UsageError("--stretch-axis: expected x, y or z, got \"" + a->stretch_axis + "\"");
-      study::Table1Scene ts = study::table1_scene_from(scene::load_scene(a->scene), a->impact, axis);
+      study::Table1Scene ts = study::table1_scene_from(scene::load_scene(a->scene, overrides_from(a->set)), a->impact, axis);
       const bool analytic = dynamic_cast<const geometry::Ellipsoid*>(ts.setup.target.shape.get()) != nullptr;
       if (a->cloud.empty()) o.cloud = analytic ? study::CloudKind::paper_grid : study::CloudKind::area_uniform;
       o.scene = std::move(ts);

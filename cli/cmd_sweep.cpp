@@ -9,6 +9,7 @@
 
 #include "cli_limits.hpp"
 #include "commands.hpp"
+#include "set_option.hpp"
 #include "impactdeck/common/run_transaction.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/scene/scene.hpp"
@@ -49,6 +50,7 @@ void register_sweep(CLI::App& app, Context& ctx) {
     std::size_t curve_samples = 201;
     unsigned threads = 0;
     std::size_t max_points = kDefaultMaxPoints, max_curve_samples = kDefaultMaxCurveSamples;
+    std::vector<std::string> set;
   };
   auto a = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
@@ -79,6 +81,7 @@ void register_sweep(CLI::App& app, Context& ctx) {
   cmd->add_option("--max-curve-samples", a->max_curve_samples,
                   "With --curves: most samples over all curves (default 20000000, 160 MB)")
       ->check(positive_number());
+  add_set_option(cmd, a->set);
   cmd->callback([a, &ctx] {
     check_threads(a->threads);
     study::SweepFormats formats;
@@ -89,7 +92,7 @@ void register_sweep(CLI::App& app, Context& ctx) {
     }
     if (a->no_png) formats.png = false;
     formats.curves = a->curves;
-    const scene::Scene sc = scene::load_scene(a->scene);
+    const scene::Scene sc = scene::load_scene(a->scene, overrides_from(a->set));
     // One transaction: the sweep's files appear together when all are written, or not at all.
     RunTransaction txn(a->out);
     try {

@@ -16,5 +16,6 @@ void register_inspect(CLI::App& app, Context& ctx);
 void register_mesh_ellipsoid(CLI::App& app, Context& ctx);
 void register_fem_check(CLI::App& app, Context& ctx);
 void register_compare_contact(CLI::App& app, Context& ctx);
+void register_campaign(CLI::App& app, Context& ctx);
 
 }  // namespace impactdeck::cli

@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   impactdeck::cli::register_mesh_ellipsoid(app, ctx);
   impactdeck::cli::register_fem_check(app, ctx);
   impactdeck::cli::register_compare_contact(app, ctx);
+  impactdeck::cli::register_campaign(app, ctx);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

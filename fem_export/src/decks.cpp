@@ -43,6 +43,9 @@ std::size_t increments(const DeckOptions& o) {
 void validate(const DeckRequest& r, const std::string& where) {
   const DeckOptions& o = r.options;
   if (!(o.time_step_s > 0) || !std::isfinite(o.time_step_s)) throw InputError(where, "time_step_s", "must be > 0");
+  if (o.aster_cpus < 1 || o.aster_mpi_processes < 1) {
+    throw InputError(where, "aster_cpus", "Code_Aster CPUs and MPI processes must be >= 1");
+  }
   if (!(o.end_time_s > o.time_step_s) || !std::isfinite(o.end_time_s)) {
     throw InputError(where, "end_time_s", "must exceed time_step_s");
   }
@@ -460,8 +463,8 @@ std::string code_aster_export(const DeckRequest& r, const TetMesh& m) {
     << "P version stable\n"
     << "P time_limit " << std::max<long>(600, static_cast<long>(increments(r.options) / 10)) << "\n"
     << "P memory_limit 2048\n"
-    << "P ncpus 1\n"
-    << "P mpi_nbcpu 1\n"
+    << "P ncpus " << r.options.aster_cpus << "\n"
+    << "P mpi_nbcpu " << r.options.aster_mpi_processes << "\n"
     << "P mpi_nbnoeud 1\n"
     << "F comm " << kJobName << ".comm D 1\n"
     << "F mmed mesh.med D 20\n"

@@ -297,6 +297,8 @@ fem_export::DeckRequest fem_request(const Scene& scene, const ImpactReport& ir, 
   r.options.solver = f.solver == FemOutputs::Solver::spooles     ? fem_export::CcxSolver::spooles
                      : f.solver == FemOutputs::Solver::iterative ? fem_export::CcxSolver::iterative
                                                                  : fem_export::CcxSolver::automatic;
+  r.options.aster_cpus = f.aster_cpus;
+  r.options.aster_mpi_processes = f.aster_mpi_processes;
   r.options.mesh.mesh_size_m = f.mesh_size_m.value_or(
       b.shape == ShapeKind::mesh ? 0.25 * target.shape->size_m() : 0.5 * r.body.semi_axes_m.minCoeff());
   r.options.adapt_mesh_size = !f.mesh_size_m;

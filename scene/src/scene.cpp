@@ -7,6 +7,7 @@
 #include <toml++/toml.h>
 
 #include "impactdeck/common/error.hpp"
+#include "overrides_toml.hpp"
 #include "impactdeck/common/input_file.hpp"
 #include "impactdeck/common/numeric.hpp"
 #include "toml_ascii.hpp"
@@ -386,7 +387,8 @@ FemOutputs read_fem(const toml::table& t, const std::string& file, double to_m) 
   r.allow({"mesh_size", "load_mesh_size", "end_time_s", "time_step_s", "probes", "code_aster", "calculix", "run",
            "load", "contact_elements", "contact_zone_factor", "linear_momentum_tolerance",
            "angular_momentum_tolerance", "model_linear_velocity_tolerance", "model_angular_velocity_tolerance",
-           "volume_tolerance", "mass_tolerance", "inertia_tolerance", "min_gamma", "max_elements", "solver"});
+           "volume_tolerance", "mass_tolerance", "inertia_tolerance", "min_gamma", "max_elements", "solver",
+           "aster_cpus", "aster_mpi_processes"});
   FemOutputs f;
   f.place = r.self();
   if (r.has("mesh_size")) f.mesh_size_m = r.positive("mesh_size") * to_m;
@@ -428,6 +430,12 @@ FemOutputs read_fem(const toml::table& t, const std::string& file, double to_m) 
     f.contact_elements = static_cast<int>(n);
   }
   if (r.has("contact_zone_factor")) f.contact_zone_factor = r.positive("contact_zone_factor");
+  for (auto [key, into] : {std::pair{"aster_cpus", &f.aster_cpus}, std::pair{"aster_mpi_processes", &f.aster_mpi_processes}}) {
+    if (!r.has(key)) continue;
+    const double n = r.positive(key);
+    if (n != std::floor(n) || n > 4096) r.fail(key, "must be a whole number in [1, 4096]");
+    *into = static_cast<int>(n);
+  }
   auto tolerance = [&](const char* key, std::optional<double>& into) {
     if (r.has(key)) into = r.positive(key);
   };
@@ -619,7 +627,8 @@ Scene build(const toml::table& root, const std::string& file, const fs::path& ba
 
 }  // namespace
 
-Scene parse_scene(const std::string& text, const std::string& name, const fs::path& base_dir) {
+Scene parse_scene(const std::string& text, const std::string& name, const fs::path& base_dir,
+                  const std::vector<Override>& overrides) {
   toml::table root;
   try {
     root = toml::parse(detail::toml_ascii(text, name), name);  // why ASCII: toml_ascii.hpp
@@ -628,14 +637,20 @@ Scene parse_scene(const std::string& text, const std::string& name, const fs::pa
     place << "line " << e.source().begin.line << ", column " << e.source().begin.column;
     throw InputError(name, place.str(), "TOML syntax error: " + std::string(e.description()));
   }
-  return build(root, name, base_dir);
+  if (overrides.empty()) return build(root, name, base_dir);
+  detail::apply_overrides(root, overrides, name);  // before validation: checked like the file
+  try {
+    return build(root, name, base_dir);
+  } catch (const InputError&) {
+    detail::rethrow_naming_override(overrides);
+  }
 }
 
-Scene load_scene(const fs::path& file) {
+Scene load_scene(const fs::path& file, const std::vector<Override>& overrides) {
   // A regular file of at most 16 MiB: a FIFO, a device or a huge file is refused before reading.
   const std::string text = read_input_file(file, "scene file", kMaxSceneBytes);
   const fs::path base = file.has_parent_path() ? file.parent_path() : fs::path(".");
-  Scene s = parse_scene(text, file.string(), base);
+  Scene s = parse_scene(text, file.string(), base, overrides);
   s.file = file;
   return s;
 }

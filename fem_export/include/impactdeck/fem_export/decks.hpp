@@ -111,6 +111,8 @@ struct DeckOptions {
   int pulse_increments = 100;
   bool code_aster = true;      ///< write impact.comm, impact.export and mesh.med
   bool calculix = true;        ///< write impact.inp and mesh.inp
+  int aster_cpus = 1;           ///< impact.export `P ncpus` (OpenMP threads of each Code_Aster process)
+  int aster_mpi_processes = 1;  ///< impact.export `P mpi_nbcpu` (MPI processes)
   /// Most tetrahedra a deck may have (scene key outputs.fem.max_elements). Checked before meshing
   /// against estimate_tet_count (a mesh size too small for the body would run Gmsh for hours) and
   /// after it against the real count. Measured here: Gmsh makes about 1300 tetrahedra per second

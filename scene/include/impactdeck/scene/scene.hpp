@@ -14,6 +14,7 @@
 #include "impactdeck/collision/impact.hpp"
 #include "impactdeck/collision/validity.hpp"
 #include "impactdeck/common/units.hpp"
+#include "impactdeck/scene/overrides.hpp"
 
 namespace impactdeck::scene {
 
@@ -87,6 +88,8 @@ struct FemOutputs {
   std::vector<Eigen::Vector3d> probes_m;   ///< in the target's frame
   bool code_aster = true;
   bool calculix = true;
+  int aster_cpus = 1;           ///< Code_Aster .export `P ncpus`
+  int aster_mpi_processes = 1;  ///< Code_Aster .export `P mpi_nbcpu`
   enum class Run { none, calculix } run = Run::none;  ///< "calculix": run ccx and the check
   /// "point": F(t) on the contact node; "hertz-patch": the Hertz pressure of each instant's
   /// contact ellipse as nodal forces (docs/fem.md).
@@ -129,11 +132,13 @@ struct Scene {
 };
 
 /// Reads and validates a scene file. Throws InputError naming file, line, key and reason.
-Scene load_scene(const std::filesystem::path& file);
+/// `overrides` (`--set`) change the TOML document before validation; an error in an overridden
+/// value names the override ("--set KEY") as its place.
+Scene load_scene(const std::filesystem::path& file, const std::vector<Override>& overrides = {});
 
 /// Same from text; `name` is used in messages and relative mesh paths resolve against `base_dir`.
 Scene parse_scene(const std::string& text, const std::string& name,
-                  const std::filesystem::path& base_dir = ".");
+                  const std::filesystem::path& base_dir = ".", const std::vector<Override>& overrides = {});
 
 const char* to_string(ShapeKind k);
 

@@ -1,0 +1,54 @@
+#pragma once
+// Campaign files (TOML, docs/campaign-format.md): one base scene and case generators, expanded into
+// cases with stable ids; the plan folder they are written to (case folders and campaign.json).
+#include <cstddef>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "impactdeck/scene/overrides.hpp"
+
+namespace impactdeck::campaign {
+
+struct Case {
+  std::size_t id = 0;
+  std::vector<scene::Override> overrides;  ///< every `--set` this case applies, generator order
+  std::optional<Eigen::Vector3d> point_m;             ///< [points]: target frame, metres
+  std::optional<Eigen::Quaterniond> orientation;      ///< [orientations]: the body's rotation
+};
+
+struct Campaign {
+  std::filesystem::path file;   ///< the campaign file
+  std::filesystem::path scene;  ///< the base scene (absolute)
+  std::string impact;           ///< the impact the table and map describe (default: the first)
+  std::vector<std::string> generators;  ///< in expansion order: cases, product, points, orientations
+  std::vector<std::string> keys;        ///< every override key, in column order (no duplicates)
+  std::vector<Case> cases;              ///< ids 0 ... N-1, row-major, last generator fastest
+};
+
+/// Reads a campaign file, expands its generators and validates every case's scene exactly like
+/// `run --set` would. Throws InputError naming the campaign file, the case and the key.
+Campaign read_campaign(const std::filesystem::path& file);
+
+/// What `campaign plan` did.
+struct PlanResult {
+  std::size_t cases = 0;
+  bool already_planned = false;  ///< the folder held this very campaign: nothing rewritten
+  std::string input_hash;
+};
+
+/// Writes `dir`/cases/<id>/scene.toml (the resolved scene) for every case and then, atomically,
+/// `dir`/campaign.json. A folder that already holds a campaign with another input hash is refused
+/// (InputError); one holding the same campaign is left as it is.
+PlanResult plan_campaign(const Campaign& campaign, const std::filesystem::path& dir);
+
+/// The campaign.json file of a plan folder (InputError when missing or unreadable).
+std::filesystem::path campaign_json(const std::filesystem::path& dir);
+
+/// FNV-1a 64-bit hash of bytes, as 16 hex digits (input hashes: change detection, not security).
+std::string fnv1a64_hex(const std::string& bytes, std::uint64_t seed = 14695981039346656037ull);
+
+}  // namespace impactdeck::campaign

@@ -1,0 +1,26 @@
+#pragma once
+// `campaign collect`: one table of every case (CSV and JSON), the worst case's files, and a map.
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace impactdeck::campaign {
+
+struct CollectResult {
+  std::filesystem::path csv, json;
+  std::optional<std::filesystem::path> worst_case;  ///< collect/worst_case (a copy of its folder)
+  std::optional<std::size_t> worst_id;
+  std::optional<std::filesystem::path> map_svg, map_vtp;  ///< point and drop campaigns
+  std::size_t done = 0, failed = 0, pending = 0;
+};
+
+/// Writes `dir`/collect/cases.csv and cases.json (keys: docs/campaign-format.md): per case its
+/// inputs, the collected impact's max force, velocity and spin jumps, momentum checks, peak von
+/// Mises and verdict where stresses exist, and the reason of a failure; copies the worst case
+/// (largest peak von Mises where every done case has one, else largest max force) to
+/// collect/worst_case; and, for point campaigns, a map over the part's surface, for drop
+/// campaigns over the orientation sphere (map.svg, map.vtp). Every file is written atomically.
+CollectResult collect(const std::filesystem::path& dir);
+
+}  // namespace impactdeck::campaign

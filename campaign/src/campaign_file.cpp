@@ -1,0 +1,287 @@
+// Campaign files: the generators and their expansion into cases (docs/campaign-format.md).
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+
+#include <toml++/toml.h>
+
+#include "impactdeck/campaign/campaign.hpp"
+#include "impactdeck/campaign/orientations.hpp"
+#include "impactdeck/common/error.hpp"
+#include "impactdeck/common/input_file.hpp"
+#include "impactdeck/common/units.hpp"
+#include "impactdeck/scene/pipeline.hpp"
+#include "impactdeck/scene/scene.hpp"
+#include "impactdeck/study/cloud.hpp"
+#include "overrides_toml.hpp"  // scene/src: the TOML value writer
+#include "toml_ascii.hpp"  // scene/src: toml++ never sees non-ASCII text (why: that header)
+
+namespace impactdeck::campaign {
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr std::size_t kMaxCases = 1000000;
+
+// One choice of one generator: the overrides it sets and what the map needs.
+struct Option {
+  std::vector<scene::Override> overrides;
+  std::optional<Eigen::Vector3d> point_m;
+  std::optional<Eigen::Quaterniond> orientation;
+};
+using Axis = std::vector<Option>;
+
+std::string place(const toml::node* n, const std::string& key) {
+  std::ostringstream s;
+  if (n && n->source().begin.line > 0) s << "line " << n->source().begin.line << ", ";
+  s << "key '" << key << "'";
+  return s.str();
+}
+
+std::string number_text(double v) { return scene::detail::toml_float_text(v); }
+std::string value_text(const toml::node& n) { return scene::detail::toml_value_text(n); }
+
+std::string vec_text(const Eigen::Vector3d& v) {
+  return "[" + number_text(v.x() + 0.0) + ", " + number_text(v.y() + 0.0) + ", " + number_text(v.z() + 0.0) + "]";
+}
+
+// Entries of a table in file order (toml++ keeps them sorted by key).
+std::vector<std::pair<std::string, const toml::node*>> in_file_order(const toml::table& t) {
+  std::vector<std::pair<std::string, const toml::node*>> e;
+  for (const auto& [k, v] : t) e.emplace_back(std::string(k.str()), &v);
+  std::stable_sort(e.begin(), e.end(), [](const auto& a, const auto& b) {
+    const auto& x = a.second->source().begin;
+    const auto& y = b.second->source().begin;
+    return x.line != y.line ? x.line < y.line : x.column < y.column;
+  });
+  return e;
+}
+
+class FileReader {
+ public:
+  explicit FileReader(fs::path file) : file_(std::move(file)), name_(file_.string()) {}
+
+  [[noreturn]] void fail(const toml::node* n, const std::string& key, const std::string& reason) const {
+    throw InputError(name_, place(n, key), reason);
+  }
+
+  // A --set key given as a table key: its syntax checked now, naming the campaign file.
+  void check_key(const toml::node* n, const std::string& table, const std::string& key) const {
+    try {
+      scene::parse_override(key + "=0");
+    } catch (const InputError& e) {
+      fail(n, table + ".\"" + key + "\"", "not a --set key: " + e.reason());
+    }
+  }
+
+  std::size_t count(const toml::table& t, const std::string& table, const char* key, std::size_t max) const {
+    const toml::node* n = t.get(key);
+    const std::string k = table + "." + key;
+    if (!n) throw InputError(name_, place(&t, table), "missing required key '" + k + "'");
+    const auto* i = n->as_integer();
+    if (!i || i->get() < 1 || static_cast<std::uint64_t>(i->get()) > max) {
+      fail(n, k, "must be a whole number in [1, " + std::to_string(max) + "]");
+    }
+    return static_cast<std::size_t>(i->get());
+  }
+
+  void only(const toml::table& t, const std::string& table, std::initializer_list<const char*> keys) const {
+    for (const auto& [k, v] : t) {
+      const std::string key(k.str());
+      if (std::none_of(keys.begin(), keys.end(), [&](const char* a) { return key == a; })) {
+        std::string list;
+        for (const char* a : keys) list += (list.empty() ? "" : ", ") + std::string(a);
+        fail(&v, table.empty() ? key : table + "." + key, "unknown key (allowed here: " + list + ")");
+      }
+    }
+  }
+
+  const fs::path& file() const { return file_; }
+  const std::string& name() const { return name_; }
+
+ private:
+  fs::path file_;
+  std::string name_;
+};
+
+std::size_t impact_index(const scene::Scene& sc, const std::string& name) {
+  for (std::size_t i = 0; i < sc.impacts.size(); ++i)
+    if (sc.impacts[i].name == name) return i;
+  return sc.impacts.size();
+}
+
+std::size_t body_index(const scene::Scene& sc, const std::string& name) {
+  for (std::size_t i = 0; i < sc.bodies.size(); ++i)
+    if (sc.bodies[i].name == name) return i;
+  return sc.bodies.size();
+}
+
+}  // namespace
+
+Campaign read_campaign(const fs::path& file) {
+  FileReader fr(file);
+  std::error_code ec;
+  const std::string text = read_input_file(file, "campaign file", kMaxSceneBytes);  // regular files only
+  toml::table root;
+  try {
+    root = toml::parse(scene::detail::toml_ascii(text, fr.name()), fr.name());
+  } catch (const toml::parse_error& e) {
+    std::ostringstream p;
+    p << "line " << e.source().begin.line << ", column " << e.source().begin.column;
+    throw InputError(fr.name(), p.str(), "TOML syntax error: " + std::string(e.description()));
+  }
+  fr.only(root, "", {"scene", "impact", "cases", "product", "points", "orientations"});
+
+  Campaign c;
+  c.file = file;
+  const toml::node* sn = root.get("scene");
+  if (!sn) throw InputError(fr.name(), "", "missing required key 'scene' (the base scene file)");
+  if (!sn->is_string() || sn->as_string()->get().empty()) fr.fail(sn, "scene", "must be a file name (string)");
+  const fs::path base_dir = fs::absolute(file).parent_path();
+  c.scene = (base_dir / sn->as_string()->get()).lexically_normal();
+  if (!fs::is_regular_file(c.scene, ec)) fr.fail(sn, "scene", "no scene file " + c.scene.string());
+  const scene::Scene base = scene::load_scene(c.scene);  // its own errors name the scene file
+
+  std::size_t impact = 0;
+  if (const toml::node* n = root.get("impact")) {
+    if (!n->is_string()) fr.fail(n, "impact", "must be an impact name (string)");
+    impact = impact_index(base, n->as_string()->get());
+    if (impact == base.impacts.size()) fr.fail(n, "impact", "the scene has no impact named '" + n->as_string()->get() + "'");
+  }
+  c.impact = base.impacts[impact].name;
+  const scene::ImpactSpec& spec = base.impacts[impact];
+
+  std::vector<Axis> axes;
+  if (const toml::node* n = root.get("cases")) {
+    const toml::array* a = n->as_array();
+    if (!a || !a->is_array_of_tables() || a->empty()) fr.fail(n, "cases", "must be a list of tables ([[cases]])");
+    Axis axis;
+    for (std::size_t i = 0; i < a->size(); ++i) {
+      Option o;
+      const std::string table = "cases[" + std::to_string(i) + "]";
+      for (const auto& [key, v] : in_file_order(*a->get(i)->as_table())) {
+        fr.check_key(v, table, key);
+        o.overrides.push_back({key, value_text(*v)});
+      }
+      axis.push_back(std::move(o));
+    }
+    axes.push_back(std::move(axis));
+    c.generators.push_back("cases");
+  }
+  if (const toml::node* n = root.get("product")) {
+    const toml::table* t = n->as_table();
+    if (!t || t->empty()) fr.fail(n, "product", "must be a table of \"KEY\" = [values]");
+    for (const auto& [key, v] : in_file_order(*t)) {
+      fr.check_key(v, "product", key);
+      const toml::array* a = v->as_array();
+      if (!a || a->empty()) fr.fail(v, "product.\"" + key + "\"", "must be a non-empty list of values");
+      Axis axis;
+      for (const toml::node& e : *a) axis.push_back(Option{{{key, value_text(e)}}, {}, {}});
+      axes.push_back(std::move(axis));
+    }
+    c.generators.push_back("product");
+  }
+  if (const toml::node* n = root.get("points")) {
+    const toml::table* t = n->as_table();
+    if (!t) fr.fail(n, "points", "must be a table");
+    fr.only(*t, "points", {"count", "seed", "csv"});
+    if (spec.first_contact) {
+      fr.fail(n, "points", "impact '" + spec.name + "' uses point = \"first-contact\": [points] sets the impact point");
+    }
+    const scene::BodySpec& target = base.body(spec.target);
+    const auto shape = scene::make_shape(target, base);
+    const double unit = metres_per(base.length_unit);
+    std::vector<geometry::SurfacePoint> cloud;
+    if (const toml::node* csv = t->get("csv")) {
+      if (t->contains("count")) fr.fail(csv, "points.csv", "give either count or csv, not both");
+      if (!csv->is_string()) fr.fail(csv, "points.csv", "must be a file name (string)");
+      // The same projection limit as `run` (1 % of the target's size).
+      cloud = study::csv_point_cloud(*shape, base_dir / csv->as_string()->get(), unit, 0.01 * shape->size_m(),
+                                     kMaxCases);
+    } else {
+      const std::size_t count = fr.count(*t, "points", "count", kMaxCases);
+      std::uint64_t seed = 1;
+      if (const toml::node* s = t->get("seed")) {
+        if (!s->is_integer() || s->as_integer()->get() < 0) fr.fail(s, "points.seed", "must be a whole number >= 0");
+        seed = static_cast<std::uint64_t>(s->as_integer()->get());
+      }
+      cloud = study::area_uniform_cloud(*shape, count, seed);
+    }
+    Axis axis;
+    const std::string key = "impacts[" + std::to_string(impact) + "].point";
+    for (const auto& p : cloud) axis.push_back(Option{{{key, vec_text(p.point_m / unit)}}, p.point_m, {}});
+    axes.push_back(std::move(axis));
+    c.generators.push_back("points");
+  }
+  if (const toml::node* n = root.get("orientations")) {
+    const toml::table* t = n->as_table();
+    if (!t) fr.fail(n, "orientations", "must be a table");
+    fr.only(*t, "orientations", {"count", "body"});
+    if (!spec.first_contact) {
+      fr.fail(n, "orientations", "impact '" + spec.name + "' has a fixed point: orientations need point = \"first-contact\"");
+    }
+    std::string body = spec.target;
+    if (const toml::node* b = t->get("body")) {
+      if (!b->is_string()) fr.fail(b, "orientations.body", "must be a body name (string)");
+      body = b->as_string()->get();
+    }
+    const std::size_t bi = body_index(base, body);
+    if (bi == base.bodies.size()) fr.fail(t->get("body"), "orientations.body", "the scene has no body named '" + body + "'");
+    const std::size_t count = fr.count(*t, "orientations", "count", 100000);
+    const std::string prefix = "bodies[" + std::to_string(bi) + "].";
+    Axis axis;
+    for (const Eigen::Quaterniond& q : super_fibonacci_orientations(count)) {
+      const Eigen::AngleAxisd aa(q);
+      Eigen::Vector3d axis_v = aa.axis();
+      double angle_deg = aa.angle() * 180.0 / M_PI;
+      if (!(angle_deg > 1e-12) || !axis_v.allFinite()) {
+        axis_v = Eigen::Vector3d::UnitZ();
+        angle_deg = 0.0;
+      }
+      axis.push_back(Option{{{prefix + "orientation_axis", vec_text(axis_v)},
+                             {prefix + "orientation_angle_deg", number_text(angle_deg)}},
+                            {},
+                            q});
+    }
+    axes.push_back(std::move(axis));
+    c.generators.push_back("orientations");
+  }
+  if (axes.empty()) {
+    throw InputError(fr.name(), "", "no case generator: give [product], [[cases]], [points] or [orientations]");
+  }
+
+  std::size_t total = 1;
+  for (const Axis& a : axes) {
+    if (total > kMaxCases / a.size()) throw InputError(fr.name(), "", "more than " + std::to_string(kMaxCases) + " cases");
+    total *= a.size();
+  }
+  // Row-major: the last axis varies fastest.
+  for (std::size_t id = 0; id < total; ++id) {
+    Case k;
+    k.id = id;
+    std::size_t rest = id, stride = total;
+    for (const Axis& a : axes) {
+      stride /= a.size();
+      const Option& o = a[rest / stride];
+      rest %= stride;
+      k.overrides.insert(k.overrides.end(), o.overrides.begin(), o.overrides.end());
+      if (o.point_m) k.point_m = o.point_m;
+      if (o.orientation) k.orientation = o.orientation;
+    }
+    for (const auto& o : k.overrides)
+      if (std::find(c.keys.begin(), c.keys.end(), o.key) == c.keys.end()) c.keys.push_back(o.key);
+    // Validated exactly like `run --set`; the message names the campaign file, case and key.
+    try {
+      scene::load_scene(c.scene, k.overrides);
+    } catch (const InputError& e) {
+      throw InputError(fr.name(), "case " + std::to_string(id) + ": " + e.place(), e.reason());
+    }
+    c.cases.push_back(std::move(k));
+  }
+  return c;
+}
+
+}  // namespace impactdeck::campaign

@@ -1,0 +1,309 @@
+// `campaign collect`: the table of every case, the worst case's files, the map.
+#include "impactdeck/campaign/collect.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include <Eigen/Geometry>
+#include <nlohmann/json.hpp>
+
+#include "impactdeck/campaign/campaign.hpp"
+#include "impactdeck/campaign/runner.hpp"
+#include "impactdeck/common/atomic_file.hpp"
+#include "impactdeck/common/error.hpp"
+#include "impactdeck/plot/drawing.hpp"
+#include "impactdeck/scene/scene.hpp"
+#include "detail.hpp"
+
+namespace impactdeck::campaign {
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+// Value at a JSON pointer, or null.
+json at(const json& j, const char* pointer) {
+  const json::json_pointer p(pointer);
+  return j.contains(p) ? j.at(p) : json(nullptr);
+}
+
+std::string cell(const json& v) {
+  if (v.is_null()) return "";
+  if (v.is_boolean()) return v.get<bool>() ? "1" : "0";
+  if (v.is_number()) {
+    char b[40];
+    std::snprintf(b, sizeof b, "%.17g", v.get<double>());
+    return b;
+  }
+  std::string s = v.is_string() ? v.get<std::string>() : v.dump();
+  if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
+  std::string q = "\"";
+  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c == '\n' || c == '\r' ? ' ' : c);
+  return q + "\"";
+}
+
+// The result columns after id, state and the inputs: name and JSON pointer into the impact.
+const std::vector<std::pair<std::string, std::string>>& result_columns() {
+  static const std::vector<std::pair<std::string, std::string>> c = {
+      {"max_force_N", "/max_force_N"},
+      {"contact_time_s", "/contact_time_s"},
+      {"impulse_total_Ns", "/impulse_total_Ns"},
+      {"target_delta_velocity_x_m_s", "/target/delta_velocity_m_s/0"},
+      {"target_delta_velocity_y_m_s", "/target/delta_velocity_m_s/1"},
+      {"target_delta_velocity_z_m_s", "/target/delta_velocity_m_s/2"},
+      {"target_delta_angular_velocity_x_rad_s", "/target/delta_angular_velocity_rad_s/0"},
+      {"target_delta_angular_velocity_y_rad_s", "/target/delta_angular_velocity_rad_s/1"},
+      {"target_delta_angular_velocity_z_rad_s", "/target/delta_angular_velocity_rad_s/2"},
+      {"impactor_delta_velocity_x_m_s", "/impactor/delta_velocity_m_s/0"},
+      {"impactor_delta_velocity_y_m_s", "/impactor/delta_velocity_m_s/1"},
+      {"impactor_delta_velocity_z_m_s", "/impactor/delta_velocity_m_s/2"},
+      {"impactor_delta_angular_velocity_x_rad_s", "/impactor/delta_angular_velocity_rad_s/0"},
+      {"impactor_delta_angular_velocity_y_rad_s", "/impactor/delta_angular_velocity_rad_s/1"},
+      {"impactor_delta_angular_velocity_z_rad_s", "/impactor/delta_angular_velocity_rad_s/2"},
+      {"impulse_relative_error", "/checks/impulse_relative_error"},
+      {"energy_relative_error", "/checks/energy_relative_error"},
+      {"impact_checks_passed", "/checks/passed"},
+      {"fem_linear_momentum_relative_error", "/fem/check/linear_momentum_relative_error"},
+      {"fem_angular_momentum_relative_error", "/fem/check/angular_momentum_relative_error"},
+      {"fem_check_passed", "/fem/check/passed"},
+      {"peak_von_mises_Pa", "/fem/check/stress/verdict/governing/max_von_mises_Pa"},
+      {"verdict", "/fem/check/stress/verdict/result"},
+      {"safety_factor", "/fem/check/stress/verdict/safety_factor"},
+  };
+  return c;
+}
+
+struct Row {
+  std::size_t id = 0;
+  CaseState state = CaseState::planned;
+  json inputs, impact, result, failure;
+};
+
+Eigen::Vector3d vec(const json& j) {
+  if (!j.is_array() || j.size() != 3) return Eigen::Vector3d::Zero();
+  return {j[0].get<double>(), j[1].get<double>(), j[2].get<double>()};
+}
+
+// Where a drop campaign's case sits on the orientation sphere: the direction the part moves
+// towards the impactor, in the part's own frame (world -z for a drop on a floor below).
+Eigen::Vector3d drop_direction(const fs::path& scene_file, const std::string& impact) {
+  const scene::Scene sc = scene::load_scene(scene_file);
+  for (const auto& i : sc.impacts) {
+    if (i.name != impact) continue;
+    const scene::BodySpec& t = sc.body(i.target);
+    const scene::BodySpec& m = sc.body(i.impactor);
+    Eigen::Vector3d d = t.velocity_m_s - m.velocity_m_s;
+    if (!(d.norm() > 0)) d = -Eigen::Vector3d::UnitZ();
+    return t.rotation.transpose() * d.normalized();
+  }
+  return -Eigen::Vector3d::UnitZ();
+}
+
+std::string vtp(const std::vector<Eigen::Vector3d>& pts, const std::vector<double>& force,
+                const std::vector<std::size_t>& ids) {
+  std::ostringstream s;
+  s.precision(17);
+  const std::size_t n = pts.size();
+  s << "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+    << "<PolyData>\n<Piece NumberOfPoints=\"" << n << "\" NumberOfVerts=\"" << n
+    << "\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n"
+    << "<Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
+  for (const auto& p : pts) s << p.x() + 0.0 << " " << p.y() + 0.0 << " " << p.z() + 0.0 << "\n";
+  s << "</DataArray></Points>\n<Verts>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
+  for (std::size_t i = 0; i < n; ++i) s << i << "\n";
+  s << "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
+  for (std::size_t i = 0; i < n; ++i) s << i + 1 << "\n";
+  s << "</DataArray>\n</Verts>\n<PointData Scalars=\"max_force_N\">\n"
+    << "<DataArray type=\"Float64\" Name=\"max_force_N\" format=\"ascii\">\n";
+  for (double f : force) s << f << "\n";
+  s << "</DataArray>\n<DataArray type=\"Int64\" Name=\"case_id\" format=\"ascii\">\n";
+  for (std::size_t id : ids) s << id << "\n";
+  s << "</DataArray>\n</PointData>\n</Piece>\n</PolyData>\n</VTKFile>\n";
+  return s.str();
+}
+
+// The map picture: each case a disc coloured by its max force (viridis, low dark). Point
+// campaigns: an oblique orthographic view of the points (target frame); drop campaigns: the
+// orientation sphere as longitude / latitude of the drop direction in the part's frame.
+std::string map_svg(const std::vector<Eigen::Vector3d>& pts, const std::vector<double>& force, bool sphere,
+                    const std::string& title) {
+  const double W = 720, H = 480, margin = 60;
+  plot::Drawing d(W, H);
+  const double fmin = *std::min_element(force.begin(), force.end());
+  const double fmax = *std::max_element(force.begin(), force.end());
+  std::vector<plot::Point2> xy;
+  if (sphere) {
+    for (const auto& p : pts) {
+      const Eigen::Vector3d u = p.normalized();
+      xy.push_back({std::atan2(u.y(), u.x()) * 180 / M_PI, std::asin(std::clamp(u.z(), -1.0, 1.0)) * 180 / M_PI});
+    }
+  } else {
+    const double az = -62 * M_PI / 180, el = 22 * M_PI / 180;
+    const Eigen::Vector3d right(-std::sin(az), std::cos(az), 0);
+    const Eigen::Vector3d up(-std::sin(el) * std::cos(az), -std::sin(el) * std::sin(az), std::cos(el));
+    for (const auto& p : pts) xy.push_back({p.dot(right), p.dot(up)});
+  }
+  double x0 = sphere ? -180 : xy[0].x, x1 = sphere ? 180 : xy[0].x, y0 = sphere ? -90 : xy[0].y, y1 = sphere ? 90 : xy[0].y;
+  for (const auto& p : xy) {
+    x0 = std::min(x0, p.x), x1 = std::max(x1, p.x), y0 = std::min(y0, p.y), y1 = std::max(y1, p.y);
+  }
+  const double span = std::max({x1 - x0, y1 - y0, 1e-30});
+  const double scale = std::min((W - 2 * margin) / (sphere ? x1 - x0 : span), (H - 2 * margin) / (sphere ? y1 - y0 : span));
+  auto to_px = [&](const plot::Point2& p) {
+    return plot::Point2{W / 2 + (p.x - 0.5 * (x0 + x1)) * scale, H / 2 - (p.y - 0.5 * (y0 + y1)) * scale};
+  };
+  if (sphere) {
+    const plot::Style grid{plot::Colour{0.7, 0.7, 0.7}, 0.5};
+    for (int lon = -180; lon <= 180; lon += 45) d.line(to_px({double(lon), -90}), to_px({double(lon), 90}), grid);
+    for (int lat = -90; lat <= 90; lat += 30) d.line(to_px({-180, double(lat)}), to_px({180, double(lat)}), grid);
+  }
+  for (std::size_t i = 0; i < xy.size(); ++i) {
+    const double t = fmax > fmin ? (force[i] - fmin) / (fmax - fmin) : 0.5;
+    d.circle(to_px(xy[i]), 6, plot::Style{plot::kBlack, 0.4, 1, plot::viridis(t), 1});
+  }
+  d.text({W / 2, 24}, title, 15, plot::Anchor::middle, plot::kBlack, true);
+  char legend[160];
+  std::snprintf(legend, sizeof legend, "max force: %.4g N (dark) to %.4g N (yellow); %zu cases", fmin, fmax, force.size());
+  d.text({W / 2, H - 16}, legend, 12, plot::Anchor::middle);
+  if (sphere) d.text({margin, H - 34}, "drop direction in the part's frame: longitude (x), latitude (y), degrees", 11);
+  return plot::to_svg(d);
+}
+
+}  // namespace
+
+CollectResult collect(const fs::path& dir_in) {
+  const fs::path dir = fs::absolute(dir_in).lexically_normal();
+  const json plan = detail::read_json(campaign_json(dir));
+  const std::string impact = plan.value("impact", "");
+  std::vector<std::string> keys = plan.value("keys", std::vector<std::string>{});
+  const auto generators = plan.value("generators", std::vector<std::string>{});
+  const bool points = std::find(generators.begin(), generators.end(), "points") != generators.end();
+  const bool drops = std::find(generators.begin(), generators.end(), "orientations") != generators.end();
+
+  CollectResult out;
+  std::vector<Row> rows;
+  for (const auto& c : plan.at("cases")) {
+    Row r;
+    r.id = c.at("id").get<std::size_t>();
+    r.inputs = c.value("overrides", json::object());
+    r.state = case_state(dir, r.id);
+    const fs::path folder = case_folder(dir, r.id);
+    if (r.state == CaseState::done) {
+      r.result = detail::read_json(folder / "result.json");
+      for (const auto& i : r.result.value("impacts", json::array()))
+        if (i.value("name", "") == impact) r.impact = i;
+      ++out.done;
+    } else if (r.state == CaseState::failed) {
+      r.failure = detail::read_json(folder / "failure.json");
+      ++out.failed;
+    } else {
+      ++out.pending;
+    }
+    rows.push_back(std::move(r));
+  }
+
+  // The table.
+  std::ostringstream csv;
+  csv << "id,state";
+  for (const auto& k : keys) csv << "," << cell(k);
+  for (const auto& [name, ptr] : result_columns()) csv << "," << name;
+  csv << ",all_checks_passed,reason\n";
+  json cases = json::array();
+  for (const Row& r : rows) {
+    csv << r.id << "," << to_string(r.state);
+    for (const auto& k : keys) csv << "," << cell(r.inputs.contains(k) ? r.inputs[k] : json(nullptr));
+    for (const auto& [name, ptr] : result_columns()) csv << "," << cell(at(r.impact, ptr.c_str()));
+    csv << "," << cell(r.result.is_null() ? json(nullptr) : r.result.value("all_checks_passed", json(nullptr)));
+    csv << "," << cell(r.failure.is_null() ? json(nullptr) : r.failure.value("reason", json("")));
+    csv << "\n";
+    // JSON: the case's results under the keys of `run --json` (the collected impact's object).
+    json j = r.impact.is_object() ? r.impact : json::object();
+    j["id"] = r.id;
+    j["state"] = to_string(r.state);
+    j["inputs"] = r.inputs;
+    if (!r.result.is_null()) {
+      j["all_checks_passed"] = r.result.value("all_checks_passed", json(nullptr));
+      j["warnings"] = r.result.value("warnings", json::array());
+    }
+    if (!r.failure.is_null()) j["reason"] = r.failure.value("reason", "");
+    cases.push_back(std::move(j));
+  }
+
+  // The worst case: the largest peak von Mises where every done case has one, else max force.
+  bool all_stress = out.done > 0;
+  for (const Row& r : rows)
+    if (r.state == CaseState::done && !at(r.impact, "/fem/check/stress/verdict/governing/max_von_mises_Pa").is_number())
+      all_stress = false;
+  const char* worst_key = all_stress ? "/fem/check/stress/verdict/governing/max_von_mises_Pa" : "/max_force_N";
+  double worst = -1;
+  for (const Row& r : rows) {
+    const json v = at(r.impact, worst_key);
+    if (r.state == CaseState::done && v.is_number() && v.get<double>() > worst) {
+      worst = v.get<double>();
+      out.worst_id = r.id;
+    }
+  }
+
+  const fs::path cdir = dir / "collect";
+  std::error_code ec;
+  fs::create_directories(cdir, ec);
+  const json doc = {{"campaign", dir.string()},
+                    {"impact", impact},
+                    {"keys", keys},
+                    {"done", out.done},
+                    {"failed", out.failed},
+                    {"pending", out.pending},
+                    {"worst_case_id", out.worst_id ? json(*out.worst_id) : json(nullptr)},
+                    {"worst_case_by", all_stress ? "peak_von_mises_Pa" : "max_force_N"},
+                    {"cases", cases}};
+  AtomicFileSet files;
+  out.csv = cdir / "cases.csv";
+  out.json = cdir / "cases.json";
+  files.add(out.csv, csv.str());
+  files.add(out.json, doc.dump(2) + "\n");
+
+  // The map over the part's surface (points) or the orientation sphere (drops).
+  if (points || drops) {
+    std::vector<Eigen::Vector3d> pts;
+    std::vector<double> force;
+    std::vector<std::size_t> ids;
+    const auto& pc = plan.at("cases");
+    for (const Row& r : rows) {
+      const json f = at(r.impact, "/max_force_N");
+      if (r.state != CaseState::done || !f.is_number()) continue;
+      if (drops) {
+        pts.push_back(drop_direction(case_folder(dir, r.id) / "scene.toml", impact));
+      } else {
+        pts.push_back(vec(pc[r.id].value("point_m", json(nullptr))));
+      }
+      force.push_back(f.get<double>());
+      ids.push_back(r.id);
+    }
+    if (!pts.empty()) {
+      out.map_svg = cdir / "map.svg";
+      out.map_vtp = cdir / "map.vtp";
+      const std::string title = drops ? "Max force over the drop orientations" : "Max force over the impact points";
+      files.add(*out.map_svg, map_svg(pts, force, drops, title));
+      files.add(*out.map_vtp, vtp(pts, force, ids));
+    }
+  }
+  files.commit();
+
+  if (out.worst_id) {  // a copy of the worst case's folder (scene, decks, result)
+    const fs::path stage = cdir / ".worst_case.partial";
+    fs::remove_all(stage, ec);
+    fs::copy(case_folder(dir, *out.worst_id), stage, fs::copy_options::recursive, ec);
+    if (ec) throw InputError(stage.string(), "copy", "cannot copy the worst case: " + ec.message());
+    fs::remove(stage / ".lock", ec);
+    out.worst_case = cdir / "worst_case";
+    fs::remove_all(*out.worst_case, ec);
+    fs::rename(stage, *out.worst_case, ec);
+    if (ec) throw InputError(out.worst_case->string(), "rename", ec.message());
+  }
+  refresh_states(dir);
+  return out;
+}
+
+}  // namespace impactdeck::campaign

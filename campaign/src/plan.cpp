@@ -1,0 +1,109 @@
+// `campaign plan`: case folders with their resolved scenes, and campaign.json.
+#include <iomanip>
+#include <set>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "impactdeck/campaign/campaign.hpp"
+#include "impactdeck/campaign/runner.hpp"
+#include "impactdeck/common/atomic_file.hpp"
+#include "impactdeck/common/error.hpp"
+#include "impactdeck/scene/scene.hpp"
+#include "detail.hpp"
+
+namespace impactdeck::campaign {
+namespace fs = std::filesystem;
+
+std::string fnv1a64_hex(const std::string& bytes, std::uint64_t h) {
+  for (unsigned char c : bytes) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  std::ostringstream s;
+  s << std::hex << std::setw(16) << std::setfill('0') << h;
+  return s.str();
+}
+
+fs::path campaign_json(const fs::path& dir) {
+  const fs::path p = dir / "campaign.json";
+  std::error_code ec;
+  if (!fs::is_regular_file(p, ec)) {
+    throw InputError(dir.string(), "campaign.json", "missing: not a planned campaign folder (run 'impactdeck campaign plan')");
+  }
+  return p;
+}
+
+PlanResult plan_campaign(const Campaign& c, const fs::path& dir_in) {
+  const fs::path dir = fs::absolute(dir_in).lexically_normal();
+  // Everything the cases read: the campaign file, the base scene, its part files, each case's
+  // resolved scene text. The hash says whether a folder already holds this very campaign.
+  std::vector<std::string> texts;
+  texts.reserve(c.cases.size());
+  for (const Case& k : c.cases) texts.push_back(scene::resolved_scene_text(c.scene, k.overrides));
+  std::string all = detail::read_text(c.file) + '\0' + detail::read_text(c.scene);
+  std::set<fs::path> parts;
+  for (const auto& b : scene::load_scene(c.scene).bodies)
+    if (!b.mesh_path.empty()) parts.insert(b.mesh_path);
+  for (const auto& p : parts) all += '\0' + detail::read_text(p);
+  std::vector<std::string> case_hashes;
+  for (const auto& t : texts) {
+    case_hashes.push_back(fnv1a64_hex(t));
+    all += '\0' + case_hashes.back();
+  }
+  PlanResult r;
+  r.cases = c.cases.size();
+  r.input_hash = fnv1a64_hex(all);
+
+  std::error_code ec;
+  if (fs::exists(dir / "campaign.json", ec)) {
+    nlohmann::json old;
+    try {
+      old = nlohmann::json::parse(detail::read_text(dir / "campaign.json"));
+    } catch (const nlohmann::json::exception&) {
+      throw InputError((dir / "campaign.json").string(), "file", "is not valid JSON");
+    }
+    if (old.value("input_hash", "") != r.input_hash) {
+      throw InputError(dir.string(), "campaign.json",
+                       "the folder holds another campaign (its input hash differs): plan into a new folder");
+    }
+    r.already_planned = true;
+    return r;
+  }
+  fs::create_directories(dir / "cases", ec);
+  if (!fs::is_directory(dir / "cases")) throw InputError(dir.string(), "--out", "cannot create the campaign folder");
+
+  nlohmann::json cases = nlohmann::json::array();
+  for (std::size_t i = 0; i < c.cases.size(); ++i) {
+    const Case& k = c.cases[i];
+    const fs::path folder = case_folder(dir, k.id);
+    fs::create_directories(folder, ec);
+    write_file_atomically(folder / "scene.toml", texts[i]);
+    nlohmann::json inputs = nlohmann::json::object();
+    for (const auto& o : k.overrides) inputs[o.key] = o.value;
+    nlohmann::json j = {{"id", k.id},
+                        {"folder", fs::path("cases") / std::to_string(k.id)},
+                        {"overrides", inputs},
+                        {"scene_hash", case_hashes[i]},
+                        {"state", "planned"}};
+    if (k.point_m) j["point_m"] = {k.point_m->x(), k.point_m->y(), k.point_m->z()};
+    if (k.orientation) {
+      j["orientation_quaternion_wxyz"] = {k.orientation->w(), k.orientation->x(), k.orientation->y(),
+                                          k.orientation->z()};
+    }
+    cases.push_back(std::move(j));
+  }
+  const nlohmann::json doc = {{"format", "impactdeck-campaign 1"},
+                              {"campaign_file", fs::absolute(c.file).lexically_normal().string()},
+                              {"scene", c.scene.string()},
+                              {"impact", c.impact},
+                              {"generators", c.generators},
+                              {"keys", c.keys},
+                              {"input_hash", r.input_hash},
+                              {"case_count", c.cases.size()},
+                              {"cases", cases}};
+  write_file_atomically(dir / "campaign.json", doc.dump(2) + "\n");  // last: its presence means planned
+  return r;
+}
+
+}  // namespace impactdeck::campaign

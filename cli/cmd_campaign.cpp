@@ -1,0 +1,127 @@
+// `impactdeck campaign plan|run|run-case|status|collect`: many cases of one scene
+// (docs/campaign-format.md), here or on a Slurm cluster.
+#include <filesystem>
+#include <iostream>
+#include <memory>
+
+#include "commands.hpp"
+#include "impactdeck/campaign/campaign.hpp"
+#include "impactdeck/campaign/collect.hpp"
+#include "impactdeck/campaign/runner.hpp"
+#include "impactdeck/common/error.hpp"
+
+namespace impactdeck::cli {
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path self_executable() {
+  std::error_code ec;
+  const fs::path p = fs::read_symlink("/proc/self/exe", ec);
+  if (ec) throw Error(ExitCode::internal_error, "cannot find the impactdeck executable (/proc/self/exe)");
+  return p;
+}
+
+}  // namespace
+
+void register_campaign(CLI::App& app, Context& ctx) {
+  struct Args {
+    std::string file, out, dir, executor = "local";
+    std::size_t id = 0, jobs = 1;
+    int threads = 1, cpus_per_task = 0;
+    bool dry_run = false, quiet = false, json = false;
+    std::vector<std::string> sbatch;
+  };
+  auto a = std::make_shared<Args>();
+  CLI::App* top = app.add_subcommand("campaign", "Many cases of one scene, here or on a Slurm cluster (docs/campaign-format.md)");
+  top->require_subcommand(1);
+
+  CLI::App* plan = top->add_subcommand("plan", "Expand a campaign file into case folders and campaign.json");
+  plan->add_option("file", a->file, "Campaign file (TOML)")->required();
+  plan->add_option("--out", a->out, "Campaign folder to create")->required();
+  plan->callback([a] {
+    const campaign::Campaign c = campaign::read_campaign(a->file);
+    const campaign::PlanResult r = campaign::plan_campaign(c, a->out);
+    std::cout << (r.already_planned ? "already planned: " : "planned: ") << r.cases << " cases in " << a->out
+              << " (input hash " << r.input_hash << ")\n";
+  });
+
+  CLI::App* run = top->add_subcommand("run", "Run every case that is not done (resumes a killed campaign)");
+  run->add_option("dir", a->dir, "Campaign folder (from 'campaign plan')")->required();
+  run->add_option("--jobs", a->jobs, "Cases at once (local); slurm: at most this many array tasks at once (%K)")
+      ->check(CLI::Range(std::size_t{1}, std::size_t{100000}));
+  run->add_option("--threads", a->threads, "ccx threads per case (default 1)")->check(CLI::Range(1, 1024));
+  run->add_option("--executor", a->executor, "local (default) or slurm")->check(CLI::IsMember({"local", "slurm"}));
+  run->add_option("--cpus-per-task", a->cpus_per_task, "slurm: CPUs per array task, the ccx threads (default: --threads)")
+      ->check(CLI::Range(1, 1024));
+  run->add_option("--sbatch-option", a->sbatch, "slurm: an extra #SBATCH option, e.g. --partition=short (repeatable)")
+      ->allow_extra_args(false);
+  run->add_flag("--dry-run", a->dry_run, "slurm: write campaign.sbatch, do not submit");
+  run->add_flag("--quiet", a->quiet, "No progress bar");
+  run->callback([a, run, &ctx] {
+    if (a->executor == "slurm") {
+      campaign::SlurmOptions o;
+      o.max_parallel = run->count("--jobs") > 0 ? a->jobs : 0;  // no --jobs: no %K limit
+      o.cpus_per_task = a->cpus_per_task > 0 ? a->cpus_per_task : a->threads;
+      o.sbatch_lines = a->sbatch;
+      o.executable = self_executable();
+      const fs::path script = campaign::write_sbatch(a->dir, o);
+      if (a->dry_run) {
+        std::cout << "wrote " << script.string() << " (not submitted)\n";
+        return;
+      }
+      const std::string job = campaign::submit_sbatch(a->dir, script);
+      std::cout << "submitted job " << job << " (" << script.string() << "); follow it with 'impactdeck campaign status "
+                << a->dir << "'\n";
+      return;
+    }
+    if (a->dry_run || a->cpus_per_task > 0 || !a->sbatch.empty()) {
+      throw UsageError("--dry-run, --cpus-per-task and --sbatch-option need --executor slurm");
+    }
+    campaign::LocalOptions o;
+    o.jobs = a->jobs;
+    o.ccx_threads = a->threads;
+    o.executable = self_executable();
+    o.progress_bar = !a->quiet;
+    const campaign::RunSummary s = campaign::run_local(a->dir, o);
+    std::cout << "campaign: " << s.total << " cases: " << s.done << " run now, " << s.skipped << " already done, "
+              << s.failed << " failed";
+    if (s.checks_failed) std::cout << ", " << s.checks_failed << " with a failed self-check";
+    if (s.other) std::cout << ", " << s.other << " not run (locked by another process)";
+    std::cout << "\n";
+    if (s.failed) std::cerr << "impactdeck: error: " << s.failed << " case(s) failed (see 'impactdeck campaign status')\n";
+    ctx.exit_code = s.exit_code();
+  });
+
+  CLI::App* one = top->add_subcommand("run-case", "Run one case (idempotent: a done case is not run again)");
+  one->add_option("dir", a->dir, "Campaign folder")->required();
+  one->add_option("id", a->id, "Case id (0 ... N-1)")->required();
+  one->add_option("--threads", a->threads, "ccx threads (default 1)")->check(CLI::Range(1, 1024));
+  one->callback([a, &ctx] {
+    const campaign::CaseOutcome o = campaign::run_case(a->dir, a->id, a->threads, &std::cerr);
+    if (o.already_done) {
+      std::cout << "case " << a->id << ": already done\n";
+    } else if (o.state == campaign::CaseState::done) {
+      std::cout << "case " << a->id << ": done" << (o.checks_passed ? "" : " (a self-check failed)") << "\n";
+    } else {
+      std::cerr << "impactdeck: error: case " << a->id << ": " << o.message << "\n";
+    }
+    ctx.exit_code = o.exit_code;
+  });
+
+  CLI::App* status = top->add_subcommand("status", "Case states (and squeue's view of the campaign's jobs)");
+  status->add_option("dir", a->dir, "Campaign folder")->required();
+  status->callback([a] { std::cout << campaign::status_report(a->dir); });
+
+  CLI::App* coll = top->add_subcommand("collect", "Table (CSV, JSON) of every case, the worst case, the map");
+  coll->add_option("dir", a->dir, "Campaign folder")->required();
+  coll->callback([a] {
+    const campaign::CollectResult r = campaign::collect(a->dir);
+    std::cout << "collected " << r.done << " done, " << r.failed << " failed, " << r.pending << " pending: "
+              << r.csv.string() << ", " << r.json.string() << "\n";
+    if (r.worst_id) std::cout << "worst case: " << *r.worst_id << " (copied to " << r.worst_case->string() << ")\n";
+    if (r.map_svg) std::cout << "map: " << r.map_svg->string() << ", " << r.map_vtp->string() << "\n";
+  });
+}
+
+}  // namespace impactdeck::cli

@@ -1,0 +1,136 @@
+#!/usr/bin/env bash
+# Campaigns end to end (issue 17): plan, run with jobs, a SIGKILL in the middle of a campaign
+# (every case finished before the kill survives byte for byte, nothing half-written counts as done,
+# a rerun completes it and the table equals an uninterrupted run's), run-case idempotence, status,
+# the Slurm script (--dry-run), and the maps of a point campaign and of a drop campaign.
+# usage: campaign_test.sh IMPACTDECK SOURCE_DIR
+set -u
+bin=$(readlink -f "$1"); src=$(readlink -f "$2")
+tmp=$(mktemp -d); [ -n "${KEEP_TMP:-}" ] || trap 'rm -rf "$tmp"' EXIT
+fails=0
+check() { if eval "$2"; then :; else echo "FAILED: $1"; fails=$((fails+1)); fi; }
+cd "$tmp" || exit 1
+
+# A base scene whose cases take a moment each (40 impacts with fine force tables).
+{
+  printf 'length_unit = "mm"\n[materials.steel]\nyoungs_modulus_Pa = 2.05e11\npoisson_ratio = 0.3\ndensity_kg_m3 = 7850\n'
+  printf '[[bodies]]\nname = "t"\nshape = "ellipsoid"\nsemi_axes = [2000, 500, 500]\nmaterial = "steel"\n'
+  printf '[[bodies]]\nname = "b"\nshape = "sphere"\nradius = 50\nmaterial = "steel"\n'
+  for i in $(seq 1 40); do
+    x=$(awk -v i="$i" 'BEGIN { printf "%.6f", -1900 + 95 * i }')
+    y=$(awk -v x="$x" 'BEGIN { printf "%.6f", 500 * sqrt(1 - (x / 2000)^2) }')
+    printf '[[impacts]]\nname = "i%02d"\ntarget = "t"\nimpactor = "b"\npoint = [%s, %s, 0]\napproach_speed_m_s = 1\nrestitution = 0.5\n' "$i" "$x" "$y"
+  done
+  printf '[outputs]\nforce_table_csv = "f.csv"\nforce_table_impulse_tolerance = 1e-8\n'
+} >base.toml
+cat >c.toml <<'TOML'
+scene = "base.toml"
+impact = "i10"
+[product]
+"impacts[9].approach_speed_m_s" = [0.5, 1, 2, 4]
+"impacts[9].restitution" = [0.3, 0.6, 0.9]
+TOML
+"$bin" campaign plan c.toml --out clean >/dev/null || { echo "FAILED: plan"; exit 1; }
+"$bin" campaign plan c.toml --out killed >/dev/null || { echo "FAILED: plan"; exit 1; }
+out=$("$bin" campaign plan c.toml --out killed)
+check "a second plan of the same campaign is a no-op" '[[ "$out" == "already planned: 12 cases"* ]]'
+check "campaign.json holds the cases, the input hash and the states" \
+  'python3 -c "import json,sys; j=json.load(open(\"killed/campaign.json\")); sys.exit(not (len(j[\"cases\"])==12 and len(j[\"input_hash\"])==16 and all(c[\"state\"]==\"planned\" for c in j[\"cases\"])))"'
+"$bin" campaign run clean --jobs 2 --quiet >/dev/null || echo "FAILED: uninterrupted run"
+
+# Kill the campaign (the whole process group) once a few cases are done.
+setsid "$bin" campaign run killed --quiet >/dev/null 2>&1 &
+pid=$!
+for _ in $(seq 600); do
+  n=$(ls killed/cases/*/result.json 2>/dev/null | wc -l)
+  [ "$n" -ge 3 ] && break
+  sleep 0.02
+done
+kill -9 -- "-$pid" 2>/dev/null
+wait "$pid" 2>/dev/null
+before=$(cd killed/cases && for f in */result.json; do [ -f "$f" ] && echo "$f $(sha256sum <"$f" | cut -c1-16)"; done)
+nbefore=$(echo "$before" | grep -c json)
+check "the kill landed in the middle of the campaign ($nbefore of 12 done)" '[ "$nbefore" -ge 3 ] && [ "$nbefore" -lt 12 ]'
+for f in killed/cases/*/result.json; do
+  python3 -c "import json,sys; json.load(open(sys.argv[1]))" "$f" 2>/dev/null || { echo "FAILED: $f is not whole"; fails=$((fails+1)); }
+done
+status=$("$bin" campaign status killed)
+check "status counts the done cases after the kill" '[[ "$status" == *"12 cases, $nbefore done"* ]]'
+out=$("$bin" campaign run killed --jobs 2 --quiet)
+check "the rerun runs only what was not done ($out)" '[[ "$out" == *"$((12 - nbefore)) run now, $nbefore already done, 0 failed"* ]]'
+after=$(cd killed/cases && for f in */result.json; do echo "$f $(sha256sum <"$f" | cut -c1-16)"; done)
+while read -r line; do
+  [ -z "$line" ] && continue
+  grep -qxF "$line" <<<"$after" || { echo "FAILED: a case finished before the kill changed: $line"; fails=$((fails+1)); }
+done <<<"$before"
+"$bin" campaign collect clean >/dev/null && "$bin" campaign collect killed >/dev/null || echo "FAILED: collect"
+check "the resumed campaign's table equals the uninterrupted one" 'cmp -s clean/collect/cases.csv killed/collect/cases.csv'
+check "the table has a row per case" '[ "$(wc -l <clean/collect/cases.csv)" = 13 ]'
+check "the table's columns" 'head -1 clean/collect/cases.csv | grep -q "^id,state,impacts\[9\].approach_speed_m_s,impacts\[9\].restitution,max_force_N,.*target_delta_velocity_x_m_s,.*target_delta_angular_velocity_z_rad_s,.*impulse_relative_error,.*peak_von_mises_Pa,verdict,safety_factor,all_checks_passed,reason$"'
+# Force grows with speed (Hertz: F ~ v^1.2): the last key varies fastest, rows 0, 3, 6, 9 are the speeds.
+check "rows in row-major order (force rises with the first key)" \
+  'awk -F, "NR>1 && (NR-2)%3==0 { if (\$5 <= prev) bad=1; prev=\$5 } END { exit bad }" clean/collect/cases.csv'
+check "the worst case is copied with its files" '[ -f clean/collect/worst_case/result.json ] && [ -f clean/collect/worst_case/out/f_i10.csv ]'
+out=$("$bin" campaign run-case killed 4)
+check "run-case of a done case does nothing" '[ "$out" = "case 4: already done" ]'
+"$bin" campaign run-case killed 12 >/dev/null 2>err.txt
+rc=$?
+check "run-case of an unknown id exits 3 naming it" '[ $rc = 3 ] && grep -q "case 12: no such case (the campaign has 12" err.txt'
+
+# A failing case: published as failed with its reason, the others run.
+cat >f.toml <<'TOML'
+scene = "base.toml"
+[[cases]]
+"impacts[0].restitution" = 0.5
+TOML
+"$bin" campaign plan f.toml --out failing >/dev/null
+rm failing/cases/0/scene.toml
+"$bin" campaign run failing --quiet >/dev/null 2>&1
+rc=$?
+check "a failed case makes run exit 3" '[ $rc = 3 ]'
+"$bin" campaign collect failing >/dev/null
+check "the table gives the failure's reason" 'grep -q "^0,failed,.*scene.toml: file: cannot be opened" failing/collect/cases.csv'
+
+# Slurm script, not submitted.
+out=$("$bin" campaign run clean --executor slurm --dry-run --jobs 3 --cpus-per-task 2 --sbatch-option=--partition=short)
+check "--dry-run writes the script only" '[[ "$out" == "wrote "*"campaign.sbatch (not submitted)" ]]'
+check "the array covers every case with %K" 'grep -qx "#SBATCH --array=0-11%3" clean/campaign.sbatch'
+check "--cpus-per-task sets the ccx threads" 'grep -qx "#SBATCH --cpus-per-task=2" clean/campaign.sbatch && grep -q "SLURM_ARRAY_TASK_ID\" --threads 2$" clean/campaign.sbatch'
+check "extra #SBATCH options" 'grep -qx "#SBATCH --partition=short" clean/campaign.sbatch'
+check "each task runs run-case with absolute paths" "grep -qx \"exec '$bin' campaign run-case '$tmp/clean' \\\"\\\$SLURM_ARRAY_TASK_ID\\\" --threads 2\" clean/campaign.sbatch"
+# What the array does, run by hand: each task line with its id is a no-op on a done campaign.
+SLURM_ARRAY_TASK_ID=5 sh clean/campaign.sbatch >task.txt 2>&1
+check "the script's command runs a case" 'grep -qx "case 5: already done" task.txt'
+
+# A point campaign over a part's surface and a drop campaign over the orientation sphere.
+# (the ball moves along the inward normal wherever it hits: every point is an impact)
+printf 'length_unit = "mm"\n[materials.steel]\nyoungs_modulus_Pa = 2.05e11\npoisson_ratio = 0.3\ndensity_kg_m3 = 7850\n' >target.toml
+printf '[[bodies]]\nname = "t"\nshape = "ellipsoid"\nsemi_axes = [200, 50, 50]\nmaterial = "steel"\n' >>target.toml
+printf '[[bodies]]\nname = "b"\nshape = "sphere"\nradius = 10\nmaterial = "steel"\n' >>target.toml
+printf '[[impacts]]\ntarget = "t"\nimpactor = "b"\npoint = [200, 0, 0]\napproach_speed_m_s = 1\nrestitution = 0.5\n' >>target.toml
+cat >points.toml <<'TOML'
+scene = "target.toml"
+[points]
+count = 6
+TOML
+"$bin" campaign plan points.toml --out pts >/dev/null && "$bin" campaign run pts --quiet >/dev/null && "$bin" campaign collect pts >/dev/null || echo "FAILED: point campaign"
+check "point campaign: SVG and VTP maps" 'grep -q "<svg" pts/collect/map.svg && grep -q "NumberOfPoints=\"6\"" pts/collect/map.vtp'
+mkdir -p parts && cp "$src/samples/parts/"*.off parts/ && cp "$src/samples/two_parts.toml" drop.toml
+cat >drop_c.toml <<'TOML'
+scene = "drop.toml"
+[orientations]
+count = 5
+TOML
+"$bin" campaign plan drop_c.toml --out drop >/dev/null && "$bin" campaign run drop --jobs 2 --quiet >/dev/null
+"$bin" campaign collect drop >/dev/null
+done_n=$(grep -c ",done," drop/collect/cases.csv)
+check "drop campaign: every orientation ran ($done_n of 5)" '[ "$done_n" = 5 ]'
+check "drop campaign: sphere map" 'grep -q "orientation" drop/collect/map.svg && grep -q "NumberOfPoints=\"5\"" drop/collect/map.vtp'
+
+# The Code_Aster .export takes its CPUs and MPI processes from the scene (set here by --set).
+"$bin" run "$src/samples/eccentric_fem.toml" --out aster --set 'outputs.fem.run="none"' --set outputs.fem.calculix=false \
+  --set outputs.fem.aster_cpus=4 --set outputs.fem.aster_mpi_processes=2 >/dev/null 2>&1 || echo "FAILED: aster deck"
+export_file=$(find aster -name impact.export | head -1)
+check "impact.export: P ncpus 4, P mpi_nbcpu 2" '[ -n "$export_file" ] && grep -qx "P ncpus 4" "$export_file" && grep -qx "P mpi_nbcpu 2" "$export_file"'
+
+[ "$fails" = 0 ] && echo "campaign_test: ok" || { echo "campaign_test: $fails failed"; exit 1; }
