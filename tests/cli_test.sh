@@ -39,11 +39,11 @@ check "paper warns about ln Phi on stderr" grep -q "outside the validity range" 
 check "two spheres exit 0" test $? -eq 0
 check "summary mentions max force" grep -q "max force" "$tmp/s.txt"
 
-# 2b. The drop-test sample (issue 12): OCCT's bottle (a B-rep) dropped tilted on a floor, first
+# 2b. The bottle drop sample (issue 12): OCCT's bottle (a B-rep) dropped tilted on a floor, first
 # contact on the bottle's lowest point. Checked: the contact lies on the risen floor with the
 # floor's normal, both self-checks pass, the jump of the bottle is upwards, and the validity block
 # flags this hit as outside Hertz's assumptions (a 2.5 mm fillet, p0 far above yield) with warnings.
-"$bin" run "$src/samples/drop_test.toml" --json --out "$tmp/drop" >"$tmp/drop.json" 2>"$tmp/drop.err"
+"$bin" run "$src/samples/drop_bottle.toml" --json --out "$tmp/drop" >"$tmp/drop.json" 2>"$tmp/drop.err"
 check "drop-test sample exit 0" test $? -eq 0
 check "drop-test force table written" test -s "$tmp/drop/force_drop.csv"
 python3 - "$tmp/drop.json" "$tmp/drop.err" <<'PY'
