@@ -314,8 +314,9 @@ double run_ccx(const fs::path& work, const CheckOptions& o, double end_time_s, d
   const auto t0 = std::chrono::steady_clock::now();
   std::string last;
   auto last_print = t0;
+  bool final_line = false;  // after the run: the last state once more, however short the run was
   auto poll = [&] {
-    if (!o.progress || std::chrono::steady_clock::now() - last_print < std::chrono::seconds(2)) return;
+    if (!o.progress || (!final_line && std::chrono::steady_clock::now() - last_print < std::chrono::seconds(2))) return;
     last_print = std::chrono::steady_clock::now();
     const auto s = last_sta_line(work / (job + ".sta"));
     if (s && s->text != last) {
@@ -338,6 +339,9 @@ double run_ccx(const fs::path& work, const CheckOptions& o, double end_time_s, d
     throw InputError(e.where(), e.place(), e.reason() + " (install the Debian package calculix-ccx, or name the "
                                                         "solver with --ccx)");
   }
+  // A run shorter than the 2 s between progress lines still shows where ccx ended.
+  final_line = true;
+  poll();
   const std::string where = log.string();
   std::string first_error, last_line;
   scan_log(log, first_error, last_line);
