@@ -10,6 +10,7 @@
 #include "set_option.hpp"
 #include "commands.hpp"
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/common/run_transaction.hpp"
 #include "impactdeck/scene/compare_contact.hpp"
 #include "impactdeck/scene/scene.hpp"
 
@@ -52,13 +53,27 @@ void register_compare_contact(CLI::App& app, Context& ctx) {
                 "Run the full-contact model only");
   cmd->callback([args, &ctx] {
     const scene::Scene sc = scene::load_scene(args->scene, overrides_from(args->set));
-    std::error_code ec;
-    std::filesystem::create_directories(args->out, ec);
-    if (ec) throw InputError(args->out, "--out", "cannot create the folder: " + ec.message());
+    // One transaction (docs/reliability.md): the decks and ccx's results are staged inside --out
+    // and published together when the comparison completed, whatever its verdict; a failure or a
+    // kill leaves --out as it was.
+    RunTransaction txn(args->out);
+    for (const auto& w : txn.warnings()) std::cerr << "impactdeck: warning: " << w << "\n";
     scene::CompareOptions o = args->options;
     o.out_dir = args->out;
     o.progress = &std::cerr;
-    const scene::CompareReport r = scene::compare_contact(sc, o);
+    o.place_output = [&txn, &args](const std::string& name, bool is_folder) {
+      return is_folder ? txn.folder(name, args->out, "--out") : txn.file(name, args->out, "--out");
+    };
+    scene::CompareReport r;
+    try {
+      r = scene::compare_contact(sc, o);
+      txn.commit();
+    } catch (const InputError& e) {
+      throw txn.public_error(e);
+    } catch (const Error& e) {
+      throw Error(e.code(), txn.public_text(e.what()));
+    }
+    scene::map_paths(r, [&txn](const std::filesystem::path& p) { return txn.public_path(p); });
     if (args->json) {
       std::cout << scene::to_json(r).dump(2) << "\n";
     } else {

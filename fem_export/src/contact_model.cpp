@@ -203,6 +203,7 @@ ContactDeck write_contact_deck(const ContactModelRequest& r, const fs::path& fol
   try {
     const auto t0 = std::chrono::steady_clock::now();
     std::array<QuadBody, 2> q;
+    std::vector<std::pair<std::string, int>> probe_nodes;  // the target's, 0-based
     std::array<const ContactBody*, 2> bodies = {&r.target, &r.impactor};
     std::array<ContactBodyMesh*, 2> meshes = {&out.target, &out.impactor};
     const char* names[2] = {"target", "impactor"};
@@ -211,6 +212,7 @@ ContactDeck write_contact_deck(const ContactModelRequest& r, const fs::path& fol
       mo.mesh_size_m = std::max(bodies[i]->far_mesh_size_m, hc);
       mo.load_mesh_size_m = hc;
       mo.load_zone_radius_m = zone;
+      mo.probes_m = bodies[i]->probes_own_m;
       MeshResult m;
       try {
         m = mesh_body(*bodies[i], mo, stage, names[i]);
@@ -218,6 +220,11 @@ ContactDeck write_contact_deck(const ContactModelRequest& r, const fs::path& fol
         throw InputError(where, "body '" + bodies[i]->name + "'", "meshing failed: " + e.reason());
       }
       q[i] = quadratic(m.mesh, *bodies[i], r.contact_point_m);
+      // Probe nodes keep their numbers: the corner nodes come first in the quadratic mesh.
+      if (i == 0) {
+        for (const auto& [group, node] : m.mesh.node_groups)
+          if (group.rfind("PROBE", 0) == 0) probe_nodes.emplace_back(group, node);
+      }
       // Keep only the faces near the contact.
       auto& cf = q[i].contact_faces;
       cf.erase(std::remove_if(cf.begin(), cf.end(),
@@ -266,6 +273,10 @@ ContactDeck write_contact_deck(const ContactModelRequest& r, const fs::path& fol
         d << "\n";
       }
     }
+    if (!probe_nodes.empty()) {
+      d << "*NSET, NSET=NPROBES\n";
+      for (const auto& pn : probe_nodes) d << pn.second + 1 << "\n";
+    }
     const char* sname[2] = {"STGT", "SIMP"};
     for (int i = 0; i < 2; ++i) {
       d << "*SURFACE, NAME=" << sname[i] << ", TYPE=ELEMENT\n";
@@ -301,7 +312,8 @@ ContactDeck write_contact_deck(const ContactModelRequest& r, const fs::path& fol
     d << "*STEP, INC=" << 20 * out.increments + 200 << "\n*DYNAMIC" << solver << "\n"
       << num(out.time_step_s) << ", " << num(out.end_time_s - out.time_step_s) << ", "
       << num(0.05 * out.time_step_s) << ", " << num(out.time_step_s) << "\n"
-      << "*CONTACT PRINT, FREQUENCY=1, SLAVE=SIMP, MASTER=STGT\nCF\n*END STEP\n";
+      << "*CONTACT PRINT, FREQUENCY=1, SLAVE=SIMP, MASTER=STGT\nCF\n"
+      << (probe_nodes.empty() ? "" : "*EL FILE, FREQUENCY=1, NSET=NPROBES\nS\n") << "*END STEP\n";
     // One more increment that prints the final state of every node and the energies.
     d << "*STEP, INC=100\n*DYNAMIC, DIRECT" << solver << "\n" << num(out.time_step_s) << ", "
       << num(out.time_step_s) << "\n"
@@ -347,6 +359,11 @@ ContactDeck write_contact_deck(const ContactModelRequest& r, const fs::path& fol
                {"end_time_s", out.end_time_s},
                {"increments", out.increments},
                {"bodies", bj}};
+    json probes = json::array();
+    for (const auto& [name, node] : probe_nodes) {
+      probes.push_back({{"name", name}, {"node", node + 1}, {"point_m", v3(q[0].nodes[node])}});
+    }
+    cj["probes"] = probes;
     write_file_atomically(stage / "contact.json", cj.dump() + "\n");
 
     const fs::path old = parent / ("." + folder.filename().string() + ".old-" + std::to_string(::getpid()));
@@ -535,6 +552,17 @@ ContactRunResult run_contact_model(const fs::path& folder, const CheckOptions& o
     p_after += P;
     l_before += c0.cross(mass * v0) + inertia * w0;
     l_after += c.cross(P) + L;
+  }
+  if (const auto it = cj.find("probes"); it != cj.end() && !it->empty()) {
+    for (const auto& p : *it) {
+      ProbeStress ps;
+      ps.name = p.at("name");
+      ps.node = p.at("node");
+      ps.point_m = vec3(p.at("point_m"));
+      r.probes.push_back(ps);
+    }
+    // The first step's output only (the second step repeats the end state).
+    r.probe_time_s = read_node_stresses(folder / (std::string(kJobName) + ".frd"), r.probes, end - 0.5 * cj.at("time_step_s").get<double>());
   }
   const double scale = std::max(std::abs(r.impulse_Ns), 1e-300);
   r.linear_momentum_relative_error = (p_after - p_before).norm() / scale;

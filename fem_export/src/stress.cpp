@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <map>
 #include <iomanip>
 #include <sstream>
 
@@ -192,6 +193,67 @@ StressResult read_stresses(const fs::path& frd, const TetMesh& mesh, const Stres
     if (v.kind == VerdictKind::survives) v.first_yield_time_s.reset();
   }
   return r;
+}
+
+std::vector<double> read_node_stresses(const fs::path& frd, std::vector<ProbeStress>& probes, double end_time_s) {
+  const std::string where = frd.string();
+  std::ifstream f(frd, std::ios::binary);
+  if (!f) throw InputError(where, "file", "CalculiX results (.frd) cannot be opened (missing or unreadable)");
+  std::map<int, std::size_t> wanted;  // ccx node id -> probe
+  for (std::size_t k = 0; k < probes.size(); ++k) {
+    wanted[probes[k].node] = k;
+    probes[k].von_mises_Pa.clear();
+    probes[k].max_von_mises_Pa = probes[k].max_von_mises_time_s = 0;
+  }
+  std::vector<double> times, vm(probes.size(), 0.0);
+  std::vector<char> seen(probes.size(), 0);
+  double t = 0;
+  bool skip = false, in_stress = false;
+  std::string line;
+  std::size_t lineno = 0;
+  auto finish = [&] {
+    for (std::size_t k = 0; k < probes.size(); ++k) {
+      if (!seen[k]) throw InputError(where, "time " + std::to_string(t), "no stress at " + probes[k].name + "'s node");
+      probes[k].von_mises_Pa.push_back(vm[k]);
+      if (vm[k] > probes[k].max_von_mises_Pa) probes[k].max_von_mises_Pa = vm[k], probes[k].max_von_mises_time_s = t;
+    }
+    times.push_back(t);
+  };
+  while (std::getline(f, line)) {
+    ++lineno;
+    if (line.rfind("  100C", 0) == 0) {
+      double v;
+      if (!field(line, 12, 12, v)) throw InputError(where, "line " + std::to_string(lineno), "bad time in a result header");
+      t = v;
+      skip = t > end_time_s * (1 + 1e-6);
+      continue;
+    }
+    if (line.rfind(" -4", 0) == 0) {
+      in_stress = !skip && line.rfind(" -4  STRESS", 0) == 0;
+      if (in_stress) std::fill(seen.begin(), seen.end(), 0);
+      continue;
+    }
+    if (line.rfind(" -3", 0) == 0) {
+      if (in_stress) finish();
+      in_stress = false;
+      continue;
+    }
+    if (!in_stress || line.rfind(" -1", 0) != 0) continue;
+    double id;
+    if (!field(line, 3, 10, id)) throw InputError(where, "line " + std::to_string(lineno), "bad node number");
+    const auto it = wanted.find(static_cast<int>(id));
+    if (it == wanted.end()) continue;
+    double sv[6];
+    for (int k = 0; k < 6; ++k) {
+      if (!field(line, 13 + 12 * k, 12, sv[k])) throw InputError(where, "line " + std::to_string(lineno), "bad stress");
+    }
+    vm[it->second] = von_mises(sv) * kPaPerMPa;
+    seen[it->second] = 1;
+  }
+  if (times.empty() && !probes.empty()) {
+    throw InputError(where, "STRESS", "no stress output (the deck requests *EL FILE S; did ccx finish?)");
+  }
+  return times;
 }
 
 void write_stress_files(const fs::path& dir, const TetMesh& m, StressResult& r, const std::string& title) {

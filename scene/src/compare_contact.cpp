@@ -29,6 +29,25 @@ namespace {
 
 json v3(const Eigen::Vector3d& v) { return json::array({v.x() + 0.0, v.y() + 0.0, v.z() + 0.0}); }
 
+json probes_json(const std::vector<fem_export::ProbeStress>& probes) {
+  json a = json::array();
+  for (const auto& p : probes) {
+    a.push_back({{"name", p.name},
+                 {"point_m", v3(p.point_m)},
+                 {"max_von_mises_Pa", p.max_von_mises_Pa},
+                 {"max_von_mises_time_s", p.max_von_mises_time_s}});
+  }
+  return a;
+}
+
+// The hybrid run's probe of that name (nullptr when it has none).
+const fem_export::ProbeStress* hybrid_probe(const CompareReport& r, const std::string& name) {
+  if (!r.hybrid_check || !r.hybrid_check->stress) return nullptr;
+  for (const auto& p : r.hybrid_check->stress->probes)
+    if (p.name == name) return &p;
+  return nullptr;
+}
+
 double rel(double value, double reference) { return reference != 0 ? value / reference - 1.0 : 0.0; }
 
 // The part's default far-field size, as the hybrid deck picks it (pipeline.cpp fem_request).
@@ -59,6 +78,9 @@ fem_export::ContactBody contact_body(const fem_export::DeckRequest& own, const P
 
 CompareReport compare_contact(const Scene& scene_in, const CompareOptions& o) {
   const std::string file = scene_in.file.string();
+  auto output = [&](const std::string& name, bool is_folder) {
+    return o.place_output ? o.place_output(name, is_folder) : o.out_dir / name;
+  };
   if (scene_in.impacts.empty()) throw InputError(file, "impacts", "the scene has no impact");
   const ImpactSpec* spec = &scene_in.impacts.front();
   if (!o.impact.empty()) {
@@ -94,6 +116,7 @@ CompareReport compare_contact(const Scene& scene_in, const CompareOptions& o) {
   rep.impact = s.name;
   rep.target = s.target;
   rep.impactor = s.impactor;
+  rep.threshold = o.threshold;
   if (scene.modulus_convention != collision::ModulusConvention::hertz) {
     rep.warnings.push_back("modulus_convention is not \"hertz\": the analytic force leaves out the Poisson terms "
                            "that the FE models contain, so they differ by design");
@@ -156,6 +179,7 @@ CompareReport compare_contact(const Scene& scene_in, const CompareOptions& o) {
   fem_export::CheckOptions check_options;
   check_options.progress = o.progress;
   check_options.timeout_s = o.solver_timeout_s;
+  check_options.threads = o.solver_threads;
   const fem_export::DeckRequest target_req = hybrid_deck_request(scene, ir, target);
   if (o.run_hybrid) {
     fem_export::DeckRequest req = target_req;
@@ -163,7 +187,7 @@ CompareReport compare_contact(const Scene& scene_in, const CompareOptions& o) {
     req.options.end_time_s = end_time;
     req.options.time_step_s = dt;
     req.options.pulse_increments = static_cast<int>(std::ceil(ir.table->time_s.back() / dt - 1e-9));
-    rep.hybrid_deck = fem_export::write_decks(req, o.out_dir / "hybrid");
+    rep.hybrid_deck = fem_export::write_decks(req, output("hybrid", true));
     target_far = rep.hybrid_deck->quality.mesh_size_m;  // after any adaptive refinement
     const fem_export::TimeSchedule ts = fem_export::time_schedule(req.options, ir.table->time_s.back());
     rep.hybrid_increments = ts.pulse_increments + ts.main_increments;
@@ -182,6 +206,7 @@ CompareReport compare_contact(const Scene& scene_in, const CompareOptions& o) {
   cr.source = scene.file.string();
   cr.impact = s.name;
   cr.target = contact_body(target_req, target, ev.target_point, ev.input.target, Eigen::Vector3d::Zero(), target_far);
+  cr.target.probes_own_m = scene.outputs.fem->probes_m;  // the hybrid deck's probes, target frame
   cr.impactor = contact_body(impactor_req, impactor, ev.impactor_point, ev.input.impactor, ev.impactor_translation_m,
                              default_mesh_size(*impactor.spec, impactor));
   cr.contact_point_m = ev.point_m;
@@ -196,7 +221,7 @@ CompareReport compare_contact(const Scene& scene_in, const CompareOptions& o) {
     cr.options.contact_elements = co.contact_elements * std::pow(std::sqrt(2.0), level);
     ContactLevel L;
     L.contact_elements = cr.options.contact_elements;
-    const fs::path folder = o.out_dir / (o.refine == 0 ? std::string("contact") : "contact_L" + std::to_string(level));
+    const fs::path folder = output(o.refine == 0 ? std::string("contact") : "contact_L" + std::to_string(level), true);
     L.deck = fem_export::write_contact_deck(cr, folder);
     if (o.progress) {
       *o.progress << "compare-contact: running the full-contact model, " << L.contact_elements
@@ -254,14 +279,29 @@ CompareReport compare_contact(const Scene& scene_in, const CompareOptions& o) {
   po.title = "Contact force, impact '" + s.name + "': full contact against the hybrid load";
   po.quantity = "contact force";
   po.force_N = true;
-  const fs::path svg = o.out_dir / "compare_force.svg";
+  const fs::path svg = output("compare_force.svg", false);
   write_file_atomically(svg, plot::to_svg(plot::stress_time_drawing(series, po)));
   rep.files.push_back(svg);
   return rep;
 }
 
+void map_paths(CompareReport& r, const std::function<fs::path(const fs::path&)>& map) {
+  for (auto& f : r.files) f = map(f);
+  for (auto& L : r.ladder) L.deck.folder = map(L.deck.folder);
+  if (r.hybrid_deck) {
+    r.hybrid_deck->folder = map(r.hybrid_deck->folder);
+    for (auto& f : r.hybrid_deck->files) f = map(f);
+  }
+  if (r.hybrid_check) {
+    for (auto& f : r.hybrid_check->solver_files) f = map(f);
+    if (r.hybrid_check->stress)
+      for (auto& f : r.hybrid_check->stress->files) f = map(f);
+  }
+}
+
 json to_json(const CompareReport& r) {
-  json j = {{"impact", r.impact}, {"target", r.target}, {"impactor", r.impactor}, {"verdict", to_string(r.verdict)}};
+  json j = {{"impact", r.impact},    {"target", r.target},       {"impactor", r.impactor},
+            {"verdict", to_string(r.verdict)}, {"threshold", r.threshold}};
   if (r.verdict == CompareVerdict::non_hertzian) {
     j["hertzian"] = false;
     j["non_hertzian_reason"] = r.non_hertzian_reason;
@@ -305,6 +345,7 @@ json to_json(const CompareReport& r) {
                 {"angular_momentum_relative_error", run.angular_momentum_relative_error},
                 {"numerical_energy_loss_fraction",
                  run.initial_kinetic_energy_J > 0 ? 1.0 - run.final_total_energy_J / run.initial_kinetic_energy_J : 0.0},
+                {"probes", probes_json(run.probes)},
                 {"folder", L.deck.folder.string()}};
   };
   const ContactLevel& fine = r.ladder.back();
@@ -319,11 +360,7 @@ json to_json(const CompareReport& r) {
   j["restitution_assumed_loss_fraction"] = r.assumed_loss_fraction;
   if (r.hybrid_deck && r.hybrid_check) {
     const auto& c = *r.hybrid_check;
-    json probes = json::array();
-    if (c.stress) {
-      for (const auto& p : c.stress->probes)
-        probes.push_back({{"name", p.name}, {"point_m", v3(p.point_m)}, {"max_von_mises_Pa", p.max_von_mises_Pa}});
-    }
+    const json probes = c.stress ? probes_json(c.stress->probes) : json::array();
     j["hybrid_run"] = {{"max_force_N", r.hybrid_max_force_N},
                        {"wall_time_s", c.solver_wall_time_s},
                        {"node_count", r.hybrid_deck->node_count},
@@ -339,6 +376,17 @@ json to_json(const CompareReport& r) {
     j["hybrid_run"] = nullptr;
     j["wall_time_ratio_full_over_hybrid"] = nullptr;
   }
+  // Each probe's peak von Mises from both models, where both have it.
+  json pc = json::array();
+  for (const auto& p : fine.run.probes) {
+    const fem_export::ProbeStress* h = hybrid_probe(r, p.name);
+    pc.push_back({{"name", p.name},
+                  {"contact_max_von_mises_Pa", p.max_von_mises_Pa},
+                  {"hybrid_max_von_mises_Pa", h ? json(h->max_von_mises_Pa) : json(nullptr)},
+                  {"hybrid_over_contact", h && p.max_von_mises_Pa > 0 ? json(h->max_von_mises_Pa / p.max_von_mises_Pa)
+                                                                       : json(nullptr)}});
+  }
+  j["probe_stresses"] = pc;
   if (r.verdict == CompareVerdict::disagree) {
     j["in_doubt"] = r.in_doubt;
     j["explanation"] = r.explanation;
@@ -375,6 +423,14 @@ std::string format_compare(const CompareReport& r) {
     o << "  hybrid: F_max applied " << r.hybrid_max_force_N << " N, " << r.hybrid_deck->node_count << " nodes, "
       << r.hybrid_check->solver_wall_time_s << " s; full/hybrid wall time "
       << f.run.wall_time_s / std::max(r.hybrid_check->solver_wall_time_s, 1e-9) << "\n";
+  }
+  for (const auto& p : f.run.probes) {
+    o << "  " << p.name << ": peak von Mises " << p.max_von_mises_Pa * 1e-6 << " MPa at " << p.max_von_mises_time_s * 1e6
+      << " us (full contact)";
+    if (const fem_export::ProbeStress* h = hybrid_probe(r, p.name)) {
+      o << ", " << h->max_von_mises_Pa * 1e-6 << " MPa at " << h->max_von_mises_time_s * 1e6 << " us (hybrid)";
+    }
+    o << "\n";
   }
   o << "  verdict: " << to_string(r.verdict);
   if (r.verdict == CompareVerdict::disagree) o << " (in doubt: " << r.in_doubt << "): " << r.explanation;

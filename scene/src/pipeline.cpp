@@ -26,7 +26,7 @@ const std::vector<std::string>& all_stages() {
   static const std::vector<std::string> s = {
       "scene",        "mesh_load",      "mesh_validation", "mass_properties",
       "curvature_index", "contact_geometry", "impact",     "force_table",
-      "fem_mesh",     "fem_decks",      "fem_run",         "write_outputs"};
+      "fem_mesh",     "fem_decks",      "fem_run",         "compare_contact", "write_outputs"};
   return s;
 }
 
@@ -35,6 +35,7 @@ bool RunReport::all_checks_passed() const {
     if (!i.result.checks.passed) return false;
     if (i.fem_deck && !i.fem_deck->body_check.passed) return false;
     if (i.fem_check && !i.fem_check->passed) return false;
+    if (i.compare && i.compare->verdict == CompareVerdict::disagree) return false;
   }
   return true;
 }
@@ -338,7 +339,7 @@ namespace {
 // Where each output of the scene goes, reserved in the run's transaction before any work (a bad
 // name fails at once): staged paths, one per impact.
 struct StagedOutputs {
-  std::vector<fs::path> table, plot, fem;
+  std::vector<fs::path> table, plot, fem, compare;
 };
 
 StagedOutputs reserve_outputs(const Scene& scene, RunTransaction& txn) {
@@ -388,6 +389,12 @@ StagedOutputs reserve_outputs(const Scene& scene, RunTransaction& txn) {
     if (scene.outputs.fem) {
       st.fem.push_back(reserve("fem_" + s.name,
                                Place{s.place.line, s.place.key + ".name"}.describe() + " (deck folder of [outputs.fem])", true));
+      if (scene.outputs.fem->compare_contact) {
+        st.compare.push_back(reserve("compare_" + s.name,
+                                     Place{s.place.line, s.place.key + ".name"}.describe() +
+                                         " (folder of [outputs.fem] compare_contact)",
+                                     true));
+      }
     }
     if (scene.outputs.force_table_csv) {
       st.table.push_back(reserve(per_impact(*scene.outputs.force_table_csv, s, "force_table_csv"), place_of("force_table_csv"), false));
@@ -541,6 +548,44 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
         }
       });
     }
+    if (const auto& cc = scene.outputs.fem->compare_contact) {
+      // The same impact as a full-contact model beside a hybrid deck with its time steps
+      // (compare_contact.hpp), in compare_<impact>/ of the staging folder.
+      clock.run("compare_contact", [&] {
+        for (std::size_t k = 0; k < report.impacts.size(); ++k) {
+          auto& ir = report.impacts[k];
+          std::error_code ec;
+          fs::create_directories(staged.compare[k], ec);
+          if (ec) throw InputError(txn.public_path(staged.compare[k]).string(), "folder", "cannot create: " + ec.message());
+          CompareOptions co;
+          co.impact = ir.spec->name;
+          co.out_dir = staged.compare[k];
+          co.threshold = cc->threshold;
+          co.refine = cc->refine;
+          co.contact.contact_elements = cc->contact_elements;
+          co.contact.contact_increments = cc->contact_increments;
+          co.contact.penalty_factor = cc->penalty_factor;
+          co.solver_timeout_s = opt.solver_timeout_s;
+          co.solver_threads = opt.solver_threads;
+          co.progress = opt.progress;
+          try {
+            ir.compare = compare_contact(scene, co);
+          } catch (const InputError& e) {
+            throw InputError(where(scene), Place{scene.outputs.fem->place.line, "outputs.fem.compare_contact"}.describe(),
+                             "impact '" + ir.spec->name + "': " + txn.public_text(e.where()) +
+                                 (e.place().empty() ? "" : ": " + e.place()) + ": " + e.reason());
+          }
+          if (ir.compare->verdict == CompareVerdict::disagree) {
+            report.warnings.push_back("impact '" + ir.spec->name + "': full-contact F_max differs from the analytic one by " +
+                                      std::to_string(100 * ir.compare->finest()->max_force_relative_difference) +
+                                      " %, beyond compare_contact_threshold; in doubt: " + ir.compare->in_doubt + ": " +
+                                      ir.compare->explanation);
+          } else if (ir.compare->verdict == CompareVerdict::non_hertzian) {
+            report.warnings.push_back("impact '" + ir.spec->name + "': compare_contact: " + ir.compare->explanation);
+          }
+        }
+      });
+    }
   }
   if (scene.outputs.force_table_csv || scene.outputs.force_plot_svg) {
     clock.run("write_outputs", [&] {
@@ -582,6 +627,10 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
         f = txn.public_path(f);
         report.files_written.push_back(f);
       }
+    }
+    if (ir.compare) {
+      map_paths(*ir.compare, [&txn](const fs::path& p) { return txn.public_path(p); });
+      for (const auto& f : ir.compare->files) report.files_written.push_back(f);
     }
     if (ir.fem_check) {
       for (auto& f : ir.fem_check->solver_files) f = txn.public_path(f);

@@ -149,6 +149,7 @@ nlohmann::json to_json(const Scene& scene, const RunReport& rep) {
         i["fem"]["load_sum_max_relative_error"] = d.patch.max_sum_relative_error;
         i["fem"]["load_moment_max_relative"] = d.patch.max_moment_relative;
       }
+      if (ir.compare) i["fem"]["compare_contact"] = to_json(*ir.compare);
     }
     impacts.push_back(std::move(i));
   }
@@ -250,6 +251,10 @@ std::string format_summary(const Scene& scene, const RunReport& rep) {
       std::istringstream lines(fem_export::format_check(*ir.fem_check));
       for (std::string l; std::getline(lines, l);) o << "  FEM check: " << l << "\n";
     }
+    if (ir.compare) {
+      std::istringstream lines(format_compare(*ir.compare));
+      for (std::string l; std::getline(lines, l);) o << "  compare-contact: " << l << "\n";
+    }
   }
   for (const auto& w : rep.warnings) o << "\nwarning: " << w;
   if (!rep.warnings.empty()) o << "\n";
@@ -272,6 +277,11 @@ std::string failed_checks_summary(const Scene& scene, const RunReport& rep) {
     if (ir.fem_check && !ir.fem_check->passed) {
       o << "; impact '" << ir.spec->name << "': FEM momentum check of deck 'fem_" << ir.spec->name << "'";
       for (const auto& f : ir.fem_check->failures) o << ": " << f;
+    }
+    if (ir.compare && ir.compare->verdict == CompareVerdict::disagree) {
+      o << "; impact '" << ir.spec->name << "': full-contact F_max differs from the analytic one by "
+        << 100 * ir.compare->finest()->max_force_relative_difference << " % (compare_contact_threshold "
+        << 100 * ir.compare->threshold << " %), in doubt: " << ir.compare->in_doubt;
     }
   }
   return scene.file.string() + ": physics self-check failed" + o.str() + "; nothing was written";

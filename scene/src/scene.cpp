@@ -3,6 +3,7 @@
 #include <cmath>
 #include <set>
 #include <sstream>
+#include <tuple>
 
 #include <toml++/toml.h>
 
@@ -388,7 +389,8 @@ FemOutputs read_fem(const toml::table& t, const std::string& file, double to_m) 
            "load", "contact_elements", "contact_zone_factor", "linear_momentum_tolerance",
            "angular_momentum_tolerance", "model_linear_velocity_tolerance", "model_angular_velocity_tolerance",
            "volume_tolerance", "mass_tolerance", "inertia_tolerance", "min_gamma", "max_elements", "solver",
-           "aster_cpus", "aster_mpi_processes"});
+           "aster_cpus", "aster_mpi_processes", "compare_contact", "compare_contact_threshold", "compare_contact_refine",
+           "compare_contact_elements", "compare_contact_increments", "compare_contact_penalty_factor"});
   FemOutputs f;
   f.place = r.self();
   if (r.has("mesh_size")) f.mesh_size_m = r.positive("mesh_size") * to_m;
@@ -457,6 +459,31 @@ FemOutputs read_fem(const toml::table& t, const std::string& file, double to_m) 
                                            {"iterative", FemOutputs::Solver::iterative}},
                                           FemOutputs::Solver::automatic);
   if (!f.code_aster && !f.calculix) r.fail("calculix", "code_aster and calculix are both false: no deck to write");
+  if (r.boolean("compare_contact").value_or(false)) {
+    FemOutputs::CompareContact c;
+    if (!f.calculix) r.fail("compare_contact", "compare_contact = true runs CalculiX: it needs calculix = true");
+    if (r.has("compare_contact_threshold")) c.threshold = r.positive("compare_contact_threshold");
+    if (r.has("compare_contact_elements")) {
+      c.contact_elements = r.positive("compare_contact_elements");
+      if (c.contact_elements > 16) r.fail("compare_contact_elements", "must lie in (0, 16]");
+    }
+    if (r.has("compare_contact_penalty_factor")) c.penalty_factor = r.positive("compare_contact_penalty_factor");
+    for (auto [key, into, lo, hi] : {std::tuple{"compare_contact_refine", &c.refine, 0, 6},
+                                     std::tuple{"compare_contact_increments", &c.contact_increments, 4, 100000}}) {
+      if (!r.has(key)) continue;
+      const double n = r.required_number(key);
+      if (n != std::floor(n) || n < lo || n > hi) {
+        r.fail(key, "must be a whole number in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+      }
+      *into = static_cast<int>(n);
+    }
+    f.compare_contact = c;
+  } else {
+    for (const char* key : {"compare_contact_threshold", "compare_contact_refine", "compare_contact_elements",
+                            "compare_contact_increments", "compare_contact_penalty_factor"}) {
+      if (r.has(key)) r.fail(key, "has no effect without compare_contact = true");
+    }
+  }
   r.reject_unknown();
   return f;
 }

@@ -31,6 +31,7 @@
 
 #include "impactdeck/fem_export/check.hpp"
 #include "impactdeck/fem_export/decks.hpp"
+#include "impactdeck/fem_export/stress.hpp"
 
 namespace impactdeck::fem_export {
 
@@ -46,6 +47,9 @@ struct ContactBody {
   Eigen::Vector3d angular_velocity_rad_s = Eigen::Vector3d::Zero();  ///< world
   Eigen::Vector3d centroid_own_m = Eigen::Vector3d::Zero();  ///< the spin's centre (exact body)
   double far_mesh_size_m = 0;  ///< element size away from the contact
+  /// Stress probes (own frame; the target's [outputs.fem] probes): embedded nodes PROBE1, ...
+  /// whose von Mises history ccx writes (`*EL FILE, NSET=`), as the hybrid deck's.
+  std::vector<Eigen::Vector3d> probes_own_m;
 };
 
 struct ContactModelOptions {
@@ -124,6 +128,10 @@ struct ContactRunResult {
   double linear_momentum_relative_error = 0, angular_momentum_relative_error = 0;
   double vibration_energy_J = 0;      ///< both bodies
   double final_total_energy_J = 0;    ///< kinetic + strain of both bodies at the end
+  /// The target's probes (PROBE1, ...): von Mises history at the contact force's times and peak;
+  /// `point_m` in the deck frame (world, origin at the contact point); `node` the ccx node.
+  std::vector<ProbeStress> probes;
+  std::vector<double> probe_time_s;
 };
 
 /// Runs ccx on the deck folder (check.hpp's runner) and reads the contact force history and the

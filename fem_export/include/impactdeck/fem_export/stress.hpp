@@ -82,6 +82,13 @@ struct StressResult {
 /// file is missing, has no stress output, or names nodes the mesh does not have.
 StressResult read_stresses(const std::filesystem::path& frd, const TetMesh& mesh, const StressInputs& in);
 
+/// Reads the von Mises history of the named ccx nodes (1-based ids: `ProbeStress::node`) from an
+/// .frd whose stress output may be limited to those nodes (`*EL FILE, NSET=`), up to `end_time_s`;
+/// fills each probe's history, peak and time, and returns the output times. Throws InputError when
+/// the file is missing or a probe has no stress at some output time.
+std::vector<double> read_node_stresses(const std::filesystem::path& frd, std::vector<ProbeStress>& probes,
+                                       double end_time_s);
+
 /// Writes into `dir`: von_mises_history.csv (time, each probe, LOAD; SI), von_mises_peak.vtu
 /// (ParaView: peak von Mises and its time per node, von Mises and displacement at the governing
 /// peak's time), von_mises_peak.msh (the same as Gmsh $NodeData views) and von_mises.svg (the

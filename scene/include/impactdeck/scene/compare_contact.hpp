@@ -6,6 +6,7 @@
 // elastic Hertz impact (R = 1): F_max and t_m are the analytic model's, the duration 2 t_m, the
 // impulse 2 m_w v_w, the jumps the model's times 2 / (1 + R).
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <ostream>
 #include <string>
@@ -28,7 +29,12 @@ struct CompareOptions {
   fem_export::ContactModelOptions contact;
   bool run_hybrid = true;                ///< false: the contact model only (tests)
   double solver_timeout_s = 0;           ///< per ccx run; 0: derived from each deck's size
+  int solver_threads = 0;                ///< ccx threads; 0: all cores
   std::ostream* progress = nullptr;
+  /// Where each output goes: `name` is "hybrid", "contact", "contact_L<k>" (folders) or
+  /// "compare_force.svg" (file). Unset: out_dir / name. `compare-contact` reserves the names in its
+  /// run transaction (staged, published only when the comparison completed).
+  std::function<std::filesystem::path(const std::string& name, bool is_folder)> place_output;
 };
 
 /// One rung of the refinement ladder.
@@ -48,6 +54,7 @@ struct CompareReport {
   std::string non_hertzian_reason;  ///< the kernel's flag explained
   std::string in_doubt;             ///< disagree: "contact mesh" or "hybrid assumptions"
   std::string explanation;          ///< one sentence saying why
+  double threshold = 0.03;          ///< the options' threshold the verdict used
   // The analytic (elastic) impact.
   double analytic_max_force_N = 0, analytic_compression_time_s = 0, analytic_duration_s = 0;
   double analytic_impulse_Ns = 0, impact_energy_J = 0;  ///< 2 m_w v_w, 1/2 m_w v_w^2
@@ -72,6 +79,10 @@ struct CompareReport {
 /// Runs the comparison. Throws InputError (exit 3) on bad input: an unknown impact, a plane or a
 /// fixed body (the full-contact model meshes both bodies and needs their masses).
 CompareReport compare_contact(const Scene& scene, const CompareOptions& options);
+
+/// Replaces every path of the report (deck folders, solver files, the plot) by `map(path)`: the
+/// staged paths of a run transaction by their published ones.
+void map_paths(CompareReport& r, const std::function<std::filesystem::path(const std::filesystem::path&)>& map);
 
 nlohmann::json to_json(const CompareReport& r);
 std::string format_compare(const CompareReport& r);

@@ -12,6 +12,7 @@
 #include "impactdeck/fem_export/check.hpp"
 #include "impactdeck/fem_export/decks.hpp"
 #include "impactdeck/geometry/shape.hpp"
+#include "impactdeck/scene/compare_contact.hpp"
 #include "impactdeck/scene/contact.hpp"
 #include "impactdeck/scene/scene.hpp"
 
@@ -28,6 +29,8 @@ struct ImpactReport {
   std::optional<std::filesystem::path> plot_path;   ///< where the F(t) SVG was written
   std::optional<fem_export::DeckResult> fem_deck;    ///< [outputs.fem]: the deck folder
   std::optional<fem_export::CheckResult> fem_check;  ///< [outputs.fem] run = "calculix"
+  /// [outputs.fem] compare_contact = true: the full-contact model against the analytic force
+  std::optional<CompareReport> compare;
 };
 
 struct StageTiming {

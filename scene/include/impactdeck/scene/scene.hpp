@@ -106,6 +106,17 @@ struct FemOutputs {
   std::optional<std::size_t> max_elements;
   /// ccx's equation solver: "auto" (by deck size), "spooles", "iterative" (docs/fem.md).
   enum class Solver { automatic, spooles, iterative } solver = Solver::automatic;
+  /// `compare_contact = true`: each impact is also run as a full-contact CalculiX model beside a
+  /// hybrid deck with the same time steps (compare_contact.hpp, docs/contact-vs-hybrid.md); a
+  /// contact F_max beyond `compare_contact_threshold` of the analytic one fails the run (exit 4).
+  struct CompareContact {
+    double threshold = 0.03;      ///< compare_contact_threshold
+    int refine = 0;               ///< compare_contact_refine: extra rungs of the ladder
+    double contact_elements = 3;  ///< compare_contact_elements: across the contact semi-axis b
+    int contact_increments = 40;  ///< compare_contact_increments: across the contact duration
+    double penalty_factor = 20;   ///< compare_contact_penalty_factor
+  };
+  std::optional<CompareContact> compare_contact;
   Place place;
 };
 
