@@ -534,29 +534,11 @@ DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
       mo.load_zone_radius_m = std::max(mo.load_zone_radius_m, 1.25 * r.patch.a_max_m);
     }
     const auto t_mesh = std::chrono::steady_clock::now();
-    // A CAD part is meshed from its B-rep with Gmsh's 2D algorithms 6, 1 and 5 in turn (a face
-    // one algorithm cannot mesh, e.g. "overlapping facets", another often can). Every try is
-    // recorded. (The B-rep's search triangulation is no fallback: its faces are not sewn.)
-    auto mesh_cad_with_fallback = [&] {
-      std::vector<MeshAttempt> failed;
-      for (int alg : {6, 1, 5}) {
-        MeshOptions m = mo;
-        m.algorithm_2d = mo.algorithm_2d ? mo.algorithm_2d : alg;
-        try {
-          MeshResult res = mesh_cad(r.body.cad, r.body.cad_unit_m, r.load_point_m, m, stage, "mesh");
-          res.quality.attempts.insert(res.quality.attempts.begin(), failed.begin(), failed.end());
-          return res;
-        } catch (const InputError& e) {
-          failed.push_back({"cad", m.algorithm_2d, m.algorithm_3d, m.mesh_size_m, m.load_mesh_size_m, e.reason()});
-          if (mo.algorithm_2d || alg == 5) throw;  // the user's algorithm only, or the last one
-        }
-      }
-      throw InputError(r.body.cad.string(), "gmsh mesh", "every try on the B-rep failed");
-    };
     auto mesh_once = [&] {
       switch (r.body.kind) {
         case BodyKind::ellipsoid: return mesh_ellipsoid(r.body.semi_axes_m, r.load_point_m, mo, stage, "mesh");
-        case BodyKind::cad: return mesh_cad_with_fallback();
+        case BodyKind::cad:  // the plugin tries Gmsh's 2D algorithms 6, 1 and 5 in turn
+          return mesh_cad(r.body.cad, r.body.cad_unit_m, r.load_point_m, mo, stage, "mesh");
         case BodyKind::part: break;
       }
       return mesh_part(r.body.surface, r.load_point_m, mo, stage, "mesh", r.body.name);

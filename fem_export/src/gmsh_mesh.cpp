@@ -748,12 +748,10 @@ MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& l
   return r;
 }
 
-MeshResult mesh_cad_with_gmsh(const fs::path& cad, double cad_unit_m, const Eigen::Vector3d& load_point_m,
-                              const MeshOptions& o, const fs::path& folder, const std::string& name) {
+// One try of the CAD route with Gmsh's 2D algorithm alg2, in a session of its own.
+MeshResult mesh_cad_once(const fs::path& cad, double cad_unit_m, const Eigen::Vector3d& load_point_m,
+                         const MeshOptions& o, const fs::path& folder, const std::string& name, int alg2) {
   const std::string where = cad.string();
-  check_options(o, where);
-  if (!fs::is_regular_file(cad)) throw InputError(where, "file", "cannot be opened (missing or unreadable)");
-  if (!(cad_unit_m > 0)) throw InputError(where, "unit", "must be > 0");
   // STEP and IGES come in mm (OpenCASCADE converts from the file's own unit); a BREP has no unit:
   // its coordinates are in cad_unit_m metres and are scaled to mm.
   const double scale = cad_unit_m * kMmPerM;
@@ -821,7 +819,6 @@ MeshResult mesh_cad_with_gmsh(const fs::path& cad, double cad_unit_m, const Eige
     gmsh::model::setPhysicalName(0, gmsh::model::addPhysicalGroup(0, {load_tag}), "LOAD");
     add_probe_groups(probe_tags);
   });
-  const int alg2 = o.algorithm_2d ? o.algorithm_2d : 6;  // Frontal-Delaunay on the B-rep faces
   generate_tets(where, o, alg2, p_mm, h0, h);
   finish_point_mesh(where, o, folder, name, load_tag, probe_tags, p_mm, h0, alg2, "cad", r);
   fs::copy_file(cad, copy, fs::copy_options::overwrite_existing);
@@ -845,6 +842,35 @@ MeshResult mesh_cad_with_gmsh(const fs::path& cad, double cad_unit_m, const Eige
   r.geo = folder / (name + ".geo");
   write_file_atomically(r.geo, g.str());
   return r;
+}
+
+// Gmsh's 2D algorithms 6 (Frontal-Delaunay), 1 and 5 in turn (a face one algorithm cannot mesh,
+// e.g. "overlapping facets", another often can), or only the user's; every try is recorded, each
+// from a fresh import of the B-rep (a failed surface mesh leaves Gmsh's model in no state to retry).
+// The B-rep's search triangulation is no fallback: its faces are not sewn.
+MeshResult mesh_cad_with_gmsh(const fs::path& cad, double cad_unit_m, const Eigen::Vector3d& load_point_m,
+                              const MeshOptions& o, const fs::path& folder, const std::string& name) {
+  // Bad options or a missing file fail once, before any try.
+  check_options(o, cad.string());
+  if (!fs::is_regular_file(cad)) throw InputError(cad.string(), "file", "cannot be opened (missing or unreadable)");
+  if (!(cad_unit_m > 0)) throw InputError(cad.string(), "unit", "must be > 0");
+  const std::vector<int> algorithms = o.algorithm_2d ? std::vector<int>{o.algorithm_2d} : std::vector<int>{6, 1, 5};
+  std::vector<MeshAttempt> failed;
+  for (std::size_t k = 0;; ++k) {
+    try {
+      MeshResult r = mesh_cad_once(cad, cad_unit_m, load_point_m, o, folder, name, algorithms[k]);
+      r.quality.attempts.insert(r.quality.attempts.begin(), failed.begin(), failed.end());
+      return r;
+    } catch (const InputError& e) {
+      if (k + 1 == algorithms.size()) {
+        if (failed.empty()) throw;
+        std::string why;
+        for (const auto& a : failed) why += "2D algorithm " + std::to_string(a.algorithm_2d) + ": " + a.outcome + "; ";
+        throw InputError(e.where(), e.place(), why + "2D algorithm " + std::to_string(algorithms[k]) + ": " + e.reason());
+      }
+      failed.push_back({"cad", algorithms[k], o.algorithm_3d, o.mesh_size_m, load_size(o), e.reason()});
+    }
+  }
 }
 
 }  // namespace impactdeck::fem_export
