@@ -180,23 +180,33 @@ SurfacePoint Ellipsoid::closest_point(const Eigen::Vector3d& q) const {
 }
 
 Curvature Ellipsoid::curvature(const SurfacePoint& at) const {
-  // Shape operator of the level set f = sum x_i^2/e_i^2 = 1: S = P H P / |grad f| with
-  // H = 2 diag(1/e_i^2), grad f = 2 (x_i/e_i^2), P = I - n n^T. Its eigenvalues are 0 (normal)
-  // and the two principal curvatures (positive: convex), its eigenvectors the directions.
+  // No eigen-solver (this runs once per sweep point): the shape operator S = P diag(1/e_i^2) P / |g|
+  // of the level set f = sum x_i^2 / e_i^2 = 1, g = grad f / 2 = (x_i / e_i^2), restricted to the
+  // tangent plane is a 2 x 2 symmetric matrix in an orthonormal tangent basis (t1, t2). Its
+  // eigenvalues: k1 = mean + radius (both well conditioned, also at an umbilic), and
+  // k2 = K / k1 with the Gaussian curvature in closed form K = 1 / ((e1 e2 e3)^2 |g|^4) (no
+  // cancellation when k2 << k1).
   const Eigen::Vector3d& p = at.point_m;
   const Eigen::Vector3d inv2 = e_.cwiseProduct(e_).cwiseInverse();
   const Eigen::Vector3d grad = p.cwiseProduct(inv2);
-  const double gnorm = grad.norm();
-  const Eigen::Vector3d n = grad / gnorm;
-  const Eigen::Matrix3d P = Eigen::Matrix3d::Identity() - n * n.transpose();
-  const Eigen::Matrix3d S = P * inv2.asDiagonal() * P / gnorm;
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(S);
-  // The normal's eigenvalue is 0; the two others are positive. Pick the two largest.
+  const double g2 = grad.squaredNorm(), g = std::sqrt(g2);
+  const Eigen::Vector3d n = grad / g;
+  const double abc2 = e_.prod() * e_.prod();
+  const double K = 1.0 / (abc2 * g2 * g2);
+  const Eigen::Vector3d helper = std::abs(n.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+  const Eigen::Vector3d t1 = n.cross(helper).normalized(), t2 = n.cross(t1);
+  const double s11 = t1.cwiseProduct(t1).dot(inv2) / g, s12 = t1.cwiseProduct(t2).dot(inv2) / g,
+               s22 = t2.cwiseProduct(t2).dot(inv2) / g;
   Curvature c;
-  c.k1_per_m = es.eigenvalues()[2];
-  c.k2_per_m = es.eigenvalues()[1];
-  c.d1 = es.eigenvectors().col(2);
-  c.d2 = es.eigenvectors().col(1);
+  c.k1_per_m = 0.5 * (s11 + s22) + std::hypot(0.5 * (s11 - s22), s12);
+  c.k2_per_m = K / c.k1_per_m;
+  // Eigenvector of k1: (s12, k1 - s11) or (k1 - s22, s12), whichever is longer; an umbilic (k1 = k2)
+  // has none: any tangent pair.
+  const Eigen::Vector2d u(s12, c.k1_per_m - s11), v(c.k1_per_m - s22, s12);
+  const Eigen::Vector2d w = u.squaredNorm() >= v.squaredNorm() ? u : v;
+  const double wn = w.norm();
+  c.d1 = wn > 1e-12 * c.k1_per_m ? ((w.x() * t1 + w.y() * t2) / wn).eval() : t1;
+  c.d2 = n.cross(c.d1);
   c.error_estimate_per_m = 0.0;
   c.sharp_feature = false;
   return c;
