@@ -502,6 +502,7 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
     for (std::size_t k = 0; k < report.impacts.size(); ++k) {
       auto& ir = report.impacts[k];
       fem_export::DeckRequest req = fem_request(scene, ir, bodies.at(ir.spec->target));
+      req.options.units.length = report.output_length_unit;
       const auto t0 = std::chrono::steady_clock::now();
       try {
         ir.fem_deck = fem_export::write_deck_files(req, staged.fem[k]);
@@ -600,6 +601,7 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
 
 RunReport run_scene(const Scene& scene, const RunOptions& opt) {
   RunReport report;
+  report.output_length_unit = opt.output_length_unit.value_or(scene.length_unit);
   StageClock clock(report);
   report.stages_run.push_back({"scene", 0.0});
   RunTransaction txn(opt.out_dir);
