@@ -4,7 +4,8 @@
 # and in the unit --output-length-unit asks for: checked in ParaView's terms (VTK's own readers:
 # every sweep point on the deck mesh's boundary surface, same bounding box), in Gmsh's (the gmsh
 # command merging the deck's .msh and the sweep's .pos, printing both bounding boxes) and in the
-# files' own words (header comments, FieldData, CSV column names, deck.json, JSON keys).
+# files' own words (header comments, FieldData, CSV column names, deck.json, JSON keys). Then the
+# solver's side: the same ccx result with the decks in cm and in m.
 # usage: output_unit_test.sh IMPACTDECK SOURCE_DIR
 set -u
 bin=$1; src=$2
@@ -162,4 +163,24 @@ assert len(mm) == len(m) == len(inch)
 err = max(max(abs(a / 1000 - b), abs(a / 25.4 - c)) for p, q, r in zip(mm, m, inch) for a, b, c in zip(p, q, r))
 assert err <= 1e-12, err
 PY
+# The solver sees one consistent unit system whatever the length: the drop sample (a cm scene)
+# through ccx with its decks in cm (the default) and in m gives the same momentum and stresses
+# (ccx's .frd prints 6 significant digits: 1e-5).
+if command -v ccx >/dev/null; then
+  for u in default m; do
+    flag=(); [ "$u" != default ] && flag=(--output-length-unit "$u")
+    "$bin" run "$src/samples/drop_test.toml" --json --out "$tmp/drop_$u" "${flag[@]}" >"$tmp/drop_$u.json" 2>/dev/null
+    check "drop sample with decks in $u: exit 0" test $? -eq 0
+  done
+  python3 - "$tmp/drop_default.json" "$tmp/drop_m.json" <<'PY' || { echo "FAILED: the deck's unit changes the FEM result"; fails=$((fails+1)); }
+import json, sys
+a, b = (json.load(open(p))["impacts"][0]["fem"]["check"] for p in sys.argv[1:])
+assert json.load(open(sys.argv[1]))["output_length_unit"] == "cm"
+va, vb = (c["stress"]["verdict"]["governing"]["max_von_mises_Pa"] for c in (a, b))
+assert a["passed"] and b["passed"]
+assert abs(va - vb) <= 1e-5 * va, (va, vb)
+assert abs(a["linear_momentum_relative_error"] - b["linear_momentum_relative_error"]) <= 1e-5, (a, b)
+print("drop sample: peak von Mises %.9g Pa (cm deck) and %.9g Pa (m deck)" % (va, vb))
+PY
+fi
 finish output_length_unit

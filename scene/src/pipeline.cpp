@@ -1,5 +1,6 @@
 #include "impactdeck/scene/pipeline.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -620,7 +621,18 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
   if (staged.report) {
     clock.run("write_outputs", [&] {
       report.files_written.push_back(txn.public_path(*staged.report));
-      write_file_atomically(*staged.report, report_html(scene, report, pictures));
+      // The page holds the run's results, not the output folder's housekeeping (staging folders of
+      // killed runs removed, an interrupted commit finished: stderr says those), so that the same
+      // inputs give the same page (docs/reliability.md: a killed run's files are old or new).
+      RunReport page = report;
+      const auto& folder_notes = txn.warnings();
+      page.warnings.erase(std::remove_if(page.warnings.begin(), page.warnings.end(),
+                                         [&](const std::string& w) {
+                                           return std::find(folder_notes.begin(), folder_notes.end(), w) !=
+                                                  folder_notes.end();
+                                         }),
+                          page.warnings.end());
+      write_file_atomically(*staged.report, report_html(scene, page, pictures));
       txn.commit();
     });
   } else {

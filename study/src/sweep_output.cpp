@@ -140,11 +140,12 @@ void write_sweep_pos(const std::filesystem::path& path, const SweepResult& r, co
   constexpr std::size_t kChunk = 8192;
   std::vector<std::string> prefix((n + kChunk - 1) / kChunk);
   std::vector<std::uint32_t> text_begin(n), text_end(n);
+  const double per_m = 1.0 / metres_per(options.length_unit);
   detail::parallel_for(prefix.size(), options.threads, 1, [&](std::size_t c) {
     std::string& out = prefix[c];
     for (std::size_t i = c * kChunk; i < std::min(n, (c + 1) * kChunk); ++i) {
       text_begin[i] = static_cast<std::uint32_t>(out.size());
-      const Eigen::Vector3d x = r.points[i].point_m / metres_per(options.length_unit);
+      const Eigen::Vector3d x = r.points[i].point_m * per_m;  // as the CSV, the .vtp and the decks
       out.append("SP(", 3);
       for (int k = 0; k < 3; ++k) {
         if (k > 0) out.push_back(',');
