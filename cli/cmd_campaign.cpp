@@ -121,6 +121,7 @@ void register_campaign(CLI::App& app, Context& ctx) {
               << r.csv.string() << ", " << r.json.string() << "\n";
     if (r.worst_id) std::cout << "worst case: " << *r.worst_id << " (copied to " << r.worst_case->string() << ")\n";
     if (r.map_svg) std::cout << "map: " << r.map_svg->string() << ", " << r.map_vtp->string() << "\n";
+    std::cout << "report: " << r.report_html.string() << "\n";
   });
 }
 

@@ -6,6 +6,7 @@
 
 #include "cli_limits.hpp"
 #include "commands.hpp"
+#include "output_unit.hpp"
 #include "set_option.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/scene/pipeline.hpp"
@@ -22,6 +23,7 @@ void register_run(CLI::App& app, Context& ctx) {
     std::vector<std::string> set;
     double solver_timeout_s = 0;
     int threads = 0;
+    std::string output_length_unit;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand("run", "Run a scene: impacts, force tables and decks it asks for");
@@ -36,6 +38,7 @@ void register_run(CLI::App& app, Context& ctx) {
   cmd->add_option("--threads", args->threads,
                   "Threads for ccx when [outputs.fem] run = \"calculix\" (default 0: all cores)")
       ->check(CLI::NonNegativeNumber);
+  add_output_length_unit_option(cmd, args->output_length_unit);
   cmd->callback([args, &ctx] {
     if (!std::isfinite(args->solver_timeout_s)) throw UsageError("--solver-timeout-s must be a finite number of seconds");
     check_threads(static_cast<unsigned>(std::min(args->threads, 1 << 30)));
@@ -45,6 +48,7 @@ void register_run(CLI::App& app, Context& ctx) {
     opt.progress = &std::cerr;  // ccx progress when [outputs.fem] run = "calculix"
     opt.solver_timeout_s = args->solver_timeout_s;
     opt.solver_threads = args->threads;
+    opt.output_length_unit = parse_output_length_unit(args->output_length_unit, sc.file.string());
     const scene::RunReport rep = scene::run_scene(sc, opt);
     if (args->json) {
       std::cout << scene::to_json(sc, rep).dump(2) << "\n";

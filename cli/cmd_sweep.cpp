@@ -9,6 +9,7 @@
 
 #include "cli_limits.hpp"
 #include "commands.hpp"
+#include "output_unit.hpp"
 #include "set_option.hpp"
 #include "impactdeck/common/run_transaction.hpp"
 #include "impactdeck/common/error.hpp"
@@ -51,6 +52,7 @@ void register_sweep(CLI::App& app, Context& ctx) {
     unsigned threads = 0;
     std::size_t max_points = kDefaultMaxPoints, max_curve_samples = kDefaultMaxCurveSamples;
     std::vector<std::string> set;
+    std::string output_length_unit;
   };
   auto a = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
@@ -82,6 +84,7 @@ void register_sweep(CLI::App& app, Context& ctx) {
                   "With --curves: most samples over all curves (default 20000000, 160 MB)")
       ->check(positive_number());
   add_set_option(cmd, a->set);
+  add_output_length_unit_option(cmd, a->output_length_unit);
   cmd->callback([a, &ctx] {
     check_threads(a->threads);
     study::SweepFormats formats;
@@ -93,6 +96,8 @@ void register_sweep(CLI::App& app, Context& ctx) {
     if (a->no_png) formats.png = false;
     formats.curves = a->curves;
     const scene::Scene sc = scene::load_scene(a->scene, overrides_from(a->set));
+    const LengthUnit output_unit =
+        parse_output_length_unit(a->output_length_unit, sc.file.string()).value_or(sc.length_unit);
     // One transaction: the sweep's files appear together when all are written, or not at all.
     RunTransaction txn(a->out);
     try {
@@ -183,6 +188,7 @@ void register_sweep(CLI::App& app, Context& ctx) {
       study::ProgressBar write_bar("write", !a->quiet);
       study::SweepWriteOptions wo;
       wo.threads = a->threads;
+      wo.length_unit = output_unit;
       wo.progress = [&write_bar](std::size_t done, std::size_t total) { write_bar.update(done, total); };
       if (!staged_base.empty()) study::write_sweep_files(staged_base, formats, r, meta, picture, wo);
       write_bar.finish();
@@ -197,6 +203,7 @@ void register_sweep(CLI::App& app, Context& ctx) {
         j["scene"] = sc.file.string();
         j["impact"] = imp.name;
         j["cloud"] = meta.cloud;
+        j["output_length_unit"] = to_string(output_unit);
         j["points"] = r.points.size();
         j["force_ratio"] = r.force_ratio;
         j["mass_only_ratio"] = r.mass_only_ratio;

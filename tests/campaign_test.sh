@@ -104,7 +104,7 @@ check "the script's command runs a case" 'grep -qx "case 5: already done" task.t
 
 # A point campaign over a part's surface and a drop campaign over the orientation sphere.
 # (the ball moves along the inward normal wherever it hits: every point is an impact)
-printf 'length_unit = "mm"\n[materials.steel]\nyoungs_modulus_Pa = 2.05e11\npoisson_ratio = 0.3\ndensity_kg_m3 = 7850\n' >target.toml
+printf 'length_unit = "mm"\n[materials.steel]\nyoungs_modulus_Pa = 2.05e11\npoisson_ratio = 0.3\ndensity_kg_m3 = 7850\nyield_strength_Pa = 3.5e8\n' >target.toml
 printf '[[bodies]]\nname = "t"\nshape = "ellipsoid"\nsemi_axes = [200, 50, 50]\nmaterial = "steel"\n' >>target.toml
 printf '[[bodies]]\nname = "b"\nshape = "sphere"\nradius = 10\nmaterial = "steel"\n' >>target.toml
 printf '[[impacts]]\ntarget = "t"\nimpactor = "b"\npoint = [200, 0, 0]\napproach_speed_m_s = 1\nrestitution = 0.5\n' >>target.toml
@@ -115,6 +115,16 @@ count = 6
 TOML
 "$bin" campaign plan points.toml --out pts >/dev/null && "$bin" campaign run pts --quiet >/dev/null && "$bin" campaign collect pts >/dev/null || echo "FAILED: point campaign"
 check "point campaign: SVG and VTP maps" 'grep -q "<svg" pts/collect/map.svg && grep -q "NumberOfPoints=\"6\"" pts/collect/map.vtp'
+# The collect's report page (issue 18): the verdict over the cases (a 10 mm steel ball at 1 m/s
+# dents steel: p0 above 1.60 sigma_y in every case), the map inline, one row per case,
+# and, where Debian's chromium is installed (scripts/test installs it), no console message.
+check "point campaign: report page" 'grep -q "<p id=\"verdict\" class=\"verdict fail\">Verdict: yields in 6 of 6 judged cases" pts/collect/report.html && grep -q "<svg" pts/collect/report.html && [ "$(grep -c "<tr><td>[0-9]*</td><td>done</td>" pts/collect/report.html)" = 6 ]'
+if command -v chromium >/dev/null 2>&1; then
+  timeout 60 chromium --headless --disable-gpu --no-sandbox --no-first-run --user-data-dir="$tmp/profile" \
+    --enable-logging=stderr --v=0 --virtual-time-budget=3000 --dump-dom "file://$tmp/pts/collect/report.html" \
+    >pts.dom 2>pts.log
+  check "point campaign: report page renders without console messages" 'grep -q "id=\"verdict\"" pts.dom && ! grep -qE "CONSOLE|Refused to|Uncaught" pts.log'
+fi
 mkdir -p parts && cp "$src/samples/parts/"*.off parts/ && cp "$src/samples/two_parts.toml" drop.toml
 cat >drop_c.toml <<'TOML'
 scene = "drop.toml"

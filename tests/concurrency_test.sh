@@ -20,7 +20,7 @@ wait "$a"; ra=$?
 wait "$b"; rb=$?
 check "first FEM run exit 0 (got $ra: $(tail -2 "$tmp/a.err"))" test "$ra" -eq 0
 check "second FEM run exit 0 (got $rb: $(tail -2 "$tmp/b.err"))" test "$rb" -eq 0
-check "one deck folder, nothing else: $(ls -A "$out" | tr '\n' ' ')" test "$(ls -A "$out")" = "fem_eccentric"
+check "one deck folder and the report, nothing else: $(ls -A "$out" | tr '\n' ' ')" test "$(ls -A "$out" | tr '\n' ' ')" = "fem_eccentric report.html "
 check "the deck holds ccx's results" test -s "$out/fem_eccentric/impact.dat" -a -s "$out/fem_eccentric/deck.json"
 "$bin" fem-check "$out/fem_eccentric" --no-run >/dev/null 2>"$tmp/check.err"
 check "the published deck's results pass the momentum check ($(cat "$tmp/check.err"))" test $? -eq 0
@@ -36,7 +36,7 @@ for i in $(seq 1 10); do
   wait "$p2"; r2=$?
   [ "$r1" -eq 0 ] && [ "$r2" -eq 0 ] || { echo "FAILED: pair $i exit $r1 $r2"; fails=$((fails+1)); }
 done
-check "only the force table is left: $(ls -A "$plain" | tr '\n' ' ')" test "$(ls -A "$plain")" = "force_two_spheres.csv"
+check "only the force table and the report are left: $(ls -A "$plain" | tr '\n' ' ')" test "$(ls -A "$plain" | tr '\n' ' ')" = "force_two_spheres.csv report.html "
 "$bin" run "$src/samples/two_spheres.toml" --out "$tmp/alone" >/dev/null 2>&1
 check "the raced file equals a lone run's byte for byte" cmp -s "$plain/force_two_spheres.csv" "$tmp/alone/force_two_spheres.csv"
 finish concurrency_test

@@ -96,8 +96,10 @@ TEST(Scene, PaperSampleReproducesHandCalculation) {
   EXPECT_LT(res.checks.energy_relative_error, impactdeck::test::kSelfCheckRel);
   // Pi/m of the ellipsoid: (1 + R) * m_w v / m1 (MODEL.md: (1 + R) * 0.09998 m/s).
   EXPECT_NEAR(-res.target_jump.delta_velocity_m_s.y(), (1 + res.restitution.coefficient) * 0.09998, 2e-5);
-  ASSERT_EQ(r.files_written.size(), 1u);
+  ASSERT_EQ(r.files_written.size(), 2u);  // the force table and the report page beside it
   EXPECT_TRUE(fs::exists(out / "force_table2.csv"));
+  EXPECT_EQ(r.files_written.back().filename(), "report.html");
+  EXPECT_TRUE(fs::exists(out / "report.html"));
   const auto j = to_json(s, r);
   for (const char* k : {"reduced_mass_kg", "effective_radius_m", "effective_modulus_Pa",
                         "hertz_constant_N_per_m1_5", "approach_velocity_m_s", "energy_flux_density",

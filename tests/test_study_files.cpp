@@ -207,6 +207,7 @@ TEST_F(SweepFiles, GmshPosViews) {
 struct Vtp {
   tinyxml2::XMLDocument doc;
   std::map<std::string, std::vector<double>> arrays;  // Float64 and Int64 values as doubles
+  std::map<std::string, double> field_data;            // <FieldData> (ASCII, one value each)
   std::string header_type;
 };
 void read_vtp(const fs::path& p, Vtp& v) {
@@ -227,6 +228,11 @@ void read_vtp(const fs::path& p, Vtp& v) {
   const char* data = text.data() + underscore + 1;
   std::size_t expected_offset = 0;
   for (const auto* a : all(root, "DataArray")) {
+    if (std::string(a->Parent()->ToElement()->Name()) == "FieldData") {
+      ASSERT_STREQ(a->Attribute("format"), "ascii");
+      v.field_data[a->Attribute("Name")] = std::stod(a->GetText());
+      continue;
+    }
     ASSERT_STREQ(a->Attribute("format"), "appended");
     const std::size_t offset = std::stoull(a->Attribute("offset"));
     EXPECT_EQ(offset, expected_offset) << a->Attribute("Name");  // blocks follow each other
@@ -292,6 +298,38 @@ TEST_F(SweepFiles, VtpIsBinaryPolyDataWithTheResultsArrays) {
       ASSERT_EQ(v.arrays["offsets"].at(i), static_cast<double>(i + 1));
     }
   }
+}
+
+// The coordinates in the output length unit (issue 18): the .vtp's points, the CSV's columns and
+// the .pos's SP(x,y,z) are point_m * (1 / metres_per(unit)) like the decks' (1000 exactly for mm),
+// and each file says which unit.
+TEST_F(SweepFiles, CoordinatesInTheOutputLengthUnit) {
+  SweepWriteOptions o;
+  o.length_unit = LengthUnit::mm;
+  write_sweep_vtp(*dir / "mm.vtp", *result, {}, o);
+  write_sweep_csv(*dir / "mm.csv", *result, {}, o);
+  write_sweep_pos(*dir / "mm.pos", *result, {}, o);
+  Vtp v;
+  read_vtp(*dir / "mm.vtp", v);
+  EXPECT_EQ(v.field_data.at("metres_per_length_unit"), 1e-3);
+  const std::size_t n = result->points.size();
+  for (std::size_t i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k) ASSERT_EQ(v.arrays["Points"].at(3 * i + k), result->points[i].point_m[k] * 1000.0);
+  const std::string csv = slurp(*dir / "mm.csv");
+  EXPECT_NE(csv.find("\nindex,x_mm,y_mm,z_mm,nx,"), std::string::npos);
+  EXPECT_NE(csv.find("coordinates in mm"), std::string::npos);
+  const std::string pos = slurp(*dir / "mm.pos");
+  EXPECT_NE(pos.find("coordinates in mm"), std::string::npos);
+  const PointResult& p0 = result->points[0];
+  ASSERT_NE(pos.find("SP("), std::string::npos);
+  double x = 0;
+  ASSERT_EQ(std::sscanf(pos.c_str() + pos.find("SP(") + 3, "%lf", &x), 1);
+  EXPECT_EQ(x, p0.point_m.x() * 1000.0);
+  // The library's default stays metres.
+  write_sweep_vtp(*dir / "m.vtp", *result, {});
+  Vtp m;
+  read_vtp(*dir / "m.vtp", m);
+  EXPECT_EQ(m.field_data.at("metres_per_length_unit"), 1.0);
 }
 
 // Every number of the CSV and the .pos reads back as the very double computed: the shortest

@@ -14,6 +14,7 @@
 #include "impactdeck/common/atomic_file.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/plot/drawing.hpp"
+#include "impactdeck/plot/html.hpp"
 #include "impactdeck/scene/scene.hpp"
 #include "detail.hpp"
 
@@ -171,6 +172,96 @@ std::string map_svg(const std::vector<Eigen::Vector3d>& pts, const std::vector<d
   return plot::to_svg(d);
 }
 
+std::string number_text(const json& v, int digits = 4) {
+  if (!v.is_number()) return "";
+  char b[40];
+  std::snprintf(b, sizeof b, "%.*g", digits, v.get<double>());
+  return b;
+}
+
+// The campaign's report page: the verdict over the cases, the counts, the table, the map.
+std::string report_page(const fs::path& dir, const std::string& impact, const std::vector<std::string>& keys,
+                        const std::vector<Row>& rows, const CollectResult& out, bool all_stress,
+                        const std::string& map_svg) {
+  plot::HtmlPage page("impactdeck campaign: " + dir.filename().string());
+  // Verdict per case: the FEM stress verdict where ccx ran, else the Hertz peak pressure against
+  // the yield onset 1.60 sigma_y (safety factor 1 / ratio).
+  std::size_t yields = 0, judged = 0;
+  double smallest = 0;
+  std::optional<std::size_t> smallest_id;
+  std::vector<std::string> verdicts(rows.size()), factors(rows.size());
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    const Row& r = rows[k];
+    if (r.state != CaseState::done) continue;
+    json sf = at(r.impact, "/fem/check/stress/verdict/safety_factor");
+    std::string word = at(r.impact, "/fem/check/stress/verdict/result").is_string()
+                           ? at(r.impact, "/fem/check/stress/verdict/result").get<std::string>()
+                           : "";
+    if (!sf.is_number()) {
+      const json ratio = at(r.impact, "/validity/peak_pressure_over_yield_onset");
+      if (ratio.is_number() && ratio.get<double>() > 0) {
+        sf = 1.0 / ratio.get<double>();
+        word = ratio.get<double>() > 1.0 ? "yields" : "survives";
+        word += " (Hertz)";
+      }
+    }
+    if (!sf.is_number()) continue;
+    ++judged;
+    if (word.rfind("yields", 0) == 0) ++yields;
+    if (!smallest_id || sf.get<double>() < smallest) smallest = sf.get<double>(), smallest_id = r.id;
+    verdicts[k] = std::string(word.rfind("yields", 0) == 0 ? plot::HtmlPage::kFail : plot::HtmlPage::kPass) + word;
+    factors[k] = number_text(sf);
+  }
+  std::string verdict;
+  if (judged == 0) {
+    verdict = "Verdict: none (no case has a yield strength to judge by)";
+  } else {
+    verdict = std::string(yields > 0 ? "Verdict: yields in " + std::to_string(yields) + " of " : "Verdict: survives in all ") +
+              std::to_string(judged) + " judged cases (smallest safety factor " + number_text(json(smallest)) +
+              ", case " + std::to_string(*smallest_id) + ")";
+  }
+  page.html("<p id=\"verdict\" class=\"verdict " + std::string(judged == 0 ? "" : yields > 0 ? "fail" : "pass") + "\">" +
+            plot::html_escape(verdict) + "</p>");
+  page.table({"campaign", "impact", "done", "failed", "pending", "worst case"},
+             {{dir.string(), impact, std::to_string(out.done), std::to_string(out.failed), std::to_string(out.pending),
+               out.worst_id ? std::to_string(*out.worst_id) + (all_stress ? " (largest peak von Mises)" : " (largest max force)")
+                            : "-"}});
+  if (!map_svg.empty()) page.figure(plot::inline_svg(map_svg), "Max force of each case (map.svg)");
+
+  std::vector<std::string> header = {"case", "state"};
+  header.insert(header.end(), keys.begin(), keys.end());
+  for (const char* h : {"max force (N)", "impulse error (Eq. 31)", "energy error (Eq. 32)", "FEM momentum error",
+                        "checks", "verdict", "safety factor", "warnings / reason"})
+    header.push_back(h);
+  std::vector<std::vector<std::string>> table;
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    const Row& r = rows[k];
+    std::vector<std::string> row = {std::to_string(r.id), to_string(r.state)};
+    for (const auto& key : keys) row.push_back(r.inputs.contains(key) ? r.inputs[key].dump() : "");
+    row.push_back(number_text(at(r.impact, "/max_force_N"), 6));
+    row.push_back(number_text(at(r.impact, "/checks/impulse_relative_error"), 3));
+    row.push_back(number_text(at(r.impact, "/checks/energy_relative_error"), 3));
+    row.push_back(number_text(at(r.impact, "/fem/check/linear_momentum_relative_error"), 3));
+    const json passed = r.result.is_null() ? json(nullptr) : r.result.value("all_checks_passed", json(nullptr));
+    row.push_back(passed.is_boolean() ? std::string(passed.get<bool>() ? plot::HtmlPage::kPass : plot::HtmlPage::kFail) +
+                                            (passed.get<bool>() ? "passed" : "failed")
+                                      : "");
+    row.push_back(verdicts[k]);
+    row.push_back(factors[k]);
+    std::string notes;
+    if (!r.failure.is_null()) notes = r.failure.value("reason", "");
+    for (const auto& w : r.result.is_null() ? json::array() : r.result.value("warnings", json::array()))
+      if (w.is_string()) notes += (notes.empty() ? "" : "; ") + w.get<std::string>();
+    for (const auto& w : at(r.impact, "/validity/warnings").is_array() ? at(r.impact, "/validity/warnings") : json::array())
+      if (w.is_string()) notes += (notes.empty() ? "" : "; ") + w.get<std::string>();
+    row.push_back(notes);
+    table.push_back(std::move(row));
+  }
+  page.heading("Cases");
+  page.table(header, table);
+  return page.str();
+}
+
 }  // namespace
 
 CollectResult collect(const fs::path& dir_in) {
@@ -265,6 +356,7 @@ CollectResult collect(const fs::path& dir_in) {
   files.add(out.json, doc.dump(2) + "\n");
 
   // The map over the part's surface (points) or the orientation sphere (drops).
+  std::string map_text;
   if (points || drops) {
     std::vector<Eigen::Vector3d> pts;
     std::vector<double> force;
@@ -285,10 +377,13 @@ CollectResult collect(const fs::path& dir_in) {
       out.map_svg = cdir / "map.svg";
       out.map_vtp = cdir / "map.vtp";
       const std::string title = drops ? "Max force over the drop orientations" : "Max force over the impact points";
-      files.add(*out.map_svg, map_svg(pts, force, drops, title));
+      map_text = map_svg(pts, force, drops, title);
+      files.add(*out.map_svg, map_text);
       files.add(*out.map_vtp, vtp(pts, force, ids));
     }
   }
+  out.report_html = cdir / "report.html";
+  files.add(out.report_html, report_page(dir, impact, keys, rows, out, all_stress, map_text));
   files.commit();
 
   if (out.worst_id) {  // a copy of the worst case's folder (scene, decks, result)

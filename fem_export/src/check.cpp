@@ -23,7 +23,6 @@ using nlohmann::json;
 
 namespace {
 
-constexpr double kMm = 1000.0;
 
 // Deck and result files: regular files only, bounded by the memory left (a .dat of a big deck
 // is large, but never larger than what the check can hold).
@@ -49,6 +48,7 @@ struct Deck {
   double contact_zone_radius_m = 0;
   std::optional<double> yield_strength_Pa;
   std::string impact;
+  DeckUnits units;  // deck.json length_unit (older decks: mm)
 };
 
 Eigen::Vector3d vec3(const json& j) { return Eigen::Vector3d(j.at(0), j.at(1), j.at(2)); }
@@ -107,6 +107,12 @@ Deck read_deck(const fs::path& dir) {
       d.probe_nodes.push_back(p.at("node"));
     }
     d.impact = j.value("impact", std::string());
+    if (j.contains("length_unit")) {
+      const auto u = j.at("length_unit").is_string() ? parse_length_unit(j.at("length_unit").get<std::string>())
+                                                     : std::nullopt;
+      if (!u) throw InputError(where, "length_unit", "must be one of \"m\", \"cm\", \"mm\", \"in\", got " + j.at("length_unit").dump());
+      d.units.length = *u;
+    }
     if (j.contains("model")) {
       const json& mj = j.at("model");
       d.model.mass_kg = mj.at("mass_kg");
@@ -160,7 +166,7 @@ Deck read_deck(const fs::path& dir) {
       if (!(ls >> id >> x.x() >> x.y() >> x.z()) || id != static_cast<long>(d.mesh.nodes_m.size()) + 1) {
         throw InputError(mp.string(), "line " + std::to_string(lineno), "bad node line");
       }
-      d.mesh.nodes_m.push_back(x / kMm);
+      d.mesh.nodes_m.push_back(x / d.units.per_m());
     } else if (block == "*ELEMENT") {
       long id;
       std::array<int, 4> t{};
@@ -193,7 +199,7 @@ struct DatFile {
   double total_mass_kg = -1;
 };
 
-DatFile read_dat(const fs::path& p) {
+DatFile read_dat(const fs::path& p, const DeckUnits& units) {
   DatFile d;
   std::istringstream in(read_text(p, "CalculiX results"));
   std::string line;
@@ -226,10 +232,10 @@ DatFile read_dat(const fs::path& p) {
     if (state == vel) {
       int node;
       Eigen::Vector3d v;
-      if (ls >> node >> v.x() >> v.y() >> v.z()) (*current)[node] = v / kMm;
+      if (ls >> node >> v.x() >> v.y() >> v.z()) (*current)[node] = v / units.per_m();
     } else if (state == mass) {
       double m;
-      if (ls >> m) d.total_mass_kg = m * kMm;  // tonne -> kg
+      if (ls >> m) d.total_mass_kg = m / units.per_kg();  // deck mass unit -> kg
       state = none;
     }
   }
@@ -435,7 +441,7 @@ CheckResult run_check(const fs::path& dir, const CheckOptions& o) {
   }
   DatFile dat;
   try {
-    dat = read_dat(dat_path);
+    dat = read_dat(dat_path, deck.units);
   } catch (const InputError& e) {
     std::string first_error, last_line;
     if (o.run_solver) scan_log(work / (std::string(kJobName) + ".log"), first_error, last_line);
@@ -597,6 +603,7 @@ CheckResult run_check(const fs::path& dir, const CheckOptions& o) {
     si.patch_load = deck.patch_load;
     si.yield_strength_Pa = deck.yield_strength_Pa;
     si.end_time_s = deck.end_time_s;
+    si.length_unit = deck.units.length;
     r.stress = read_stresses(frd, m, si);
     write_stress_files(work, m, *r.stress,
                        "Von Mises stress, impact '" + deck.impact + "' (" + (deck.patch_load ? "Hertz-patch" : "point") + " load)");

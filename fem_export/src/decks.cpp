@@ -22,10 +22,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// SI -> mm-N-s-tonne.
-constexpr double kMm = 1000.0;          // mm per m
-constexpr double kMPa = 1e-6;           // MPa per Pa
-constexpr double kTonnePerMm3 = 1e-12;  // (t/mm^3) per (kg/m^3)
 constexpr const char* kMedMesh = "BODYMESH";
 
 std::string num(double v) {
@@ -103,7 +99,7 @@ std::string header_lines(const std::string& c, const DeckRequest& r, const std::
   std::ostringstream h;
   h << c << " impactdeck " << kVersion << ": " << what << "\n"
     << c << " Hybrid approach: the impactor is replaced by its Hertz force history at node group LOAD.\n"
-    << c << " Units: mm, N, s, tonne (E in MPa, density in t/mm3, velocity in mm/s).\n"
+    << c << " Units: " << r.options.units.description() << ".\n"
     << c << " Scene: " << (r.source.empty() ? "(none)" : r.source) << "; impact: " << r.impact << "\n"
     << c << " Impulse " << num(r.impulse_Ns) << " N s along (" << num(r.direction.x()) << ", "
     << num(r.direction.y()) << ", " << num(r.direction.z()) << "); contact ends at "
@@ -119,6 +115,39 @@ std::vector<std::string> probe_groups(const TetMesh& m) {
 }
 
 }  // namespace
+
+std::string DeckUnits::name() const {
+  switch (length) {
+    case LengthUnit::mm: return "mm-N-s-tonne";
+    case LengthUnit::m: return "m-N-s-kg";
+    case LengthUnit::cm: return "cm-N-s-(100 kg)";
+    case LengthUnit::in: return "in-N-s-(N s^2/in)";
+  }
+  return "?";
+}
+
+std::string DeckUnits::stress_unit() const {
+  switch (length) {
+    case LengthUnit::mm: return "MPa";
+    case LengthUnit::m: return "Pa";
+    case LengthUnit::cm: return "N/cm2";
+    case LengthUnit::in: return "N/in2";
+  }
+  return "?";
+}
+
+std::string DeckUnits::description() const {
+  const std::string l = to_string(length);
+  std::string mass;
+  switch (length) {
+    case LengthUnit::mm: mass = "tonne"; break;
+    case LengthUnit::m: mass = "kg"; break;
+    case LengthUnit::cm: mass = "100 kg (N s^2/cm)"; break;
+    case LengthUnit::in: mass = "N s^2/in (39.37 kg)"; break;
+  }
+  return l + ", N, s, " + mass + " (E in " + stress_unit() + ", density in " + mass + "/" + l + "3, velocity in " +
+         l + "/s)";
+}
 
 const char* to_string(LoadKind k) { return k == LoadKind::hertz_patch ? "hertz-patch" : "point"; }
 
@@ -265,12 +294,13 @@ TimeSchedule time_schedule(const DeckOptions& o, double contact_end_s) {
   return t;
 }
 
-std::string calculix_mesh_inp(const TetMesh& m) {
+std::string calculix_mesh_inp(const TetMesh& m, const DeckUnits& u) {
   std::ostringstream s;
-  s << "** impactdeck " << kVersion << ": mesh of the target body (mm), included by impact.inp\n";
+  s << "** impactdeck " << kVersion << ": mesh of the target body (" << to_string(u.length)
+    << "), included by impact.inp\n";
   s << "*NODE, NSET=BODYN\n" << std::setprecision(15);
   for (std::size_t i = 0; i < m.nodes_m.size(); ++i) {
-    const Eigen::Vector3d x = m.nodes_m[i] * kMm;
+    const Eigen::Vector3d x = m.nodes_m[i] * u.per_m();
     s << i + 1 << ", " << num(x.x()) << ", " << num(x.y()) << ", " << num(x.z()) << "\n";
   }
   s << "*ELEMENT, TYPE=C3D4, ELSET=BODY\n";
@@ -299,8 +329,8 @@ std::string calculix_inp(const DeckRequest& r, const TetMesh& m, const PatchLoad
   }
   s << "*HEADING\nimpactdeck hybrid impact " << r.impact << "\n";
   s << "*INCLUDE, INPUT=mesh.inp\n";
-  s << "*MATERIAL, NAME=BODYMAT\n*ELASTIC\n" << num(r.material.youngs_modulus_Pa * kMPa) << ", "
-    << num(r.material.poisson_ratio) << "\n*DENSITY\n" << num(r.material.density_kg_m3 * kTonnePerMm3) << "\n";
+  s << "*MATERIAL, NAME=BODYMAT\n*ELASTIC\n" << num(r.material.youngs_modulus_Pa * o.units.per_Pa()) << ", "
+    << num(r.material.poisson_ratio) << "\n*DENSITY\n" << num(r.material.density_kg_m3 * o.units.per_kg_m3()) << "\n";
   s << "*SOLID SECTION, ELSET=BODY, MATERIAL=BODYMAT\n" << std::setprecision(15);
   if (patch) {
     for (std::size_t k = 0; k < patch->nodes.size(); ++k) {
@@ -360,8 +390,8 @@ std::string code_aster_comm(const DeckRequest& r, const TetMesh& m, const PatchL
   s << "MAIL = LIRE_MAILLAGE(FORMAT='MED', UNITE=20)\n\n";
   s << "MODELE = AFFE_MODELE(MAILLAGE=MAIL,\n"
        "                     AFFE=_F(GROUP_MA=('BODY',), PHENOMENE='MECANIQUE', MODELISATION='3D'))\n\n";
-  s << "MATER = DEFI_MATERIAU(ELAS=_F(E=" << num(r.material.youngs_modulus_Pa * kMPa)
-    << ", NU=" << num(r.material.poisson_ratio) << ", RHO=" << num(r.material.density_kg_m3 * kTonnePerMm3)
+  s << "MATER = DEFI_MATERIAU(ELAS=_F(E=" << num(r.material.youngs_modulus_Pa * r.options.units.per_Pa())
+    << ", NU=" << num(r.material.poisson_ratio) << ", RHO=" << num(r.material.density_kg_m3 * r.options.units.per_kg_m3())
     << "))\n\n";
   s << "CHMAT = AFFE_MATERIAU(MAILLAGE=MAIL, AFFE=_F(GROUP_MA=('BODY',), MATER=MATER))\n\n";
   auto function = [&](const std::string& name, const std::vector<double>& t, const std::vector<double>& f) {
@@ -424,7 +454,7 @@ std::string code_aster_comm(const DeckRequest& r, const TetMesh& m, const PatchL
        "                  CONTRAINTE=('SIGM_ELNO',),\n"
        "                  CRITERES=('SIEQ_ELNO', 'SIEQ_NOEU'))\n\n";
   const auto probes = probe_groups(m);
-  if (!probes.empty()) s << "# Velocity of each probe node, mm/s, one table per component (unit 38).\n";
+  if (!probes.empty()) s << "# Velocity of each probe node, " << to_string(r.options.units.length) << "/s, one table per component (unit 38).\n";
   const char* comps[3] = {"DX", "DY", "DZ"};
   for (std::size_t i = 0; i < probes.size(); ++i) {
     for (int k = 0; k < 3; ++k) {
@@ -527,6 +557,7 @@ DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
     // contact ellipse spans contact_elements elements along its short axis, evenly over the patch.
     MeshOptions mo = r.options.mesh;
     mo.quality_floor_gamma = r.options.tolerances.min_gamma;
+    mo.output_unit = r.options.units.length;
     if (r.options.load == LoadKind::hertz_patch) {
       const double h_patch = 2.0 * r.patch.b_max_m / r.options.contact_elements;
       const double h0 = mo.load_mesh_size_m > 0 ? mo.load_mesh_size_m : mo.mesh_size_m / 3.0;
@@ -627,12 +658,12 @@ DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
     if (r.body.kind == BodyKind::part) names.push_back("mesh_part.stl");
     if (r.body.kind == BodyKind::cad) names.push_back("mesh_part" + r.body.cad.extension().string());
     if (r.options.calculix) {
-      write_file_atomically(stage / "mesh.inp", calculix_mesh_inp(m));
+      write_file_atomically(stage / "mesh.inp", calculix_mesh_inp(m, r.options.units));
       write_file_atomically(stage / (std::string(kJobName) + ".inp"), calculix_inp(r, m, pl));
       names.insert(names.end(), {"mesh.inp", std::string(kJobName) + ".inp"});
     }
     if (r.options.code_aster) {
-      write_med(m, stage / "mesh.med", kMedMesh);
+      write_med(m, stage / "mesh.med", kMedMesh, r.options.units.length);
       write_file_atomically(stage / (std::string(kJobName) + ".comm"), code_aster_comm(r, m, pl));
       write_file_atomically(stage / (std::string(kJobName) + ".export"), code_aster_export(r, m));
       names.insert(names.end(), {"mesh.med", std::string(kJobName) + ".comm", std::string(kJobName) + ".export"});
@@ -693,7 +724,8 @@ DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
                  {"source", r.source},
                  {"impact", r.impact},
                  {"job", kJobName},
-                 {"deck_units", "mm-N-s-tonne"},
+                 {"deck_units", r.options.units.name()},
+                 {"length_unit", to_string(r.options.units.length)},
                  {"frame", "target"},
                  {"impulse_Ns", r.impulse_Ns},
                  {"direction", v3(r.direction)},

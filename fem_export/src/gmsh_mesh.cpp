@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <map>
 #include <mutex>
 #include <sstream>
@@ -268,10 +269,14 @@ void check_mesh(const MeshResult& r, const std::string& where) {
   }
 }
 
-void write_msh(const fs::path& folder, const std::string& name, MeshResult& r) {
+// Gmsh works in mm; the .msh files are written in the output unit.
+double msh_scaling_factor(const MeshOptions& o) { return 1.0 / (kMmPerM * metres_per(o.output_unit)); }
+
+void write_msh(const fs::path& folder, const std::string& name, const MeshOptions& o, MeshResult& r) {
   r.msh41 = folder / (name + ".msh");
   r.msh22 = folder / (name + "_v22.msh");
   gmsh::option::setNumber("Mesh.SaveAll", 0);  // physical groups only: BODY, LOAD, PROBEk
+  gmsh::option::setNumber("Mesh.ScalingFactor", msh_scaling_factor(o));
   gmsh::option::setNumber("Mesh.MshFileVersion", 4.1);
   gmsh::write(r.msh41.string());
   gmsh::option::setNumber("Mesh.MshFileVersion", 2.2);
@@ -295,13 +300,17 @@ void finish_point_mesh(const std::string& where, const MeshOptions& o, const fs:
   r.quality.mesh_size_m = o.mesh_size_m;
   r.quality.load_mesh_size_m = h0_mm / kMmPerM;
   r.quality.attempts.push_back({route, algorithm_2d, o.algorithm_3d, o.mesh_size_m, h0_mm / kMmPerM, "ok"});
-  gmsh_step(where, "write", [&] { write_msh(folder, name, r); });
+  gmsh_step(where, "write", [&] { write_msh(folder, name, o, r); });
 }
 
 
-std::string geo_header(const std::string& what) {
+std::string geo_header(const std::string& what, const MeshOptions& o) {
+  std::ostringstream s;
+  s << std::setprecision(17) << msh_scaling_factor(o);
   return "// impactdeck " + std::string(kVersion) + ": " + what +
-         "\n// Units: mm. Reproduce the mesh with: gmsh -3 -format msh41 <this file>\n";
+         "\n// Units: this script is in mm; the mesh is saved in " + to_string(o.output_unit) +
+         " (Mesh.ScalingFactor), like the deck's mesh.msh.\n// Reproduce the mesh with: gmsh -3 -format msh41 <this file>\n"
+         "Mesh.ScalingFactor = " + s.str() + ";\n";
 }
 
 }  // namespace
@@ -372,7 +381,7 @@ MeshResult mesh_ellipsoid_with_gmsh(const Eigen::Vector3d& semi_axes_m, const Ei
 
   std::ostringstream g;
   g << geo_header("ellipsoid " + fmt(ax.x()) + " x " + fmt(ax.y()) + " x " + fmt(ax.z()) +
-                  " mm (semi-axes), load point at a sphere pole");
+                  " mm (semi-axes), load point at a sphere pole", o);
   g << "SetFactory(\"OpenCASCADE\");\n" << geo_options(h, alg2, o.algorithm_3d);
   g << "Sphere(1) = {0, 0, 0, 1};\n";
   if (angle > 1e-14) {
@@ -716,13 +725,13 @@ MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& l
                         "kept: the best min gamma of the tries"});
   }
   r.quality.attempts = attempts;
-  gmsh_step(where, "write", [&] { write_msh(folder, name, r); });
+  gmsh_step(where, "write", [&] { write_msh(folder, name, o, r); });
 
   const Try& t = tries[kept];
   const double h = h_first * t.size_factor, h0 = std::min(h0_first, h);
   std::ostringstream g;
   g << geo_header("mesh part (" + where + ") from memory, written as " + stl_copy.filename().string() +
-                  " (mm)");
+                  " (mm)", o);
   if (attempts.size() > 1) g << "// Settings of try " << kept + 1 << " (see mesh_attempts in mesh_quality.json).\n";
   g << geo_options(h, t.own_triangles ? 6 : t.algorithm_2d, o.algorithm_3d);
   g << "Merge \"" << stl_copy.filename().string() << "\";\n";
@@ -824,7 +833,7 @@ MeshResult mesh_cad_once(const fs::path& cad, double cad_unit_m, const Eigen::Ve
   fs::copy_file(cad, copy, fs::copy_options::overwrite_existing);
 
   std::ostringstream g;
-  g << geo_header("CAD part from " + cad.filename().string() + " (copied as " + copy.filename().string() + ")");
+  g << geo_header("CAD part from " + cad.filename().string() + " (copied as " + copy.filename().string() + ")", o);
   g << "SetFactory(\"OpenCASCADE\");\nGeometry.OCCTargetUnit = \"MM\";\n" << geo_options(h, alg2, o.algorithm_3d);
   g << "Merge \"" << copy.filename().string() << "\";\n";
   if (scaled) g << "Dilate {{0, 0, 0}, {" << fmt(scale) << ", " << fmt(scale) << ", " << fmt(scale) << "}} { Volume{:}; }\n";

@@ -6,6 +6,7 @@
 #include <set>
 
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/fem_export/decks.hpp"
 #include "impactdeck/fem_export/mesh.hpp"
 
 namespace impactdeck::fem_export {
@@ -42,7 +43,8 @@ std::string padded(const std::string& s, std::size_t width) {
 
 }  // namespace
 
-void write_med(const TetMesh& mesh, const fs::path& path, const std::string& mesh_name) {
+void write_med(const TetMesh& mesh, const fs::path& path, const std::string& mesh_name, LengthUnit length_unit) {
+  const DeckUnits units{length_unit};
   const std::string where = path.string();
   auto check = [&](med_err rc, const char* step) {
     if (rc < 0) throw InputError(where, "MED", std::string("libmedc failed: ") + step);
@@ -58,15 +60,18 @@ void write_med(const TetMesh& mesh, const fs::path& path, const std::string& mes
 
   // Axis names and units: 3 fields of MED_SNAME_SIZE characters each.
   const std::string axis = padded("X", MED_SNAME_SIZE) + padded("Y", MED_SNAME_SIZE) + padded("Z", MED_SNAME_SIZE);
-  const std::string unit = padded("mm", MED_SNAME_SIZE) + padded("mm", MED_SNAME_SIZE) + padded("mm", MED_SNAME_SIZE);
+  const std::string l = to_string(length_unit);
+  const std::string unit = padded(l, MED_SNAME_SIZE) + padded(l, MED_SNAME_SIZE) + padded(l, MED_SNAME_SIZE);
+  const std::string description = "impactdeck target body, " + units.name();
   check(MEDmeshCr(fid, mesh_name.c_str(), 3, 3, MED_UNSTRUCTURED_MESH,
-                  "impactdeck target body, mm-N-s-tonne", "s", MED_SORT_DTIT, MED_CARTESIAN,
+                  description.c_str(), "s", MED_SORT_DTIT, MED_CARTESIAN,
                   axis.c_str(), unit.c_str()), "MEDmeshCr");
 
   std::vector<med_float> xyz;
   xyz.reserve(3 * mesh.nodes_m.size());
   for (const auto& p : mesh.nodes_m) {
-    xyz.insert(xyz.end(), {p.x() * 1000.0, p.y() * 1000.0, p.z() * 1000.0});
+    const Eigen::Vector3d x = p * units.per_m();
+    xyz.insert(xyz.end(), {x.x(), x.y(), x.z()});
   }
   check(MEDmeshNodeCoordinateWr(fid, mesh_name.c_str(), MED_NO_DT, MED_NO_IT, 0.0, MED_FULL_INTERLACE,
                                 static_cast<med_int>(mesh.nodes_m.size()), xyz.data()),

@@ -11,6 +11,7 @@
 
 #include "impactdeck/common/atomic_file.hpp"
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/fem_export/decks.hpp"
 #include "impactdeck/plot/stress_plot.hpp"
 
 namespace impactdeck::fem_export {
@@ -19,8 +20,6 @@ using nlohmann::json;
 
 namespace {
 
-constexpr double kPaPerMPa = 1e6;
-constexpr double kMPerMm = 1e-3;
 
 double von_mises(const double s[6]) {
   const double a = s[0] - s[1], b = s[1] - s[2], c = s[2] - s[0];
@@ -67,6 +66,8 @@ StressResult read_stresses(const fs::path& frd, const TetMesh& mesh, const Stres
     throw InputError(where, "LOAD", "load node is not a node of the mesh");
   }
   StressResult r;
+  r.length_unit = in.length_unit;
+  const DeckUnits units{in.length_unit};
   r.contact_zone_radius_m = in.contact_zone_radius_m;
   r.inside_zone_meaningful = in.patch_load;
   const Eigen::Vector3d c = mesh.nodes_m[in.load_node];
@@ -161,13 +162,13 @@ StressResult read_stresses(const fs::path& frd, const TetMesh& mesh, const Stres
       for (int k = 0; k < 3; ++k) {
         if (!field(line, 13 + 12 * k, 12, u[k])) throw InputError(where, "line " + std::to_string(lineno), "bad displacement");
       }
-      disp[node] = Eigen::Vector3d(u[0], u[1], u[2]) * kMPerMm;
+      disp[node] = Eigen::Vector3d(u[0], u[1], u[2]) / units.per_m();
     } else {
       double sv[6];
       for (int k = 0; k < 6; ++k) {
         if (!field(line, 13 + 12 * k, 12, sv[k])) throw InputError(where, "line " + std::to_string(lineno), "bad stress");
       }
-      vm[node] = von_mises(sv) * kPaPerMPa;
+      vm[node] = von_mises(sv) / units.per_Pa();
       seen[node] = 1;
     }
   }
@@ -247,7 +248,7 @@ std::vector<double> read_node_stresses(const fs::path& frd, std::vector<ProbeStr
     for (int k = 0; k < 6; ++k) {
       if (!field(line, 13 + 12 * k, 12, sv[k])) throw InputError(where, "line " + std::to_string(lineno), "bad stress");
     }
-    vm[it->second] = von_mises(sv) * kPaPerMPa;
+    vm[it->second] = von_mises(sv) / DeckUnits{}.per_Pa();  // contact decks are in mm-N-s-tonne (MPa)
     seen[it->second] = 1;
   }
   if (times.empty() && !probes.empty()) {
@@ -276,13 +277,17 @@ void write_stress_files(const fs::path& dir, const TetMesh& m, StressResult& r, 
     }
   });
 
-  // 2. VTK XML unstructured grid (ASCII): positions in m, tetrahedra (VTK type 10).
+  // 2. VTK XML unstructured grid (ASCII): positions in the deck's length unit, tetrahedra (VTK type 10).
+  const double per_m = DeckUnits{r.length_unit}.per_m();
+  const std::string unit = to_string(r.length_unit);
   const fs::path vtu = dir / "von_mises_peak.vtu";
   write_file_atomically(vtu, [&](std::ostream& o) {
     o << std::setprecision(9);
     o << "<?xml version=\"1.0\"?>\n<!-- impactdeck: peak von Mises over time (Pa) and the fields at the time of the "
-         "governing peak, t = " << r.peak_field_time_s << " s -->\n"
+         "governing peak, t = " << r.peak_field_time_s << " s; positions in " << unit << " -->\n"
       << "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n"
+      << "<FieldData>\n<DataArray type=\"Float64\" Name=\"metres_per_length_unit\" NumberOfTuples=\"1\" format=\"ascii\">"
+      << metres_per(r.length_unit) << "</DataArray>\n</FieldData>\n"
       << "<Piece NumberOfPoints=\"" << m.nodes_m.size() << "\" NumberOfCells=\"" << m.tets.size() << "\">\n"
       << "<PointData Scalars=\"von_mises_peak_Pa\" Vectors=\"displacement_at_peak_m\">\n";
     auto scalars = [&](const char* name, const std::vector<double>& v) {
@@ -296,7 +301,10 @@ void write_stress_files(const fs::path& dir, const TetMesh& m, StressResult& r, 
     o << "<DataArray type=\"Float64\" Name=\"displacement_at_peak_m\" NumberOfComponents=\"3\" format=\"ascii\">\n";
     for (const auto& u : r.displacement_at_peak_m) o << u.x() << " " << u.y() << " " << u.z() << "\n";
     o << "</DataArray>\n</PointData>\n<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-    for (const auto& x : m.nodes_m) o << x.x() << " " << x.y() << " " << x.z() << "\n";
+    for (const auto& p : m.nodes_m) {
+      const Eigen::Vector3d x = p * per_m;
+      o << x.x() << " " << x.y() << " " << x.z() << "\n";
+    }
     o << "</DataArray>\n</Points>\n<Cells>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
     for (const auto& t : m.tets) o << t[0] << " " << t[1] << " " << t[2] << " " << t[3] << "\n";
     o << "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
@@ -306,13 +314,15 @@ void write_stress_files(const fs::path& dir, const TetMesh& m, StressResult& r, 
     o << "</DataArray>\n</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
   });
 
-  // 3. Gmsh MSH 2.2 with $NodeData views (open with gmsh; positions in m like the .vtu).
+  // 3. Gmsh MSH 2.2 with $NodeData views (open with gmsh; positions in the deck's unit like the .vtu,
+  // said in each view's name).
   const fs::path msh = dir / "von_mises_peak.msh";
   write_file_atomically(msh, [&](std::ostream& o) {
     o << std::setprecision(9);
     o << "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n" << m.nodes_m.size() << "\n";
     for (std::size_t i = 0; i < m.nodes_m.size(); ++i) {
-      o << i + 1 << " " << m.nodes_m[i].x() << " " << m.nodes_m[i].y() << " " << m.nodes_m[i].z() << "\n";
+      const Eigen::Vector3d x = m.nodes_m[i] * per_m;
+      o << i + 1 << " " << x.x() << " " << x.y() << " " << x.z() << "\n";
     }
     o << "$EndNodes\n$Elements\n" << m.tets.size() << "\n";
     for (std::size_t e = 0; e < m.tets.size(); ++e) {
@@ -321,7 +331,7 @@ void write_stress_files(const fs::path& dir, const TetMesh& m, StressResult& r, 
     }
     o << "$EndElements\n";
     auto view = [&](const std::string& name, int comps, const auto& value) {
-      o << "$NodeData\n1\n\"" << name << "\"\n1\n" << r.peak_field_time_s << "\n3\n0\n" << comps << "\n"
+      o << "$NodeData\n1\n\"" << name << ", positions in " << unit << "\"\n1\n" << r.peak_field_time_s << "\n3\n0\n" << comps << "\n"
         << m.nodes_m.size() << "\n";
       for (std::size_t i = 0; i < m.nodes_m.size(); ++i) {
         o << i + 1;

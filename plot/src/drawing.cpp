@@ -1,5 +1,7 @@
 #include "impactdeck/plot/drawing.hpp"
 
+#include "impactdeck/plot/html.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -128,19 +130,7 @@ std::string num(double v) {
   return s;
 }
 
-std::string escape(const std::string& t) {
-  std::string o;
-  for (char c : t) {
-    switch (c) {
-      case '&': o += "&amp;"; break;
-      case '<': o += "&lt;"; break;
-      case '>': o += "&gt;"; break;
-      case '"': o += "&quot;"; break;
-      default: o += c;
-    }
-  }
-  return o;
-}
+std::string escape(const std::string& t) { return html_escape(t); }  // XML needs the same
 
 std::string style_attrs(const Style& s) {
   std::ostringstream o;

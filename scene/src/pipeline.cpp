@@ -1,7 +1,10 @@
 #include "impactdeck/scene/pipeline.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <fstream>
+#include <iterator>
 #include <limits>
 #include <sstream>
 
@@ -17,6 +20,7 @@
 #include "impactdeck/geometry/part.hpp"
 #include "impactdeck/geometry/plane.hpp"
 #include "impactdeck/plot/force_plot.hpp"
+#include "impactdeck/scene/report_html.hpp"
 #include "numeric_checks.hpp"
 
 namespace impactdeck::scene {
@@ -340,7 +344,10 @@ namespace {
 // name fails at once): staged paths, one per impact.
 struct StagedOutputs {
   std::vector<fs::path> table, plot, fem, compare;
+  std::optional<fs::path> report;  ///< report.html: written beside any other output
 };
+
+constexpr const char* kReportHtml = "report.html";
 
 StagedOutputs reserve_outputs(const Scene& scene, RunTransaction& txn) {
   StagedOutputs st;
@@ -402,6 +409,9 @@ StagedOutputs reserve_outputs(const Scene& scene, RunTransaction& txn) {
     if (scene.outputs.force_plot_svg) {
       st.plot.push_back(reserve(per_impact(*scene.outputs.force_plot_svg, s, "force_plot_svg"), place_of("force_plot_svg"), false));
     }
+  }
+  if (scene.outputs.fem || scene.outputs.force_table_csv || scene.outputs.force_plot_svg) {
+    st.report = reserve(kReportHtml, "report.html (the run's report page, written beside its other outputs)", false);
   }
   return st;
 }
@@ -509,6 +519,7 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
     for (std::size_t k = 0; k < report.impacts.size(); ++k) {
       auto& ir = report.impacts[k];
       fem_export::DeckRequest req = fem_request(scene, ir, bodies.at(ir.spec->target));
+      req.options.units.length = report.output_length_unit;
       const auto t0 = std::chrono::steady_clock::now();
       try {
         ir.fem_deck = fem_export::write_deck_files(req, staged.fem[k]);
@@ -615,11 +626,24 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
     report.warnings.push_back("a self-check failed: no output file was written");
     return;  // the transaction is rolled back: nothing of this run is visible
   }
-  if (scene.outputs.force_table_csv || scene.outputs.force_plot_svg) {
-    clock.run("write_outputs", [&] { txn.commit(); });
-  } else {
-    txn.commit();
+  // The report page shows the stress pictures ccx's run left in the staged deck folders.
+  std::vector<std::vector<ReportPicture>> pictures(report.impacts.size());
+  if (staged.report) {
+    for (std::size_t k = 0; k < report.impacts.size(); ++k) {
+      const auto& ir = report.impacts[k];
+      if (!ir.fem_check || !ir.fem_check->stress) continue;
+      for (const auto& f : ir.fem_check->stress->files) {
+        if (f.extension() != ".svg") continue;
+        ReportPicture p;
+        p.caption = "Von Mises stress against time at the probes and the contact node (the paper's Fig. 15), " +
+                    txn.public_path(f).string();
+        std::ifstream in(f, std::ios::binary);
+        p.svg.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+        if (!p.svg.empty()) pictures[k].push_back(std::move(p));
+      }
+    }
   }
+  // Public paths (the report page names them; the commit below publishes them unchanged).
   for (auto& ir : report.impacts) {
     if (ir.fem_deck) {
       ir.fem_deck->folder = txn.public_path(ir.fem_deck->folder);
@@ -643,12 +667,33 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
     if (ir.table_path) report.files_written.push_back(*ir.table_path);
     if (ir.plot_path) report.files_written.push_back(*ir.plot_path);
   }
+  if (staged.report) {
+    clock.run("write_outputs", [&] {
+      report.files_written.push_back(txn.public_path(*staged.report));
+      // The page holds the run's results, not the output folder's housekeeping (staging folders of
+      // killed runs removed, an interrupted commit finished: stderr says those), so that the same
+      // inputs give the same page (docs/reliability.md: a killed run's files are old or new).
+      RunReport page = report;
+      const auto& folder_notes = txn.warnings();
+      page.warnings.erase(std::remove_if(page.warnings.begin(), page.warnings.end(),
+                                         [&](const std::string& w) {
+                                           return std::find(folder_notes.begin(), folder_notes.end(), w) !=
+                                                  folder_notes.end();
+                                         }),
+                          page.warnings.end());
+      write_file_atomically(*staged.report, report_html(scene, page, pictures));
+      txn.commit();
+    });
+  } else {
+    txn.commit();
+  }
 }
 
 }  // namespace
 
 RunReport run_scene(const Scene& scene, const RunOptions& opt) {
   RunReport report;
+  report.output_length_unit = opt.output_length_unit.value_or(scene.length_unit);
   StageClock clock(report);
   report.stages_run.push_back({"scene", 0.0});
   RunTransaction txn(opt.out_dir);

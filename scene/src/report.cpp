@@ -58,6 +58,7 @@ nlohmann::json to_json(const Scene& scene, const RunReport& rep) {
   j["impactdeck_version"] = kVersion;
   j["scene"] = scene.file.string();
   j["length_unit"] = to_string(scene.length_unit);
+  j["output_length_unit"] = to_string(rep.output_length_unit);
   j["modulus_convention"] =
       scene.modulus_convention == collision::ModulusConvention::hertz ? "hertz" : "paper";
   nlohmann::json impacts = nlohmann::json::array();

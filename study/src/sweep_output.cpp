@@ -24,13 +24,15 @@ namespace {
 constexpr const char* kWhat = "sweep output";
 std::string num(double v) { return detail::shortest(v, kWhat); }
 
-void header(std::ostream& o, const char* comment, const SweepMeta& m, const SweepResult& r) {
+void header(std::ostream& o, const char* comment, const SweepMeta& m, const SweepResult& r,
+            LengthUnit unit = LengthUnit::m) {
   o << comment << " impactdeck " << kVersion << " sweep: maximal Hertz contact force over the surface\n";
   if (!m.source.empty()) o << comment << " scene: " << m.source << "\n";
   if (!m.impact.empty())
     o << comment << " impact: " << m.impact << " (" << m.impactor << " hits " << m.target << " along the inward normal)\n";
   if (!m.cloud.empty()) o << comment << " cloud: " << m.cloud << ", " << r.points.size() << " points\n";
-  o << comment << " units: SI (m, kg, N, s); coordinates in the target's frame\n";
+  o << comment << " units: SI (m, kg, N, s) but coordinates in " << to_string(unit) << " (metres per unit "
+    << num(metres_per(unit)) << "), in the target's frame\n";
   o << comment << " force ratio min/max = " << num(r.force_ratio) << " (min at point " << r.min_index
     << ", max at point " << r.max_index << ")\n";
   o << comment << " flagged points: " << r.flagged_count << " (the contact model does not apply there: left out of "
@@ -63,9 +65,11 @@ void write_sweep_csv(const std::filesystem::path& path, const SweepResult& r, co
   // Column by column (one more is one more line here).
   detail::CsvTable t;
   t.integer("index", [](std::size_t i) { return i; });
-  t.number("x_m", [&](std::size_t i) { return P[i].point_m.x(); });
-  t.number("y_m", [&](std::size_t i) { return P[i].point_m.y(); });
-  t.number("z_m", [&](std::size_t i) { return P[i].point_m.z(); });
+  const double per_m = 1.0 / metres_per(options.length_unit);
+  const std::string u = to_string(options.length_unit);
+  t.number("x_" + u, [&](std::size_t i) { return P[i].point_m.x() * per_m; });
+  t.number("y_" + u, [&](std::size_t i) { return P[i].point_m.y() * per_m; });
+  t.number("z_" + u, [&](std::size_t i) { return P[i].point_m.z() * per_m; });
   t.number("nx", [&](std::size_t i) { return P[i].normal.x(); });
   t.number("ny", [&](std::size_t i) { return P[i].normal.y(); });
   t.number("nz", [&](std::size_t i) { return P[i].normal.z(); });
@@ -91,7 +95,7 @@ void write_sweep_csv(const std::filesystem::path& path, const SweepResult& r, co
   t.integer("sharp_feature", [&](std::size_t i) { return P[i].sharp_feature ? 1 : 0; });
   t.text("flag", [&](std::size_t i) { return std::string_view(collision::flag_word(P[i].flag)); });
   write_file_atomically(path, [&](std::ostream& o) {
-    header(o, "#", meta, r);
+    header(o, "#", meta, r, options.length_unit);
     o << t.header();
     detail::write_rows(o, P.size(), t.rows(kWhat), row_options(options));
   });
@@ -136,11 +140,12 @@ void write_sweep_pos(const std::filesystem::path& path, const SweepResult& r, co
   constexpr std::size_t kChunk = 8192;
   std::vector<std::string> prefix((n + kChunk - 1) / kChunk);
   std::vector<std::uint32_t> text_begin(n), text_end(n);
+  const double per_m = 1.0 / metres_per(options.length_unit);
   detail::parallel_for(prefix.size(), options.threads, 1, [&](std::size_t c) {
     std::string& out = prefix[c];
     for (std::size_t i = c * kChunk; i < std::min(n, (c + 1) * kChunk); ++i) {
       text_begin[i] = static_cast<std::uint32_t>(out.size());
-      const Eigen::Vector3d& x = r.points[i].point_m;
+      const Eigen::Vector3d x = r.points[i].point_m * per_m;  // as the CSV, the .vtp and the decks
       out.append("SP(", 3);
       for (int k = 0; k < 3; ++k) {
         if (k > 0) out.push_back(',');
@@ -151,7 +156,7 @@ void write_sweep_pos(const std::filesystem::path& path, const SweepResult& r, co
     }
   }, nullptr);
   write_file_atomically(path, [&](std::ostream& o) {
-    header(o, "//", meta, r);
+    header(o, "//", meta, r, options.length_unit);
     o << "// open with: gmsh " << path.filename().string() << "\n";
     // SP(x,y,z){v}; for the points of one view (chunks of points formatted in parallel). Progress
     // runs over all views: view k of m reports k n + done of m n.
@@ -220,7 +225,7 @@ template <class Get>
 VtpArray vector_array(const char* name, const std::vector<PointResult>& P, Get get) {
   return {"Float64", name, 3, [&P, get](std::size_t begin, std::size_t end, char* out) {
             for (std::size_t i = begin; i < end; ++i) {
-              const Eigen::Vector3d& x = get(P[i]);
+              const Eigen::Vector3d x = get(P[i]);
               for (int k = 0; k < 3; ++k) {
                 const double v = finite(x[k]);
                 std::memcpy(out + 24 * (i - begin) + 8 * k, &v, 8);
@@ -263,7 +268,8 @@ void write_sweep_vtp(const std::filesystem::path& path, const SweepResult& r, co
       // collision::ContactFlag's number (0: valid)
       scalar_array("flag", P, [](const PointResult& p) { return static_cast<double>(p.flag); }),
       vector_array("normal", P, [](const PointResult& p) -> const Eigen::Vector3d& { return p.normal; })};
-  const VtpArray points = vector_array("Points", P, [](const PointResult& p) -> const Eigen::Vector3d& { return p.point_m; });
+  const double per_m = 1.0 / metres_per(options.length_unit);
+  const VtpArray points = vector_array("Points", P, [per_m](const PointResult& p) -> Eigen::Vector3d { return p.point_m * per_m; });
   const VtpArray connectivity = count_array("connectivity", 0), offsets = count_array("offsets", 1);
 
   // Appended raw data: per array a block size (UInt32, or UInt64 when a block needs it or when
@@ -281,13 +287,15 @@ void write_sweep_vtp(const std::filesystem::path& path, const SweepResult& r, co
     };
     o << "<?xml version=\"1.0\"?>\n";
     std::ostringstream h;
-    header(h, "", meta, r);
+    header(h, "", meta, r, options.length_unit);
     std::string comment = h.str();
     // "--" is not allowed inside an XML comment.
     for (std::size_t k; (k = comment.find("--")) != std::string::npos;) comment.replace(k, 2, "- -");
     o << "<!--\n" << comment << "-->\n";
     o << "<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"" << (little_endian() ? "LittleEndian" : "BigEndian")
       << "\" header_type=\"" << (wide ? "UInt64" : "UInt32") << "\">\n<PolyData>\n"
+      << "<FieldData>\n<DataArray type=\"Float64\" Name=\"metres_per_length_unit\" NumberOfTuples=\"1\" "
+         "format=\"ascii\">" << num(metres_per(options.length_unit)) << "</DataArray>\n</FieldData>\n"
       << "<Piece NumberOfPoints=\"" << n << "\" NumberOfVerts=\"" << n
       << "\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n"
       << "<PointData Scalars=\"max_force_N\" Normals=\"normal\">\n";

@@ -12,6 +12,8 @@ struct CollectResult {
   std::optional<std::filesystem::path> worst_case;  ///< collect/worst_case (a copy of its folder)
   std::optional<std::size_t> worst_id;
   std::optional<std::filesystem::path> map_svg, map_vtp;  ///< point and drop campaigns
+  /// collect/report.html: one self-contained page (verdict, counts, the cases' table, the map)
+  std::filesystem::path report_html;
   std::size_t done = 0, failed = 0, pending = 0;
 };
 
@@ -20,7 +22,8 @@ struct CollectResult {
 /// Mises and verdict where stresses exist, and the reason of a failure; copies the worst case
 /// (largest peak von Mises where every done case has one, else largest max force) to
 /// collect/worst_case; and, for point campaigns, a map over the part's surface, for drop
-/// campaigns over the orientation sphere (map.svg, map.vtp). Every file is written atomically.
+/// campaigns over the orientation sphere (map.svg, map.vtp); and report.html, a self-contained
+/// page of all that (verdict over the cases, checks, map). Every file is written atomically.
 CollectResult collect(const std::filesystem::path& dir);
 
 }  // namespace impactdeck::campaign

@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "impactdeck/collision/force_history.hpp"
+#include "impactdeck/common/units.hpp"
 #include "impactdeck/fem_export/mesh.hpp"
 #include "impactdeck/fem_export/patch_load.hpp"
 
@@ -24,6 +25,23 @@ namespace impactdeck::fem_export {
 
 /// The job name of every deck: impact.inp (CalculiX), impact.comm / impact.export (Code_Aster).
 inline constexpr const char* kJobName = "impact";
+
+/// The solver's unit system of a deck: lengths in `length`, forces in N, times in s, so masses in
+/// N s^2 / length unit and stresses in N / length unit^2 (mm: mm-N-s-tonne with MPa, the default;
+/// m: SI). One consistent system whatever the length unit; every deck file states it.
+struct DeckUnits {
+  LengthUnit length = LengthUnit::mm;
+  double per_m() const { return 1.0 / metres_per(length); }          ///< deck lengths per metre
+  double per_kg() const { return metres_per(length); }               ///< deck masses per kg
+  double per_Pa() const { return metres_per(length) * metres_per(length); }  ///< deck stresses per Pa
+  double per_kg_m3() const { return per_Pa() * per_Pa(); }           ///< deck densities per kg/m^3
+  double per_J() const { return per_m(); }                           ///< deck energies (N x length) per J
+  /// "mm-N-s-tonne", "m-N-s-kg", "cm-N-s-(100 kg)", "in-N-s-(N s^2/in)" (deck.json deck_units).
+  std::string name() const;
+  /// One line for the header comments: lengths, forces, times, masses, E, density, velocity.
+  std::string description() const;
+  std::string stress_unit() const;  ///< "MPa", "Pa", "N/cm2", "N/in2"
+};
 
 struct DeckMaterial {
   double youngs_modulus_Pa = 0;
@@ -120,6 +138,9 @@ struct DeckOptions {
   /// such a mesh takes hours (its own limit: --solver-timeout-s).
   std::size_t max_elements = 500000;
   CcxSolver solver = CcxSolver::automatic;  ///< impact.inp's equation solver
+  /// The decks' unit system (every file of the folder: .geo, .msh, MED, .inp, .comm, and the
+  /// stress files after a ccx run); `run --output-length-unit`, default the scene's unit.
+  DeckUnits units;
   MeshOptions mesh;
   /// The mesh size is a default, not the user's: while the FE body's volume or inertia (of the
   /// tetrahedra, or of ccx's mass matrix) differs from the part's by more than half its
@@ -246,6 +267,6 @@ std::string code_aster_comm(const DeckRequest& request, const TetMesh& mesh, con
 std::string code_aster_export(const DeckRequest& request, const TetMesh& mesh);
 /// Text of the CalculiX main deck and of its included mesh.
 std::string calculix_inp(const DeckRequest& request, const TetMesh& mesh, const PatchLoad* patch = nullptr);
-std::string calculix_mesh_inp(const TetMesh& mesh);
+std::string calculix_mesh_inp(const TetMesh& mesh, const DeckUnits& units = {});
 
 }  // namespace impactdeck::fem_export

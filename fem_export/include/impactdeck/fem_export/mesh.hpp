@@ -17,6 +17,8 @@
 
 #include <Eigen/Dense>
 
+#include "impactdeck/common/units.hpp"
+
 namespace impactdeck::fem_export {
 
 /// Linear tetrahedra with named node groups. Node and element indices are 0-based; every
@@ -106,6 +108,9 @@ struct MeshOptions {
   /// (no 2D remeshing; also tried at once when Gmsh cannot classify and reparametrize the
   /// surface). Every try is reported.
   bool fallback = true;
+  /// Length unit of the written .msh files (Gmsh works in mm; Mesh.ScalingFactor converts on
+  /// save, and the .geo sets the same factor).
+  LengthUnit output_unit = LengthUnit::mm;
   /// Smallest acceptable Gmsh gamma after optimisation (a try below it counts as failed when
   /// fallback is on; the decks' quality check compares the final mesh with its own floor).
   double quality_floor_gamma = 0.01;
@@ -163,6 +168,8 @@ MeshResult mesh_cad(const std::filesystem::path& cad, double cad_unit_m,
 
 /// Writes the mesh as MED (libmedc, the format Code_Aster reads by default): nodes in mm, TETRA4
 /// cells in group BODY, node groups as families. Throws InputError on failure.
-void write_med(const TetMesh& mesh, const std::filesystem::path& path, const std::string& mesh_name);
+/// `unit`: the length unit of the coordinates (the deck's, DeckUnits; stated as the axes' unit).
+void write_med(const TetMesh& mesh, const std::filesystem::path& path, const std::string& mesh_name,
+               LengthUnit unit = LengthUnit::mm);
 
 }  // namespace impactdeck::fem_export

@@ -30,6 +30,9 @@ struct StressInputs {
   bool patch_load = false;                            ///< hertz-patch: the zone's stresses mean something
   std::optional<double> yield_strength_Pa;
   double end_time_s = 0;                              ///< output after this (the momentum step) is ignored
+  /// The deck's length unit (DeckUnits): the .frd's displacements are in it and its stresses in
+  /// N per its square; the .vtu / .msh positions are written in it.
+  LengthUnit length_unit = LengthUnit::mm;
 };
 
 /// The largest von Mises stress of a region over all output times.
@@ -75,6 +78,7 @@ struct StressResult {
   std::vector<Eigen::Vector3d> displacement_at_peak_m;
   double peak_field_time_s = 0;
   std::size_t frd_bytes = 0;
+  LengthUnit length_unit = LengthUnit::mm;   ///< of the positions in the .vtu / .msh (the deck's)
   std::vector<std::filesystem::path> files;  ///< written by write_stress_files
 };
 
@@ -83,14 +87,15 @@ struct StressResult {
 StressResult read_stresses(const std::filesystem::path& frd, const TetMesh& mesh, const StressInputs& in);
 
 /// Reads the von Mises history of the named ccx nodes (1-based ids: `ProbeStress::node`) from an
-/// .frd whose stress output may be limited to those nodes (`*EL FILE, NSET=`), up to `end_time_s`;
+/// .frd in mm-N-s-tonne (a contact deck) whose stress output may be limited to those nodes
+/// (`*EL FILE, NSET=`), up to `end_time_s`;
 /// fills each probe's history, peak and time, and returns the output times. Throws InputError when
 /// the file is missing or a probe has no stress at some output time.
 std::vector<double> read_node_stresses(const std::filesystem::path& frd, std::vector<ProbeStress>& probes,
                                        double end_time_s);
 
 /// Writes into `dir`: von_mises_history.csv (time, each probe, LOAD; SI), von_mises_peak.vtu
-/// (ParaView: peak von Mises and its time per node, von Mises and displacement at the governing
+/// (ParaView; positions in r.length_unit, stated in its FieldData metres_per_length_unit: peak von Mises and its time per node, von Mises and displacement at the governing
 /// peak's time), von_mises_peak.msh (the same as Gmsh $NodeData views) and von_mises.svg (the
 /// paper's Fig. 15: von Mises against time at the probes and the load). Records them in `files`.
 void write_stress_files(const std::filesystem::path& dir, const TetMesh& mesh, StressResult& r,

@@ -44,6 +44,8 @@ struct RunReport {
   std::vector<std::string> stages_skipped;
   std::vector<std::string> warnings;
   std::vector<std::filesystem::path> files_written;
+  /// The length unit of every geometric output (the FEM decks' unit system, DeckUnits).
+  LengthUnit output_length_unit = LengthUnit::m;
   bool all_checks_passed() const;
 };
 
@@ -53,6 +55,8 @@ struct RunOptions {
   /// ccx wall-time limit per deck (--solver-timeout-s); 0: derived from the deck's size.
   double solver_timeout_s = 0;
   int solver_threads = 0;               ///< threads for ccx ([outputs.fem] run); 0: all cores
+  /// Length unit of every geometric output (--output-length-unit); unset: the scene's length_unit.
+  std::optional<LengthUnit> output_length_unit;
 };
 
 /// Builds the shape of a body (analytic or mesh). Throws InputError.

@@ -2,12 +2,16 @@
 // Files of a sweep: per-point CSV (and the force curves), a Gmsh post-processing view (.pos), a
 // VTK PolyData file (.vtp, ParaView), and the Fig. 4-like picture: wireframe of the body with a
 // circle per point, radius proportional to F_max, darker for lower force, colour bar in force
-// units. Coordinates in every file are metres in the target's frame. Every file is written
+// units. Coordinates in every file are in SweepWriteOptions::length_unit (default m; the CLI's
+// --output-length-unit, default the scene's unit) in the target's frame, and each file says so
+// (CSV columns x_<unit>, the .pos and .vtp header comments, the .vtp's FieldData
+// metres_per_length_unit); every other quantity is SI with its unit in its name. Every file is written
 // atomically; no NaN or Inf is ever written (a non-finite value is an internal error).
 #include <filesystem>
 #include <string>
 #include <vector>
 
+#include "impactdeck/common/units.hpp"
 #include "impactdeck/geometry/shape.hpp"
 #include "impactdeck/plot/drawing.hpp"
 #include "impactdeck/study/sweep.hpp"
@@ -32,9 +36,11 @@ struct SweepWriteOptions {
   ProgressFn progress;
   /// VTP block sizes as UInt64 even when every block fits UInt32 (they must above 4 GiB).
   bool vtp_uint64_headers = false;
+  /// Unit of the point coordinates in every file (the FEM decks' unit, so that both overlay).
+  LengthUnit length_unit = LengthUnit::m;
 };
 
-/// `# ...` comment lines (with the count of sharp points), then one row per point: index, x_m, y_m, z_m, nx, ny, nz,
+/// `# ...` comment lines (with the count of sharp points), then one row per point: index, x_U, y_U, z_U (U: options.length_unit, e.g. x_mm), nx, ny, nz,
 /// target_radius_m, impactor_radius_m, effective_radius_m, reduced_mass_kg,
 /// hertz_constant_N_per_m1_5, max_indentation_m, max_force_N, force_ratio (F / largest F),
 /// compression_time_s, restitution, contact_time_s, impulse_total_Ns, the target's velocity jump

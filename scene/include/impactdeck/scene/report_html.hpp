@@ -1,0 +1,36 @@
+#pragma once
+// `run`'s report page (report.html): one self-contained file (plot/html.hpp) with the inputs (the
+// scene's text, materials, bodies, units), each impact's results with their checks (impulse,
+// Eq. 31; Carnot, Eq. 32; the FEM checks), the validity warnings, the pictures (F(t), Fig. 15) and
+// the verdict (survives / yields, safety factor). Every text from the scene is escaped.
+#include <string>
+#include <vector>
+
+#include "impactdeck/scene/pipeline.hpp"
+#include "impactdeck/scene/scene.hpp"
+
+namespace impactdeck::scene {
+
+/// A picture of an impact beyond the F(t) plot the page draws itself: SVG text or PNG bytes.
+struct ReportPicture {
+  std::string caption;
+  std::string svg;  ///< an SVG document (inlined), or empty
+  std::string png;  ///< PNG bytes (a data URI), or empty
+};
+
+/// The verdict of one impact: from the FEM stresses when ccx ran (yield strength / governing
+/// peak von Mises), else from the Hertz peak pressure against the yield onset 1.60 sigma_y
+/// (Johnson); none without a yield strength.
+struct ImpactVerdict {
+  enum class Kind { none, survives, yields } kind = Kind::none;
+  double safety_factor = 0;  ///< > 1 survives
+  std::string basis;         ///< what it was judged on
+};
+ImpactVerdict impact_verdict(const ImpactReport& ir);
+
+/// The page. `pictures[k]`: the extra pictures of impact k (may be shorter than the impacts).
+/// The paths in `report` are shown as they are (pass the public ones).
+std::string report_html(const Scene& scene, const RunReport& report,
+                        const std::vector<std::vector<ReportPicture>>& pictures = {});
+
+}  // namespace impactdeck::scene
