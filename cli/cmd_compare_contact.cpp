@@ -9,6 +9,7 @@
 #include "cli_limits.hpp"
 #include "set_option.hpp"
 #include "commands.hpp"
+#include "conventions.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/scene/compare_contact.hpp"
 #include "impactdeck/scene/scene.hpp"
@@ -28,7 +29,7 @@ void register_compare_contact(CLI::App& app, Context& ctx) {
   cmd->add_option("scene", args->scene, "Scene file (TOML)")->required();
   add_set_option(cmd, args->set);
   cmd->add_option("--impact", args->options.impact, "Impact name (default: the scene's first)");
-  cmd->add_option("--out", args->out, "Output folder (created): hybrid/, contact*/, compare_force.svg");
+  cmd->add_option("-o,--out", args->out, "Output folder (created): hybrid/, contact*/, compare_force.svg");
   cmd->add_flag("--json", args->json, "Print one JSON document on stdout (keys: docs/cli.md)");
   cmd->add_option("--threshold", args->options.threshold,
                   "Max |F_max contact / analytic - 1| before exit 4 (default 0.03)")
@@ -57,8 +58,11 @@ void register_compare_contact(CLI::App& app, Context& ctx) {
     if (ec) throw InputError(args->out, "--out", "cannot create the folder: " + ec.message());
     scene::CompareOptions o = args->options;
     o.out_dir = args->out;
-    o.progress = &std::cerr;
-    const scene::CompareReport r = scene::compare_contact(sc, o);
+    o.progress = ctx.progress();
+    const scene::CompareReport r = [&] {
+      VerboseTimer timer(ctx, "compare-contact", "hybrid and contact runs");
+      return scene::compare_contact(sc, o);
+    }();
     if (args->json) {
       std::cout << scene::to_json(r).dump(2) << "\n";
     } else {

@@ -465,7 +465,10 @@ TEST(Table1Files, CsvMarkdownHeatmap) {
   const Table1Result r = run_table1(o);
   write_table1_csv(dir / "t.csv", r);
   const std::string csv = slurp(dir / "t.csv");
-  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 2 + 1 + 81);  // 2 comments, header, 81 cells
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 81);  // header, 81 cells: no comment line
+  EXPECT_EQ(csv.rfind("geometric_ratio,mass_ratio,collision_force_ratio,mass_only_ratio", 0), 0u);
+  const std::string side = slurp(dir / "t.csv.json");  // the settings moved to the JSON sidecar
+  EXPECT_NE(side.find("\"settings\": \"cloud paper-grid"), std::string::npos) << side;
   const std::string md = table1_markdown(r);
   EXPECT_NE(md.find("| **1e4** |"), std::string::npos);
   EXPECT_NE(md.find("Eq. 40"), std::string::npos);

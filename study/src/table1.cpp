@@ -233,15 +233,14 @@ Table1Result run_table1(const Table1Options& o) {
       if (o.progress) {
         so.progress = [&](std::size_t done, std::size_t) { o.progress(done_before + done, total); };
       }
-      SweepResult sr;
-      try {
-        sr = run_sweep(s, clouds[gi], so);
-      } catch (const InputError& e) {
-        if (!o.scene) throw;
+      // run_sweep's errors name the scene and the cell (the paper's setting: no file).
+      s.context = {};
+      if (o.scene) {
         std::ostringstream place;
         place << "cell g = " << o.geometric_ratios[gi] << ", mu = " << o.mass_ratios[mi];
-        throw InputError(o.scene->source, place.str() + (e.place().empty() ? "" : ": " + e.place()), e.reason());
+        s.context = {o.scene->source, place.str()};
       }
+      const SweepResult sr = run_sweep(s, clouds[gi], so);
       done_before += clouds[gi].size();
       res.ratio[gi][mi] = sr.force_ratio;
       res.mass_only[gi][mi] = sr.mass_only_ratio;
