@@ -40,7 +40,8 @@ void register_campaign(CLI::App& app, Context& ctx) {
   CLI::App* plan = top->add_subcommand("plan", "Expand a campaign file into case folders and campaign.json");
   plan->add_option("file", a->file, "Campaign file (TOML)")->required();
   plan->add_option("-o,--out", a->out, "Campaign folder to create")->required();
-  plan->callback([a] {
+  plan->callback([a, &ctx] {
+    VerboseTimer timer(ctx, "campaign plan", "plan " + a->file);
     const campaign::Campaign c = campaign::read_campaign(a->file);
     const campaign::PlanResult r = campaign::plan_campaign(c, a->out);
     std::cout << (r.already_planned ? "already planned: " : "planned: ") << r.cases << " cases in " << a->out
@@ -59,6 +60,7 @@ void register_campaign(CLI::App& app, Context& ctx) {
       ->allow_extra_args(false);
   run->add_flag("--dry-run", a->dry_run, "slurm: write campaign.sbatch, do not submit");
   run->callback([a, run, &ctx] {
+    VerboseTimer timer(ctx, "campaign run", "cases of " + a->dir);
     if (a->executor == "slurm") {
       campaign::SlurmOptions o;
       o.max_parallel = run->count("--jobs") > 0 ? a->jobs : 0;  // no --jobs: no %K limit
@@ -98,6 +100,7 @@ void register_campaign(CLI::App& app, Context& ctx) {
   one->add_option("id", a->id, "Case id (0 ... N-1)")->required();
   one->add_option("--threads", a->threads, "ccx threads (default 1)")->check(CLI::Range(1, 1024));
   one->callback([a, &ctx] {
+    VerboseTimer timer(ctx, "campaign run-case", "case " + std::to_string(a->id));
     const campaign::CaseOutcome o = campaign::run_case(a->dir, a->id, a->threads, ctx.progress());
     if (o.already_done) {
       std::cout << "case " << a->id << ": already done\n";
@@ -115,7 +118,8 @@ void register_campaign(CLI::App& app, Context& ctx) {
 
   CLI::App* coll = top->add_subcommand("collect", "Table (CSV, JSON) of every case, the worst case, the map");
   coll->add_option("dir", a->dir, "Campaign folder")->required();
-  coll->callback([a] {
+  coll->callback([a, &ctx] {
+    VerboseTimer timer(ctx, "campaign collect", "collect " + a->dir);
     const campaign::CollectResult r = campaign::collect(a->dir);
     std::cout << "collected " << r.done << " done, " << r.failed << " failed, " << r.pending << " pending: "
               << r.csv.string() << ", " << r.json.string() << "\n";

@@ -11,6 +11,7 @@
 
 #include "cli_limits.hpp"
 #include "commands.hpp"
+#include "conventions.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/common/run_transaction.hpp"
 #include "impactdeck/fem_export/check.hpp"
@@ -64,6 +65,7 @@ void register_fem_check(CLI::App& app, Context& ctx) {
     }
     fem_export::CheckResult r;
     try {
+      VerboseTimer timer(ctx, "fem-check", "ccx and the checks");
       r = fem_export::run_check(args->dir, o);
     } catch (const InputError& e) {
       if (txn) throw txn->public_error(e);

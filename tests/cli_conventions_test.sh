@@ -7,24 +7,17 @@ set -u
 bin=$1; src=$2; py=$3; man_page=${4:-}; completion=${5:-}
 . "$(dirname "$0")/check_lib.sh"
 
-# usage_error NAME PATTERN ARGS...: exit 2, one stderr line matching PATTERN.
-usage_error() {
-  local name=$1 pattern=$2; shift 2
+# refused CODE NAME PATTERN ARGS...: exit CODE, one stderr line matching PATTERN.
+refused() {
+  local code=$1 name=$2 pattern=$3; shift 3
   "$bin" "$@" >"$tmp/u.out" 2>"$tmp/u.err"
   local rc=$?
-  check "$name: exit 2" test "$rc" -eq 2
+  check "$name: exit $code" test "$rc" -eq "$code"
   check "$name: one line" test "$(wc -l <"$tmp/u.err")" -eq 1
   check "$name: '$pattern'" grep -Eq -- "$pattern" "$tmp/u.err"
 }
-# input_error NAME PATTERN ARGS...: exit 3, one stderr line matching PATTERN.
-input_error() {
-  local name=$1 pattern=$2; shift 2
-  "$bin" "$@" >"$tmp/u.out" 2>"$tmp/u.err"
-  local rc=$?
-  check "$name: exit 3" test "$rc" -eq 3
-  check "$name: one line" test "$(wc -l <"$tmp/u.err")" -eq 1
-  check "$name: '$pattern'" grep -Eq -- "$pattern" "$tmp/u.err"
-}
+usage_error() { refused 2 "$@"; }  # usage_error NAME PATTERN ARGS...
+input_error() { refused 3 "$@"; }  # input_error NAME PATTERN ARGS...
 
 # 1. Did you mean: subcommands, flags, scene keys, enum values.
 usage_error "subcommand rnu" "did you mean 'run'\?" rnu samples.toml
@@ -46,6 +39,7 @@ check "a refused scene writes nothing" test ! -e "$tmp/typo_out/fem_impact"
 sed 's/contact_radius = "[a-z]*"/contact_radius = "eliptical"/' "$src/samples/two_spheres.toml" >"$tmp/typo_value.toml"
 grep -q eliptical "$tmp/typo_value.toml" || sed -i 's/^\(\[\[impacts\]\]\)$/\1\ncontact_radius = "eliptical"/' "$tmp/typo_value.toml"
 input_error "scene value eliptical" "unknown value \"eliptical\" .*; did you mean 'elliptical'\?" run "$tmp/typo_value.toml" --out "$tmp/typo_out"
+input_error "--preset" "unknown preset \"papr\" .*; did you mean 'paper'\?" study table1 --preset papr --out "$tmp/x"
 input_error "--impact name" "did you mean 'fig4'\?" sweep "$src/samples/fig4_sweep.toml" --impact fig5 --out "$tmp/x"
 
 # 2. -q / -v and -o / --out on every command. Each runnable command's help lists them.

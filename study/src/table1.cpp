@@ -9,6 +9,7 @@
 #include "impactdeck/collision/compression.hpp"
 #include "impactdeck/collision/eccentric.hpp"
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/common/suggest.hpp"
 #include "impactdeck/geometry/ellipsoid.hpp"
 #include "impactdeck/geometry/mass_properties.hpp"
 #include "impactdeck/geometry/mesh_shape.hpp"
@@ -109,7 +110,7 @@ std::shared_ptr<const geometry::Shape> stretched_target(const geometry::Shape& t
 
 Table1Options table1_preset(const std::string& name) {
   if (name != "paper") {
-    throw InputError("", "--preset", "unknown preset \"" + name + "\" (available: \"paper\")");
+    throw InputError("", "--preset", "unknown preset \"" + name + "\" (available: \"paper\")" + did_you_mean(name, {"paper"}));
   }
   Table1Options o;
   o.geometric_ratios = kDecades;
