@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "commands.hpp"
+#include "conventions.hpp"
 #include "impactdeck/campaign/campaign.hpp"
 #include "impactdeck/campaign/collect.hpp"
 #include "impactdeck/campaign/runner.hpp"
@@ -29,7 +30,7 @@ void register_campaign(CLI::App& app, Context& ctx) {
     std::string file, out, dir, executor = "local";
     std::size_t id = 0, jobs = 1;
     int threads = 1, cpus_per_task = 0;
-    bool dry_run = false, quiet = false, json = false;
+    bool dry_run = false, json = false;
     std::vector<std::string> sbatch;
   };
   auto a = std::make_shared<Args>();
@@ -38,8 +39,9 @@ void register_campaign(CLI::App& app, Context& ctx) {
 
   CLI::App* plan = top->add_subcommand("plan", "Expand a campaign file into case folders and campaign.json");
   plan->add_option("file", a->file, "Campaign file (TOML)")->required();
-  plan->add_option("--out", a->out, "Campaign folder to create")->required();
-  plan->callback([a] {
+  plan->add_option("-o,--out", a->out, "Campaign folder to create")->required();
+  plan->callback([a, &ctx] {
+    VerboseTimer timer(ctx, "campaign plan", "plan " + a->file);
     const campaign::Campaign c = campaign::read_campaign(a->file);
     const campaign::PlanResult r = campaign::plan_campaign(c, a->out);
     std::cout << (r.already_planned ? "already planned: " : "planned: ") << r.cases << " cases in " << a->out
@@ -57,8 +59,8 @@ void register_campaign(CLI::App& app, Context& ctx) {
   run->add_option("--sbatch-option", a->sbatch, "slurm: an extra #SBATCH option, e.g. --partition=short (repeatable)")
       ->allow_extra_args(false);
   run->add_flag("--dry-run", a->dry_run, "slurm: write campaign.sbatch, do not submit");
-  run->add_flag("--quiet", a->quiet, "No progress bar");
   run->callback([a, run, &ctx] {
+    VerboseTimer timer(ctx, "campaign run", "cases of " + a->dir);
     if (a->executor == "slurm") {
       campaign::SlurmOptions o;
       o.max_parallel = run->count("--jobs") > 0 ? a->jobs : 0;  // no --jobs: no %K limit
@@ -82,7 +84,7 @@ void register_campaign(CLI::App& app, Context& ctx) {
     o.jobs = a->jobs;
     o.ccx_threads = a->threads;
     o.executable = self_executable();
-    o.progress_bar = !a->quiet;
+    o.progress_bar = !ctx.quiet;
     const campaign::RunSummary s = campaign::run_local(a->dir, o);
     std::cout << "campaign: " << s.total << " cases: " << s.done << " run now, " << s.skipped << " already done, "
               << s.failed << " failed";
@@ -98,7 +100,8 @@ void register_campaign(CLI::App& app, Context& ctx) {
   one->add_option("id", a->id, "Case id (0 ... N-1)")->required();
   one->add_option("--threads", a->threads, "ccx threads (default 1)")->check(CLI::Range(1, 1024));
   one->callback([a, &ctx] {
-    const campaign::CaseOutcome o = campaign::run_case(a->dir, a->id, a->threads, &std::cerr);
+    VerboseTimer timer(ctx, "campaign run-case", "case " + std::to_string(a->id));
+    const campaign::CaseOutcome o = campaign::run_case(a->dir, a->id, a->threads, ctx.progress());
     if (o.already_done) {
       std::cout << "case " << a->id << ": already done\n";
     } else if (o.state == campaign::CaseState::done) {
@@ -115,7 +118,8 @@ void register_campaign(CLI::App& app, Context& ctx) {
 
   CLI::App* coll = top->add_subcommand("collect", "Table (CSV, JSON) of every case, the worst case, the map");
   coll->add_option("dir", a->dir, "Campaign folder")->required();
-  coll->callback([a] {
+  coll->callback([a, &ctx] {
+    VerboseTimer timer(ctx, "campaign collect", "collect " + a->dir);
     const campaign::CollectResult r = campaign::collect(a->dir);
     std::cout << "collected " << r.done << " done, " << r.failed << " failed, " << r.pending << " pending: "
               << r.csv.string() << ", " << r.json.string() << "\n";

@@ -9,6 +9,7 @@
 #include "cli_limits.hpp"
 #include "set_option.hpp"
 #include "commands.hpp"
+#include "conventions.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/common/run_transaction.hpp"
 #include "impactdeck/scene/compare_contact.hpp"
@@ -29,7 +30,7 @@ void register_compare_contact(CLI::App& app, Context& ctx) {
   cmd->add_option("scene", args->scene, "Scene file (TOML)")->required();
   add_set_option(cmd, args->set);
   cmd->add_option("--impact", args->options.impact, "Impact name (default: the scene's first)");
-  cmd->add_option("--out", args->out, "Output folder (created): hybrid/, contact*/, compare_force.svg");
+  cmd->add_option("-o,--out", args->out, "Output folder (created): hybrid/, contact*/, compare_force.svg");
   cmd->add_flag("--json", args->json, "Print one JSON document on stdout (keys: docs/cli.md)");
   cmd->add_option("--threshold", args->options.threshold,
                   "Max |F_max contact / analytic - 1| before exit 4 (default 0.03)")
@@ -57,15 +58,16 @@ void register_compare_contact(CLI::App& app, Context& ctx) {
     // and published together when the comparison completed, whatever its verdict; a failure or a
     // kill leaves --out as it was.
     RunTransaction txn(args->out);
-    for (const auto& w : txn.warnings()) std::cerr << "impactdeck: warning: " << w << "\n";
+    for (const auto& w : txn.warnings()) ctx.warn(w);
     scene::CompareOptions o = args->options;
     o.out_dir = args->out;
-    o.progress = &std::cerr;
+    o.progress = ctx.progress();
     o.place_output = [&txn, &args](const std::string& name, bool is_folder) {
       return is_folder ? txn.folder(name, args->out, "--out") : txn.file(name, args->out, "--out");
     };
     scene::CompareReport r;
     try {
+      VerboseTimer timer(ctx, "compare-contact", "hybrid and contact runs");
       r = scene::compare_contact(sc, o);
       txn.commit();
     } catch (const InputError& e) {

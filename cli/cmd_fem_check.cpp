@@ -11,6 +11,7 @@
 
 #include "cli_limits.hpp"
 #include "commands.hpp"
+#include "conventions.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/common/run_transaction.hpp"
 #include "impactdeck/fem_export/check.hpp"
@@ -23,7 +24,6 @@ void register_fem_check(CLI::App& app, Context& ctx) {
     std::string dir;
     bool json = false;
     bool no_run = false;
-    bool verbose = false;
     fem_export::CheckOptions options;
   };
   auto args = std::make_shared<Args>();
@@ -40,7 +40,6 @@ void register_fem_check(CLI::App& app, Context& ctx) {
   cmd->add_option("--threads", args->options.threads,
                   "Threads for ccx: OMP_NUM_THREADS, CCX_NPROC_EQUATION_SOLVER (default 0: all cores)")
       ->check(CLI::NonNegativeNumber);
-  cmd->add_flag("--verbose", args->verbose, "Echo the settings on stderr");
   cmd->add_option("--solver-timeout-s", args->options.timeout_s,
                   "Wall-time limit of the ccx run (default: derived from the deck's size, stated in --json)")
       ->check(positive_number());
@@ -49,9 +48,9 @@ void register_fem_check(CLI::App& app, Context& ctx) {
     if (!std::isfinite(args->options.timeout_s)) throw UsageError("--solver-timeout-s must be a finite number of seconds");
     fem_export::CheckOptions o = args->options;
     o.run_solver = !args->no_run;
-    o.progress = &std::cerr;
-    if (args->verbose) {
-      std::cerr << "fem-check: dir " << args->dir << ", ccx " << o.ccx << ", run " << o.run_solver
+    o.progress = ctx.progress();
+    if (ctx.verbose) {
+      std::cerr << "impactdeck: fem-check: dir " << args->dir << ", ccx " << o.ccx << ", run " << o.run_solver
                 << ", linear tolerance " << o.linear_tolerance << ", angular tolerance "
                 << o.angular_tolerance << ", threads " << o.threads << "\n";
     }
@@ -66,6 +65,7 @@ void register_fem_check(CLI::App& app, Context& ctx) {
     }
     fem_export::CheckResult r;
     try {
+      VerboseTimer timer(ctx, "fem-check", "ccx and the checks");
       r = fem_export::run_check(args->dir, o);
     } catch (const InputError& e) {
       if (txn) throw txn->public_error(e);
@@ -99,7 +99,7 @@ void register_fem_check(CLI::App& app, Context& ctx) {
       if (r.stress) {
         for (auto& f : r.stress->files) f = fs::path(args->dir) / f.filename();
       }
-      for (const auto& w : txn->warnings()) std::cerr << "impactdeck: warning: " << InputError::one_line(w) << "\n";
+      for (const auto& w : txn->warnings()) ctx.warn(w);
     }
     if (args->json) {
       std::cout << fem_export::to_json(r).dump(2) << "\n";

@@ -6,13 +6,15 @@
 #include <memory>
 
 #include "commands.hpp"
+#include "conventions.hpp"
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/common/suggest.hpp"
 #include "impactdeck/common/numeric.hpp"
 #include "impactdeck/geometry/inspect.hpp"
 
 namespace impactdeck::cli {
 
-void register_inspect(CLI::App& app, Context& /*ctx*/) {
+void register_inspect(CLI::App& app, Context& ctx) {
   struct Args {
     std::string part, unit;
     std::optional<double> density, mass;
@@ -36,9 +38,10 @@ void register_inspect(CLI::App& app, Context& /*ctx*/) {
                 "Accept approximate mass properties of an open / non-manifold / self-intersecting part");
   cmd->add_flag("--no-self-intersections", args->no_self, "Skip the self-intersection test (huge parts)");
   cmd->add_option("--sharp-angle-deg", args->sharp_deg, "Dihedral angle above which an edge is sharp (default 30)");
-  cmd->callback([args] {
+  cmd->callback([args, &ctx] {
     auto unit = parse_length_unit(args->unit);
-    if (!unit) throw UsageError("--length-unit '" + args->unit + "': expected m, cm, mm or in");
+    if (!unit) throw UsageError("--length-unit '" + args->unit + "': expected m, cm, mm or in" +
+                                        did_you_mean(args->unit, length_unit_names()));
     // > 0 and within [1e-100, 1e100] (numeric.hpp): mass and inertia then stay finite.
     if (args->density && !(*args->density > 0 && within_magnitude_range(*args->density)))
       throw UsageError("--density-kg-m3 must be > 0 and within 1e-100 .. 1e+100");
@@ -60,10 +63,14 @@ void register_inspect(CLI::App& app, Context& /*ctx*/) {
     opt.accept_approximate = args->approximate;
     opt.check_self_intersections = !args->no_self;
     opt.sharp_angle_deg = args->sharp_deg;
-    const geometry::InspectReport rep = geometry::inspect_part(opt);
+    geometry::InspectReport rep;
+    {
+      VerboseTimer timer(ctx, "inspect", "inspect " + args->part);
+      rep = geometry::inspect_part(opt);
+    }
     if (args->json) {
       std::cout << rep.document.dump(2) << "\n";
-      for (const auto& w : rep.warnings) std::cerr << "impactdeck: warning: " << InputError::one_line(w) << "\n";
+      for (const auto& w : rep.warnings) ctx.warn(w);
       return;
     }
     std::cout << rep.text;

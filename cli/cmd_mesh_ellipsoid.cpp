@@ -4,13 +4,14 @@
 #include <memory>
 
 #include "commands.hpp"
+#include "conventions.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/geometry/ellipsoid_mesh.hpp"
 #include "impactdeck/geometry/mesh_io.hpp"
 
 namespace impactdeck::cli {
 
-void register_mesh_ellipsoid(CLI::App& app, Context& /*ctx*/) {
+void register_mesh_ellipsoid(CLI::App& app, Context& ctx) {
   struct Args {
     double a = 0, b = 0, c = 0;
     int subdivisions = 5;
@@ -24,9 +25,10 @@ void register_mesh_ellipsoid(CLI::App& app, Context& /*ctx*/) {
   cmd->add_option("B", args->b, "Semi-axis along y")->required();
   cmd->add_option("C", args->c, "Semi-axis along z")->required();
   cmd->add_option("--subdivisions", args->subdivisions, "Icosahedron subdivisions N, 0..10 (default 5: 20480 triangles)");
-  cmd->add_option("-o,--output", args->out, "Output STL file (written atomically)")->required();
+  cmd->add_option("-o,--out,--output", args->out, "Output STL file (written atomically)")->required();
   cmd->add_flag("--ascii", args->ascii, "ASCII STL instead of binary");
-  cmd->callback([args] {
+  cmd->callback([args, &ctx] {
+    VerboseTimer timer(ctx, "mesh-ellipsoid", "mesh and write");
     const auto mesh = geometry::make_ellipsoid_mesh(args->a, args->b, args->c, args->subdivisions);
     if (args->ascii) geometry::write_stl_ascii(args->out, mesh, LengthUnit::m, "ellipsoid");
     else geometry::write_stl_binary(args->out, mesh, LengthUnit::m, "impactdeck mesh-ellipsoid");

@@ -1,12 +1,15 @@
 // `impactdeck run SCENE [--json] [--out DIR]`: compute what the scene asks for, nothing more.
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <iostream>
+#include <sstream>
 #include <memory>
 
 #include "cli_limits.hpp"
 #include "commands.hpp"
 #include "output_unit.hpp"
+#include "conventions.hpp"
 #include "set_option.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/scene/pipeline.hpp"
@@ -29,7 +32,7 @@ void register_run(CLI::App& app, Context& ctx) {
   CLI::App* cmd = app.add_subcommand("run", "Run a scene: impacts, force tables and decks it asks for");
   cmd->add_option("scene", args->scene, "Scene file (TOML, docs/scene-format.md)")->required();
   cmd->add_flag("--json", args->json, "Print one JSON document on stdout (keys: docs/cli.md)");
-  cmd->add_option("--out", args->out, "Output folder (created if missing; default: current folder). Everything "
+  cmd->add_option("-o,--out", args->out, "Output folder (created if missing; default: current folder). Everything "
                   "a run writes appears there only when every stage and check passed (docs/reliability.md)");
   cmd->add_option("--solver-timeout-s", args->solver_timeout_s,
                   "Wall-time limit of each ccx run (default: derived from the deck's size, stated in --json)")
@@ -45,18 +48,23 @@ void register_run(CLI::App& app, Context& ctx) {
     const scene::Scene sc = scene::load_scene(args->scene, overrides_from(args->set));
     scene::RunOptions opt;
     opt.out_dir = args->out;
-    opt.progress = &std::cerr;  // ccx progress when [outputs.fem] run = "calculix"
+    opt.progress = ctx.progress();  // ccx progress when [outputs.fem] run = "calculix"
     opt.solver_timeout_s = args->solver_timeout_s;
     opt.solver_threads = args->threads;
     opt.output_length_unit = parse_output_length_unit(args->output_length_unit, sc.file.string());
     const scene::RunReport rep = scene::run_scene(sc, opt);
+    for (const auto& st : rep.stages_run) {
+      std::ostringstream t;
+      t << "stage " << st.name << ": " << std::setprecision(3) << st.seconds << " s";
+      ctx.note("run", t.str());
+    }
     if (args->json) {
       std::cout << scene::to_json(sc, rep).dump(2) << "\n";
     } else {
       std::cout << scene::format_summary(sc, rep);
     }
     if (args->json)
-      for (const auto& w : rep.warnings) std::cerr << "impactdeck: warning: " << InputError::one_line(w) << "\n";
+      for (const auto& w : rep.warnings) ctx.warn(w);
     if (!rep.all_checks_passed()) {
       std::cerr << "impactdeck: error: " << scene::failed_checks_summary(sc, rep) << "\n";
       ctx.exit_code = static_cast<int>(ExitCode::check_failed);

@@ -7,10 +7,12 @@
 
 #include "cli_limits.hpp"
 #include "commands.hpp"
+#include "conventions.hpp"
 #include "set_option.hpp"
 #include "impactdeck/common/run_transaction.hpp"
 #include "impactdeck/common/atomic_file.hpp"
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/common/suggest.hpp"
 #include "impactdeck/common/numeric.hpp"
 #include "impactdeck/geometry/ellipsoid.hpp"
 #include "impactdeck/plot/drawing.hpp"
@@ -60,7 +62,7 @@ void register_study(CLI::App& app, Context& ctx) {
     std::size_t count = 0;
     std::uint64_t seed = 1;
     unsigned threads = 0;
-    bool json = false, quiet = false, no_png = false;
+    bool json = false, no_png = false;
     std::size_t max_points = kDefaultMaxPoints;
     std::vector<std::string> set;  // --set, with --scene
   };
@@ -69,7 +71,7 @@ void register_study(CLI::App& app, Context& ctx) {
   study->require_subcommand(1);
   CLI::App* cmd = study->add_subcommand(
       "table1", "The paper's Table 1: collision force ratio over geometric ratio g = a/b and mass ratio m1/m2");
-  cmd->add_option("--preset", a->preset, "Starting setting (default and only preset: paper, MODEL.md)");
+  cmd->add_option("--preset", a->preset, "Starting setting (default and only preset: paper, docs/table1.md)");
   cmd->add_option("--geometric-ratios", a->g, "Comma-separated g = a/b values (rows)");
   cmd->add_option("--mass-ratios", a->mu, "Comma-separated m1/m2 values (columns)");
   cmd->add_option("--size-ratio", a->size_ratio, "Smaller semi-axis / sphere radius (paper preset: 20)");
@@ -88,10 +90,9 @@ void register_study(CLI::App& app, Context& ctx) {
   cmd->add_option("--count", a->count, "Area-uniform points per cell (default 2000)");
   cmd->add_option("--seed", a->seed, "Seed of the area-uniform cloud");
   cmd->add_option("--threads", a->threads, "Worker threads (default 0: all cores)");
-  cmd->add_option("--out", a->out, "Output folder for table1.csv/.md/_heatmap.svg/.png (default: .)");
+  cmd->add_option("-o,--out", a->out, "Output folder for table1.csv/.md/_heatmap.svg/.png (default: .)");
   cmd->add_flag("--no-png", a->no_png, "Do not render the PNG heat map");
   cmd->add_flag("--json", a->json, "Print the JSON document on stdout");
-  cmd->add_flag("--quiet", a->quiet, "No progress bar");
   cmd->add_option("--max-points", a->max_points,
                   "Most impact evaluations (cells x points per cell) of the study (default 1000000)")
       ->check(positive_number());
@@ -119,14 +120,16 @@ void register_study(CLI::App& app, Context& ctx) {
       if (a->rule == "paper") o.rule = collision::ContactRule::paper;
       else if (a->rule == "mean") o.rule = collision::ContactRule::mean;
       else if (a->rule == "elliptical") o.rule = collision::ContactRule::elliptical;
-      else throw UsageError("--radius-rule: expected paper, mean or elliptical, got \"" + a->rule + "\"");
+      else throw UsageError("--radius-rule: expected paper, mean or elliptical, got \"" + a->rule + "\"" +
+                                did_you_mean(a->rule, {"paper", "mean", "elliptical"}));
     }
     if (!a->cloud.empty()) {
       if (a->cloud == "grid") o.cloud = study::CloudKind::paper_grid;
       else if (a->cloud == "uniform") o.cloud = study::CloudKind::area_uniform;
       else if (a->cloud == "both") o.cloud = study::CloudKind::both;
       else if (a->cloud == "vertices") o.cloud = study::CloudKind::vertices;
-      else throw UsageError("--cloud: expected grid, uniform, both or vertices, got \"" + a->cloud + "\"");
+      else throw UsageError("--cloud: expected grid, uniform, both or vertices, got \"" + a->cloud + "\"" +
+                                did_you_mean(a->cloud, {"grid", "uniform", "both", "vertices"}));
     }
     if (!a->set.empty() && a->scene.empty()) throw UsageError("--set needs --scene");
     if (!a->scene.empty()) {
@@ -134,7 +137,7 @@ void register_study(CLI::App& app, Context& ctx) {
       if (a->stretch_axis.empty() || a->stretch_axis == "x") axis = 0;
       else if (a->stretch_axis == "y") axis = 1;
       else if (a->stretch_axis == "z") axis = 2;
-      else throw UsageError("--stretch-axis: expected x, y or z, got \"" + a->stretch_axis + "\"");
+      else throw UsageError("--stretch-axis: expected x, y or z, got \"" + a->stretch_axis + "\"");  // one letter: no "did you mean"
       study::Table1Scene ts = study::table1_scene_from(scene::load_scene(a->scene, overrides_from(a->set)), a->impact, axis);
       const bool analytic = dynamic_cast<const geometry::Ellipsoid*>(ts.setup.target.shape.get()) != nullptr;
       if (a->cloud.empty()) o.cloud = analytic ? study::CloudKind::paper_grid : study::CloudKind::area_uniform;
@@ -158,11 +161,15 @@ void register_study(CLI::App& app, Context& ctx) {
     RunTransaction txn(a->out);
     const std::string where = txn.out_dir().string();
     const fs::path csv = txn.file("table1.csv", where, "--out"), md = txn.file("table1.md", where, "--out");
+    txn.file("table1.csv.json", where, "--out");  // the CSV's JSON sidecar, written with it
     const fs::path svg = txn.file("table1_heatmap.svg", where, "--out");
     const fs::path png = a->no_png ? fs::path() : txn.file("table1_heatmap.png", where, "--out");
-    study::ProgressBar bar("table1", !a->quiet);
+    study::ProgressBar bar("table1", !ctx.quiet);
     o.progress = [&bar](std::size_t done, std::size_t total) { bar.update(done, total); };
-    const study::Table1Result r = study::run_table1(o);
+    const study::Table1Result r = [&] {
+      VerboseTimer timer(ctx, "study table1", "table1 cells");
+      return study::run_table1(o);
+    }();
     bar.finish();
 
     const fs::path out(a->out);
@@ -176,7 +183,7 @@ void register_study(CLI::App& app, Context& ctx) {
     } catch (const InputError& e) {
       throw txn.public_error(e);
     }
-    for (const auto& w : txn.warnings()) std::cerr << "impactdeck: warning: " << InputError::one_line(w) << "\n";
+    for (const auto& w : txn.warnings()) ctx.warn(w);
 
     if (a->json) {
       std::cout << study::table1_json(r).dump(2) << "\n";
@@ -186,7 +193,6 @@ void register_study(CLI::App& app, Context& ctx) {
                 << ", " << (out / "table1.md").string() << ", " << (out / "table1_heatmap.svg").string()
                 << (a->no_png ? "" : ", " + (out / "table1_heatmap.png").string()) << "\n";
     }
-    (void)ctx;
   });
 }
 

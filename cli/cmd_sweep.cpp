@@ -10,27 +10,29 @@
 #include "cli_limits.hpp"
 #include "commands.hpp"
 #include "output_unit.hpp"
+#include "conventions.hpp"
 #include "set_option.hpp"
 #include "impactdeck/common/run_transaction.hpp"
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/common/suggest.hpp"
 #include "impactdeck/scene/scene.hpp"
 #include "impactdeck/study/cloud.hpp"
 #include "impactdeck/study/progress.hpp"
 #include "impactdeck/study/scene_sweep.hpp"
 #include "impactdeck/study/sweep.hpp"
 #include "impactdeck/study/sweep_output.hpp"
+#include "impactdeck/common/json_number.hpp"
 
 namespace impactdeck::cli {
 namespace fs = std::filesystem;
 
 namespace {
 
-nlohmann::json vec(const Eigen::Vector3d& v) { return {v.x() + 0.0, v.y() + 0.0, v.z() + 0.0}; }
 
 nlohmann::json point_json(std::size_t index, const study::PointResult& p) {
   return {{"index", index},
-          {"point_m", vec(p.point_m)},
-          {"normal", vec(p.normal)},
+          {"point_m", json_vector(p.point_m)},
+          {"normal", json_vector(p.normal)},
           {"max_force_N", p.max_force_N},
           {"reduced_mass_kg", p.reduced_mass_kg},
           {"effective_radius_m", p.effective_radius_m},
@@ -47,7 +49,7 @@ void register_sweep(CLI::App& app, Context& ctx) {
     int grid_steps = 8;
     std::size_t count = 2000;
     std::uint64_t seed = 1;
-    bool curves = false, json = false, quiet = false, no_png = false;
+    bool curves = false, json = false, no_png = false;
     std::size_t curve_samples = 201;
     unsigned threads = 0;
     std::size_t max_points = kDefaultMaxPoints, max_curve_samples = kDefaultMaxCurveSamples;
@@ -71,13 +73,12 @@ void register_sweep(CLI::App& app, Context& ctx) {
   cmd->add_flag("--curves", a->curves, "Also compute F(t) at every point (PREFIX_curves.csv)");
   cmd->add_option("--curve-samples", a->curve_samples, "Samples per curve (default 201)");
   cmd->add_option("--threads", a->threads, "Worker threads (default 0: all cores)");
-  cmd->add_option("--out", a->out, "Output folder (created if missing; default: current folder)");
+  cmd->add_option("-o,--out", a->out, "Output folder (created if missing; default: current folder)");
   cmd->add_option("--prefix", a->prefix, "File name prefix (default sweep_IMPACT)");
   cmd->add_option("--formats", a->formats,
                   "Files to write, comma-separated: csv,vtp,pos,svg,png (default: all five)");
   cmd->add_flag("--no-png", a->no_png, "Do not render the PNG picture (png left out of --formats)");
   cmd->add_flag("--json", a->json, "Print a JSON summary on stdout");
-  cmd->add_flag("--quiet", a->quiet, "No progress bar");
   cmd->add_option("--max-points", a->max_points, "Most points a sweep may evaluate (default 1000000)")
       ->check(positive_number());
   cmd->add_option("--max-curve-samples", a->max_curve_samples,
@@ -111,7 +112,8 @@ void register_sweep(CLI::App& app, Context& ctx) {
       else if (a->cloud == "uniform") kind = study::CloudKind::area_uniform;
       else if (a->cloud == "both") kind = study::CloudKind::both;
       else if (a->cloud == "vertices") kind = study::CloudKind::vertices;
-      else throw UsageError("--cloud: expected grid, uniform, both, vertices or auto, got \"" + a->cloud + "\"");
+      else throw UsageError("--cloud: expected grid, uniform, both, vertices or auto, got \"" + a->cloud + "\"" +
+                            did_you_mean(a->cloud, {"grid", "uniform", "both", "vertices", "auto"}));
       const std::string where = sc.file.string();
       if (a->points.empty()) {
         const double points = cloud_size(*ss.setup.target.shape, kind, a->grid_steps, a->count);
@@ -137,6 +139,8 @@ void register_sweep(CLI::App& app, Context& ctx) {
         if (!wanted) continue;
         const std::string staged = reserve(suffix).string();
         staged_base = staged.substr(0, staged.size() - std::char_traits<char>::length(suffix));
+        if (std::string_view(suffix).substr(std::string_view(suffix).size() - 4) == ".csv")
+          reserve(std::string(suffix) + ".json");  // its JSON sidecar (common/csv_sidecar.hpp)
       }
 
       std::vector<geometry::SurfacePoint> cloud;
@@ -148,25 +152,22 @@ void register_sweep(CLI::App& app, Context& ctx) {
         check_points(points, a->max_points, a->points, "--points", "its rows");
         if (a->curves) check_curve_samples(points, a->curve_samples, a->max_curve_samples, where);
       } else {
-        try {
-          cloud = study::make_cloud(*ss.setup.target.shape, kind, a->grid_steps, a->count, a->seed);
-        } catch (const InputError& e) {
-          throw InputError(sc.file.string(), e.place(), "target '" + imp.target + "': " + e.reason());
-        }
+        cloud = study::make_cloud(*ss.setup.target.shape, kind, a->grid_steps, a->count, a->seed,
+                                  {sc.file.string(), "target '" + imp.target + "'"});
       }
 
-      study::ProgressBar bar("sweep", !a->quiet);
+      study::ProgressBar bar("sweep", !ctx.quiet);
       study::SweepOptions opt;
       opt.threads = a->threads;
       opt.curves = a->curves;
       opt.curve_samples = a->curve_samples;
       opt.progress = [&bar](std::size_t done, std::size_t total) { bar.update(done, total); };
       study::SweepResult r;
-      try {
+      {
+        // Errors name the scene and the impact themselves (setup.context); the bar ends its line
+        // when unwinding (~ProgressBar), before the error is printed.
+        VerboseTimer timer(ctx, "sweep", "sweep of " + std::to_string(cloud.size()) + " points");
         r = study::run_sweep(ss.setup, cloud, opt);
-      } catch (const InputError& e) {
-        bar.finish();
-        throw InputError(sc.file.string(), "impact '" + imp.name + "': " + e.place(), e.reason());
       }
       bar.finish();
 
@@ -185,15 +186,18 @@ void register_sweep(CLI::App& app, Context& ctx) {
       picture.target = ss.setup.target.shape.get();
       picture.centroid_m = ss.setup.target.volume.centroid_m;
       picture.options.title = "Maximal collision force: " + imp.impactor + " hits " + imp.target + " (impact '" + imp.name + "')";
-      study::ProgressBar write_bar("write", !a->quiet);
+      study::ProgressBar write_bar("write", !ctx.quiet);
       study::SweepWriteOptions wo;
       wo.threads = a->threads;
       wo.length_unit = output_unit;
       wo.progress = [&write_bar](std::size_t done, std::size_t total) { write_bar.update(done, total); };
-      if (!staged_base.empty()) study::write_sweep_files(staged_base, formats, r, meta, picture, wo);
+      if (!staged_base.empty()) {
+        VerboseTimer timer(ctx, "sweep", "write files");
+        study::write_sweep_files(staged_base, formats, r, meta, picture, wo);
+      }
       write_bar.finish();
       txn.commit();
-      for (const auto& w : txn.warnings()) std::cerr << "impactdeck: warning: " << InputError::one_line(w) << "\n";
+      for (const auto& w : txn.warnings()) ctx.warn(w);
 
       const auto& pmin = r.points[r.min_index];
       const auto& pmax = r.points[r.max_index];
@@ -261,7 +265,6 @@ void register_sweep(CLI::App& app, Context& ctx) {
     } catch (const InputError& e) {
       throw txn.public_error(e);  // name the final paths, not the staging folder
     }
-    (void)ctx;
   });
 }
 

@@ -1,12 +1,24 @@
 #pragma once
 // Sub-commands of the `impactdeck` CLI. Each registers itself on the app and stores its exit code
 // in `exit_code` when it runs. The CLI only wires the libraries together.
+#include <iosfwd>
+#include <string>
+
 #include <CLI/CLI.hpp>
 
 namespace impactdeck::cli {
 
 struct Context {
   int exit_code = 0;
+  bool quiet = false;    ///< -q: no progress, no warnings on stderr (errors only); stdout unchanged
+  bool verbose = false;  ///< -v: also the settings and each stage's wall time on stderr
+
+  /// "impactdeck: warning: TEXT" on stderr unless quiet (the warning stays in the report/JSON).
+  void warn(const std::string& text) const;
+  /// Where solver progress lines go: stderr, or nowhere when quiet.
+  std::ostream* progress() const;
+  /// A line on stderr when verbose: "impactdeck: COMMAND: TEXT".
+  void note(const std::string& command, const std::string& text) const;
 };
 
 void register_run(CLI::App& app, Context& ctx);

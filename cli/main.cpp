@@ -4,8 +4,11 @@
 #include <cstring>
 #include <exception>
 #include <iostream>
+#include <string>
+#include <vector>
 
 #include "commands.hpp"
+#include "conventions.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/common/version.hpp"
 
@@ -23,6 +26,8 @@ int main(int argc, char** argv) {
   impactdeck::cli::register_fem_check(app, ctx);
   impactdeck::cli::register_compare_contact(app, ctx);
   impactdeck::cli::register_campaign(app, ctx);
+  impactdeck::cli::register_generated_docs(app, ctx);
+  impactdeck::cli::add_verbosity_flags(app, ctx);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -32,7 +37,9 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::cerr << "impactdeck: usage error: " << impactdeck::InputError::one_line(e.what()) << " (run 'impactdeck --help')\n";  // one line, as every error
+    const std::string why = impactdeck::cli::explain_command_line(app, std::vector<std::string>(argv + 1, argv + argc));
+    std::cerr << "impactdeck: usage error: " << impactdeck::InputError::one_line(why.empty() ? e.what() : why)
+              << " (run 'impactdeck --help')\n";  // one line, as every error
     return static_cast<int>(ExitCode::usage);
   } catch (const impactdeck::Error& e) {
     std::cerr << "impactdeck: error: " << impactdeck::InputError::one_line(e.what()) << "\n";

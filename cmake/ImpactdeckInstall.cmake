@@ -37,6 +37,10 @@ if(NOT IMPACTDECK_CORE_ONLY)
   # The command and its plugins side by side: the plugin loader looks beside the executable.
   install(TARGETS impactdeck RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
   install(TARGETS impactdeck_gmsh_mesher impactdeck_gmsh_cad LIBRARY DESTINATION ${CMAKE_INSTALL_BINDIR})
+  # Generated from the CLI definition at build time (cli/CMakeLists.txt).
+  install(FILES ${PROJECT_BINARY_DIR}/cli/impactdeck.1 DESTINATION ${CMAKE_INSTALL_MANDIR}/man1)
+  install(FILES ${PROJECT_BINARY_DIR}/cli/impactdeck.bash DESTINATION ${CMAKE_INSTALL_DATADIR}/bash-completion/completions
+          RENAME impactdeck)
 endif()
 
 configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/impactdeckConfig.cmake.in

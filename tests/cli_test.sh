@@ -95,7 +95,7 @@ done
 check "sweep --no-png writes no PNG" test ! -e "$tmp/sw/sweep_fig4.png"
 "$bin" sweep "$src/samples/fig4_sweep.toml" --out "$tmp/swf" --quiet --formats png,csv >/dev/null 2>&1
 check "sweep --formats png,csv exit 0" test $? -eq 0
-check "sweep --formats writes what it lists" test "$(ls "$tmp/swf" | tr '\n' ' ')" = "sweep_fig4.csv sweep_fig4.png "
+check "sweep --formats writes what it lists" test "$(ls "$tmp/swf" | tr '\n' ' ')" = "sweep_fig4.csv sweep_fig4.csv.json sweep_fig4.png "
 "$bin" sweep "$src/samples/fig4_sweep.toml" --out "$tmp/swg" --quiet --formats csv,stl >/dev/null 2>"$tmp/swg.err"
 check "sweep --formats with an unknown name exit 2" test $? -eq 2
 check "sweep --formats names it" grep -q "'stl' is not one of csv, vtp, pos, svg, png" "$tmp/swg.err"

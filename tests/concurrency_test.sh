@@ -36,7 +36,8 @@ for i in $(seq 1 10); do
   wait "$p2"; r2=$?
   [ "$r1" -eq 0 ] && [ "$r2" -eq 0 ] || { echo "FAILED: pair $i exit $r1 $r2"; fails=$((fails+1)); }
 done
-check "only the force table and the report are left: $(ls -A "$plain" | tr '\n' ' ')" test "$(ls -A "$plain" | tr '\n' ' ')" = "force_two_spheres.csv report.html "
+check "only the force table, its sidecar and the report are left: $(ls -A "$plain" | tr '\n' ' ')" \
+  test "$(ls -A "$plain" | tr '\n' ' ')" = "force_two_spheres.csv force_two_spheres.csv.json report.html "
 "$bin" run "$src/samples/two_spheres.toml" --out "$tmp/alone" >/dev/null 2>&1
 check "the raced file equals a lone run's byte for byte" cmp -s "$plain/force_two_spheres.csv" "$tmp/alone/force_two_spheres.csv"
 finish concurrency_test

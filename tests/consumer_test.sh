@@ -19,6 +19,8 @@ check "version file installed" test -f "$tmp/full/lib/cmake/impactdeck/impactdec
 check "public header installed" test -f "$tmp/full/include/impactdeck/collision/impact.hpp"
 check "generated version header installed" test -f "$tmp/full/include/impactdeck/common/version.hpp"
 check "plugins beside the command" test -f "$tmp/full/bin/libimpactdeck_gmsh_cad.so" -a -f "$tmp/full/bin/libimpactdeck_gmsh_mesher.so"
+check "man page installed" test -s "$tmp/full/share/man/man1/impactdeck.1"
+check "bash completion installed" bash -c ". '$tmp/full/share/bash-completion/completions/impactdeck' && complete -p impactdeck"
 cmake -S "$src/tests/consumer" -B "$tmp/cfull" -G Ninja -DCMAKE_PREFIX_PATH="$tmp/full" > "$tmp/cfull.log" 2>&1
 check "consumer configures against the full package" test $? -eq 0
 cmake --build "$tmp/cfull" > "$tmp/cfull_build.log" 2>&1

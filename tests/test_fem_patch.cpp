@@ -308,9 +308,13 @@ TEST(FemStress, VonMisesPeaksZonesAndVerdictFromAFrd) {
 
   // Files: CSV with a column per series, VTU with every node and tetrahedron, MSH views, SVG.
   write_stress_files(d, m, r, "test");
-  ASSERT_EQ(r.files.size(), 4u);
+  ASSERT_EQ(r.files.size(), 5u);  // the CSV's JSON sidecar too
   const std::string csv = slurp(d / "von_mises_history.csv");
-  EXPECT_NE(csv.find("time_s,PROBE1_von_mises_Pa,LOAD_von_mises_Pa\n"), std::string::npos) << csv;
+  EXPECT_EQ(csv.rfind("time_s,PROBE1_von_mises_Pa,LOAD_von_mises_Pa\n", 0), 0u) << "no comment lines: " << csv;
+  const nlohmann::json side = nlohmann::json::parse(slurp(d / "von_mises_history.csv.json"));
+  EXPECT_EQ(side.at("columns").at(1).at("unit"), "Pa");
+  EXPECT_EQ(side.at("columns").at(0).at("unit"), "s");
+  EXPECT_NE(side.at("metadata").at("PROBE1").get<std::string>().find("mm"), std::string::npos);
   EXPECT_NE(csv.find("\n2e-06,"), std::string::npos) << csv;
   const std::string vtu = slurp(d / "von_mises_peak.vtu");
   EXPECT_NE(vtu.find("NumberOfPoints=\"5\" NumberOfCells=\"2\""), std::string::npos);

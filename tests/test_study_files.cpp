@@ -11,6 +11,7 @@
 
 #include <cairo.h>
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 #include <tinyxml2.h>
 
 #include "impactdeck/common/error.hpp"
@@ -315,9 +316,13 @@ TEST_F(SweepFiles, CoordinatesInTheOutputLengthUnit) {
   const std::size_t n = result->points.size();
   for (std::size_t i = 0; i < n; ++i)
     for (int k = 0; k < 3; ++k) ASSERT_EQ(v.arrays["Points"].at(3 * i + k), result->points[i].point_m[k] * 1000.0);
+  // The CSV is plain (header + rows); its JSON sidecar names the unit of every column.
   const std::string csv = slurp(*dir / "mm.csv");
-  EXPECT_NE(csv.find("\nindex,x_mm,y_mm,z_mm,nx,"), std::string::npos);
-  EXPECT_NE(csv.find("coordinates in mm"), std::string::npos);
+  EXPECT_EQ(csv.rfind("index,x_mm,y_mm,z_mm,nx,", 0), 0u);
+  const nlohmann::json side = nlohmann::json::parse(slurp(*dir / "mm.csv.json"));
+  EXPECT_EQ(side.at("columns").at(1).at("name"), "x_mm");
+  EXPECT_EQ(side.at("columns").at(1).at("unit"), "mm");
+  EXPECT_NE(side.dump().find("in mm"), std::string::npos);
   const std::string pos = slurp(*dir / "mm.pos");
   EXPECT_NE(pos.find("coordinates in mm"), std::string::npos);
   const PointResult& p0 = result->points[0];
@@ -503,7 +508,10 @@ TEST(Table1Files, CsvMarkdownHeatmap) {
   const Table1Result r = run_table1(o);
   write_table1_csv(dir / "t.csv", r);
   const std::string csv = slurp(dir / "t.csv");
-  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 2 + 1 + 81);  // 2 comments, header, 81 cells
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 81);  // header, 81 cells: no comment line
+  EXPECT_EQ(csv.rfind("geometric_ratio,mass_ratio,collision_force_ratio,mass_only_ratio", 0), 0u);
+  const std::string side = slurp(dir / "t.csv.json");  // the settings moved to the JSON sidecar
+  EXPECT_NE(side.find("\"settings\": \"cloud paper-grid"), std::string::npos) << side;
   const std::string md = table1_markdown(r);
   EXPECT_NE(md.find("| **1e4** |"), std::string::npos);
   EXPECT_NE(md.find("Eq. 40"), std::string::npos);

@@ -12,6 +12,7 @@
 #include "impactdeck/campaign/campaign.hpp"
 #include "impactdeck/campaign/runner.hpp"
 #include "impactdeck/common/atomic_file.hpp"
+#include "impactdeck/common/csv_sidecar.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/plot/drawing.hpp"
 #include "impactdeck/plot/html.hpp"
@@ -353,6 +354,13 @@ CollectResult collect(const fs::path& dir_in) {
   out.csv = cdir / "cases.csv";
   out.json = cdir / "cases.json";
   files.add(out.csv, csv.str());
+  {  // the table's JSON sidecar: the unit of every column (common/csv_sidecar.hpp)
+    const std::string text = csv.str();
+    files.add(csv_sidecar_path(out.csv),
+              csv_sidecar_text(out.csv, csv_columns(std::string_view(text).substr(0, text.find('\n'))),
+                               {{"title", "impactdeck campaign collect: one row per case (cases.json: the same, "
+                                          "with every case's inputs and results)"}}));
+  }
   files.add(out.json, doc.dump(2) + "\n");
 
   // The map over the part's surface (points) or the orientation sphere (drops).

@@ -10,6 +10,8 @@ std::optional<LengthUnit> parse_length_unit(std::string_view text) {
   return std::nullopt;
 }
 
+std::vector<std::string> length_unit_names() { return {"m", "cm", "mm", "in"}; }
+
 const char* to_string(LengthUnit u) {
   switch (u) {
     case LengthUnit::m: return "m";

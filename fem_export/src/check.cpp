@@ -15,6 +15,7 @@
 #include "impactdeck/common/numeric.hpp"
 #include "impactdeck/fem_export/decks.hpp"
 #include "impactdeck/fem_export/mesh.hpp"
+#include "impactdeck/common/json_number.hpp"
 #include "solver_process.hpp"
 
 namespace impactdeck::fem_export {
@@ -643,11 +644,10 @@ double default_solver_timeout_s(std::size_t nodes, std::size_t increments) {
 }
 
 json to_json(const CheckResult& r) {
-  auto v3 = [](const Eigen::Vector3d& v) { return json::array({v.x() + 0.0, v.y() + 0.0, v.z() + 0.0}); };
   json probes = json::array();
   for (const auto& p : r.probes) {
     probes.push_back({{"name", p.name},
-                      {"point_m", v3(p.point_m)},
+                      {"point_m", json_vector(p.point_m)},
                       {"mean_velocity_m_s", p.mean_velocity_m_s},
                       {"mean_velocity_scatter_m_s", p.scatter_m_s},
                       {"rigid_body_velocity_m_s", p.rigid_body_velocity_m_s},
@@ -661,8 +661,8 @@ json to_json(const CheckResult& r) {
             {"fe_velocity_m_s", r.fe_velocity_m_s},
             {"linear_momentum_relative_error", r.linear_momentum_relative_error},
             {"angular_momentum_relative_error", nullptr},
-            {"angular_velocity_fe_rad_s", v3(r.angular_velocity_fe_rad_s)},
-            {"angular_velocity_expected_rad_s", v3(r.angular_velocity_expected_rad_s)},
+            {"angular_velocity_fe_rad_s", json_vector(r.angular_velocity_fe_rad_s)},
+            {"angular_velocity_expected_rad_s", json_vector(r.angular_velocity_expected_rad_s)},
             {"probes", probes},
             {"solver_wall_time_s", r.solver_wall_time_s},
             {"solver_timeout_s", r.solver_timeout_s},
@@ -674,14 +674,13 @@ json to_json(const CheckResult& r) {
             {"passed", r.passed},
             {"failures", r.failures}};
   if (r.angular_momentum_relative_error) j["angular_momentum_relative_error"] = *r.angular_momentum_relative_error;
-  auto opt = [](const std::optional<double>& x) { return x ? json(*x) : json(nullptr); };
-  j["model_linear_velocity_relative_error"] = opt(r.model_linear_velocity_relative_error);
-  j["model_angular_velocity_relative_error"] = opt(r.model_angular_velocity_relative_error);
+  j["model_linear_velocity_relative_error"] = json_number(r.model_linear_velocity_relative_error);
+  j["model_angular_velocity_relative_error"] = json_number(r.model_angular_velocity_relative_error);
   j["model_linear_velocity_tolerance"] = r.model_linear_velocity_tolerance;
   j["model_angular_velocity_tolerance"] = r.model_angular_velocity_tolerance;
-  j["fe_rigid_velocity_m_s"] = v3(r.fe_rigid_velocity_m_s);
-  j["model_delta_velocity_m_s"] = v3(r.model_delta_velocity_m_s);
-  j["model_delta_angular_velocity_rad_s"] = v3(r.model_delta_angular_velocity_rad_s);
+  j["fe_rigid_velocity_m_s"] = json_vector(r.fe_rigid_velocity_m_s);
+  j["model_delta_velocity_m_s"] = json_vector(r.model_delta_velocity_m_s);
+  j["model_delta_angular_velocity_rad_s"] = json_vector(r.model_delta_angular_velocity_rad_s);
   j["body"] = to_json(r.body);
   j["stress"] = r.stress ? to_json(*r.stress) : json(nullptr);
   return j;

@@ -15,6 +15,7 @@
 #include "impactdeck/common/atomic_file.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/common/version.hpp"
+#include "impactdeck/common/json_number.hpp"
 
 namespace impactdeck::fem_export {
 namespace fs = std::filesystem;
@@ -29,7 +30,7 @@ constexpr double kTonnePerMm3 = 1e-12;
 // ccx face numbers of a tetrahedron (corner triples, 0-based): S1 1-2-3, S2 1-4-2, S3 2-4-3, S4 3-4-1.
 constexpr int kTetFaces[4][3] = {{0, 1, 2}, {0, 3, 1}, {1, 3, 2}, {2, 3, 0}};
 
-std::string num(double v) {
+std::string json_number(double v) {
   std::ostringstream s;
   s << std::setprecision(12) << v + 0.0;
   std::string t = s.str();
@@ -37,10 +38,9 @@ std::string num(double v) {
   return t;
 }
 
-json v3(const Eigen::Vector3d& v) { return json::array({v.x(), v.y(), v.z()}); }
 Eigen::Vector3d vec3(const json& j) { return Eigen::Vector3d(j.at(0), j.at(1), j.at(2)); }
 json m3(const Eigen::Matrix3d& m) {
-  return json::array({v3(m.row(0).transpose()), v3(m.row(1).transpose()), v3(m.row(2).transpose())});
+  return json::array({json_vector(m.row(0).transpose()), json_vector(m.row(1).transpose()), json_vector(m.row(2).transpose())});
 }
 Eigen::Matrix3d mat3(const json& j) {
   Eigen::Matrix3d m;
@@ -261,7 +261,7 @@ ContactDeck write_contact_deck(const ContactModelRequest& r, const fs::path& fol
     for (int i = 0; i < 2; ++i) {
       for (std::size_t n = 0; n < q[i].nodes.size(); ++n) {
         const Eigen::Vector3d p = q[i].nodes[n] * kMm;
-        d << base[i] + n + 1 << ", " << num(p.x()) << ", " << num(p.y()) << ", " << num(p.z()) << "\n";
+        d << base[i] + n + 1 << ", " << json_number(p.x()) << ", " << json_number(p.y()) << ", " << json_number(p.z()) << "\n";
       }
     }
     const char* eset[2] = {"ETGT", "EIMP"};
@@ -286,13 +286,13 @@ ContactDeck write_contact_deck(const ContactModelRequest& r, const fs::path& fol
     for (int i = 0; i < 2; ++i) {
       const DeckMaterial& m = bodies[i]->material;
       d << "*MATERIAL, NAME=" << mname[i] << "\n*ELASTIC\n"
-        << num(m.youngs_modulus_Pa * kMPa) << ", " << num(m.poisson_ratio) << "\n*DENSITY\n"
-        << num(m.density_kg_m3 * kTonnePerMm3) << "\n*SOLID SECTION, ELSET=" << eset[i] << ", MATERIAL=" << mname[i]
+        << json_number(m.youngs_modulus_Pa * kMPa) << ", " << json_number(m.poisson_ratio) << "\n*DENSITY\n"
+        << json_number(m.density_kg_m3 * kTonnePerMm3) << "\n*SOLID SECTION, ELSET=" << eset[i] << ", MATERIAL=" << mname[i]
         << "\n";
     }
     // Slave: the impactor's surface; master: the target's (both refined alike).
     d << "*SURFACE INTERACTION, NAME=SI1\n*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR\n"
-      << num(out.penalty_N_m3 * kMPa / kMm) << "\n"
+      << json_number(out.penalty_N_m3 * kMPa / kMm) << "\n"
       << "*CONTACT PAIR, INTERACTION=SI1, TYPE=SURFACE TO SURFACE\nSIMP, STGT\n";
     // Initial velocities: v + omega x (x - c) of each body (mm/s).
     d << "*INITIAL CONDITIONS, TYPE=VELOCITY\n";
@@ -301,7 +301,7 @@ ContactDeck write_contact_deck(const ContactModelRequest& r, const fs::path& fol
       const Eigen::Vector3d c = b.rotation * b.centroid_own_m + b.position_m - r.contact_point_m;
       for (std::size_t n = 0; n < q[i].nodes.size(); ++n) {
         const Eigen::Vector3d v = (b.velocity_m_s + b.angular_velocity_rad_s.cross(q[i].nodes[n] - c)) * kMm;
-        for (int k = 0; k < 3; ++k) d << base[i] + n + 1 << ", " << k + 1 << ", " << num(v[k]) << "\n";
+        for (int k = 0; k < 3; ++k) d << base[i] + n + 1 << ", " << k + 1 << ", " << json_number(v[k]) << "\n";
       }
     }
     const std::string solver = o.iterative_solver ? ", SOLVER=ITERATIVE SCALING" : "";
@@ -310,13 +310,13 @@ ContactDeck write_contact_deck(const ContactModelRequest& r, const fs::path& fol
     // The floor dt / 20 allows two cutbacks, and keeps the small steps ccx takes when the contact
     // opens ("impact rules") from costing many increments after the separation.
     d << "*STEP, INC=" << 20 * out.increments + 200 << "\n*DYNAMIC" << solver << "\n"
-      << num(out.time_step_s) << ", " << num(out.end_time_s - out.time_step_s) << ", "
-      << num(0.05 * out.time_step_s) << ", " << num(out.time_step_s) << "\n"
+      << json_number(out.time_step_s) << ", " << json_number(out.end_time_s - out.time_step_s) << ", "
+      << json_number(0.05 * out.time_step_s) << ", " << json_number(out.time_step_s) << "\n"
       << "*CONTACT PRINT, FREQUENCY=1, SLAVE=SIMP, MASTER=STGT\nCF\n"
       << (probe_nodes.empty() ? "" : "*EL FILE, FREQUENCY=1, NSET=NPROBES\nS\n") << "*END STEP\n";
     // One more increment that prints the final state of every node and the energies.
-    d << "*STEP, INC=100\n*DYNAMIC, DIRECT" << solver << "\n" << num(out.time_step_s) << ", "
-      << num(out.time_step_s) << "\n"
+    d << "*STEP, INC=100\n*DYNAMIC, DIRECT" << solver << "\n" << json_number(out.time_step_s) << ", "
+      << json_number(out.time_step_s) << "\n"
       << "*CONTACT PRINT, SLAVE=SIMP, MASTER=STGT\nCF\n*NODE PRINT, NSET=NALL\nU, V\n"
       << "*EL PRINT, ELSET=ETGT, TOTALS=ONLY\nELSE, ELKE\n*EL PRINT, ELSET=EIMP, TOTALS=ONLY\nELSE, ELKE\n*END STEP\n";
     write_file_atomically(stage / (std::string(kJobName) + ".inp"), d.str());
@@ -327,7 +327,7 @@ ContactDeck write_contact_deck(const ContactModelRequest& r, const fs::path& fol
       const ContactBody& b = *bodies[i];
       json nodes = json::array(), w = json::array();
       for (std::size_t n = 0; n < q[i].nodes.size(); ++n) {
-        nodes.push_back(v3(q[i].nodes[n]));
+        nodes.push_back(json_vector(q[i].nodes[n]));
         w.push_back(q[i].node_mass_kg[n]);
       }
       bj.push_back({{"name", b.name},
@@ -337,10 +337,10 @@ ContactDeck write_contact_deck(const ContactModelRequest& r, const fs::path& fol
                     {"element_count", q[i].elements.size()},
                     {"contact_faces", q[i].contact_faces.size()},
                     {"fe_mass_kg", q[i].mass_kg},
-                    {"fe_centroid_m", v3(q[i].centroid)},
+                    {"fe_centroid_m", json_vector(q[i].centroid)},
                     {"fe_inertia_kg_m2", m3(q[i].inertia)},
-                    {"velocity_m_s", v3(b.velocity_m_s)},
-                    {"angular_velocity_rad_s", v3(b.angular_velocity_rad_s)},
+                    {"velocity_m_s", json_vector(b.velocity_m_s)},
+                    {"angular_velocity_rad_s", json_vector(b.angular_velocity_rad_s)},
                     {"nodes_m", nodes},
                     {"node_mass_kg", w}});
     }
@@ -350,8 +350,8 @@ ContactDeck write_contact_deck(const ContactModelRequest& r, const fs::path& fol
                {"job", kJobName},
                {"deck_units", "mm-N-s-tonne"},
                {"frame", "world, origin at the contact point"},
-               {"contact_point_m", v3(r.contact_point_m)},
-               {"normal", v3(r.normal)},
+               {"contact_point_m", json_vector(r.contact_point_m)},
+               {"normal", json_vector(r.normal)},
                {"contact_mesh_size_m", hc},
                {"penalty_N_m3", out.penalty_N_m3},
                {"penalty_factor", o.penalty_factor},
@@ -361,7 +361,7 @@ ContactDeck write_contact_deck(const ContactModelRequest& r, const fs::path& fol
                {"bodies", bj}};
     json probes = json::array();
     for (const auto& [name, node] : probe_nodes) {
-      probes.push_back({{"name", name}, {"node", node + 1}, {"point_m", v3(q[0].nodes[node])}});
+      probes.push_back({{"name", name}, {"node", node + 1}, {"point_m", json_vector(q[0].nodes[node])}});
     }
     cj["probes"] = probes;
     write_file_atomically(stage / "contact.json", cj.dump() + "\n");

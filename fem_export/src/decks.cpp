@@ -16,6 +16,7 @@
 #include "impactdeck/common/run_transaction.hpp"
 #include "impactdeck/common/version.hpp"
 #include "impactdeck/fem_export/force_table.hpp"
+#include "impactdeck/common/json_number.hpp"
 
 namespace impactdeck::fem_export {
 namespace fs = std::filesystem;
@@ -672,11 +673,11 @@ DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
     fh.source = r.source;
     fh.impact = r.impact;
     fh.direction = r.direction;
-    write_file_atomically(stage / "force.csv", [&](std::ostream& out) { write_force_table_csv(out, r.force, fh); });
-    names.push_back("force.csv");
+    write_force_table_files(stage / "force.csv", r.force, fh);
+    names.insert(names.end(), {"force.csv", "force.csv.json"});
 
     using nlohmann::json;
-    auto v3 = [](const Eigen::Vector3d& v) { return json::array({v.x() + 0.0, v.y() + 0.0, v.z() + 0.0}); };
+    auto v3 = [](const auto& v) { return json_vector(v); };  // common/json_number.hpp
     auto m3 = [&](const Eigen::Matrix3d& a) { return json::array({v3(a.row(0)), v3(a.row(1)), v3(a.row(2))}); };
     json quality = {{"node_count", q.node_count},
                     {"tet_count", q.tet_count},

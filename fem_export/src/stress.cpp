@@ -10,9 +10,11 @@
 #include <sstream>
 
 #include "impactdeck/common/atomic_file.hpp"
+#include "impactdeck/common/csv_sidecar.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/fem_export/decks.hpp"
 #include "impactdeck/plot/stress_plot.hpp"
+#include "impactdeck/common/json_number.hpp"
 
 namespace impactdeck::fem_export {
 namespace fs = std::filesystem;
@@ -265,8 +267,6 @@ void write_stress_files(const fs::path& dir, const TetMesh& m, StressResult& r, 
   // 1. History CSV, SI.
   const fs::path csv = dir / "von_mises_history.csv";
   write_file_atomically(csv, [&](std::ostream& o) {
-    o << "# von Mises stress (Pa) against time (s) at each probe and at the contact node LOAD (impactdeck)\n";
-    for (const auto* p : series) o << "# " << p->name << " at " << mm_text(p->point_m) << "\n";
     o << "time_s";
     for (const auto* p : series) o << "," << p->name << "_von_mises_Pa";
     o << "\n" << std::setprecision(9);
@@ -276,6 +276,16 @@ void write_stress_files(const fs::path& dir, const TetMesh& m, StressResult& r, 
       o << "\n";
     }
   });
+  {  // Its JSON sidecar: what used to be `#` lines (common/csv_sidecar.hpp).
+    std::vector<std::string> columns = {"time_s"};
+    std::vector<std::pair<std::string, std::string>> meta = {
+        {"title", "von Mises stress (Pa) against time (s) at each probe and at the contact node LOAD (impactdeck)"}};
+    for (const auto* p : series) {
+      columns.push_back(p->name + "_von_mises_Pa");
+      meta.push_back({p->name, "at " + mm_text(p->point_m)});
+    }
+    write_csv_sidecar(csv, columns, meta);
+  }
 
   // 2. VTK XML unstructured grid (ASCII): positions in the deck's length unit, tetrahedra (VTK type 10).
   const double per_m = DeckUnits{r.length_unit}.per_m();
@@ -369,7 +379,7 @@ void write_stress_files(const fs::path& dir, const TetMesh& m, StressResult& r, 
     plot::write_svg(svg, plot::stress_time_drawing(ps, po));
     r.files.push_back(svg);
   }
-  r.files.insert(r.files.begin(), {csv, vtu, msh});
+  r.files.insert(r.files.begin(), {csv, csv_sidecar_path(csv), vtu, msh});
 }
 
 std::string format_stress(const StressResult& r) {
@@ -404,15 +414,14 @@ std::string format_stress(const StressResult& r) {
 }
 
 json to_json(const StressResult& r) {
-  auto v3 = [](const Eigen::Vector3d& v) { return json::array({v.x() + 0.0, v.y() + 0.0, v.z() + 0.0}); };
   auto peak = [&](const VonMisesPeak& p) {
     if (p.node < 0) return json(nullptr);
-    return json{{"max_von_mises_Pa", p.von_mises_Pa}, {"time_s", p.time_s}, {"node", p.node + 1}, {"point_m", v3(p.point_m)}};
+    return json{{"max_von_mises_Pa", p.von_mises_Pa}, {"time_s", p.time_s}, {"node", p.node + 1}, {"point_m", json_vector(p.point_m)}};
   };
   auto probe = [&](const ProbeStress& p) {
     return json{{"name", p.name},
                 {"node", p.node + 1},
-                {"point_m", v3(p.point_m)},
+                {"point_m", json_vector(p.point_m)},
                 {"max_von_mises_Pa", p.max_von_mises_Pa},
                 {"max_von_mises_time_s", p.max_von_mises_time_s}};
   };

@@ -11,15 +11,15 @@
 #include "impactdeck/common/version.hpp"
 #include "impactdeck/geometry/cad_shape.hpp"
 #include "impactdeck/geometry/part.hpp"
+#include "impactdeck/common/json_number.hpp"
+#include "impactdeck/common/stage.hpp"
 
 namespace impactdeck::geometry {
 namespace {
 
-nlohmann::json num(double x) { return std::isfinite(x) ? nlohmann::json(x + 0.0) : nlohmann::json(nullptr); }
-nlohmann::json vec(const Eigen::Vector3d& v) { return {num(v.x()), num(v.y()), num(v.z())}; }
 nlohmann::json mat(const Eigen::Matrix3d& m) {
   nlohmann::json j = nlohmann::json::array();
-  for (int i = 0; i < 3; ++i) j.push_back({num(m(i, 0)), num(m(i, 1)), num(m(i, 2))});
+  for (int i = 0; i < 3; ++i) j.push_back({json_number(m(i, 0)), json_number(m(i, 1)), json_number(m(i, 2))});
   return j;
 }
 std::string text(const Eigen::Vector3d& v) {
@@ -142,29 +142,29 @@ InspectReport inspect_part(const InspectOptions& a) {
     j["repairs"] = part.repairs.actions;
     j["mass_properties_approximate"] = part.approximate_mass;
     j["approximation_reason"] = part.approximate_mass ? nlohmann::json(part.approximation_reason) : nlohmann::json(nullptr);
-    j["volume_m3"] = num(vp.volume_m3);
-    j["area_m2"] = num(vp.area_m2);
-    j["density_kg_m3"] = density ? num(*density) : nlohmann::json(nullptr);
-    j["mass_kg"] = density ? num(*density * vp.volume_m3) : nlohmann::json(nullptr);
-    j["center_of_mass_m"] = vec(vp.centroid_m);
+    j["volume_m3"] = json_number(vp.volume_m3);
+    j["area_m2"] = json_number(vp.area_m2);
+    j["density_kg_m3"] = density ? json_number(*density) : nlohmann::json(nullptr);
+    j["mass_kg"] = density ? json_number(*density * vp.volume_m3) : nlohmann::json(nullptr);
+    j["center_of_mass_m"] = json_vector(vp.centroid_m);
     j["inertia_per_density_m5"] = mat(vp.inertia_per_density_m5);
     j["inertia_kg_m2"] = density ? mat(inertia) : nlohmann::json(nullptr);
-    j["principal_moments_kg_m2"] = density ? vec(pa.moments * *density) : nlohmann::json(nullptr);
-    j["principal_moments_per_density_m5"] = vec(pa.moments);
+    j["principal_moments_kg_m2"] = density ? json_vector(pa.moments * *density) : nlohmann::json(nullptr);
+    j["principal_moments_per_density_m5"] = json_vector(pa.moments);
     j["principal_axes"] = mat(pa.axes);  // columns are the axes
-    j["principal_moment_relative_gaps"] = {num(pa.relative_gaps[0]), num(pa.relative_gaps[1])};
+    j["principal_moment_relative_gaps"] = {json_number(pa.relative_gaps[0]), json_number(pa.relative_gaps[1])};
     j["principal_axes_well_defined"] = pa.axes_well_defined();
     j["sharp_edges"] = part.sharp_edges;
-    j["mean_edge_length_m"] = num(part.mean_edge_length_m);
+    j["mean_edge_length_m"] = json_number(part.mean_edge_length_m);
     nlohmann::json queries = nlohmann::json::array();
     for (std::size_t i = 0; i < points.size(); ++i) {
       const MeshShape& shape = *part.shape;
       const auto sp = shape.closest_point(points[i]);
       nlohmann::json q;
-      q["query_m"] = vec(points[i]);
-      q["surface_point_m"] = vec(sp.point_m);
-      q["distance_m"] = num(sp.distance_m);
-      q["normal"] = vec(sp.normal);
+      q["query_m"] = json_vector(points[i]);
+      q["surface_point_m"] = json_vector(sp.point_m);
+      q["distance_m"] = json_number(sp.distance_m);
+      q["normal"] = json_vector(sp.normal);
       try {
         const auto fit = shape.curvature_fit(sp.point_m);
         const auto& c = fit.curvature;
@@ -174,15 +174,15 @@ InspectReport inspect_part(const InspectOptions& a) {
           q["principal_directions"] = nullptr;
           q["curvature_error_estimate_1_per_m"] = nullptr;
         } else {
-          q["principal_curvatures_1_per_m"] = {num(c.k1_per_m), num(c.k2_per_m)};
-          q["principal_directions"] = {vec(c.d1), vec(c.d2)};
-          q["curvature_error_estimate_1_per_m"] = num(c.error_estimate_per_m);
-          q["fit_condition_number"] = num(fit.condition_number);
+          q["principal_curvatures_1_per_m"] = {json_number(c.k1_per_m), json_number(c.k2_per_m)};
+          q["principal_directions"] = {json_vector(c.d1), json_vector(c.d2)};
+          q["curvature_error_estimate_1_per_m"] = json_number(c.error_estimate_per_m);
+          q["fit_condition_number"] = json_number(fit.condition_number);
           q["fit_points"] = fit.neighbourhood_points;
           q["planar_neighbourhood"] = fit.planar;
         }
         try {
-          q["paper_radius_m"] = c.sharp_feature ? nlohmann::json(nullptr) : num(shape.paper_radius_m(sp));
+          q["paper_radius_m"] = c.sharp_feature ? nlohmann::json(nullptr) : json_number(shape.paper_radius_m(sp));
         } catch (const InputError& e) {
           q["paper_radius_m"] = nullptr;
           warnings.push_back("--at " + args->at[i] + ": " + e.reason());
@@ -276,18 +276,18 @@ InspectReport inspect_cad(const InspectOptions& a, const std::vector<Eigen::Vect
   j["mass_properties_source"] = "exact (OpenCASCADE, B-rep solid)";
   j["triangulation"] = {{"triangles", shape->triangulation().mesh().triangle_count()},
                         {"vertices", shape->triangulation().mesh().vertex_count()},
-                        {"volume_relative_difference", num(shape->triangulation_volume_relative_difference())}};
-  j["volume_m3"] = num(vp.volume_m3);
-  j["area_m2"] = num(vp.area_m2);
-  j["density_kg_m3"] = density ? num(*density) : nlohmann::json(nullptr);
-  j["mass_kg"] = density ? num(*density * vp.volume_m3) : nlohmann::json(nullptr);
-  j["center_of_mass_m"] = vec(vp.centroid_m);
+                        {"volume_relative_difference", json_number(shape->triangulation_volume_relative_difference())}};
+  j["volume_m3"] = json_number(vp.volume_m3);
+  j["area_m2"] = json_number(vp.area_m2);
+  j["density_kg_m3"] = density ? json_number(*density) : nlohmann::json(nullptr);
+  j["mass_kg"] = density ? json_number(*density * vp.volume_m3) : nlohmann::json(nullptr);
+  j["center_of_mass_m"] = json_vector(vp.centroid_m);
   j["inertia_per_density_m5"] = mat(vp.inertia_per_density_m5);
   j["inertia_kg_m2"] = density ? mat(vp.inertia_per_density_m5 * *density) : nlohmann::json(nullptr);
-  j["principal_moments_kg_m2"] = density ? vec(pa.moments * *density) : nlohmann::json(nullptr);
-  j["principal_moments_per_density_m5"] = vec(pa.moments);
+  j["principal_moments_kg_m2"] = density ? json_vector(pa.moments * *density) : nlohmann::json(nullptr);
+  j["principal_moments_per_density_m5"] = json_vector(pa.moments);
   j["principal_axes"] = mat(pa.axes);
-  j["principal_moment_relative_gaps"] = {num(pa.relative_gaps[0]), num(pa.relative_gaps[1])};
+  j["principal_moment_relative_gaps"] = {json_number(pa.relative_gaps[0]), json_number(pa.relative_gaps[1])};
   j["principal_axes_well_defined"] = pa.axes_well_defined();
   j["sharp_edges"] = shape->sharp_edge_count();
   std::ostringstream o;
@@ -308,10 +308,10 @@ InspectReport inspect_cad(const InspectOptions& a, const std::vector<Eigen::Vect
     const CadLocation loc = shape->locate(points[i]);
     const SurfacePoint& sp = loc.point;
     nlohmann::json q;
-    q["query_m"] = vec(points[i]);
-    q["surface_point_m"] = vec(sp.point_m);
-    q["distance_m"] = num(sp.distance_m);
-    q["normal"] = vec(sp.normal);
+    q["query_m"] = json_vector(points[i]);
+    q["surface_point_m"] = json_vector(sp.point_m);
+    q["distance_m"] = json_number(sp.distance_m);
+    q["normal"] = json_vector(sp.normal);
     q["face"] = loc.face;
     q["edge"] = loc.edge >= 0 ? nlohmann::json(loc.edge) : nlohmann::json(nullptr);
     Curvature c;
@@ -330,11 +330,11 @@ InspectReport inspect_cad(const InspectOptions& a, const std::vector<Eigen::Vect
       q["paper_radius_m"] = nullptr;
       o << "    SHARP EDGE OR CORNER: curvature undefined, the local radius is your call\n";
     } else {
-      q["principal_curvatures_1_per_m"] = {num(c.k1_per_m), num(c.k2_per_m)};
-      q["principal_directions"] = {vec(c.d1), vec(c.d2)};
-      q["curvature_error_estimate_1_per_m"] = num(c.error_estimate_per_m);
+      q["principal_curvatures_1_per_m"] = {json_number(c.k1_per_m), json_number(c.k2_per_m)};
+      q["principal_directions"] = {json_vector(c.d1), json_vector(c.d2)};
+      q["curvature_error_estimate_1_per_m"] = json_number(c.error_estimate_per_m);
       try {
-        q["paper_radius_m"] = num(shape->paper_radius_m(sp));
+        q["paper_radius_m"] = json_number(shape->paper_radius_m(sp));
       } catch (const InputError& e) {
         q["paper_radius_m"] = nullptr;
         warnings.push_back("--at " + label + ": " + e.reason());
@@ -346,7 +346,7 @@ InspectReport inspect_cad(const InspectOptions& a, const std::vector<Eigen::Vect
     queries.push_back(q);
   }
   j["points"] = queries;
-  j["stage_times_s"] = {{"mesh_load", shape->load_seconds()}};
+  j["stage_times_s"] = {{stage_name(Stage::mesh_load), shape->load_seconds()}};
   j["warnings"] = warnings;
   for (const auto& w : warnings) o << "  warning: " << w << "\n";
   InspectReport out;

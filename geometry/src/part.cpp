@@ -4,31 +4,32 @@
 #include <sstream>
 
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/common/stage.hpp"
 #include "text_mesh_readers.hpp"
 
 namespace impactdeck::geometry {
 
 namespace {
+// Runs f as `stage`, recording its wall time when it completes (a stage that throws is not listed).
 template <class F>
-auto timed(std::vector<StageSeconds>& stages, const std::string& name, F&& f) {
-  const auto t0 = std::chrono::steady_clock::now();
-  auto record = [&] {
-    stages.push_back({name, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()});
-  };
+auto timed(std::vector<StageSeconds>& stages, Stage stage, F&& f) {
+  double seconds = 0;
+  auto done = [&] { stages.push_back({stage_name(stage), seconds}); };
   if constexpr (std::is_void_v<decltype(f())>) {
-    f();
-    record();
+    { ScopedTimer t([&](double s) { seconds = s; }); f(); }
+    done();
   } else {
-    auto v = f();
-    record();
+    auto v = [&] { ScopedTimer t([&](double s) { seconds = s; }); return f(); }();
+    done();
     return v;
   }
 }
 }  // namespace
 
 const std::vector<std::string>& part_stages() {
-  static const std::vector<std::string> names{"mesh_load", "mesh_validation", "mass_properties", "sharp_edges",
-                                              "curvature_index"};
+  static const std::vector<std::string> names{stage_name(Stage::mesh_load), stage_name(Stage::mesh_validation),
+                                              stage_name(Stage::mass_properties), stage_name(Stage::sharp_edges),
+                                              stage_name(Stage::curvature_index)};
   return names;
 }
 
@@ -36,7 +37,7 @@ Part load_part(const std::filesystem::path& file, const PartOptions& opt) {
   Part part;
   part.file = file;
   const std::string where = file.string();
-  part.loaded = timed(part.stages, "mesh_load", [&] { return load_mesh(file, opt.length_unit); });
+  part.loaded = timed(part.stages, Stage::mesh_load, [&] { return load_mesh(file, opt.length_unit); });
   detail::check_part_extent(part.loaded, where);  // size range, memory for the stages below
   part.warnings = part.loaded.warnings;
   TriangleMesh mesh = std::move(part.loaded.mesh);
@@ -45,7 +46,7 @@ Part load_part(const std::filesystem::path& file, const PartOptions& opt) {
   // The validation's shells and mass integrals are those of the mesh it validated (the repaired
   // one after a repair): the mass_properties stage reuses them.
   ValidationByproducts by;
-  ValidationReport report = timed(part.stages, "mesh_validation", [&] {
+  ValidationReport report = timed(part.stages, Stage::mesh_validation, [&] {
     part.validation = validate_mesh(mesh, opt.validation, &by);
     if (!opt.repair) return part.validation;
     part.repairs = repair_mesh(mesh);
@@ -87,7 +88,7 @@ Part load_part(const std::filesystem::path& file, const PartOptions& opt) {
     part.warnings.push_back(where + ": APPROXIMATE mass properties: " + part.approximation_reason);
   }
 
-  MeshMassProperties mass = timed(part.stages, "mass_properties", [&] {
+  MeshMassProperties mass = timed(part.stages, Stage::mass_properties, [&] {
     by.shells = ShellLabels();
     return std::move(by.mass);
   });
@@ -108,16 +109,16 @@ Part load_part(const std::filesystem::path& file, const PartOptions& opt) {
   part.mass = mass;
   if (!opt.build_surface_index) {
     // Only what a report needs; the mesh is released with this function.
-    timed(part.stages, "sharp_edges", [&] {
+    timed(part.stages, Stage::sharp_edges, [&] {
       // The validation's edge table (a reversal above keeps its undirected edges and their faces).
       part.sharp_edges = count_sharp_edges(mesh, by.edges, opt.shape.sharp_angle_deg);
       by.edges = EdgeTable();
       part.mean_edge_length_m = mesh.mean_edge_length_m();
     });
-    part.stages_skipped.push_back("curvature_index");
+    part.stages_skipped.push_back(stage_name(Stage::curvature_index));
     return part;
   }
-  part.shape = timed(part.stages, "curvature_index", [&] {
+  part.shape = timed(part.stages, Stage::curvature_index, [&] {
     return std::make_shared<const MeshShape>(std::move(mesh), mass, opt.shape);
   });
   part.sharp_edges = part.shape->sharp_edge_count();

@@ -8,9 +8,11 @@
 #include "impactdeck/collision/hertz.hpp"
 #include "impactdeck/common/atomic_file.hpp"
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/common/suggest.hpp"
 #include "impactdeck/plot/stress_plot.hpp"
 #include "impactdeck/scene/contact.hpp"
 #include "impactdeck/scene/pipeline.hpp"
+#include "impactdeck/common/json_number.hpp"
 
 namespace impactdeck::scene {
 namespace fs = std::filesystem;
@@ -27,13 +29,12 @@ const char* to_string(CompareVerdict v) {
 
 namespace {
 
-json v3(const Eigen::Vector3d& v) { return json::array({v.x() + 0.0, v.y() + 0.0, v.z() + 0.0}); }
 
 json probes_json(const std::vector<fem_export::ProbeStress>& probes) {
   json a = json::array();
   for (const auto& p : probes) {
     a.push_back({{"name", p.name},
-                 {"point_m", v3(p.point_m)},
+                 {"point_m", json_vector(p.point_m)},
                  {"max_von_mises_Pa", p.max_von_mises_Pa},
                  {"max_von_mises_time_s", p.max_von_mises_time_s}});
   }
@@ -87,7 +88,11 @@ CompareReport compare_contact(const Scene& scene_in, const CompareOptions& o) {
     spec = nullptr;
     for (const auto& s : scene_in.impacts)
       if (s.name == o.impact) spec = &s;
-    if (!spec) throw InputError(file, "--impact", "no impact named '" + o.impact + "' in the scene");
+    if (!spec) {
+      std::vector<std::string> names;
+      for (const auto& s : scene_in.impacts) names.push_back(s.name);
+      throw InputError(file, "--impact", "no impact named '" + o.impact + "' in the scene" + did_you_mean(o.impact, names));
+    }
   }
   if (!(o.threshold > 0) || o.refine < 0 || o.refine > 6) {
     throw InputError(file, "options", "--threshold must be > 0 and --refine within 0..6");
@@ -318,9 +323,9 @@ json to_json(const CompareReport& r) {
                    {"impact_energy_J", r.impact_energy_J},
                    {"contact_semi_axes_m", {r.semi_axis_a_m, r.semi_axis_b_m}},
                    {"restitution", r.restitution},
-                   {"delta_velocity_m_s", {{"target", v3(r.analytic_target_dv)}, {"impactor", v3(r.analytic_impactor_dv)}}},
+                   {"delta_velocity_m_s", {{"target", json_vector(r.analytic_target_dv)}, {"impactor", json_vector(r.analytic_impactor_dv)}}},
                    {"delta_angular_velocity_rad_s",
-                    {{"target", v3(r.analytic_target_dw)}, {"impactor", v3(r.analytic_impactor_dw)}}}};
+                    {{"target", json_vector(r.analytic_target_dw)}, {"impactor", json_vector(r.analytic_impactor_dw)}}}};
   auto level_json = [&](const ContactLevel& L) {
     const auto& run = L.run;
     return json{{"contact_elements", L.contact_elements},
@@ -337,9 +342,9 @@ json to_json(const CompareReport& r) {
                 {"penalty_N_m3", L.deck.penalty_N_m3},
                 {"contact_duration_s", run.contact_duration_s},
                 {"impulse_Ns", run.impulse_Ns},
-                {"delta_velocity_m_s", {{"target", v3(run.target.delta_velocity_m_s)}, {"impactor", v3(run.impactor.delta_velocity_m_s)}}},
+                {"delta_velocity_m_s", {{"target", json_vector(run.target.delta_velocity_m_s)}, {"impactor", json_vector(run.impactor.delta_velocity_m_s)}}},
                 {"delta_angular_velocity_rad_s",
-                 {{"target", v3(run.target.delta_angular_velocity_rad_s)}, {"impactor", v3(run.impactor.delta_angular_velocity_rad_s)}}},
+                 {{"target", json_vector(run.target.delta_angular_velocity_rad_s)}, {"impactor", json_vector(run.impactor.delta_angular_velocity_rad_s)}}},
                 {"vibration_energy_J", run.vibration_energy_J},
                 {"linear_momentum_relative_error", run.linear_momentum_relative_error},
                 {"angular_momentum_relative_error", run.angular_momentum_relative_error},
@@ -365,8 +370,8 @@ json to_json(const CompareReport& r) {
                        {"wall_time_s", c.solver_wall_time_s},
                        {"node_count", r.hybrid_deck->node_count},
                        {"increments", r.hybrid_increments},
-                       {"delta_velocity_m_s", {{"target", v3(r.hybrid_target_dv)}}},
-                       {"delta_angular_velocity_rad_s", {{"target", v3(r.hybrid_target_dw)}}},
+                       {"delta_velocity_m_s", {{"target", json_vector(r.hybrid_target_dv)}}},
+                       {"delta_angular_velocity_rad_s", {{"target", json_vector(r.hybrid_target_dw)}}},
                        {"probes", probes},
                        {"checks_passed", c.passed},
                        {"folder", r.hybrid_deck->folder.string()}};

@@ -5,7 +5,9 @@
 #include <cmath>
 #include <fstream>
 #include <iterator>
+#include <functional>
 #include <limits>
+#include <optional>
 #include <sstream>
 
 #include "impactdeck/collision/elliptical.hpp"
@@ -13,6 +15,7 @@
 #include "impactdeck/common/atomic_file.hpp"
 #include "impactdeck/common/run_transaction.hpp"
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/common/stage.hpp"
 #include "impactdeck/fem_export/force_table.hpp"
 #include "impactdeck/geometry/cad_shape.hpp"
 #include "impactdeck/geometry/ellipsoid.hpp"
@@ -27,10 +30,14 @@ namespace impactdeck::scene {
 namespace fs = std::filesystem;
 
 const std::vector<std::string>& all_stages() {
-  static const std::vector<std::string> s = {
-      "scene",        "mesh_load",      "mesh_validation", "mass_properties",
-      "curvature_index", "contact_geometry", "impact",     "force_table",
-      "fem_mesh",     "fem_decks",      "fem_run",         "compare_contact", "write_outputs"};
+  static const std::vector<std::string> s = [] {
+    std::vector<std::string> names;
+    for (Stage st : {Stage::scene, Stage::mesh_load, Stage::mesh_validation, Stage::mass_properties,
+                     Stage::curvature_index, Stage::contact_geometry, Stage::impact, Stage::force_table,
+                     Stage::fem_mesh, Stage::fem_decks, Stage::fem_run, Stage::compare_contact, Stage::write_outputs})
+      names.push_back(stage_name(st));
+    return names;
+  }();
   return s;
 }
 
@@ -46,26 +53,22 @@ bool RunReport::all_checks_passed() const {
 
 namespace {
 
+// Adds `seconds` to the stage's time (listed at its first run).
+void add_stage(RunReport& r, const std::string& name, double seconds) {
+  for (auto& st : r.stages_run)
+    if (st.name == name) { st.seconds += seconds; return; }
+  r.stages_run.push_back({name, seconds});
+}
+void add_stage(RunReport& r, Stage stage, double seconds) { add_stage(r, stage_name(stage), seconds); }
+
+// Runs f as a stage: its wall time, measured around the work (ScopedTimer), goes to the report.
 class StageClock {
  public:
   explicit StageClock(RunReport& r) : r_(r) {}
   template <class F>
-  auto run(const std::string& name, F&& f) {
-    const auto t0 = std::chrono::steady_clock::now();
-    auto done = [&] {
-      const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      for (auto& st : r_.stages_run)
-        if (st.name == name) { st.seconds += s; return; }
-      r_.stages_run.push_back({name, s});
-    };
-    if constexpr (std::is_void_v<decltype(f())>) {
-      f();
-      done();
-    } else {
-      auto v = f();
-      done();
-      return v;
-    }
+  auto run(Stage stage, F&& f) {
+    ScopedTimer timer([this, stage](double s) { add_stage(r_, stage, s); });
+    return f();
   }
 
  private:
@@ -73,12 +76,6 @@ class StageClock {
 };
 
 std::string where(const Scene& s) { return s.file.string(); }
-
-void add_stage(RunReport& r, const std::string& name, double seconds) {
-  for (auto& st : r.stages_run)
-    if (st.name == name) { st.seconds += seconds; return; }
-  r.stages_run.push_back({name, seconds});
-}
 
 }  // namespace
 
@@ -96,7 +93,7 @@ std::shared_ptr<const geometry::Shape> make_shape(const BodySpec& b, const Scene
         if (geometry::cad_format(b.mesh_path)) {  // STEP / IGES / BREP: exact B-rep queries
           auto cad = geometry::CadShape::load(b.mesh_path, scene.length_unit);
           if (report) {
-            add_stage(*report, "mesh_load", cad->load_seconds());
+            add_stage(*report, Stage::mesh_load, cad->load_seconds());
             for (const auto& w : cad->warnings()) report->warnings.push_back("body '" + b.name + "': " + w);
           }
           return cad;
@@ -108,13 +105,7 @@ std::shared_ptr<const geometry::Shape> make_shape(const BodySpec& b, const Scene
         opt.validation.check_self_intersections = b.mesh_self_intersection_check;
         geometry::Part part = geometry::load_part(b.mesh_path, opt);
         if (report) {
-          for (const auto& st : part.stages) {
-            if (st.name == "mass_properties") continue;  // counted by the caller's stage
-            bool found = false;
-            for (auto& r : report->stages_run)
-              if (r.name == st.name) { r.seconds += st.seconds; found = true; }
-            if (!found) report->stages_run.push_back({st.name, st.seconds});
-          }
+          for (const auto& st : part.stages) add_stage(*report, st.name, st.seconds);  // as the loader measured them
           for (const auto& w : part.warnings) report->warnings.push_back("body '" + b.name + "': " + w);
           for (const auto& a : part.repairs.actions)
             report->warnings.push_back("body '" + b.name + "': repaired: " + a);
@@ -133,7 +124,10 @@ PreparedBody prepare_body(const BodySpec& b, const Scene& scene, RunReport* repo
   PreparedBody p;
   p.name = b.name;
   p.spec = &b;
-  p.shape = make_shape(b, scene, report);
+  p.shape = make_shape(b, scene, report);  // a part's own stages, mass integrals included
+  // The body's mass and inertia (an analytic or CAD shape's integrals here): timed where they run.
+  std::optional<ScopedTimer<std::function<void(double)>>> timer;
+  if (report) timer.emplace([report](double s) { add_stage(*report, Stage::mass_properties, s); });
   p.pose.rotation = b.rotation;
   p.pose.position_m = b.position_m;
   p.velocity_m_s = b.velocity_m_s;
@@ -404,7 +398,9 @@ StagedOutputs reserve_outputs(const Scene& scene, RunTransaction& txn) {
       }
     }
     if (scene.outputs.force_table_csv) {
-      st.table.push_back(reserve(per_impact(*scene.outputs.force_table_csv, s, "force_table_csv"), place_of("force_table_csv"), false));
+      const std::string csv = per_impact(*scene.outputs.force_table_csv, s, "force_table_csv");
+      st.table.push_back(reserve(csv, place_of("force_table_csv"), false));
+      reserve(csv + ".json", place_of("force_table_csv") + " (its JSON sidecar)", false);
     }
     if (scene.outputs.force_plot_svg) {
       st.plot.push_back(reserve(per_impact(*scene.outputs.force_plot_svg, s, "force_plot_svg"), place_of("force_plot_svg"), false));
@@ -421,21 +417,10 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
 
   // Bodies that take part in an impact (others are not even built).
   std::map<std::string, PreparedBody> bodies;
-  clock.run("mass_properties", [&] {
-    for (const auto& s : scene.impacts)
-      for (const std::string* name : {&s.target, &s.impactor})
-        if (!bodies.count(*name)) bodies.emplace(*name, prepare_body(scene.body(*name), scene, &report));
-  });
-  // Mesh stages ran inside the mass_properties clock: leave only the integration in it.
-  {
-    double inner = 0;
-    StageTiming* mass = nullptr;
-    for (auto& st : report.stages_run) {
-      if (st.name == "mesh_load" || st.name == "mesh_validation" || st.name == "curvature_index") inner += st.seconds;
-      if (st.name == "mass_properties") mass = &st;
-    }
-    if (mass) mass->seconds = std::max(0.0, mass->seconds - inner);
-  }
+  // Each stage of a body (mesh_load, ..., mass_properties) is timed where it runs (prepare_body).
+  for (const auto& s : scene.impacts)
+    for (const std::string* name : {&s.target, &s.impactor})
+      if (!bodies.count(*name)) bodies.emplace(*name, prepare_body(scene.body(*name), scene, &report));
 
   for (const auto& s : scene.impacts) {
     ImpactReport ir;
@@ -447,7 +432,7 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
                           collision::effective_modulus_Pa(target.material, impactor.material, scene.modulus_convention),
                           s.restitution);
     });
-    ir.contact = clock.run("contact_geometry", [&] { return locate_contact(scene, s, model); });
+    ir.contact = clock.run(Stage::contact_geometry, [&] { return locate_contact(scene, s, model); });
     if (ir.contact.result.flag != collision::ContactFlag::none) {
       const Place place{s.place.line, s.place.key + ".point"};
       throw InputError(where(scene), place.describe(),
@@ -464,7 +449,7 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
         }
       }
     }
-    ir.result = clock.run("impact", [&] {
+    ir.result = clock.run(Stage::impact, [&] {
       return in_impact(scene, s, [&] {
         const collision::ImpactInput in = impact_input(scene, s, model, ir.contact);
         detail::check_impact_magnitudes(scene, s, in, ir.contact.result.effective_radius_m);
@@ -494,7 +479,7 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
     return;
   }
   if (scene.outputs.force_table_csv || want_fem) {
-    clock.run("force_table", [&] {
+    clock.run(Stage::force_table, [&] {
       for (auto& ir : report.impacts) {
         try {
           ir.table = collision::sample_force_table(ir.result.history, scene.outputs.force_table);
@@ -540,11 +525,11 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
           << " (the mesher kept the part's own triangles, or a coarser load size was asked for)";
         report.warnings.push_back(m.str());
       }
-      add_stage(report, "fem_mesh", ir.fem_deck->mesh_seconds);
-      add_stage(report, "fem_decks", total - ir.fem_deck->mesh_seconds);
+      add_stage(report, Stage::fem_mesh, ir.fem_deck->mesh_seconds);
+      add_stage(report, Stage::fem_decks, total - ir.fem_deck->mesh_seconds);
     }
     if (scene.outputs.fem->run == FemOutputs::Run::calculix) {
-      clock.run("fem_run", [&] {
+      clock.run(Stage::fem_run, [&] {
         for (auto& ir : report.impacts) {
           // A mesh that misses the body checks is not worth a solver run (it fails anyway).
           if (!ir.fem_deck->body_check.passed) {
@@ -562,7 +547,7 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
     if (const auto& cc = scene.outputs.fem->compare_contact) {
       // The same impact as a full-contact model beside a hybrid deck with its time steps
       // (compare_contact.hpp), in compare_<impact>/ of the staging folder.
-      clock.run("compare_contact", [&] {
+      clock.run(Stage::compare_contact, [&] {
         for (std::size_t k = 0; k < report.impacts.size(); ++k) {
           auto& ir = report.impacts[k];
           std::error_code ec;
@@ -599,7 +584,7 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
     }
   }
   if (scene.outputs.force_table_csv || scene.outputs.force_plot_svg) {
-    clock.run("write_outputs", [&] {
+    clock.run(Stage::write_outputs, [&] {
       for (std::size_t k = 0; k < report.impacts.size(); ++k) {
         auto& ir = report.impacts[k];
         if (scene.outputs.force_table_csv) {
@@ -607,9 +592,7 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
           h.source = scene.file.string();
           h.impact = ir.spec->name;
           h.direction = -ir.contact.normal;  // force on the target: along -n (world)
-          write_file_atomically(staged.table[k], [&](std::ostream& out) {
-            fem_export::write_force_table_csv(out, *ir.table, h);
-          });
+          fem_export::write_force_table_files(staged.table[k], *ir.table, h);
           ir.table_path = txn.public_path(staged.table[k]);
         }
         if (scene.outputs.force_plot_svg) {
@@ -668,7 +651,7 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
     if (ir.plot_path) report.files_written.push_back(*ir.plot_path);
   }
   if (staged.report) {
-    clock.run("write_outputs", [&] {
+    clock.run(Stage::write_outputs, [&] {
       report.files_written.push_back(txn.public_path(*staged.report));
       // The page holds the run's results, not the output folder's housekeeping (staging folders of
       // killed runs removed, an interrupted commit finished: stderr says those), so that the same
@@ -695,7 +678,7 @@ RunReport run_scene(const Scene& scene, const RunOptions& opt) {
   RunReport report;
   report.output_length_unit = opt.output_length_unit.value_or(scene.length_unit);
   StageClock clock(report);
-  report.stages_run.push_back({"scene", 0.0});
+  report.stages_run.push_back({stage_name(Stage::scene), 0.0});
   RunTransaction txn(opt.out_dir);
   for (const auto& w : txn.warnings()) report.warnings.push_back(w);
   try {

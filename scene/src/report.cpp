@@ -5,27 +5,25 @@
 #include <sstream>
 
 #include "impactdeck/common/version.hpp"
+#include "impactdeck/common/json_number.hpp"
 
 namespace impactdeck::scene {
 namespace {
 
 // + 0.0 turns -0 into 0 so that outputs never show "-0".
-nlohmann::json vec(const Eigen::Vector3d& v) { return {v.x() + 0.0, v.y() + 0.0, v.z() + 0.0}; }
 std::string text(const Eigen::Vector3d& v) {
   std::ostringstream s;
   s << std::setprecision(6) << "(" << v.x() + 0.0 << ", " << v.y() + 0.0 << ", " << v.z() + 0.0 << ")";
   return s.str();
 }
 
-// Never NaN or Inf in an output: a non-finite value becomes null.
-nlohmann::json num(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
 
 nlohmann::json body_json(const std::string& name, const collision::VelocityJump& j, const collision::KernelBody& k) {
   return {{"name", name},
-          {"delta_velocity_m_s", vec(j.delta_velocity_m_s)},
-          {"delta_angular_velocity_rad_s", vec(j.delta_angular_velocity_rad_s)},
-          {"lever_arm_m", vec(k.lever_arm_m)},
-          {"principal_curvatures_1_per_m", {num(k.curvature.k1_per_m), num(k.curvature.k2_per_m)}}};
+          {"delta_velocity_m_s", json_vector(j.delta_velocity_m_s)},
+          {"delta_angular_velocity_rad_s", json_vector(j.delta_angular_velocity_rad_s)},
+          {"lever_arm_m", json_vector(k.lever_arm_m)},
+          {"principal_curvatures_1_per_m", {json_number(k.curvature.k1_per_m), json_number(k.curvature.k2_per_m)}}};
 }
 
 // The 1/R a rule assigns to one body (reported; the elliptical rule uses both tensors).
@@ -34,19 +32,19 @@ double rule_curvature(const collision::ContactCurvature& c, collision::ContactRu
 }
 
 nlohmann::json validity_json(const collision::ValidityReport& v) {
-  nlohmann::json j = {{"indentation_over_radius", num(v.indentation_over_radius)},
+  nlohmann::json j = {{"indentation_over_radius", json_number(v.indentation_over_radius)},
                       {"max_indentation_over_radius", v.limits.max_indentation_over_radius},
-                      {"contact_semi_axis_a_m", num(v.contact_semi_axis_a_m)},
-                      {"contact_semi_axis_b_m", num(v.contact_semi_axis_b_m)},
-                      {"smallest_curvature_radius_m", num(v.smallest_curvature_radius_m)},
-                      {"contact_size_over_radius", num(v.contact_size_over_radius)},
+                      {"contact_semi_axis_a_m", json_number(v.contact_semi_axis_a_m)},
+                      {"contact_semi_axis_b_m", json_number(v.contact_semi_axis_b_m)},
+                      {"smallest_curvature_radius_m", json_number(v.smallest_curvature_radius_m)},
+                      {"contact_size_over_radius", json_number(v.contact_size_over_radius)},
                       {"max_contact_size_over_radius", v.limits.max_contact_size_over_radius},
-                      {"peak_pressure_Pa", num(v.peak_pressure_Pa)},
+                      {"peak_pressure_Pa", json_number(v.peak_pressure_Pa)},
                       {"ok", v.ok},
                       {"warnings", v.warnings}};
-  j["yield_onset_pressure_Pa"] = v.yield_onset_pressure_Pa ? num(*v.yield_onset_pressure_Pa) : nlohmann::json(nullptr);
+  j["yield_onset_pressure_Pa"] = v.yield_onset_pressure_Pa ? json_number(*v.yield_onset_pressure_Pa) : nlohmann::json(nullptr);
   j["peak_pressure_over_yield_onset"] =
-      v.peak_pressure_over_yield_onset ? num(*v.peak_pressure_over_yield_onset) : nlohmann::json(nullptr);
+      v.peak_pressure_over_yield_onset ? json_number(*v.peak_pressure_over_yield_onset) : nlohmann::json(nullptr);
   if (!v.yielding_body.empty()) j["yield_checked_body"] = v.yielding_body;
   return j;
 }
@@ -72,53 +70,53 @@ nlohmann::json to_json(const Scene& scene, const RunReport& rep) {
     i["target"] = body_json(ir.spec->target, r.target_jump, kin.target);
     i["impactor"] = body_json(ir.spec->impactor, r.impactor_jump, kin.impactor);
     i["contact_mode"] = ir.spec->first_contact ? "first-contact" : "point";
-    i["contact_point_m"] = vec(ir.contact.point_m);
-    i["contact_normal"] = vec(ir.contact.normal);
-    i["travel_m"] = num(ir.contact.travel_m);
-    i["projection_distance_m"] = num(ir.contact.target_point.distance_m);
+    i["contact_point_m"] = json_vector(ir.contact.point_m);
+    i["contact_normal"] = json_vector(ir.contact.normal);
+    i["travel_m"] = json_number(ir.contact.travel_m);
+    i["projection_distance_m"] = json_number(ir.contact.target_point.distance_m);
     i["contact_radius_rule"] = to_string(ir.spec->contact_radius);
-    i["target_principal_curvatures_1_per_m"] = {num(kin.target.curvature.k1_per_m), num(kin.target.curvature.k2_per_m)};
-    i["target_contact_curvature_1_per_m"] = num(rule_curvature(kin.target.curvature, ir.spec->contact_radius));
-    i["impactor_contact_curvature_1_per_m"] = num(rule_curvature(kin.impactor.curvature, ir.spec->contact_radius));
-    i["relative_curvatures_1_per_m"] = {num(kr.relative_curvature_A_per_m), num(kr.relative_curvature_B_per_m)};
-    i["contact_ellipse_axis_ratio"] = num(kr.contact_ellipse_axis_ratio);
+    i["target_principal_curvatures_1_per_m"] = {json_number(kin.target.curvature.k1_per_m), json_number(kin.target.curvature.k2_per_m)};
+    i["target_contact_curvature_1_per_m"] = json_number(rule_curvature(kin.target.curvature, ir.spec->contact_radius));
+    i["impactor_contact_curvature_1_per_m"] = json_number(rule_curvature(kin.impactor.curvature, ir.spec->contact_radius));
+    i["relative_curvatures_1_per_m"] = {json_number(kr.relative_curvature_A_per_m), json_number(kr.relative_curvature_B_per_m)};
+    i["contact_ellipse_axis_ratio"] = json_number(kr.contact_ellipse_axis_ratio);
     i["validity"] = validity_json(ir.validity);
-    i["reduced_mass_kg"] = num(r.reduced_mass_kg);
-    i["effective_radius_m"] = num(r.effective_radius_m);
-    i["effective_modulus_Pa"] = num(r.effective_modulus_Pa);
-    i["hertz_constant_N_per_m1_5"] = num(r.hertz_constant);
-    i["approach_velocity_m_s"] = num(r.approach_velocity_m_s);
+    i["reduced_mass_kg"] = json_number(r.reduced_mass_kg);
+    i["effective_radius_m"] = json_number(r.effective_radius_m);
+    i["effective_modulus_Pa"] = json_number(r.effective_modulus_Pa);
+    i["hertz_constant_N_per_m1_5"] = json_number(r.hertz_constant);
+    i["approach_velocity_m_s"] = json_number(r.approach_velocity_m_s);
     i["restitution_model"] = collision::to_string(r.restitution_kind);
     if (r.restitution_kind == collision::RestitutionModel::Kind::energy_flux) {
-      i["energy_flux_density"] = num(r.restitution.energy_flux_density);
+      i["energy_flux_density"] = json_number(r.restitution.energy_flux_density);
       i["energy_flux_density_unit"] = collision::to_string(ir.spec->restitution.flux_unit);
-      i["energy_flux_density_J_m3"] = num(r.restitution.energy_flux_density_J_m3);
-      i["ln_energy_flux_density"] = num(r.restitution.ln_energy_flux);
+      i["energy_flux_density_J_m3"] = json_number(r.restitution.energy_flux_density_J_m3);
+      i["ln_energy_flux_density"] = json_number(r.restitution.ln_energy_flux);
       i["restitution_clamped"] = r.restitution.clamped;
     } else {
       i["energy_flux_density"] = nullptr;
       if (r.restitution_kind == collision::RestitutionModel::Kind::table) i["restitution_clamped"] = r.restitution.clamped;
     }
-    i["restitution"] = num(r.restitution.coefficient);
-    i["max_indentation_m"] = num(c.max_indentation_m);
-    i["max_force_N"] = num(c.max_force_N);
-    i["compression_time_s"] = num(c.compression_time_s);
-    i["contact_time_s"] = num(r.history.contact_time_s());
-    i["impulse_compression_Ns"] = num(r.history.impulse_compression_Ns());
-    i["impulse_total_Ns"] = num(r.history.impulse_total_Ns());
+    i["restitution"] = json_number(r.restitution.coefficient);
+    i["max_indentation_m"] = json_number(c.max_indentation_m);
+    i["max_force_N"] = json_number(c.max_force_N);
+    i["compression_time_s"] = json_number(c.compression_time_s);
+    i["contact_time_s"] = json_number(r.history.contact_time_s());
+    i["impulse_compression_Ns"] = json_number(r.history.impulse_compression_Ns());
+    i["impulse_total_Ns"] = json_number(r.history.impulse_total_Ns());
     const auto& k = r.checks;
-    i["checks"] = {{"impulse_relative_error", num(k.impulse_relative_error)},
-                   {"energy_relative_error", num(k.energy_relative_error)},
+    i["checks"] = {{"impulse_relative_error", json_number(k.impulse_relative_error)},
+                   {"energy_relative_error", json_number(k.energy_relative_error)},
                    {"impulse_threshold", k.thresholds.impulse_relative},
                    {"energy_threshold", k.thresholds.energy_relative},
-                   {"impulse_compression_numerical_Ns", num(k.impulse_compression_numerical_Ns)},
-                   {"carnot_loss_J", num(k.carnot_loss_J)},
-                   {"kinetic_energy_loss_J", num(k.kinetic_energy_loss_J)},
+                   {"impulse_compression_numerical_Ns", json_number(k.impulse_compression_numerical_Ns)},
+                   {"carnot_loss_J", json_number(k.carnot_loss_J)},
+                   {"kinetic_energy_loss_J", json_number(k.kinetic_energy_loss_J)},
                    {"passed", k.passed}};
     if (ir.table) {
       i["force_table"] = {{"samples", ir.table->time_s.size()},
-                          {"impulse_Ns", num(ir.table->impulse_Ns)},
-                          {"impulse_relative_error", num(ir.table->impulse_relative_error)},
+                          {"impulse_Ns", json_number(ir.table->impulse_Ns)},
+                          {"impulse_relative_error", json_number(ir.table->impulse_relative_error)},
                           {"impulse_tolerance", ir.table->impulse_tolerance},
                           {"tolerance_met", ir.table->tolerance_met}};
       if (ir.table_path) i["force_table"]["path"] = ir.table_path->string();

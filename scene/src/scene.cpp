@@ -8,6 +8,7 @@
 #include <toml++/toml.h>
 
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/common/suggest.hpp"
 #include "overrides_toml.hpp"
 #include "impactdeck/common/input_file.hpp"
 #include "impactdeck/common/numeric.hpp"
@@ -141,11 +142,13 @@ class Reader {
       missing(k);
     }
     std::string list;
+    std::vector<std::string> names;
     for (const auto& [name, value] : options) {
       if (*s == name) return value;
       list += (list.empty() ? "" : ", ") + ("\"" + name + "\"");
+      names.push_back(name);
     }
-    fail(k, "unknown value \"" + *s + "\" (expected one of " + list + ")");
+    fail(k, "unknown value \"" + *s + "\" (expected one of " + list + ")" + did_you_mean(*s, names));
   }
 
   [[noreturn]] void missing(const std::string& k) const {
@@ -162,7 +165,8 @@ class Reader {
       std::string list;
       for (const auto& u : all) list += (list.empty() ? "" : ", ") + u;
       throw InputError(file_, Place{line_of(&node), key_path(k)}.describe(),
-                       "unknown key (allowed here: " + list + ")");
+                       "unknown key (allowed here: " + list + ")" +
+                           did_you_mean(k, std::vector<std::string>(all.begin(), all.end())));
     }
   }
 
@@ -534,6 +538,12 @@ const toml::array& table_array(const toml::node* n, const std::string& key, cons
   return *a;
 }
 
+std::vector<std::string> material_names(const Scene& sc) {
+  std::vector<std::string> names;
+  for (const auto& [name, m] : sc.materials) names.push_back(name);
+  return names;
+}
+
 Scene build(const toml::table& root, const std::string& file, const fs::path& base_dir) {
   Scene sc;
   sc.file = file;
@@ -542,7 +552,9 @@ Scene build(const toml::table& root, const std::string& file, const fs::path& ba
            "checks", "validity", "materials", "bodies", "impacts", "outputs"});
   const std::string unit_text = r.required_string("length_unit");
   auto unit = parse_length_unit(unit_text);
-  if (!unit) r.fail("length_unit", "unknown unit \"" + unit_text + "\" (expected m, cm, mm or in)");
+  if (!unit)
+    r.fail("length_unit", "unknown unit \"" + unit_text + "\" (expected m, cm, mm or in)" +
+                              did_you_mean(unit_text, length_unit_names()));
   sc.length_unit = *unit;
   const double to_m = metres_per(*unit);
 
@@ -605,7 +617,8 @@ Scene build(const toml::table& root, const std::string& file, const fs::path& ba
     auto m = sc.materials.find(b.material);
     if (m == sc.materials.end()) {
       throw InputError(file, Place{b.place.line, "bodies[" + std::to_string(i) + "].material"}.describe(),
-                       "unknown material '" + b.material + "' (define it under [materials." + b.material + "])");
+                       "unknown material '" + b.material + "' (define it under [materials." + b.material + "])" +
+                           did_you_mean(b.material, material_names(sc)));
     }
     if (!b.fixed && !b.mass_kg && !m->second.density_kg_m3) {
       throw InputError(file, Place{b.place.line, "bodies[" + std::to_string(i) + "]"}.describe(),
@@ -625,8 +638,10 @@ Scene build(const toml::table& root, const std::string& file, const fs::path& ba
       for (const auto& b : sc.bodies) found = found || b.name == *who;
       if (!found) {
         const char* key = who == &s.target ? "target" : "impactor";
+        std::vector<std::string> names;
+        for (const auto& b : sc.bodies) names.push_back(b.name);
         throw InputError(file, Place{s.place.line, "impacts[" + std::to_string(i) + "]." + key}.describe(),
-                         "no body named '" + *who + "'");
+                         "no body named '" + *who + "'" + did_you_mean(*who, names));
       }
     }
     if (!s.first_contact) {

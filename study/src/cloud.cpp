@@ -10,9 +10,10 @@
 
 namespace impactdeck::study {
 
-std::vector<geometry::SurfacePoint> paper_grid_cloud(const geometry::Ellipsoid& target, int steps) {
+std::vector<geometry::SurfacePoint> paper_grid_cloud(const geometry::Ellipsoid& target, int steps,
+                                                     const InputContext& context) {
   if (steps < 1 || steps > 4096) {
-    throw InputError("", "grid steps", "must lie in [1, 4096], got " + std::to_string(steps));
+    throw context.error("grid steps", "must lie in [1, 4096], got " + std::to_string(steps));
   }
   const Eigen::Vector3d& e = target.semi_axes_m();
   std::vector<geometry::SurfacePoint> out;
@@ -39,8 +40,8 @@ std::vector<geometry::SurfacePoint> paper_grid_cloud(const geometry::Ellipsoid& 
 }
 
 std::vector<geometry::SurfacePoint> area_uniform_cloud(const geometry::Shape& target, std::size_t count,
-                                                       std::uint64_t seed) {
-  if (count == 0) throw InputError("", "point count", "must be at least 1");
+                                                       std::uint64_t seed, const InputContext& context) {
+  if (count == 0) throw context.error("point count", "must be at least 1");
   return target.sample_surface(count, seed);
 }
 
@@ -54,9 +55,9 @@ const char* to_string(CloudKind k) {
   return "?";
 }
 
-std::vector<geometry::SurfacePoint> mesh_vertex_cloud(const geometry::Shape& target) {
+std::vector<geometry::SurfacePoint> mesh_vertex_cloud(const geometry::Shape& target, const InputContext& context) {
   const auto* m = dynamic_cast<const geometry::MeshShape*>(&target);
-  if (!m) throw InputError("", "cloud", "the vertex cloud needs a mesh target; this target is a " + target.kind());
+  if (!m) throw context.error("cloud", "the vertex cloud needs a mesh target; this target is a " + target.kind());
   std::vector<geometry::SurfacePoint> out;
   out.reserve(m->mesh().vertices_m.size());
   for (const Eigen::Vector3d& v : m->mesh().vertices_m) {
@@ -80,19 +81,20 @@ std::vector<geometry::SurfacePoint> projected_grid_cloud(const geometry::Shape& 
 }
 
 std::vector<geometry::SurfacePoint> make_cloud(const geometry::Shape& target, CloudKind kind,
-                                               int grid_steps, std::size_t count, std::uint64_t seed) {
-  if (kind == CloudKind::vertices) return mesh_vertex_cloud(target);
+                                               int grid_steps, std::size_t count, std::uint64_t seed,
+                                               const InputContext& context) {
+  if (kind == CloudKind::vertices) return mesh_vertex_cloud(target, context);
   std::vector<geometry::SurfacePoint> cloud;
   if (kind != CloudKind::area_uniform) {
     const auto* e = dynamic_cast<const geometry::Ellipsoid*>(&target);
     if (!e) {
-      throw InputError("", "cloud", "the paper grid needs an analytic ellipsoid or sphere; this target is a " +
+      throw context.error("cloud", "the paper grid needs an analytic ellipsoid or sphere; this target is a " +
                                         target.kind() + " (use the area-uniform cloud)");
     }
-    cloud = paper_grid_cloud(*e, grid_steps);
+    cloud = paper_grid_cloud(*e, grid_steps, context);
   }
   if (kind != CloudKind::paper_grid) {
-    auto u = area_uniform_cloud(target, count, seed);
+    auto u = area_uniform_cloud(target, count, seed, context);
     cloud.insert(cloud.end(), u.begin(), u.end());
   }
   return cloud;

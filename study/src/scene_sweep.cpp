@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/common/suggest.hpp"
 #include "impactdeck/scene/pipeline.hpp"
 
 namespace impactdeck::study {
@@ -20,7 +21,9 @@ SceneSweep sweep_from_scene(const scene::Scene& sc, const std::string& name) {
   if (!out.impact) {
     std::string list;
     for (const auto& i : sc.impacts) list += (list.empty() ? "" : ", ") + ("'" + i.name + "'");
-    throw InputError(file, "--impact", "no impact named '" + name + "' (the scene has " + list + ")");
+    std::vector<std::string> names;
+    for (const auto& i : sc.impacts) names.push_back(i.name);
+    throw InputError(file, "--impact", "no impact named '" + name + "' (the scene has " + list + ")" + did_you_mean(name, names));
   }
   const scene::ImpactSpec& s = *out.impact;
   // The sweep's setting: the target at rest, the impactor translating along the inward normal.
@@ -44,6 +47,7 @@ SceneSweep sweep_from_scene(const scene::Scene& sc, const std::string& name) {
     throw InputError(file, s.place.describe(), "impact '" + s.name + "': " + e.reason());
   }
   out.setup.restitution = s.restitution;
+  out.setup.context = {file, "impact '" + s.name + "'"};
   if (s.approach_speed_m_s) {
     out.setup.approach_speed_m_s = *s.approach_speed_m_s;
   } else {

@@ -66,12 +66,12 @@ void sample_curve(const PointResult& p, std::size_t samples, double* out) {
 }
 
 SweepResult run_sweep(const SweepSetup& s, const std::vector<geometry::SurfacePoint>& cloud, const SweepOptions& o) {
-  if (cloud.empty()) throw InputError("", "sweep", "the point cloud is empty");
-  if (!s.target.shape || !s.impactor.shape) throw InputError("", "sweep", "a body has no shape");
+  if (cloud.empty()) throw s.context.error("sweep", "the point cloud is empty");
+  if (!s.target.shape || !s.impactor.shape) throw s.context.error("sweep", "a body has no shape");
   if (!(s.approach_speed_m_s > 0.0) || !std::isfinite(s.approach_speed_m_s)) {
-    throw InputError("", "approach speed", "must be positive and finite");
+    throw s.context.error("approach speed", "must be positive and finite");
   }
-  if (o.curves && o.curve_samples < 2) throw InputError("", "curve samples", "must be at least 2");
+  if (o.curves && o.curve_samples < 2) throw s.context.error("curve samples", "must be at least 2");
   if (s.restitution.kind == collision::RestitutionModel::Kind::table) {
     collision::validate_restitution_table(s.restitution.table);
   }
@@ -116,7 +116,7 @@ SweepResult run_sweep(const SweepSetup& s, const std::vector<geometry::SurfacePo
       any = true;
     }
     m << "): the contact model applies nowhere";
-    throw InputError("", "sweep", m.str());
+    throw s.context.error("sweep", m.str());
   }
   res.min_index = res.max_index = first;
   double mw_min = res.points[first].reduced_mass_kg, mw_max = mw_min;

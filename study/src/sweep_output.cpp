@@ -12,7 +12,9 @@
 #include <thread>
 
 #include "impactdeck/common/atomic_file.hpp"
+#include "impactdeck/common/csv_sidecar.hpp"
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/common/suggest.hpp"
 #include "impactdeck/common/version.hpp"
 #include "number_text.hpp"
 #include "parallel.hpp"
@@ -41,6 +43,28 @@ void header(std::ostream& o, const char* comment, const SweepMeta& m, const Swee
     if (r.flag_counts[f] > 0) o << "; " << collision::flag_word(static_cast<collision::ContactFlag>(f)) << " " << r.flag_counts[f];
   }
   o << ")\n";
+}
+
+// What header() says, for the CSVs' JSON sidecar (common/csv_sidecar.hpp).
+std::vector<std::pair<std::string, std::string>> sidecar_metadata(const SweepMeta& m, const SweepResult& r,
+                                                                   LengthUnit unit) {
+  std::vector<std::pair<std::string, std::string>> d = {
+      {"title", "impactdeck sweep: maximal Hertz contact force over the surface"}};
+  if (!m.source.empty()) d.push_back({"scene", m.source});
+  if (!m.impact.empty()) d.push_back({"impact", m.impact + " (" + m.impactor + " hits " + m.target + " along the inward normal)"});
+  if (!m.cloud.empty()) d.push_back({"cloud", m.cloud + ", " + std::to_string(r.points.size()) + " points"});
+  d.push_back({"frame", "coordinates in the target's frame, in " + std::string(to_string(unit)) + " (metres per unit " +
+                            num(metres_per(unit)) + "); every other column SI"});
+  d.push_back({"force_ratio", num(r.force_ratio) + " (min at point " + std::to_string(r.min_index) + ", max at point " +
+                                  std::to_string(r.max_index) + ")"});
+  std::string flags = std::to_string(r.flagged_count) + " (the contact model does not apply there: left out of "
+                      "min/max; column flag names why";
+  for (int f = 1; f < collision::kContactFlagCount; ++f) {
+    if (r.flag_counts[f] > 0)
+      flags += std::string("; ") + collision::flag_word(static_cast<collision::ContactFlag>(f)) + " " + std::to_string(r.flag_counts[f]);
+  }
+  d.push_back({"flagged_points", flags + ")"});
+  return d;
 }
 
 double max_force(const SweepResult& r) { return r.points[r.max_index].max_force_N; }
@@ -95,10 +119,10 @@ void write_sweep_csv(const std::filesystem::path& path, const SweepResult& r, co
   t.integer("sharp_feature", [&](std::size_t i) { return P[i].sharp_feature ? 1 : 0; });
   t.text("flag", [&](std::size_t i) { return std::string_view(collision::flag_word(P[i].flag)); });
   write_file_atomically(path, [&](std::ostream& o) {
-    header(o, "#", meta, r, options.length_unit);
     o << t.header();
     detail::write_rows(o, P.size(), t.rows(kWhat), row_options(options));
   });
+  write_csv_sidecar(path, csv_columns(t.header()), sidecar_metadata(meta, r, options.length_unit));
 }
 
 void write_sweep_curves_csv(const std::filesystem::path& path, const SweepResult& r, const SweepMeta& meta,
@@ -107,8 +131,6 @@ void write_sweep_curves_csv(const std::filesystem::path& path, const SweepResult
     throw InputError(path.string(), "curves", "the sweep was run without force curves");
   }
   write_file_atomically(path, [&](std::ostream& o) {
-    header(o, "#", meta, r);
-    o << "# F(t) at each point: " << r.curve_samples << " samples uniform over [0, contact time]\n";
     o << "point,time_s,force_N\n";
     const double last = static_cast<double>(r.curve_samples - 1);
     // One unit of work per point: its curve_samples rows (none for a flagged point: the model does not apply there).
@@ -129,6 +151,10 @@ void write_sweep_curves_csv(const std::filesystem::path& path, const SweepResult
       }
     }, row_options(options));
   });
+  auto d = sidecar_metadata(meta, r, options.length_unit);
+  d.push_back({"curves", "F(t) at each point: " + std::to_string(r.curve_samples) +
+                             " samples uniform over [0, contact time]; none at a flagged point"});
+  write_csv_sidecar(path, {"point", "time_s", "force_N"}, d);
 }
 
 void write_sweep_pos(const std::filesystem::path& path, const SweepResult& r, const SweepMeta& meta,
@@ -344,7 +370,9 @@ SweepFormats parse_sweep_formats(const std::string& list) {
     const std::string name = list.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
     bool* flag = name == "csv" ? &f.csv : name == "vtp" ? &f.vtp : name == "pos" ? &f.pos
                : name == "svg" ? &f.svg : name == "png" ? &f.png : nullptr;
-    if (!flag) throw std::invalid_argument("'" + name + "' is not one of csv, vtp, pos, svg, png");
+    if (!flag)
+      throw std::invalid_argument("'" + name + "' is not one of csv, vtp, pos, svg, png" +
+                                  did_you_mean(name, {"csv", "vtp", "pos", "svg", "png"}));
     if (*flag) throw std::invalid_argument("'" + name + "' is listed twice");
     *flag = true;
     if (comma == std::string::npos) break;

@@ -9,6 +9,7 @@
 #include "impactdeck/collision/compression.hpp"
 #include "impactdeck/collision/eccentric.hpp"
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/common/suggest.hpp"
 #include "impactdeck/geometry/ellipsoid.hpp"
 #include "impactdeck/geometry/mass_properties.hpp"
 #include "impactdeck/geometry/mesh_shape.hpp"
@@ -109,7 +110,7 @@ std::shared_ptr<const geometry::Shape> stretched_target(const geometry::Shape& t
 
 Table1Options table1_preset(const std::string& name) {
   if (name != "paper") {
-    throw InputError("", "--preset", "unknown preset \"" + name + "\" (available: \"paper\")");
+    throw InputError("", "--preset", "unknown preset \"" + name + "\" (available: \"paper\")" + did_you_mean(name, {"paper"}));
   }
   Table1Options o;
   o.geometric_ratios = kDecades;
@@ -233,15 +234,14 @@ Table1Result run_table1(const Table1Options& o) {
       if (o.progress) {
         so.progress = [&](std::size_t done, std::size_t) { o.progress(done_before + done, total); };
       }
-      SweepResult sr;
-      try {
-        sr = run_sweep(s, clouds[gi], so);
-      } catch (const InputError& e) {
-        if (!o.scene) throw;
+      // run_sweep's errors name the scene and the cell (the paper's setting: no file).
+      s.context = {};
+      if (o.scene) {
         std::ostringstream place;
         place << "cell g = " << o.geometric_ratios[gi] << ", mu = " << o.mass_ratios[mi];
-        throw InputError(o.scene->source, place.str() + (e.place().empty() ? "" : ": " + e.place()), e.reason());
+        s.context = {o.scene->source, place.str()};
       }
+      const SweepResult sr = run_sweep(s, clouds[gi], so);
       done_before += clouds[gi].size();
       res.ratio[gi][mi] = sr.force_ratio;
       res.mass_only[gi][mi] = sr.mass_only_ratio;

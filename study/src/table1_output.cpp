@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "impactdeck/common/atomic_file.hpp"
+#include "impactdeck/common/csv_sidecar.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/common/version.hpp"
 #include "number_text.hpp"
@@ -77,11 +78,11 @@ std::string settings_line(const Table1Result& r) {
 }  // namespace
 
 void write_table1_csv(const std::filesystem::path& path, const Table1Result& r) {
+  std::vector<std::string> columns = {"geometric_ratio", "mass_ratio", "collision_force_ratio", "mass_only_ratio"};
+  if (r.compared) columns.insert(columns.end(), {"paper_ratio", "delta"});
   write_file_atomically(path, [&](std::ostream& o) {
-    o << "# impactdeck " << kVersion << " study table1: collision force ratio min/max F_max over a cloud\n"
-      << "# " << settings_line(r) << "\n";
-    o << "geometric_ratio,mass_ratio,collision_force_ratio,mass_only_ratio";
-    if (r.compared) o << ",paper_ratio,delta";
+    o << columns.front();
+    for (std::size_t c = 1; c < columns.size(); ++c) o << ',' << columns[c];
     o << "\n";
     for (std::size_t gi = 0; gi < r.ratio.size(); ++gi) {
       for (std::size_t mi = 0; mi < r.ratio[gi].size(); ++mi) {
@@ -92,6 +93,9 @@ void write_table1_csv(const std::filesystem::path& path, const Table1Result& r) 
       }
     }
   });
+  write_csv_sidecar(path, columns,
+                    {{"title", "impactdeck study table1: collision force ratio min/max F_max over a cloud"},
+                     {"settings", settings_line(r)}});
 }
 
 std::string table1_markdown(const Table1Result& r) {

@@ -68,6 +68,22 @@ class InputError : public Error {
   std::string where_, place_, reason_;
 };
 
+/// Where an input comes from, handed to the library code that checks it so that its errors name
+/// the file and place themselves (no catch-and-rethrow to add them): `where` the file (empty for
+/// programmatic input), `place` what in it (e.g. "impact 'fig4'"), put before the error's own place.
+struct InputContext {
+  std::string where;
+  std::string place;
+
+  /// InputError(where, "PLACE: place", reason) (just `place` when this context has none).
+  InputError error(const std::string& place_in_context, const std::string& reason) const {
+    const std::string p = place.empty() ? place_in_context
+                          : place_in_context.empty() ? place
+                                                     : place + ": " + place_in_context;
+    return InputError(where, p, reason);
+  }
+};
+
 /// A physics self-check (impulse, Carnot energy, FEM momentum) exceeded its threshold.
 class CheckFailed : public Error {
  public:

@@ -3,6 +3,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace impactdeck {
 
@@ -22,5 +23,7 @@ constexpr double metres_per(LengthUnit u) {
 /// Parses "m", "cm", "mm", "in"; nullopt for anything else.
 std::optional<LengthUnit> parse_length_unit(std::string_view text);
 const char* to_string(LengthUnit u);
+/// The names parse_length_unit accepts (for "did you mean").
+std::vector<std::string> length_unit_names();
 
 }  // namespace impactdeck

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "impactdeck/geometry/ellipsoid.hpp"
+#include "impactdeck/common/error.hpp"
 #include "impactdeck/geometry/shape.hpp"
 
 namespace impactdeck::study {
@@ -15,12 +16,13 @@ namespace impactdeck::study {
 /// [-1, 1]^2 with step 1/`steps`, kept where (y/b)^2 + (z/c)^2 <= 1, lifted to both sides
 /// x = +-a sqrt(1 - (y/b)^2 - (z/c)^2); points on the rim (x = 0) appear once.
 /// For steps = 8: 390 points, both tips and the rim included. Throws InputError for steps < 1.
-std::vector<geometry::SurfacePoint> paper_grid_cloud(const geometry::Ellipsoid& target, int steps = 8);
+std::vector<geometry::SurfacePoint> paper_grid_cloud(const geometry::Ellipsoid& target, int steps = 8,
+                                                     const InputContext& context = {});
 
 /// `count` points uniform by area (Shape::sample_surface), deterministic for a seed.
 /// Throws InputError for count = 0.
 std::vector<geometry::SurfacePoint> area_uniform_cloud(const geometry::Shape& target, std::size_t count,
-                                                       std::uint64_t seed);
+                                                       std::uint64_t seed, const InputContext& context = {});
 
 enum class CloudKind {
   paper_grid,    ///< paper_grid_cloud(steps); the target must be an analytic ellipsoid
@@ -32,7 +34,7 @@ enum class CloudKind {
 /// The vertices of a mesh target, in mesh order, each with the normal closest_point gives there
 /// (on a corner of a sharp edge: the normal of one adjacent face; such points are flagged by the
 /// sweep). Throws InputError when the shape is not a mesh.
-std::vector<geometry::SurfacePoint> mesh_vertex_cloud(const geometry::Shape& target);
+std::vector<geometry::SurfacePoint> mesh_vertex_cloud(const geometry::Shape& target, const InputContext& context = {});
 
 /// The paper grid (paper_grid_cloud) of the ellipsoid inscribed in the shape's axis-aligned
 /// bounding box of `vertices`, each point moved to the closest point of the shape: on a mesh of an
@@ -52,8 +54,10 @@ std::vector<geometry::SurfacePoint> csv_point_cloud(const geometry::Shape& targe
                                                     double max_distance_m, std::size_t max_points = 100000000);
 
 /// The cloud of a kind. Throws InputError when the grid is asked of a shape that is not an
-/// analytic ellipsoid, or the vertices of a shape that is not a mesh.
+/// analytic ellipsoid, or the vertices of a shape that is not a mesh; `context` names the file and
+/// target in its errors (all the cloud functions take one).
 std::vector<geometry::SurfacePoint> make_cloud(const geometry::Shape& target, CloudKind kind,
-                                               int grid_steps, std::size_t count, std::uint64_t seed);
+                                               int grid_steps, std::size_t count, std::uint64_t seed,
+                                               const InputContext& context = {});
 
 }  // namespace impactdeck::study

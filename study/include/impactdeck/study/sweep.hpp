@@ -16,6 +16,7 @@
 
 #include <Eigen/Dense>
 
+#include "impactdeck/common/error.hpp"
 #include "impactdeck/collision/hertz.hpp"
 #include "impactdeck/collision/impact.hpp"
 #include "impactdeck/geometry/shape.hpp"
@@ -34,6 +35,7 @@ struct SweepSetup {
   double effective_modulus_Pa = 0;   ///< E* (Eq. 28 or Hertz convention)
   double approach_speed_m_s = 1.0;   ///< impactor velocity = -speed * n at every point
   collision::RestitutionModel restitution;  ///< R, contact time and impulse at every point
+  InputContext context;  ///< file and place run_sweep's errors name (e.g. the scene, "impact 'fig4'")
 };
 
 /// Called from the calling thread about ten times a second with (points done, total).

@@ -40,7 +40,8 @@ struct SweepWriteOptions {
   LengthUnit length_unit = LengthUnit::m;
 };
 
-/// `# ...` comment lines (with the count of sharp points), then one row per point: index, x_U, y_U, z_U (U: options.length_unit, e.g. x_mm), nx, ny, nz,
+/// A header line, then one row per point (the metadata, with the count of flagged points, goes to the
+/// JSON sidecar PATH.json, common/csv_sidecar.hpp): index, x_U, y_U, z_U (U: options.length_unit, e.g. x_mm), nx, ny, nz,
 /// target_radius_m, impactor_radius_m, effective_radius_m, reduced_mass_kg,
 /// hertz_constant_N_per_m1_5, max_indentation_m, max_force_N, force_ratio (F / largest F),
 /// compression_time_s, restitution, contact_time_s, impulse_total_Ns, the target's velocity jump
@@ -52,7 +53,7 @@ struct SweepWriteOptions {
 void write_sweep_csv(const std::filesystem::path& path, const SweepResult& r, const SweepMeta& meta,
                      const SweepWriteOptions& options = {});
 
-/// Long format `point,time_s,force_N`, one row per curve sample (needs r.curves_N).
+/// Long format `point,time_s,force_N`, one row per curve sample (needs r.curves_N); sidecar PATH.json.
 void write_sweep_curves_csv(const std::filesystem::path& path, const SweepResult& r, const SweepMeta& meta,
                             const SweepWriteOptions& options = {});
 

@@ -13,7 +13,7 @@
 namespace impactdeck::study {
 
 /// Columns: geometric_ratio, mass_ratio, collision_force_ratio, mass_only_ratio, and, when
-/// compared, paper_ratio, delta.
+/// compared, paper_ratio, delta; the settings go to the JSON sidecar PATH.json (common/csv_sidecar.hpp).
 void write_table1_csv(const std::filesystem::path& path, const Table1Result& r);
 
 /// The report (GitHub-flavoured Markdown).

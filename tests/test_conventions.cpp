@@ -1,0 +1,102 @@
+// The shared conventions in common/: "did you mean" (edit distance), the CSV sidecar, the JSON
+// number helper. The CLI's use of them is tested end to end in cli_conventions_test.sh.
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <vector>
+
+#include <Eigen/Dense>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "impactdeck/common/csv_sidecar.hpp"
+#include "impactdeck/common/json_number.hpp"
+#include "impactdeck/common/suggest.hpp"
+#include "impactdeck/common/units.hpp"
+#include "scratch_files.hpp"
+
+namespace impactdeck {
+namespace {
+
+TEST(Suggest, EditDistanceCountsEachEditOnce) {
+  EXPECT_EQ(edit_distance("", ""), 0u);
+  EXPECT_EQ(edit_distance("run", "run"), 0u);
+  EXPECT_EQ(edit_distance("rnu", "run"), 1u);              // a swap of neighbours
+  EXPECT_EQ(edit_distance("mesh_sise", "mesh_size"), 1u);  // a substitution
+  EXPECT_EQ(edit_distance("swep", "sweep"), 1u);           // an insertion
+  EXPECT_EQ(edit_distance("sweeep", "sweep"), 1u);         // a deletion
+  EXPECT_EQ(edit_distance("MM", "mm"), 0u);                // case ignored
+  EXPECT_EQ(edit_distance("kitten", "sitting"), 3u);       // the textbook Levenshtein case
+  EXPECT_EQ(edit_distance("abc", ""), 3u);
+  EXPECT_EQ(edit_distance("ca", "abc"), 3u);  // optimal string alignment (not Damerau's 2): no edit of a swapped pair
+  // Symmetric.
+  for (const char* a : {"table1", "tabel1", "x", "compare-contact"})
+    for (const char* b : {"table1", "campaign", "", "contact"}) EXPECT_EQ(edit_distance(a, b), edit_distance(b, a));
+}
+
+TEST(Suggest, NearestNameOnlyForATypo) {
+  const std::vector<std::string> subs = {"run", "sweep", "study", "inspect", "mesh-ellipsoid", "fem-check",
+                                         "compare-contact", "campaign"};
+  EXPECT_EQ(nearest_name("rnu", subs), "run");
+  EXPECT_EQ(nearest_name("swep", subs), "sweep");
+  EXPECT_EQ(nearest_name("inspcet", subs), "inspect");
+  EXPECT_EQ(nearest_name("fem_check", subs), "fem-check");
+  EXPECT_EQ(nearest_name("xyzzy", subs), "");   // nothing near
+  EXPECT_EQ(nearest_name("r", subs), "");       // one letter is no typo of anything
+  EXPECT_EQ(nearest_name("", subs), "");
+  EXPECT_EQ(nearest_name("run", subs), "");     // the word itself is not a suggestion
+  EXPECT_EQ(nearest_name("zz", {"m", "cm", "mm", "in"}), "");
+  EXPECT_EQ(nearest_name("mmm", length_unit_names()), "mm");
+  EXPECT_EQ(nearest_name("inch", length_unit_names()), "in");
+  EXPECT_EQ(nearest_name("nm", {"m", "mm"}), "mm");  // both 1 edit away: the one of the same length wins
+  EXPECT_EQ(nearest_name("abcde", {"abcdefg", "abcdef"}), "abcdef");  // 2 and 1 edits: the nearest wins
+  EXPECT_EQ(did_you_mean("mesh_sise", {"mesh_size", "load_mesh_size", "run"}), "; did you mean 'mesh_size'?");
+  EXPECT_EQ(did_you_mean("colour", {"mass_kg", "name"}), "");
+}
+
+TEST(CsvSidecar, UnitsFromColumnNames) {
+  EXPECT_EQ(csv_column_unit("time_s"), "s");
+  EXPECT_EQ(csv_column_unit("force_N"), "N");
+  EXPECT_EQ(csv_column_unit("x_m"), "m");
+  EXPECT_EQ(csv_column_unit("target_dvx_m_s"), "m/s");
+  EXPECT_EQ(csv_column_unit("target_dwz_rad_s"), "rad/s");
+  EXPECT_EQ(csv_column_unit("impulse_total_Ns"), "N s");
+  EXPECT_EQ(csv_column_unit("hertz_constant_N_per_m1_5"), "N/m^1.5");
+  EXPECT_EQ(csv_column_unit("PROBE1_von_mises_Pa"), "Pa");
+  EXPECT_EQ(csv_column_unit("reduced_mass_kg"), "kg");
+  EXPECT_EQ(csv_column_unit("force_ratio"), "1");
+  EXPECT_EQ(csv_column_unit("nx"), "1");
+  EXPECT_EQ(csv_column_unit("index"), "");
+  EXPECT_EQ(csv_column_unit("flag"), "");
+  EXPECT_EQ(csv_column_unit("all_checks_passed"), "");
+}
+
+TEST(CsvSidecar, TextIsJsonWithEveryColumn) {
+  const std::string text = csv_sidecar_text("/some/where/force.csv", csv_columns("time_s,force_N\n"),
+                                            {{"scene", "a \"quoted\" \\ name\twith a tab"}, {"impact", "hit"}});
+  const nlohmann::json j = nlohmann::json::parse(text);
+  EXPECT_EQ(j.at("file"), "force.csv");
+  ASSERT_EQ(j.at("columns").size(), 2u);
+  EXPECT_EQ(j.at("columns")[0], (nlohmann::json{{"name", "time_s"}, {"unit", "s"}}));
+  EXPECT_EQ(j.at("columns")[1], (nlohmann::json{{"name", "force_N"}, {"unit", "N"}}));
+  EXPECT_EQ(j.at("metadata").at("scene"), "a \"quoted\" \\ name\twith a tab");
+  EXPECT_TRUE(j.contains("impactdeck_version"));
+  EXPECT_NO_THROW(nlohmann::json::parse(csv_sidecar_text("t.csv", {}, {})));
+  EXPECT_EQ(csv_sidecar_path("out/t.csv"), std::filesystem::path("out/t.csv.json"));
+}
+
+TEST(JsonNumber, NonFiniteIsNullAndNoNegativeZero) {
+  const double inf = std::numeric_limits<double>::infinity();
+  EXPECT_TRUE(json_number(std::nan("")).is_null());
+  EXPECT_TRUE(json_number(inf).is_null());
+  EXPECT_TRUE(json_number(std::optional<double>()).is_null());
+  EXPECT_EQ(json_number(std::optional<double>(2.5)), 2.5);
+  EXPECT_EQ(json_number(-0.0).dump(), "0.0");
+  EXPECT_EQ(json_vector(Eigen::Vector3d(1, -0.0, inf)).dump(), "[1.0,0.0,null]");
+  EXPECT_EQ(json_vector(std::vector<double>{3, std::nan("")}).dump(), "[3.0,null]");
+  const Eigen::Matrix3d m = Eigen::Matrix3d::Identity();
+  EXPECT_EQ(json_vector(m.row(1)).dump(), "[0.0,1.0,0.0]");
+}
+
+}  // namespace
+}  // namespace impactdeck
