@@ -30,7 +30,8 @@ constexpr double kTonnePerMm3 = 1e-12;
 // ccx face numbers of a tetrahedron (corner triples, 0-based): S1 1-2-3, S2 1-4-2, S3 2-4-3, S4 3-4-1.
 constexpr int kTetFaces[4][3] = {{0, 1, 2}, {0, 3, 1}, {1, 3, 2}, {2, 3, 0}};
 
-std::string json_number(double v) {
+// A number of the deck text (12 digits, always with a decimal point or exponent).
+std::string deck_number(double v) {
   std::ostringstream s;
   s << std::setprecision(12) << v + 0.0;
   std::string t = s.str();
@@ -261,7 +262,7 @@ ContactDeck write_contact_deck(const ContactModelRequest& r, const fs::path& fol
     for (int i = 0; i < 2; ++i) {
       for (std::size_t n = 0; n < q[i].nodes.size(); ++n) {
         const Eigen::Vector3d p = q[i].nodes[n] * kMm;
-        d << base[i] + n + 1 << ", " << json_number(p.x()) << ", " << json_number(p.y()) << ", " << json_number(p.z()) << "\n";
+        d << base[i] + n + 1 << ", " << deck_number(p.x()) << ", " << deck_number(p.y()) << ", " << deck_number(p.z()) << "\n";
       }
     }
     const char* eset[2] = {"ETGT", "EIMP"};
@@ -286,13 +287,13 @@ ContactDeck write_contact_deck(const ContactModelRequest& r, const fs::path& fol
     for (int i = 0; i < 2; ++i) {
       const DeckMaterial& m = bodies[i]->material;
       d << "*MATERIAL, NAME=" << mname[i] << "\n*ELASTIC\n"
-        << json_number(m.youngs_modulus_Pa * kMPa) << ", " << json_number(m.poisson_ratio) << "\n*DENSITY\n"
-        << json_number(m.density_kg_m3 * kTonnePerMm3) << "\n*SOLID SECTION, ELSET=" << eset[i] << ", MATERIAL=" << mname[i]
+        << deck_number(m.youngs_modulus_Pa * kMPa) << ", " << deck_number(m.poisson_ratio) << "\n*DENSITY\n"
+        << deck_number(m.density_kg_m3 * kTonnePerMm3) << "\n*SOLID SECTION, ELSET=" << eset[i] << ", MATERIAL=" << mname[i]
         << "\n";
     }
     // Slave: the impactor's surface; master: the target's (both refined alike).
     d << "*SURFACE INTERACTION, NAME=SI1\n*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR\n"
-      << json_number(out.penalty_N_m3 * kMPa / kMm) << "\n"
+      << deck_number(out.penalty_N_m3 * kMPa / kMm) << "\n"
       << "*CONTACT PAIR, INTERACTION=SI1, TYPE=SURFACE TO SURFACE\nSIMP, STGT\n";
     // Initial velocities: v + omega x (x - c) of each body (mm/s).
     d << "*INITIAL CONDITIONS, TYPE=VELOCITY\n";
@@ -301,7 +302,7 @@ ContactDeck write_contact_deck(const ContactModelRequest& r, const fs::path& fol
       const Eigen::Vector3d c = b.rotation * b.centroid_own_m + b.position_m - r.contact_point_m;
       for (std::size_t n = 0; n < q[i].nodes.size(); ++n) {
         const Eigen::Vector3d v = (b.velocity_m_s + b.angular_velocity_rad_s.cross(q[i].nodes[n] - c)) * kMm;
-        for (int k = 0; k < 3; ++k) d << base[i] + n + 1 << ", " << k + 1 << ", " << json_number(v[k]) << "\n";
+        for (int k = 0; k < 3; ++k) d << base[i] + n + 1 << ", " << k + 1 << ", " << deck_number(v[k]) << "\n";
       }
     }
     const std::string solver = o.iterative_solver ? ", SOLVER=ITERATIVE SCALING" : "";
@@ -310,13 +311,13 @@ ContactDeck write_contact_deck(const ContactModelRequest& r, const fs::path& fol
     // The floor dt / 20 allows two cutbacks, and keeps the small steps ccx takes when the contact
     // opens ("impact rules") from costing many increments after the separation.
     d << "*STEP, INC=" << 20 * out.increments + 200 << "\n*DYNAMIC" << solver << "\n"
-      << json_number(out.time_step_s) << ", " << json_number(out.end_time_s - out.time_step_s) << ", "
-      << json_number(0.05 * out.time_step_s) << ", " << json_number(out.time_step_s) << "\n"
+      << deck_number(out.time_step_s) << ", " << deck_number(out.end_time_s - out.time_step_s) << ", "
+      << deck_number(0.05 * out.time_step_s) << ", " << deck_number(out.time_step_s) << "\n"
       << "*CONTACT PRINT, FREQUENCY=1, SLAVE=SIMP, MASTER=STGT\nCF\n"
       << (probe_nodes.empty() ? "" : "*EL FILE, FREQUENCY=1, NSET=NPROBES\nS\n") << "*END STEP\n";
     // One more increment that prints the final state of every node and the energies.
-    d << "*STEP, INC=100\n*DYNAMIC, DIRECT" << solver << "\n" << json_number(out.time_step_s) << ", "
-      << json_number(out.time_step_s) << "\n"
+    d << "*STEP, INC=100\n*DYNAMIC, DIRECT" << solver << "\n" << deck_number(out.time_step_s) << ", "
+      << deck_number(out.time_step_s) << "\n"
       << "*CONTACT PRINT, SLAVE=SIMP, MASTER=STGT\nCF\n*NODE PRINT, NSET=NALL\nU, V\n"
       << "*EL PRINT, ELSET=ETGT, TOTALS=ONLY\nELSE, ELKE\n*EL PRINT, ELSET=EIMP, TOTALS=ONLY\nELSE, ELKE\n*END STEP\n";
     write_file_atomically(stage / (std::string(kJobName) + ".inp"), d.str());
