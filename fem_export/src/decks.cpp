@@ -13,6 +13,7 @@
 
 #include "impactdeck/common/atomic_file.hpp"
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/common/stage.hpp"
 #include "impactdeck/common/run_transaction.hpp"
 #include "impactdeck/common/version.hpp"
 #include "impactdeck/fem_export/force_table.hpp"
@@ -617,6 +618,7 @@ DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
     std::optional<PatchLoad> patch;
     if (r.options.load == LoadKind::hertz_patch) {
       auto compute = [&] {
+        const ScopedTimer timer([&](double sec) { out.decks_seconds += sec; });
         try {
           patch = hertz_patch_load(mr.mesh, mr.mesh.node_of("LOAD"), r.direction, r.patch, r.force);
         } catch (const InputError& e) {
@@ -650,6 +652,7 @@ DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
       out.patch.load_node_count = 1;
       out.patch.max_nodes_loaded_at_once = 1;
     }
+    const ScopedTimer decks_timer([&](double sec) { out.decks_seconds += sec; });  // to the end of the writing
     out.contact_zone_radius_m = std::max(r.options.contact_zone_factor * r.patch.a_max_m, 2.0 * q.load_mesh_size_m);
     out.body_check = compare_body(m, r.material.density_kg_m3, r.model, r.options.tolerances,
                                   r.impulse_Ns * r.direction, r.load_point_m);

@@ -227,7 +227,8 @@ struct DeckResult {
   std::vector<std::filesystem::path> files;  ///< every file of the folder, in writing order
   MeshQuality quality;
   std::size_t node_count = 0, tet_count = 0;
-  double mesh_seconds = 0;  ///< wall time of the meshing part
+  double mesh_seconds = 0;   ///< wall time of the meshing (Gmsh, every try and re-mesh)
+  double decks_seconds = 0;  ///< wall time of the rest: patch load, body check, every file written
   LoadKind load = LoadKind::point;
   PatchSummary patch;
   double contact_zone_radius_m = 0;
