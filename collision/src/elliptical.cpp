@@ -7,6 +7,7 @@
 
 
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/common/symmetric2.hpp"
 
 namespace impactdeck::collision {
 namespace {
@@ -76,15 +77,13 @@ RelativeCurvatures relative_curvatures(double k1a, double k2a, const Eigen::Vect
   };
   // Gap h = 1/2 x^T (C_a + C_b) x = A x^2 + B y^2 in the principal frame of the sum.
   const Eigen::Matrix2d sum = 0.5 * (tensor(k1a, k2a, d1a, d2a) + tensor(k1b, k2b, d1b, d2b));
-  // Its eigenvalues in closed form (2 x 2 symmetric: mean -/+ radius; absolute accuracy eps |B|, as
-  // an iterative solver's), and A's eigenvector: (s12, A - s11) or (A - s22, s12), the longer one.
+  // Its eigenvalues and A's direction in closed form (absolute accuracy eps |B|, as an iterative
+  // solver's); A = B: any tangent direction.
   const double s11 = sum(0, 0), s22 = sum(1, 1), s12 = 0.5 * (sum(0, 1) + sum(1, 0));
-  const double mean = 0.5 * (s11 + s22), radius = std::hypot(0.5 * (s11 - s22), s12);
-  const double A = mean - radius, B = mean + radius;
-  const Eigen::Vector2d u(s12, A - s11), v(A - s22, s12);
-  const Eigen::Vector2d w = u.squaredNorm() >= v.squaredNorm() ? u : v;
-  const Eigen::Vector2d ev = w.squaredNorm() > 0.0 ? w.normalized() : Eigen::Vector2d::UnitX();
-  return {A, B, (T * ev).normalized()};
+  const Symmetric2Eigenvalues e = symmetric2_eigenvalues(s11, s12, s22);
+  double x = 1, y = 0;
+  symmetric2_eigenvector(s11, s12, s22, e.lo, 0.0, x, y);
+  return {e.lo, e.hi, (x * t1 + y * t2).normalized()};
 }
 
 EllipticalContact elliptical_contact(const RelativeCurvatures& c) {

@@ -12,6 +12,7 @@
 #include <gsl/gsl_sf_ellint.h>
 
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/common/symmetric2.hpp"
 
 namespace impactdeck::geometry {
 
@@ -193,19 +194,16 @@ Curvature Ellipsoid::curvature(const SurfacePoint& at) const {
   const Eigen::Vector3d n = grad / g;
   const double abc2 = e_.prod() * e_.prod();
   const double K = 1.0 / (abc2 * g2 * g2);
-  const Eigen::Vector3d helper = std::abs(n.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
-  const Eigen::Vector3d t1 = n.cross(helper).normalized(), t2 = n.cross(t1);
+  const Eigen::Vector3d t1 = n.unitOrthogonal(), t2 = n.cross(t1);
   const double s11 = t1.cwiseProduct(t1).dot(inv2) / g, s12 = t1.cwiseProduct(t2).dot(inv2) / g,
                s22 = t2.cwiseProduct(t2).dot(inv2) / g;
   Curvature c;
-  c.k1_per_m = 0.5 * (s11 + s22) + std::hypot(0.5 * (s11 - s22), s12);
+  c.k1_per_m = symmetric2_eigenvalues(s11, s12, s22).hi;
   c.k2_per_m = K / c.k1_per_m;
-  // Eigenvector of k1: (s12, k1 - s11) or (k1 - s22, s12), whichever is longer; an umbilic (k1 = k2)
-  // has none: any tangent pair.
-  const Eigen::Vector2d u(s12, c.k1_per_m - s11), v(c.k1_per_m - s22, s12);
-  const Eigen::Vector2d w = u.squaredNorm() >= v.squaredNorm() ? u : v;
-  const double wn = w.norm();
-  c.d1 = wn > 1e-12 * c.k1_per_m ? ((w.x() * t1 + w.y() * t2) / wn).eval() : t1;
+  // The direction of k1; an umbilic (k1 = k2) has none: any tangent pair.
+  double x = 1, y = 0;
+  symmetric2_eigenvector(s11, s12, s22, c.k1_per_m, 1e-12 * c.k1_per_m, x, y);
+  c.d1 = x * t1 + y * t2;
   c.d2 = n.cross(c.d1);
   c.error_estimate_per_m = 0.0;
   c.sharp_feature = false;
