@@ -3,7 +3,8 @@
 // through compare-contact with a refinement ladder; prints the ladder as a Markdown table and the
 // ratio at the first rung whose F_max is within 1 % of the analytic (= the hybrid's applied) one.
 // Wall times of this shared machine: the load average is printed with them.
-// Usage: bench_compare_contact [REFINE=2] [CONTACT_ELEMENTS=1] [POINT_Z_MM=25]
+// The scene: bench/contact_ladder/paper.toml.
+// Usage: bench_compare_contact [REFINE=2] [CONTACT_ELEMENTS=1]
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -21,37 +22,14 @@ using namespace impactdeck;
 int main(int argc, char** argv) {
   const int refine = argc > 1 ? std::atoi(argv[1]) : 2;
   const double elements = argc > 2 ? std::atof(argv[2]) : 1.0;
-  const std::string text = R"(length_unit = "mm"
-modulus_convention = "hertz"
-[materials.steel]
-youngs_modulus_Pa = 2.05e11
-poisson_ratio = 0.3
-density_kg_m3 = 7850
-[[bodies]]
-name = "ellipsoid"
-shape = "ellipsoid"
-semi_axes = [100, 25, 25]
-material = "steel"
-[[bodies]]
-name = "ball"
-shape = "sphere"
-radius = 10
-material = "steel"
-[[impacts]]
-name = "paper"
-target = "ellipsoid"
-impactor = "ball"
-point = [0, 0, 25]
-approach_speed_m_s = 1
-restitution = 1.0
-)";
   std::string l1, l5, l15;
   std::ifstream("/proc/loadavg") >> l1 >> l5 >> l15;
   const fs::path work = fs::temp_directory_path() / "impactdeck_bench_compare";
   fs::remove_all(work);
   fs::create_directories(work);
   try {
-    const scene::Scene sc = scene::parse_scene(text, "paper_geometry.toml");
+    // The scene of docs/contact-vs-hybrid.md's ladder (scripts/contact-ladder runs the same file).
+    const scene::Scene sc = scene::load_scene(fs::path(IMPACTDECK_SOURCE_DIR) / "bench" / "contact_ladder" / "paper.toml");
     scene::CompareOptions o;
     o.out_dir = work;
     o.refine = refine;
