@@ -184,8 +184,9 @@ KernelResult solve_kernel(const KernelInput& in) noexcept {
     r.contact_semi_axis_a_m = e.a_m;
     r.contact_semi_axis_b_m = e.b_m;
   } else {
-    r.contact_semi_axis_a_m = r.contact_semi_axis_b_m =
-        std::cbrt(3.0 * r.max_force_N * r.effective_radius_m / (4.0 * in.effective_modulus_Pa));
+    // a = (3 F R / 4 E*)^(1/3) = sqrt(R x_max) at the peak (F = 4/3 E* sqrt(R) x^(3/2)): a square
+    // root instead of a cube root per point.
+    r.contact_semi_axis_a_m = r.contact_semi_axis_b_m = std::sqrt(r.effective_radius_m * r.max_indentation_m);
   }
   r.peak_pressure_Pa = 3.0 * r.max_force_N / (2.0 * M_PI * r.contact_semi_axis_a_m * r.contact_semi_axis_b_m);
 

@@ -8,6 +8,21 @@
 
 namespace impactdeck::collision {
 
+namespace {
+
+// ln(cubic_metres_per(u)), computed once.
+double ln_cubic_metres_per(EnergyFluxUnit u) {
+  static const double ln_cm3 = std::log(1e-6), ln_mm3 = std::log(1e-9);
+  switch (u) {
+    case EnergyFluxUnit::J_per_m3: return 0.0;
+    case EnergyFluxUnit::J_per_cm3: return ln_cm3;
+    case EnergyFluxUnit::J_per_mm3: return ln_mm3;
+  }
+  return 0.0;
+}
+
+}  // namespace
+
 double cubic_metres_per(EnergyFluxUnit u) {
   switch (u) {
     case EnergyFluxUnit::J_per_m3: return 1.0;
@@ -87,8 +102,11 @@ RestitutionValue evaluate_restitution(const RestitutionModel& m, double m_w, dou
       break;
     case RestitutionModel::Kind::energy_flux: {
       const double ln_si = std::log(m_w) + 2.0 * std::log(v_w) - std::log(2.0) - 3.0 * std::log(r_w);
-      out.energy_flux_density_J_m3 = std::exp(ln_si);
-      out.ln_energy_flux = ln_si + std::log(cubic_metres_per(m.flux_unit));
+      // m v^2 / (2 r^3) directly where it is a normal number (no exp per sweep point), from the
+      // log where the product would over- or underflow.
+      const double phi = m_w * v_w * v_w / (2.0 * r_w * r_w * r_w);
+      out.energy_flux_density_J_m3 = phi > 1e-300 && phi < 1e300 ? phi : std::exp(ln_si);
+      out.ln_energy_flux = ln_si + ln_cubic_metres_per(m.flux_unit);
       double ln_used = out.ln_energy_flux;
       out.outside_range = !(ln_used > kEnergyFluxLnMin && ln_used < kEnergyFluxLnMax);
       if (out.outside_range) {

@@ -16,7 +16,7 @@
 
 namespace impactdeck::geometry {
 
-Ellipsoid::Ellipsoid(double a, double b, double c) : e_(a, b, c) {
+Ellipsoid::Ellipsoid(double a, double b, double c) : e_(a, b, c), inv_e2_(Eigen::Vector3d::Zero()), abc2_(0) {
   for (int i = 0; i < 3; ++i) {
     if (!(e_[i] > 0.0) || !std::isfinite(e_[i])) {
       std::ostringstream s;
@@ -24,6 +24,8 @@ Ellipsoid::Ellipsoid(double a, double b, double c) : e_(a, b, c) {
       throw InputError("", "semi_axes", s.str());
     }
   }
+  inv_e2_ = e_.cwiseProduct(e_).cwiseInverse();
+  abc2_ = e_.prod() * e_.prod();
 }
 
 double Ellipsoid::area_m2() const {
@@ -188,16 +190,23 @@ Curvature Ellipsoid::curvature(const SurfacePoint& at) const {
   // k2 = K / k1 with the Gaussian curvature in closed form K = 1 / ((e1 e2 e3)^2 |g|^4) (no
   // cancellation when k2 << k1).
   const Eigen::Vector3d& p = at.point_m;
-  const Eigen::Vector3d inv2 = e_.cwiseProduct(e_).cwiseInverse();
+  Curvature c;
+  c.error_estimate_per_m = 0.0;
+  c.sharp_feature = false;
+  if (is_sphere()) {  // an umbilic everywhere (a sweep's ball impactor): 1/r, any tangent pair
+    c.k1_per_m = c.k2_per_m = 1.0 / e_.x();
+    c.d1 = p.normalized().unitOrthogonal();
+    c.d2 = p.normalized().cross(c.d1);
+    return c;
+  }
+  const Eigen::Vector3d& inv2 = inv_e2_;
   const Eigen::Vector3d grad = p.cwiseProduct(inv2);
   const double g2 = grad.squaredNorm(), g = std::sqrt(g2);
   const Eigen::Vector3d n = grad / g;
-  const double abc2 = e_.prod() * e_.prod();
-  const double K = 1.0 / (abc2 * g2 * g2);
+  const double K = 1.0 / (abc2_ * g2 * g2);
   const Eigen::Vector3d t1 = n.unitOrthogonal(), t2 = n.cross(t1);
   const double s11 = t1.cwiseProduct(t1).dot(inv2) / g, s12 = t1.cwiseProduct(t2).dot(inv2) / g,
                s22 = t2.cwiseProduct(t2).dot(inv2) / g;
-  Curvature c;
   c.k1_per_m = symmetric2_eigenvalues(s11, s12, s22).hi;
   c.k2_per_m = K / c.k1_per_m;
   // The direction of k1; an umbilic (k1 = k2) has none: any tangent pair.
@@ -205,8 +214,6 @@ Curvature Ellipsoid::curvature(const SurfacePoint& at) const {
   symmetric2_eigenvector(s11, s12, s22, c.k1_per_m, 1e-12 * c.k1_per_m, x, y);
   c.d1 = x * t1 + y * t2;
   c.d2 = n.cross(c.d1);
-  c.error_estimate_per_m = 0.0;
-  c.sharp_feature = false;
   return c;
 }
 
@@ -274,9 +281,13 @@ std::optional<SurfacePoint> Ellipsoid::support_point(const Eigen::Vector3d& dire
   if (!(len > 0.0) || !std::isfinite(len)) throw InputError("", "direction", "must be a non-zero finite vector");
   // Scaled first (u = direction / |direction|): |M u| stays finite for any finite direction.
   const Eigen::Vector3d u = direction / len;
-  const Eigen::Vector3d mu = e_.cwiseProduct(e_).cwiseProduct(u);
   SurfacePoint sp;
-  sp.point_m = mu / std::sqrt(u.dot(mu));
+  if (is_sphere()) {  // r u (a sweep's ball impactor, once per point)
+    sp.point_m = e_.x() * u;
+  } else {
+    const Eigen::Vector3d mu = e_.cwiseProduct(e_).cwiseProduct(u);
+    sp.point_m = mu / std::sqrt(u.dot(mu));
+  }
   sp.normal = u;
   sp.distance_m = 0.0;
   return sp;

@@ -53,7 +53,8 @@ ContactModel::ContactModel(const PreparedBody& target, const PreparedBody& impac
       effective_modulus_Pa_(effective_modulus_Pa),
       restitution_(restitution),
       target_body_(collision::kernel_body(target.rigid_body())),
-      impactor_body_(collision::kernel_body(impactor.rigid_body())) {
+      impactor_body_(collision::kernel_body(impactor.rigid_body())),
+      impactor_mesh_(dynamic_cast<const geometry::MeshShape*>(impactor.shape.get())) {
   if (target.fixed() && impactor.fixed()) {
     throw InputError("", "bodies", "both bodies are fixed (infinite mass): nothing can move");
   }
@@ -79,8 +80,8 @@ collision::ContactCurvature ContactModel::surface(const PreparedBody& b, const g
   return c;
 }
 
-ContactEvaluation ContactModel::evaluate(ContactEvaluation e, const Eigen::Vector3d& impactor_centroid_world,
-                                        std::optional<double> approach_speed_m_s) const {
+void ContactModel::evaluate(ContactEvaluation& e, const Eigen::Vector3d& impactor_centroid_world,
+                            std::optional<double> approach_speed_m_s) const {
   collision::KernelInput& in = e.input;
   try {
     e.target_curvature = target_.shape->curvature(e.target_point);
@@ -90,7 +91,7 @@ ContactEvaluation ContactModel::evaluate(ContactEvaluation e, const Eigen::Vecto
     // sweep goes on and `run` names the reason.
     e.curvature_problem = (err.place().empty() ? "" : err.place() + ": ") + err.reason();
     e.result.flag = collision::ContactFlag::no_curvature;
-    return e;
+    return;
   }
   in.target = target_body_;
   in.impactor = impactor_body_;
@@ -105,7 +106,6 @@ ContactEvaluation ContactModel::evaluate(ContactEvaluation e, const Eigen::Vecto
   // The paper's sweep setting: the impactor moves along the inward normal at the given speed.
   if (approach_speed_m_s) in.impactor.velocity_m_s = -*approach_speed_m_s * e.normal;
   e.result = collision::solve_kernel(in);
-  return e;
 }
 
 ContactEvaluation ContactModel::at_surface_point(const geometry::SurfacePoint& at,
@@ -121,9 +121,7 @@ ContactEvaluation ContactModel::at_surface_point(const geometry::SurfacePoint& a
   std::optional<geometry::SurfacePoint> support;
   if (impactor_.shape->bounded()) {
     // A mesh touches with its smoothed surface where that is smooth (see first_contact).
-    if (const auto* mesh = dynamic_cast<const geometry::MeshShape*>(impactor_.shape.get())) {
-      support = mesh->smooth_support_point(down_own);
-    }
+    if (impactor_mesh_) support = impactor_mesh_->smooth_support_point(down_own);
     if (!support) support = impactor_.shape->support_point(down_own);
   }
   if (const auto& sp = support) {
@@ -136,7 +134,8 @@ ContactEvaluation ContactModel::at_surface_point(const geometry::SurfacePoint& a
   }
   e.impactor_translation_m = e.point_m - touch_world;
   const Eigen::Vector3d centroid = placed_centroid + e.impactor_translation_m;
-  return evaluate(std::move(e), centroid, approach_speed_m_s);
+  evaluate(e, centroid, approach_speed_m_s);  // in place: no copy of the evaluation per sweep point
+  return e;
 }
 
 ContactEvaluation ContactModel::at_first_contact() const {
@@ -156,7 +155,8 @@ ContactEvaluation ContactModel::at_first_contact() const {
   e.travel_m = fc.travel_m;
   e.impactor_translation_m = fc.travel_m * u.normalized();
   const Eigen::Vector3d centroid = impactor_.centroid_world_m() + e.impactor_translation_m;
-  return evaluate(std::move(e), centroid, std::nullopt);
+  evaluate(e, centroid, std::nullopt);
+  return e;
 }
 
 }  // namespace impactdeck::scene

@@ -40,6 +40,8 @@ class Ellipsoid final : public Shape {
 
  private:
   Eigen::Vector3d e_;
+  Eigen::Vector3d inv_e2_;  ///< 1 / e_i^2, per-point invariants of the curvature
+  double abc2_;             ///< (a b c)^2
 };
 
 /// Mean and Gaussian curvature of the ellipsoid at a surface point, closed forms (tests).

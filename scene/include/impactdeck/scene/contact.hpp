@@ -12,6 +12,10 @@
 #include "impactdeck/geometry/pose.hpp"
 #include "impactdeck/geometry/shape.hpp"
 
+namespace impactdeck::geometry {
+class MeshShape;
+}
+
 namespace impactdeck::scene {
 
 struct BodySpec;
@@ -91,8 +95,9 @@ class ContactModel {
   collision::ContactRule rule() const { return rule_; }
 
  private:
-  ContactEvaluation evaluate(ContactEvaluation e, const Eigen::Vector3d& impactor_centroid_world_m,
-                             std::optional<double> approach_speed_m_s) const;
+  /// Fills e's curvatures, kernel input and result (e's points, normal and translation set).
+  void evaluate(ContactEvaluation& e, const Eigen::Vector3d& impactor_centroid_world_m,
+                std::optional<double> approach_speed_m_s) const;
   collision::ContactCurvature surface(const PreparedBody& b, const geometry::SurfacePoint& own,
                                       const geometry::Curvature& k) const;
 
@@ -102,6 +107,7 @@ class ContactModel {
   double effective_modulus_Pa_;
   const collision::RestitutionModel& restitution_;
   collision::KernelBody target_body_, impactor_body_;
+  const geometry::MeshShape* impactor_mesh_;  ///< the impactor as a mesh (smooth support point), or null
 };
 
 }  // namespace impactdeck::scene
