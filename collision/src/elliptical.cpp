@@ -68,6 +68,23 @@ RelativeCurvatures relative_curvatures(double k1a, double k2a, const Eigen::Vect
     return std::abs(s - 1.0) <= 4.0 * std::numeric_limits<double>::epsilon() ? v : Eigen::Vector3d(v / std::sqrt(s));
   };
   const Eigen::Vector3d n = unit(normal);
+  // One body umbilic (k1 = k2: a ball, a plane) and the other's principal directions an
+  // orthonormal tangent pair (as a surface's curvature comes): the sum's principal frame is the
+  // other body's, A and B its curvatures plus the umbilic's, halved. No eigen-solve per point.
+  constexpr double kFrameTolerance = 1e-13;  // a few hundred ulps: round-off of computed directions
+  const auto tangent_frame = [&](const Eigen::Vector3d& d1, const Eigen::Vector3d& d2) {
+    return std::abs(d1.squaredNorm() - 1.0) <= kFrameTolerance && std::abs(d2.squaredNorm() - 1.0) <= kFrameTolerance &&
+           std::abs(d1.dot(d2)) <= kFrameTolerance && std::abs(d1.dot(n)) <= kFrameTolerance &&
+           std::abs(d2.dot(n)) <= kFrameTolerance;
+  };
+  const auto with_umbilic = [&](double k1, double k2, const Eigen::Vector3d& d1, const Eigen::Vector3d& d2,
+                                double k_umbilic) -> RelativeCurvatures {
+    const bool first_lower = k1 <= k2;
+    return {0.5 * ((first_lower ? k1 : k2) + k_umbilic), 0.5 * ((first_lower ? k2 : k1) + k_umbilic),
+            first_lower ? d1 : d2};
+  };
+  if (k1b == k2b && k1a != k2a && tangent_frame(d1a, d2a)) return with_umbilic(k1a, k2a, d1a, d2a, k1b);
+  if (k1a == k2a && k1b != k2b && tangent_frame(d1b, d2b)) return with_umbilic(k1b, k2b, d1b, d2b, k1a);
   // Tangent basis (t1, t2) of the plane normal to n.
   const Eigen::Vector3d t1 = n.unitOrthogonal(), t2 = n.cross(t1);
   // Gap h = 1/2 x^T (C_a + C_b) x = A x^2 + B y^2 in the principal frame of the sum, with each

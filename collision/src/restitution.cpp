@@ -101,11 +101,13 @@ RestitutionValue evaluate_restitution(const RestitutionModel& m, double m_w, dou
       R = m.constant;
       break;
     case RestitutionModel::Kind::energy_flux: {
-      const double ln_si = std::log(m_w) + 2.0 * std::log(v_w) - std::log(2.0) - 3.0 * std::log(r_w);
-      // m v^2 / (2 r^3) directly where it is a normal number (no exp per sweep point), from the
-      // log where the product would over- or underflow.
+      // Phi = m v^2 / (2 r^3) and its log directly where it is a normal number (one log per sweep
+      // point), from the sum of the logs where the product would over- or underflow.
       const double phi = m_w * v_w * v_w / (2.0 * r_w * r_w * r_w);
-      out.energy_flux_density_J_m3 = phi > 1e-300 && phi < 1e300 ? phi : std::exp(ln_si);
+      const bool direct = phi > 1e-300 && phi < 1e300;
+      const double ln_si =
+          direct ? std::log(phi) : std::log(m_w) + 2.0 * std::log(v_w) - std::log(2.0) - 3.0 * std::log(r_w);
+      out.energy_flux_density_J_m3 = direct ? phi : std::exp(ln_si);
       out.ln_energy_flux = ln_si + ln_cubic_metres_per(m.flux_unit);
       double ln_used = out.ln_energy_flux;
       out.outside_range = !(ln_used > kEnergyFluxLnMin && ln_used < kEnergyFluxLnMax);

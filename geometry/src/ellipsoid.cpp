@@ -201,12 +201,12 @@ Curvature Ellipsoid::curvature(const SurfacePoint& at) const {
   }
   const Eigen::Vector3d& inv2 = inv_e2_;
   const Eigen::Vector3d grad = p.cwiseProduct(inv2);
-  const double g2 = grad.squaredNorm(), g = std::sqrt(g2);
-  const Eigen::Vector3d n = grad / g;
+  const double g2 = grad.squaredNorm(), inv_g = 1.0 / std::sqrt(g2);
+  const Eigen::Vector3d n = grad * inv_g;
   const double K = 1.0 / (abc2_ * g2 * g2);
   const Eigen::Vector3d t1 = n.unitOrthogonal(), t2 = n.cross(t1);
-  const double s11 = t1.cwiseProduct(t1).dot(inv2) / g, s12 = t1.cwiseProduct(t2).dot(inv2) / g,
-               s22 = t2.cwiseProduct(t2).dot(inv2) / g;
+  const double s11 = t1.cwiseProduct(t1).dot(inv2) * inv_g, s12 = t1.cwiseProduct(t2).dot(inv2) * inv_g,
+               s22 = t2.cwiseProduct(t2).dot(inv2) * inv_g;
   c.k1_per_m = symmetric2_eigenvalues(s11, s12, s22).hi;
   c.k2_per_m = K / c.k1_per_m;
   // The direction of k1; an umbilic (k1 = k2) has none: any tangent pair.
