@@ -49,6 +49,47 @@ void sweep(benchmark::State& st, bool curves) {
   st.counters["threads"] = o.threads;
 }
 
+// Where a sweep point's time goes (1 thread, the same cloud): the target's curvature alone, the
+// whole contact evaluation (support point, both curvatures, Eq. 26 radii, kernel), and the sweep
+// point (the evaluation plus the result record).
+void BM_PointCurvature(benchmark::State& st) {
+  const study::SweepSetup s = setup();
+  const auto& c = cloud();
+  for (auto _ : st) {
+    for (const auto& p : c) benchmark::DoNotOptimize(s.target.shape->curvature(p));
+  }
+  st.SetItemsProcessed(static_cast<int64_t>(st.iterations()) * static_cast<int64_t>(c.size()));
+}
+void BM_PointContact(benchmark::State& st) {
+  const study::SweepSetup s = setup();
+  const scene::ContactModel model(s.target, s.impactor, s.rule, s.effective_modulus_Pa, s.restitution);
+  const auto& c = cloud();
+  for (auto _ : st) {
+    for (const auto& p : c) benchmark::DoNotOptimize(model.at_surface_point(p, s.approach_speed_m_s).result.max_force_N);
+  }
+  st.SetItemsProcessed(static_cast<int64_t>(st.iterations()) * static_cast<int64_t>(c.size()));
+}
+void BM_PointKernel(benchmark::State& st) {
+  const study::SweepSetup s = setup();
+  const scene::ContactModel model(s.target, s.impactor, s.rule, s.effective_modulus_Pa, s.restitution);
+  const auto& c = cloud();
+  std::vector<collision::KernelInput> inputs;
+  for (std::size_t i = 0; i < c.size(); i += 16) inputs.push_back(model.at_surface_point(c[i], s.approach_speed_m_s).input);
+  for (auto _ : st) {
+    for (const auto& in : inputs) benchmark::DoNotOptimize(collision::solve_kernel(in).max_force_N);
+  }
+  st.SetItemsProcessed(static_cast<int64_t>(st.iterations()) * static_cast<int64_t>(inputs.size()));
+}
+void BM_PointSweep(benchmark::State& st) {
+  const study::SweepSetup s = setup();
+  const scene::ContactModel model(s.target, s.impactor, s.rule, s.effective_modulus_Pa, s.restitution);
+  const auto& c = cloud();
+  for (auto _ : st) {
+    for (const auto& p : c) benchmark::DoNotOptimize(study::sweep_point(model, s.approach_speed_m_s, p).max_force_N);
+  }
+  st.SetItemsProcessed(static_cast<int64_t>(st.iterations()) * static_cast<int64_t>(c.size()));
+}
+
 void BM_SweepFmax(benchmark::State& st) { sweep(st, false); }
 void BM_SweepFullCurve(benchmark::State& st) { sweep(st, true); }
 
@@ -66,6 +107,10 @@ void BM_Table1Paper(benchmark::State& st) {
 
 }  // namespace
 
+BENCHMARK(BM_PointCurvature)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PointKernel)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PointContact)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PointSweep)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_SweepFmax)->Arg(1)->Arg(kCores)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_SweepFullCurve)->Arg(1)->Arg(kCores)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Table1Paper)->Arg(1)->Arg(kCores)->Unit(benchmark::kMillisecond)->UseRealTime();

@@ -54,7 +54,9 @@ ContactModel::ContactModel(const PreparedBody& target, const PreparedBody& impac
       restitution_(restitution),
       target_body_(collision::kernel_body(target.rigid_body())),
       impactor_body_(collision::kernel_body(impactor.rigid_body())),
-      impactor_mesh_(dynamic_cast<const geometry::MeshShape*>(impactor.shape.get())) {
+      impactor_mesh_(dynamic_cast<const geometry::MeshShape*>(impactor.shape.get())),
+      target_centroid_(target.centroid_world_m()),
+      impactor_centroid_(impactor.centroid_world_m()) {
   if (target.fixed() && impactor.fixed()) {
     throw InputError("", "bodies", "both bodies are fixed (infinite mass): nothing can move");
   }
@@ -95,7 +97,7 @@ void ContactModel::evaluate(ContactEvaluation& e, const Eigen::Vector3d& impacto
   }
   in.target = target_body_;
   in.impactor = impactor_body_;
-  in.target.lever_arm_m = e.point_m - target_.centroid_world_m();
+  in.target.lever_arm_m = e.point_m - target_centroid_;
   in.impactor.lever_arm_m = e.point_m - impactor_centroid_world;
   in.target.curvature = surface(target_, e.target_point, e.target_curvature);
   in.impactor.curvature = surface(impactor_, e.impactor_point, e.impactor_curvature);
@@ -116,7 +118,7 @@ ContactEvaluation ContactModel::at_surface_point(const geometry::SurfacePoint& a
   e.normal = target_.pose.direction_to_world(at.normal);
   // The impactor touches with its support point along -n; a plane (unbounded) is laid tangent.
   const Eigen::Vector3d down_own = impactor_.pose.direction_to_own(-e.normal);
-  const Eigen::Vector3d placed_centroid = impactor_.centroid_world_m();
+  const Eigen::Vector3d& placed_centroid = impactor_centroid_;
   Eigen::Vector3d touch_world;
   std::optional<geometry::SurfacePoint> support;
   if (impactor_.shape->bounded()) {
@@ -154,7 +156,7 @@ ContactEvaluation ContactModel::at_first_contact() const {
   e.normal = fc.normal;
   e.travel_m = fc.travel_m;
   e.impactor_translation_m = fc.travel_m * u.normalized();
-  const Eigen::Vector3d centroid = impactor_.centroid_world_m() + e.impactor_translation_m;
+  const Eigen::Vector3d centroid = impactor_centroid_ + e.impactor_translation_m;
   evaluate(e, centroid, std::nullopt);
   return e;
 }

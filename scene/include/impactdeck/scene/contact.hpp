@@ -108,6 +108,7 @@ class ContactModel {
   const collision::RestitutionModel& restitution_;
   collision::KernelBody target_body_, impactor_body_;
   const geometry::MeshShape* impactor_mesh_;  ///< the impactor as a mesh (smooth support point), or null
+  Eigen::Vector3d target_centroid_, impactor_centroid_;  ///< world, as placed
 };
 
 }  // namespace impactdeck::scene
