@@ -294,7 +294,7 @@ PYBIND11_MODULE(impactdeck, m) {
           const auto k1 = curvatures1_per_m.cast<std::vector<double>>(), k2 = curvatures2_per_m.cast<std::vector<double>>();
           if (k1.size() != 2 || k2.size() != 2) throw UsageError("curvatures: expected (k1, k2) per body, 1/m");
           // Principal directions: given, or any tangent pair (enough when a body is isotropic).
-          const Eigen::Vector3d t = (std::abs(n.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY()).cross(n).normalized();
+          const Eigen::Vector3d t = n.unitOrthogonal();
           const Eigen::Vector3d d1a = directions1.is_none() ? t : vec3(directions1, "directions1");
           const Eigen::Vector3d d1b = directions2.is_none() ? t : vec3(directions2, "directions2");
           auto surface = [&](const std::vector<double>& k, const Eigen::Vector3d& d1) {

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <iomanip>
 #include <sstream>
@@ -46,6 +47,59 @@ std::string mm_text(const Eigen::Vector3d& p_m) {
   s << std::setprecision(4) << "(" << p_m.x() * 1e3 + 0.0 << ", " << p_m.y() * 1e3 + 0.0 << ", "
     << p_m.z() * 1e3 + 0.0 << ") mm";
   return s.str();
+}
+
+// One pass over a ccx .frd (both readers below): the result blocks of every output time, each
+// "  100C" header's time, each " -4  NAME" block start, its " -1" node records and its " -3" end.
+// `block` says whether a block's records are wanted (false: skipped); `record` gets the node number
+// and the line; `end` closes a wanted block. Returns the bytes read.
+struct FrdVisitor {
+  std::function<void(double time_s)> time;
+  std::function<bool(const std::string& line)> block;
+  std::function<void(long node, const std::string& line, std::size_t lineno)> record;
+  std::function<void()> end;
+};
+
+std::size_t scan_frd(std::istream& f, const std::string& where, const FrdVisitor& v) {
+  std::string line;
+  std::size_t lineno = 0, bytes = 0;
+  bool wanted = false;
+  while (std::getline(f, line)) {
+    ++lineno;
+    bytes += line.size() + 1;
+    if (line.rfind("  100C", 0) == 0) {
+      double t;
+      if (!field(line, 12, 12, t)) throw InputError(where, "line " + std::to_string(lineno), "bad time in a result header");
+      v.time(t);
+      continue;
+    }
+    if (line.rfind(" -4", 0) == 0) {
+      wanted = v.block(line);
+      continue;
+    }
+    if (line.rfind(" -3", 0) == 0) {
+      if (wanted) v.end();
+      wanted = false;
+      continue;
+    }
+    if (!wanted || line.rfind(" -1", 0) != 0) continue;
+    double id;
+    if (!field(line, 3, 10, id) || id < 1 || id != std::floor(id) || id > 1e15) {
+      throw InputError(where, "line " + std::to_string(lineno), "bad node number in a result line");
+    }
+    v.record(static_cast<long>(id), line, lineno);
+  }
+  return bytes;
+}
+
+// The `count` 12-wide values of a " -1" record (displacements, stress components).
+void record_values(const std::string& line, std::size_t lineno, const std::string& where, int count, double* out,
+                   const char* what) {
+  for (int k = 0; k < count; ++k) {
+    if (!field(line, 13 + 12 * static_cast<std::size_t>(k), 12, out[k])) {
+      throw InputError(where, "line " + std::to_string(lineno), std::string("bad ") + what);
+    }
+  }
 }
 
 }  // namespace
@@ -90,8 +144,6 @@ StressResult read_stresses(const fs::path& frd, const TetMesh& mesh, const Stres
   enum class Block { none, disp, stress } block = Block::none;
   double t = 0, governing_best = -1;
   bool skip = false;
-  std::string line;
-  std::size_t lineno = 0;
   auto finish_stress = [&] {
     for (std::size_t i = 0; i < n; ++i) {
       if (!seen[i]) throw InputError(where, "time " + std::to_string(t), "stress block misses node " + std::to_string(i + 1));
@@ -125,55 +177,40 @@ StressResult read_stresses(const fs::path& frd, const TetMesh& mesh, const Stres
       r.displacement_at_peak_m = disp;
     }
   };
-  while (std::getline(f, line)) {
-    ++lineno;
-    r.frd_bytes += line.size() + 1;
-    if (line.rfind("  100C", 0) == 0) {
-      double v;
-      if (!field(line, 12, 12, v)) throw InputError(where, "line " + std::to_string(lineno), "bad time in a result header");
-      t = v;
-      skip = t > in.end_time_s * (1 + 1e-6);  // the momentum step's increment
-      continue;
-    }
-    if (line.rfind(" -4  DISP", 0) == 0) {
-      block = skip ? Block::none : Block::disp;
-      continue;
-    }
-    if (line.rfind(" -4  STRESS", 0) == 0) {
-      block = skip ? Block::none : Block::stress;
-      std::fill(seen.begin(), seen.end(), 0);
-      continue;
-    }
-    if (line.rfind(" -4", 0) == 0) {
-      block = Block::none;
-      continue;
-    }
-    if (line.rfind(" -3", 0) == 0) {
-      if (block == Block::stress) finish_stress();
-      block = Block::none;
-      continue;
-    }
-    if (block == Block::none || line.rfind(" -1", 0) != 0) continue;
-    double id;
-    if (!field(line, 3, 10, id) || id < 1 || id > static_cast<double>(n)) {
+  FrdVisitor visit;
+  visit.time = [&](double time_s) {
+    t = time_s;
+    skip = t > in.end_time_s * (1 + 1e-6);  // the momentum step's increment
+  };
+  visit.block = [&](const std::string& line) {
+    block = skip                                     ? Block::none
+            : line.rfind(" -4  DISP", 0) == 0   ? Block::disp
+            : line.rfind(" -4  STRESS", 0) == 0 ? Block::stress
+                                                     : Block::none;
+    if (block == Block::stress) std::fill(seen.begin(), seen.end(), 0);
+    return block != Block::none;
+  };
+  visit.record = [&](long id, const std::string& line, std::size_t lineno) {
+    if (id > static_cast<long>(n)) {
       throw InputError(where, "line " + std::to_string(lineno), "a result line names a node the mesh does not have");
     }
     const std::size_t node = static_cast<std::size_t>(id) - 1;
     if (block == Block::disp) {
       double u[3];
-      for (int k = 0; k < 3; ++k) {
-        if (!field(line, 13 + 12 * k, 12, u[k])) throw InputError(where, "line " + std::to_string(lineno), "bad displacement");
-      }
+      record_values(line, lineno, where, 3, u, "displacement");
       disp[node] = Eigen::Vector3d(u[0], u[1], u[2]) / units.per_m();
     } else {
       double sv[6];
-      for (int k = 0; k < 6; ++k) {
-        if (!field(line, 13 + 12 * k, 12, sv[k])) throw InputError(where, "line " + std::to_string(lineno), "bad stress");
-      }
+      record_values(line, lineno, where, 6, sv, "stress");
       vm[node] = von_mises(sv) / units.per_Pa();
       seen[node] = 1;
     }
-  }
+  };
+  visit.end = [&] {
+    if (block == Block::stress) finish_stress();
+    block = Block::none;
+  };
+  r.frd_bytes = scan_frd(f, where, visit);
   if (r.time_s.empty()) {
     throw InputError(where, "STRESS", "no stress output (the deck requests *EL FILE S; did ccx finish?)");
   }
@@ -202,7 +239,7 @@ std::vector<double> read_node_stresses(const fs::path& frd, std::vector<ProbeStr
   const std::string where = frd.string();
   std::ifstream f(frd, std::ios::binary);
   if (!f) throw InputError(where, "file", "CalculiX results (.frd) cannot be opened (missing or unreadable)");
-  std::map<int, std::size_t> wanted;  // ccx node id -> probe
+  std::map<long, std::size_t> wanted;  // ccx node id -> probe
   for (std::size_t k = 0; k < probes.size(); ++k) {
     wanted[probes[k].node] = k;
     probes[k].von_mises_Pa.clear();
@@ -211,10 +248,26 @@ std::vector<double> read_node_stresses(const fs::path& frd, std::vector<ProbeStr
   std::vector<double> times, vm(probes.size(), 0.0);
   std::vector<char> seen(probes.size(), 0);
   double t = 0;
-  bool skip = false, in_stress = false;
-  std::string line;
-  std::size_t lineno = 0;
-  auto finish = [&] {
+  bool skip = false;
+  FrdVisitor visit;
+  visit.time = [&](double time_s) {
+    t = time_s;
+    skip = t > end_time_s * (1 + 1e-6);
+  };
+  visit.block = [&](const std::string& line) {
+    const bool stress = !skip && line.rfind(" -4  STRESS", 0) == 0;
+    if (stress) std::fill(seen.begin(), seen.end(), 0);
+    return stress;
+  };
+  visit.record = [&](long id, const std::string& line, std::size_t lineno) {
+    const auto it = wanted.find(id);
+    if (it == wanted.end()) return;
+    double sv[6];
+    record_values(line, lineno, where, 6, sv, "stress");
+    vm[it->second] = von_mises(sv) / DeckUnits{}.per_Pa();  // contact decks are in mm-N-s-tonne (MPa)
+    seen[it->second] = 1;
+  };
+  visit.end = [&] {
     for (std::size_t k = 0; k < probes.size(); ++k) {
       if (!seen[k]) throw InputError(where, "time " + std::to_string(t), "no stress at " + probes[k].name + "'s node");
       probes[k].von_mises_Pa.push_back(vm[k]);
@@ -222,37 +275,7 @@ std::vector<double> read_node_stresses(const fs::path& frd, std::vector<ProbeStr
     }
     times.push_back(t);
   };
-  while (std::getline(f, line)) {
-    ++lineno;
-    if (line.rfind("  100C", 0) == 0) {
-      double v;
-      if (!field(line, 12, 12, v)) throw InputError(where, "line " + std::to_string(lineno), "bad time in a result header");
-      t = v;
-      skip = t > end_time_s * (1 + 1e-6);
-      continue;
-    }
-    if (line.rfind(" -4", 0) == 0) {
-      in_stress = !skip && line.rfind(" -4  STRESS", 0) == 0;
-      if (in_stress) std::fill(seen.begin(), seen.end(), 0);
-      continue;
-    }
-    if (line.rfind(" -3", 0) == 0) {
-      if (in_stress) finish();
-      in_stress = false;
-      continue;
-    }
-    if (!in_stress || line.rfind(" -1", 0) != 0) continue;
-    double id;
-    if (!field(line, 3, 10, id)) throw InputError(where, "line " + std::to_string(lineno), "bad node number");
-    const auto it = wanted.find(static_cast<int>(id));
-    if (it == wanted.end()) continue;
-    double sv[6];
-    for (int k = 0; k < 6; ++k) {
-      if (!field(line, 13 + 12 * k, 12, sv[k])) throw InputError(where, "line " + std::to_string(lineno), "bad stress");
-    }
-    vm[it->second] = von_mises(sv) / DeckUnits{}.per_Pa();  // contact decks are in mm-N-s-tonne (MPa)
-    seen[it->second] = 1;
-  }
+  scan_frd(f, where, visit);
   if (times.empty() && !probes.empty()) {
     throw InputError(where, "STRESS", "no stress output (the deck requests *EL FILE S; did ccx finish?)");
   }
