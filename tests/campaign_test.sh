@@ -115,6 +115,9 @@ count = 6
 TOML
 "$bin" campaign plan points.toml --out pts >/dev/null && "$bin" campaign run pts --quiet >/dev/null && "$bin" campaign collect pts >/dev/null || echo "FAILED: point campaign"
 check "point campaign: SVG and VTP maps" 'grep -q "<svg" pts/collect/map.svg && grep -q "NumberOfPoints=\"6\"" pts/collect/map.vtp'
+# The VTP map in the scene's unit (mm, stated), so that it overlays the cases' decks: every point
+# on the 200 x 50 x 50 mm ellipsoid.
+check "point campaign: VTP map in the scene's mm, on the part" 'grep -q "metres_per_length_unit\" NumberOfTuples=\"1\" format=\"ascii\">0.001<" pts/collect/map.vtp && awk "/<Points>/ {p=1; next} p && /<\/DataArray>/ {p=0} p {v=\$1*\$1/40000+\$2*\$2/2500+\$3*\$3/2500; if (v<0.999 || v>1.001) bad=1; n++} END {exit bad || n!=6}" pts/collect/map.vtp'
 # The collect's report page (issue 18): the verdict over the cases (a 10 mm steel ball at 1 m/s
 # dents steel: p0 above 1.60 sigma_y in every case), the map inline, one row per case,
 # and, where Debian's chromium is installed (scripts/test installs it), no console message.

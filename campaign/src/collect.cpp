@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <sstream>
 
 #include <Eigen/Geometry>
@@ -16,6 +17,7 @@
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/plot/drawing.hpp"
 #include "impactdeck/plot/html.hpp"
+#include "impactdeck/common/units.hpp"
 #include "impactdeck/scene/scene.hpp"
 #include "detail.hpp"
 
@@ -103,16 +105,31 @@ Eigen::Vector3d drop_direction(const fs::path& scene_file, const std::string& im
   return -Eigen::Vector3d::UnitZ();
 }
 
+// `unit`: the points' length unit (a point campaign: the scene's, so that the map overlays the
+// cases' decks); none for a drop campaign, whose points are unit directions.
 std::string vtp(const std::vector<Eigen::Vector3d>& pts, const std::vector<double>& force,
-                const std::vector<std::size_t>& ids) {
+                const std::vector<std::size_t>& ids, std::optional<LengthUnit> unit) {
   std::ostringstream s;
   s.precision(17);
   const std::size_t n = pts.size();
-  s << "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
-    << "<PolyData>\n<Piece NumberOfPoints=\"" << n << "\" NumberOfVerts=\"" << n
+  const double per = unit ? 1.0 / metres_per(*unit) : 1.0;
+  s << "<?xml version=\"1.0\"?>\n<!--\nimpactdeck campaign collect: one point per case, max_force_N in N; ";
+  if (unit) {
+    s << "points (the impact points, target frame) in " << to_string(*unit) << " (metres per unit "
+      << metres_per(*unit) << ", FieldData metres_per_length_unit), the scene's length unit\n";
+  } else {
+    s << "points: unit drop directions in the part's frame (dimensionless)\n";
+  }
+  s << "-->\n<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n<PolyData>\n";
+  if (unit) {
+    s << "<FieldData>\n<DataArray type=\"Float64\" Name=\"metres_per_length_unit\" NumberOfTuples=\"1\" "
+         "format=\"ascii\">"
+      << metres_per(*unit) << "</DataArray>\n</FieldData>\n";
+  }
+  s << "<Piece NumberOfPoints=\"" << n << "\" NumberOfVerts=\"" << n
     << "\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n"
     << "<Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-  for (const auto& p : pts) s << p.x() + 0.0 << " " << p.y() + 0.0 << " " << p.z() + 0.0 << "\n";
+  for (const auto& p : pts) s << p.x() * per + 0.0 << " " << p.y() * per + 0.0 << " " << p.z() * per + 0.0 << "\n";
   s << "</DataArray></Points>\n<Verts>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
   for (std::size_t i = 0; i < n; ++i) s << i << "\n";
   s << "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
@@ -369,10 +386,12 @@ CollectResult collect(const fs::path& dir_in) {
     std::vector<Eigen::Vector3d> pts;
     std::vector<double> force;
     std::vector<std::size_t> ids;
+    std::optional<LengthUnit> unit;  // a point campaign's: its scene's length unit
     const auto& pc = plan.at("cases");
     for (const Row& r : rows) {
       const json f = at(r.impact, "/max_force_N");
       if (r.state != CaseState::done || !f.is_number()) continue;
+      if (!drops && !unit) unit = scene::load_scene(case_folder(dir, r.id) / "scene.toml").length_unit;
       if (drops) {
         pts.push_back(drop_direction(case_folder(dir, r.id) / "scene.toml", impact));
       } else {
@@ -387,7 +406,7 @@ CollectResult collect(const fs::path& dir_in) {
       const std::string title = drops ? "Max force over the drop orientations" : "Max force over the impact points";
       map_text = map_svg(pts, force, drops, title);
       files.add(*out.map_svg, map_text);
-      files.add(*out.map_vtp, vtp(pts, force, ids));
+      files.add(*out.map_vtp, vtp(pts, force, ids, unit));
     }
   }
   out.report_html = cdir / "report.html";
