@@ -1,31 +1,23 @@
 #pragma once
 // Bounded work in `sweep` and `study`: the number of impact evaluations and of force-curve samples
 // is known before any is computed, and refused above a limit the user can raise
-// (docs/reliability.md, "Limits").
+// (docs/reliability.md, "Limits"); the checks are study/limits.hpp's.
 #include <cstddef>
 #include <string>
 
 #include <CLI/CLI.hpp>
 
-#include "impactdeck/geometry/shape.hpp"
-#include "impactdeck/study/cloud.hpp"
+#include "impactdeck/study/limits.hpp"
 
 namespace impactdeck::cli {
 
-inline constexpr std::size_t kDefaultMaxPoints = 1000000;           ///< --max-points
-inline constexpr std::size_t kDefaultMaxCurveSamples = 20000000;    ///< --max-curve-samples (160 MB)
-inline constexpr unsigned kMaxThreads = 1024;                       ///< --threads
+using study::check_curve_samples;  // the limits live in study/ (the sweep command there checks them)
+using study::check_points;
+using study::cloud_size;
+using study::kDefaultMaxCurveSamples;
+using study::kDefaultMaxPoints;
 
-/// Points study::make_cloud would make (an upper bound for the paper grid: 2 (2N + 1)^2).
-double cloud_size(const geometry::Shape& target, study::CloudKind kind, int grid_steps, std::size_t count);
-
-/// Throws InputError(where, option, ...) when `evaluations` exceeds `limit`, saying which limit
-/// (--max-points) and how the figure came about (`what`).
-void check_points(double evaluations, std::size_t limit, const std::string& where, const std::string& option,
-                  const std::string& what);
-
-/// The same for --curves: points x --curve-samples against --max-curve-samples.
-void check_curve_samples(double points, std::size_t samples, std::size_t limit, const std::string& where);
+inline constexpr unsigned kMaxThreads = 1024;  ///< --threads
 
 /// --threads above kMaxThreads is a usage error.
 void check_threads(unsigned threads);

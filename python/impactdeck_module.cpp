@@ -29,6 +29,7 @@
 #include "impactdeck/scene/report.hpp"
 #include "impactdeck/study/cloud.hpp"
 #include "impactdeck/study/scene_sweep.hpp"
+#include "impactdeck/study/sweep_command.hpp"
 
 namespace py = pybind11;
 namespace fs = std::filesystem;
@@ -395,19 +396,15 @@ PYBIND11_MODULE(impactdeck, m) {
         {
           py::gil_scoped_release release;
           const scene::Scene sc = scene::load_scene(scene_path);
-          const study::SceneSweep ss = study::sweep_from_scene(sc, impact);
-          const bool analytic = ss.setup.target.shape->kind() == "ellipsoid";
-          study::CloudKind kind = study::CloudKind::area_uniform;
-          if (cloud == "auto") kind = analytic ? study::CloudKind::paper_grid : study::CloudKind::area_uniform;
-          else if (cloud == "grid") kind = study::CloudKind::paper_grid;
-          else if (cloud == "uniform") kind = study::CloudKind::area_uniform;
-          else if (cloud == "both") kind = study::CloudKind::both;
-          else if (cloud == "vertices") kind = study::CloudKind::vertices;
-          else throw UsageError("cloud: expected grid, uniform, both, vertices or auto, got \"" + cloud + "\"");
-          const auto pts = study::make_cloud(*ss.setup.target.shape, kind, grid_steps, count, seed);
-          study::SweepOptions o;
-          o.threads = threads;
-          r = study::run_sweep(ss.setup, pts, o);
+          study::SweepRequest q;  // no out_dir: no files
+          q.impact = impact;
+          q.cloud = cloud;
+          q.count = count;
+          q.seed = seed;
+          q.grid_steps = grid_steps;
+          q.max_points = std::numeric_limits<std::size_t>::max();  // a script sizes its own sweep
+          q.sweep.threads = threads;
+          r = study::run_sweep_command(sc, q).result;
         }
         const std::size_t N = r.points.size();
         py::array_t<double> point({N, std::size_t{3}}), normal({N, std::size_t{3}});

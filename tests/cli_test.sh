@@ -107,6 +107,11 @@ assert d["points"] == 390, d["points"]
 assert 0 < d["force_ratio"] <= 1
 assert d["min"]["max_force_N"] <= d["max"]["max_force_N"]
 assert abs(d["min"]["max_force_N"] / d["max"]["max_force_N"] - d["force_ratio"]) < 1e-12
+# The stages that ran, in order, with their wall times (an analytic target: no mesh stages).
+assert d["stages_run"] == ["scene", "cloud", "sweep", "write_outputs"], d["stages_run"]
+assert set(d["stage_times_s"]) == set(d["stages_run"]) and all(t >= 0 for t in d["stage_times_s"].values())
+assert d["stage_times_s"]["sweep"] >= d["seconds"] * 0.5
+assert [f.rsplit("/", 1)[1] for f in d["files_written"]] == ["sweep_fig4.csv", "sweep_fig4.csv.json", "sweep_fig4.pos", "sweep_fig4.vtp", "sweep_fig4.svg"], d["files_written"]
 PY
 passes=$((passes+1))
 "$bin" sweep "$src/samples/fig4_sweep.toml" --impact nope --out "$tmp/sw2" >/dev/null 2>"$tmp/sw2.err"

@@ -1,7 +1,7 @@
 #pragma once
 // The stages of `run` (scene/pipeline) and of loading a part (geometry/part): one enum, one name
 // each. The names are a contract: `stages_run`, `stages_skipped` and `stage_times_s` of
-// `run --json` and `inspect --json` (docs/cli.md).
+// `run --json`, `inspect --json` and `sweep --json` (docs/cli.md).
 #include <chrono>
 
 namespace impactdeck {
@@ -20,6 +20,8 @@ enum class Stage {
   fem_decks,
   fem_run,
   compare_contact,  ///< [outputs.fem] compare_contact = true (scene/compare_contact.hpp)
+  cloud,            ///< `sweep`: the point cloud on the target (generated or read)
+  sweep,            ///< `sweep`: the impact at every point of the cloud
   write_outputs,
 };
 
@@ -39,6 +41,8 @@ constexpr const char* stage_name(Stage s) {
     case Stage::fem_decks: return "fem_decks";
     case Stage::fem_run: return "fem_run";
     case Stage::compare_contact: return "compare_contact";
+    case Stage::cloud: return "cloud";
+    case Stage::sweep: return "sweep";
     case Stage::write_outputs: return "write_outputs";
   }
   return "?";
