@@ -7,6 +7,8 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <regex>
 
 #include "fem_test_util.hpp"
@@ -180,6 +182,13 @@ compare_contact_increments = 12
   EXPECT_TRUE(fs::is_regular_file(out / "compare_hit" / "compare_force.svg"));
   EXPECT_TRUE(fs::is_regular_file(out / "compare_hit" / "contact" / "impact.frd"));
   EXPECT_TRUE(fs::is_directory(out / "fem_hit"));
+  // The report page shows the comparison beside the hybrid's checks.
+  {
+    std::ifstream page(out / "report.html");
+    const std::string html((std::istreambuf_iterator<char>(page)), std::istreambuf_iterator<char>());
+    EXPECT_NE(html.find("full contact (ccx): F_max vs analytic"), std::string::npos);
+    EXPECT_NE(html.find("Full-contact comparison (compare_contact)"), std::string::npos);
+  }
   for (const auto& e : fs::directory_iterator(out)) {
     EXPECT_EQ(e.path().filename().string().rfind(".impactdeck", 0), std::string::npos) << e.path();
   }

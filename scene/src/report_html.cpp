@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "impactdeck/fem_export/stress.hpp"
+#include "impactdeck/scene/compare_contact.hpp"
 #include "impactdeck/plot/force_plot.hpp"
 #include "impactdeck/plot/html.hpp"
 #include "impactdeck/scene/report.hpp"
@@ -197,6 +198,12 @@ std::string report_html(const Scene& scene, const RunReport& rep, const std::vec
         checks.push_back({"FEM vs rigid model: spin jump",
                           check_row_value(*fc.model_angular_velocity_relative_error, fc.model_angular_velocity_tolerance)});
     }
+    if (ir.compare) {
+      if (const ContactLevel* f = ir.compare->finest()) {
+        checks.push_back({"full contact (ccx): F_max vs analytic",
+                          check_row_value(std::abs(f->max_force_relative_difference), ir.compare->threshold)});
+      }
+    }
     page.heading("Checks", 3);
     page.table({"check", "relative error vs tolerance"}, checks);
     if (ir.fem_deck) {
@@ -205,6 +212,7 @@ std::string report_html(const Scene& scene, const RunReport& rep, const std::vec
                      fem_export::DeckUnits{rep.output_length_unit}.description() + ")");
     }
     if (ir.fem_check && ir.fem_check->stress) page.preformatted("FEM stresses", fem_export::format_stress(*ir.fem_check->stress));
+    if (ir.compare) page.preformatted("Full-contact comparison (compare_contact)", format_compare(*ir.compare));
 
     page.heading("Pictures", 3);
     plot::ForcePlotOptions po;
