@@ -65,6 +65,17 @@ void sample_curve(const PointResult& p, std::size_t samples, double* out) {
   if (R > 0.0) out[samples - 1] = 0.0;  // end of contact
 }
 
+std::string flag_counts_text(const SweepResult& r) {
+  std::ostringstream m;
+  bool any = false;
+  for (int f = 1; f < collision::kContactFlagCount; ++f) {
+    if (r.flag_counts[f] == 0) continue;
+    m << (any ? ", " : "") << r.flag_counts[f] << " " << collision::flag_word(static_cast<collision::ContactFlag>(f));
+    any = true;
+  }
+  return m.str();
+}
+
 SweepResult run_sweep(const SweepSetup& s, const std::vector<geometry::SurfacePoint>& cloud, const SweepOptions& o) {
   if (cloud.empty()) throw s.context.error("sweep", "the point cloud is empty");
   if (!s.target.shape || !s.impactor.shape) throw s.context.error("sweep", "a body has no shape");
@@ -107,16 +118,8 @@ SweepResult run_sweep(const SweepSetup& s, const std::vector<geometry::SurfacePo
   }
   res.sharp_count = res.flag_counts[static_cast<std::size_t>(collision::ContactFlag::sharp)];
   if (first == n) {
-    std::ostringstream m;
-    m << "all " << n << " points of the cloud are flagged (";
-    bool any = false;
-    for (int f = 1; f < collision::kContactFlagCount; ++f) {
-      if (res.flag_counts[f] == 0) continue;
-      m << (any ? ", " : "") << res.flag_counts[f] << " " << collision::flag_word(static_cast<collision::ContactFlag>(f));
-      any = true;
-    }
-    m << "): the contact model applies nowhere";
-    throw s.context.error("sweep", m.str());
+    throw s.context.error("sweep", "all " + std::to_string(n) + " points of the cloud are flagged (" +
+                                       flag_counts_text(res) + "): the contact model applies nowhere");
   }
   res.min_index = res.max_index = first;
   double mw_min = res.points[first].reduced_mass_kg, mw_max = mw_min;

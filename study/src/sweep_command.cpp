@@ -228,14 +228,8 @@ std::string format_sweep(const SweepReport& rep) {
     << "  time                  " << r.seconds << " s on " << r.threads_used << " threads (" << std::setprecision(3)
     << rate << " points/s)\n";
   if (r.flagged_count > 0) {
-    o << "  flagged points        " << r.flagged_count << " (";
-    bool any = false;
-    for (int f = 1; f < collision::kContactFlagCount; ++f) {
-      if (r.flag_counts[f] == 0) continue;
-      o << (any ? ", " : "") << r.flag_counts[f] << " " << collision::flag_word(static_cast<collision::ContactFlag>(f));
-      any = true;
-    }
-    o << "): the model does not apply there; left out of min/max, `flag` column in the files\n";
+    o << "  flagged points        " << r.flagged_count << " (" << flag_counts_text(r)
+      << "): the model does not apply there; left out of min/max, `flag` column in the files\n";
   }
   if (r.restitution_clamped_count > 0) {
     o << "  warning: ln(Phi) clamped into Eq. 30's range at " << r.restitution_clamped_count << " points\n";

@@ -12,6 +12,7 @@
 #include <cstddef>
 #include <functional>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -101,6 +102,9 @@ struct SweepResult {
   unsigned threads_used = 0;
   double seconds = 0;                        ///< wall time of the point loop
 };
+
+/// "3 sharp, 2 saddle": the non-zero counts of flagged points by flag word (messages, summaries).
+std::string flag_counts_text(const SweepResult& r);
 
 /// One point (the sweep's kernel): the target is hit at `at` (its own frame). Never throws: a point
 /// where the model does not apply comes back flagged.
