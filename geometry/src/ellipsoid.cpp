@@ -16,12 +16,12 @@
 
 namespace impactdeck::geometry {
 
-Ellipsoid::Ellipsoid(double a, double b, double c) : e_(a, b, c) {
+Ellipsoid::Ellipsoid(double a, double b, double c, const InputContext& ctx) : e_(a, b, c) {
   for (int i = 0; i < 3; ++i) {
     if (!(e_[i] > 0.0) || !std::isfinite(e_[i])) {
       std::ostringstream s;
       s << "semi-axes must be positive and finite, got (" << a << ", " << b << ", " << c << ") m";
-      throw InputError("", "semi_axes", s.str());
+      throw ctx.error("semi_axes", s.str());
     }
   }
 }
