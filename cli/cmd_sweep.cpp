@@ -101,7 +101,7 @@ void register_sweep(CLI::App& app, Context& ctx) {
         parse_output_length_unit(a->output_length_unit, sc.file.string()).value_or(sc.length_unit);
     // One transaction: the sweep's files appear together when all are written, or not at all.
     RunTransaction txn(a->out);
-    try {
+    txn.run([&] {  // messages name the final paths, not the staging folder
       const study::SceneSweep ss = study::sweep_from_scene(sc, a->impact);
       const scene::ImpactSpec& imp = *ss.impact;
 
@@ -262,9 +262,7 @@ void register_sweep(CLI::App& app, Context& ctx) {
         }
         for (const auto& f : files) std::cout << "  wrote " << f.string() << "\n";
       }
-    } catch (const InputError& e) {
-      throw txn.public_error(e);  // name the final paths, not the staging folder
-    }
+    });
   });
 }
 
