@@ -67,13 +67,14 @@ std::string describe(const std::vector<Segment>& segs, std::size_t upto, std::si
   return s;
 }
 
-// The value text parsed as TOML: `v = VALUE`.
+// The value text parsed as TOML: `v = VALUE` (VALUE made ASCII first, its own line and column
+// named by a non-ASCII character outside a string).
 toml::table parse_value(const Override& o, const InputContext& where) {
-  const std::string doc = "v = " + o.value + "\n";
+  const std::string ascii = detail::toml_ascii(o.value, where.at("--set " + o.key + ": value '" + o.value + "'"));
+  const std::string doc = "v = " + ascii + "\n";
   toml::table t;
   try {
-    const InputContext value = where.at("--set " + o.key + ": value '" + o.value + "'");
-    t = toml::parse(detail::toml_ascii(doc, value), "--set " + o.key);
+    t = toml::parse(doc, "--set " + o.key);
   } catch (const toml::parse_error& e) {
     bad_key(where, o.key, "value '" + o.value + "' is not a TOML value (" + std::string(e.description()) +
                               "; strings need quotes: KEY='\"text\"')");
