@@ -65,16 +65,12 @@ void register_compare_contact(CLI::App& app, Context& ctx) {
     o.place_output = [&txn, &args](const std::string& name, bool is_folder) {
       return is_folder ? txn.folder(name, args->out, "--out") : txn.file(name, args->out, "--out");
     };
-    scene::CompareReport r;
-    try {
+    scene::CompareReport r = txn.run([&] {
       VerboseTimer timer(ctx, "compare-contact", "hybrid and contact runs");
-      r = scene::compare_contact(sc, o);
+      scene::CompareReport report = scene::compare_contact(sc, o);
       txn.commit();
-    } catch (const InputError& e) {
-      throw txn.public_error(e);
-    } catch (const Error& e) {
-      throw Error(e.code(), txn.public_text(e.what()));
-    }
+      return report;
+    });
     scene::map_paths(r, [&txn](const std::filesystem::path& p) { return txn.public_path(p); });
     if (args->json) {
       std::cout << scene::to_json(r).dump(2) << "\n";

@@ -63,14 +63,11 @@ void register_fem_check(CLI::App& app, Context& ctx) {
       txn.emplace(args->dir, "deck folder");
       o.work_dir = txn->scratch("ccx");
     }
-    fem_export::CheckResult r;
-    try {
+    auto check = [&] {
       VerboseTimer timer(ctx, "fem-check", "ccx and the checks");
-      r = fem_export::run_check(args->dir, o);
-    } catch (const InputError& e) {
-      if (txn) throw txn->public_error(e);
-      throw;
-    }
+      return fem_export::run_check(args->dir, o);
+    };
+    fem_export::CheckResult r = txn ? txn->run(check) : check();  // messages name the deck folder
     if (!r.passed) {
       std::ostringstream m;
       m << (fs::path(args->dir) / "impact.dat").string() << ": FEM check failed: ";
@@ -86,15 +83,13 @@ void register_fem_check(CLI::App& app, Context& ctx) {
       return;
     }
     if (txn) {
-      try {
+      txn->run([&] {
         for (const auto& f : r.solver_files) {
           const fs::path staged = txn->file(f.filename().string(), args->dir, "ccx results");
           fs::rename(f, staged);
         }
         txn->commit();
-      } catch (const InputError& e) {
-        throw txn->public_error(e);
-      }
+      });
       for (auto& f : r.solver_files) f = fs::path(args->dir) / f.filename();
       if (r.stress) {
         for (auto& f : r.stress->files) f = fs::path(args->dir) / f.filename();

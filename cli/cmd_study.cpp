@@ -173,16 +173,14 @@ void register_study(CLI::App& app, Context& ctx) {
     bar.finish();
 
     const fs::path out(a->out);
-    try {
+    txn.run([&] {
       study::write_table1_csv(csv, r);
       write_file_atomically(md, "# Table 1 study (impactdeck study table1)\n\n" + study::table1_markdown(r));
       const plot::Drawing heat = study::table1_heatmap(r);
       plot::write_svg(svg, heat);
       if (!a->no_png) plot::write_png(png, heat, 1.25);
       txn.commit();
-    } catch (const InputError& e) {
-      throw txn.public_error(e);
-    }
+    });
     for (const auto& w : txn.warnings()) ctx.warn(w);
 
     if (a->json) {

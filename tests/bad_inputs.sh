@@ -2,9 +2,13 @@
 # Runs every case of tests/data/bad/cases.tsv through the CLI: the exit code must match, stderr
 # must be exactly one line matching the case's pattern, and the output folder must stay empty.
 # A case expecting exit 0 (a tricky input that must be read correctly) must print nothing on
-# stderr instead, and its pattern must match a line of stdout. {DECK} is a fresh copy of the
-# one-tetrahedron deck tests/data/bad/fem/deck, which must come back unchanged (fem-check leaves a
-# deck folder as it was after any failure); {FEM} is tests/data/bad/fem (fake solvers).
+# stderr instead, and its pattern must match a line of stdout. A `run` of a scene whose expected
+# message is about the scene itself (the pattern begins with the scene's file name) must begin with
+# the scene's path as given, then a line, a key, an override or "file" (the file itself missing or
+# unreadable): the context of an error raised deep in the library cannot get lost unnoticed.
+# {DECK} is a fresh copy of the one-tetrahedron deck tests/data/bad/fem/deck, which must come back
+# unchanged (fem-check leaves a deck folder as it was after any failure); {FEM} is
+# tests/data/bad/fem (fake solvers).
 # usage: bad_inputs.sh IMPACTDECK SOURCE_DIR
 set -u
 bin=$1; src=$2
@@ -33,6 +37,20 @@ while IFS=$'\t' read -r name args code pattern; do
   else
     [ "$lines" -eq 1 ] || problems="$problems $lines stderr lines (expected 1);"
     printf '%s' "$msg" | grep -Eq -- "$pattern" || problems="$problems message does not match /$pattern/;"
+    # shellcheck disable=SC2086
+    set -- $a
+    if [ "$1" = run ] && [ "$code" = 3 ]; then
+      scene_re=$(basename -- "$2" | sed 's/\./\\./g')
+      case "$pattern" in
+        "$scene_re: "*)
+          head="impactdeck: error: $2: "
+          rest=${msg#"$head"}
+          [ "$rest" != "$msg" ] || problems="$problems message does not begin with '$head';"
+          printf '%s' "$rest" | grep -Eq "^(line [0-9]+|key '|--set |file: )" ||
+            problems="$problems no line, key, override or 'file' after the scene's path;"
+          ;;
+      esac
+    fi
   fi
   [ -z "$(ls -A "$out" 2>/dev/null)" ] || problems="$problems output folder not empty: $(ls -A "$out");"
   if [ -d "$deck" ]; then

@@ -119,7 +119,7 @@ check "run without calculix message" grep -q "outputs.fem.run" "$tmp/nocx.err"
 sed -e 's/^probes = .*/probes = [[0, 600, 0]]/' -e 's/^run = "calculix".*/run = "none"/' "$src/samples/paper_table2_fem.toml" >"$tmp/probe.toml"
 "$bin" run "$tmp/probe.toml" --out "$tmp/probe" >/dev/null 2>"$tmp/probe.err"
 check "probe outside -> exit 3" test $? -eq 3
-check "probe outside message" grep -q "probe.toml: line [0-9]*, key 'outputs.fem': impact 'table2': FEM deck .*fem_table2/mesh.geo: PROBE1: probe point is not inside the ellipsoid" "$tmp/probe.err"
+check "probe outside message" grep -q "probe.toml: line [0-9]*, key 'outputs.fem': impact 'table2': FEM deck: .*fem_table2/mesh.geo: PROBE1: probe point is not inside the ellipsoid" "$tmp/probe.err"
 check "no deck after a failure" test ! -e "$tmp/probe/fem_table2"
 
 finish fem_samples_test

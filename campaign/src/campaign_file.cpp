@@ -68,13 +68,11 @@ class FileReader {
     throw InputError(name_, place(n, key), reason);
   }
 
-  // A --set key given as a table key: its syntax checked now, naming the campaign file.
+  // A --set key given as a table key: its syntax checked now, naming the campaign file and key.
   void check_key(const toml::node* n, const std::string& table, const std::string& key) const {
-    try {
-      scene::parse_override(key + "=0");
-    } catch (const InputError& e) {
-      fail(n, table + ".\"" + key + "\"", "not a --set key: " + e.reason());
-    }
+    const std::string k = table + ".\"" + key + "\"";
+    if (key.find_first_not_of(" \t") == std::string::npos) fail(n, k, "not a --set key: it is empty");
+    scene::parse_override(key + "=0", InputContext{name_, place(n, k)});
   }
 
   std::size_t count(const toml::table& t, const std::string& table, const char* key, std::size_t max) const {
@@ -273,12 +271,9 @@ Campaign read_campaign(const fs::path& file) {
     }
     for (const auto& o : k.overrides)
       if (std::find(c.keys.begin(), c.keys.end(), o.key) == c.keys.end()) c.keys.push_back(o.key);
-    // Validated exactly like `run --set`; the message names the campaign file, case and key.
-    try {
-      scene::load_scene(c.scene, k.overrides);
-    } catch (const InputError& e) {
-      throw InputError(fr.name(), "case " + std::to_string(id) + ": " + e.place(), e.reason());
-    }
+    // Validated exactly like `run --set`; the message names the campaign file and case, then the
+    // scene and the key.
+    scene::load_scene(c.scene, k.overrides, InputContext{fr.name(), "case " + std::to_string(id)});
     c.cases.push_back(std::move(k));
   }
   return c;

@@ -202,7 +202,7 @@ CompressionPhase compression_phase(double m_w, double v_w, double k_h) noexcept 
   return c;
 }
 
-void check_compression_range(const CompressionPhase& c) {
+void check_compression_range(const CompressionPhase& c, const InputContext& ctx, const std::string& inputs) {
   const double m_w = c.reduced_mass_kg, v_w = c.approach_velocity_m_s, k_h = c.hertz_constant;
   // Every number of the solve within [1e-100, 1e100] (numeric.hpp): beyond, the self-checks'
   // products under- or overflow and would print NaN or fail as "physics".
@@ -217,7 +217,8 @@ void check_compression_range(const CompressionPhase& c) {
     s << "the " << name << " is " << value << ", outside the magnitudes impactdeck computes with (1e-100 to "
       << "1e+100, SI): the inputs (reduced mass " << m_w << " kg, approach velocity " << v_w
       << " m/s, Hertz constant " << k_h << " N/m^1.5) are too extreme";
-    throw InputError("", "numeric range", s.str());
+    if (!inputs.empty()) s << "; check " << inputs;
+    throw ctx.error("numeric range", s.str());
   }
 }
 

@@ -105,14 +105,14 @@ ForceTable sample_force_table(const ForceHistory& h, const ForceTableOptions& o)
       m << "a step of " << o.time_step_s << " s gives " << samples << " samples over the " << h.contact_time_s()
         << " s contact, more than the limit of " << o.max_samples
         << " (force_table_max_samples in [outputs]: raise it, or use a larger step)";
-      throw InputError("", "force_table_time_step_s", m.str());
+      throw o.time_step_context.error("", m.str());
     }
     fill_uniform(h, static_cast<std::size_t>(n_comp), static_cast<std::size_t>(n_rest), t);
   } else {
     std::size_t n = 8;
     if (2 * n + 1 > o.max_samples) {
-      throw InputError("", "force_table_max_samples",
-                       "is " + std::to_string(o.max_samples) + ", below the 17 samples of the coarsest table");
+      throw o.max_samples_context.error(
+          "", "is " + std::to_string(o.max_samples) + ", below the 17 samples of the coarsest table");
     }
     for (;;) {
       fill_uniform(h, n, n, t);

@@ -8,16 +8,16 @@
 namespace impactdeck::collision {
 namespace {
 
-void check_material(const ElasticMaterial& m, const char* which) {
+void check_material(const ElasticMaterial& m, const char* which, const InputContext& ctx) {
   if (!(m.youngs_modulus_Pa > 0.0) || !std::isfinite(m.youngs_modulus_Pa)) {
     std::ostringstream s;
     s << "Young's modulus must be a positive finite number, got " << m.youngs_modulus_Pa << " Pa";
-    throw InputError("", std::string(which) + " youngs_modulus_Pa", s.str());
+    throw ctx.error(std::string(which) + " youngs_modulus_Pa", s.str());
   }
   if (!(m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5)) {
     std::ostringstream s;
     s << "Poisson's ratio must lie in (-1, 0.5), got " << m.poisson_ratio;
-    throw InputError("", std::string(which) + " poisson_ratio", s.str());
+    throw ctx.error(std::string(which) + " poisson_ratio", s.str());
   }
 }
 
@@ -29,9 +29,9 @@ double compliance(const ElasticMaterial& m, ModulusConvention c) {
 }  // namespace
 
 double effective_modulus_Pa(const ElasticMaterial& a, const ElasticMaterial& b,
-                            ModulusConvention convention) {
-  check_material(a, "target material");
-  check_material(b, "impactor material");
+                            ModulusConvention convention, const InputContext& ctx) {
+  check_material(a, "target material", ctx);
+  check_material(b, "impactor material", ctx);
   return 1.0 / (compliance(a, convention) + compliance(b, convention));
 }
 

@@ -70,29 +70,31 @@ std::string explain_flag(const KernelInput& in, const KernelResult& r, const std
 ImpactResult solve_impact(const ImpactInput& in) {
   const double nn = in.contact.normal.norm();
   if (!(nn > 0.0) || !std::isfinite(nn)) {
-    throw InputError("", "contact normal", "must be a non-zero finite vector");
+    throw in.context.error("contact normal", "must be a non-zero finite vector");
   }
   if (in.target.fixed() && in.impactor.fixed()) {
-    throw InputError("", "bodies", "both bodies are fixed (infinite mass): nothing can move");
+    throw in.context.error("bodies", "both bodies are fixed (infinite mass): nothing can move");
   }
   if (!(in.effective_modulus_Pa > 0.0) || !std::isfinite(in.effective_modulus_Pa)) {
-    throw InputError("", "effective modulus", "must be positive and finite");
+    throw in.context.error("effective modulus", "must be positive and finite");
   }
   if (in.restitution.kind == RestitutionModel::Kind::constant &&
       !(in.restitution.constant >= 0.0 && in.restitution.constant <= 1.0)) {
     std::ostringstream s;
     s << "must lie in [0, 1], got " << in.restitution.constant;
-    throw InputError("", "restitution", s.str());
+    throw in.context.error("restitution", s.str());
   }
-  if (in.restitution.kind == RestitutionModel::Kind::table) validate_restitution_table(in.restitution.table);
+  if (in.restitution.kind == RestitutionModel::Kind::table) {
+    validate_restitution_table(in.restitution.table, in.context.at("restitution"));
+  }
 
   Contact c = in.contact;
   // A unit normal is used as given (bit for bit what the kernel sees in a sweep); others are
   // normalised.
   if (std::abs(nn - 1.0) > 1e-12) c.normal /= nn;
   KernelInput k;
-  k.target = kernel_body(in.target);
-  k.impactor = kernel_body(in.impactor);
+  k.target = kernel_body(in.target, in.context.at("target"));
+  k.impactor = kernel_body(in.impactor, in.context.at("impactor"));
   k.target.lever_arm_m = c.point_m - in.target.center_of_mass_m;
   k.impactor.lever_arm_m = c.point_m - in.impactor.center_of_mass_m;
   k.target.curvature = in.target_curvature;
@@ -110,7 +112,7 @@ ImpactResult solve_impact(const ImpactInput& in) {
                         : (kr.flag == ContactFlag::restitution_range || kr.flag == ContactFlag::restitution_invalid)
                             ? "restitution"
                             : "contact";
-    throw InputError("", place, explain_flag(k, kr));
+    throw in.context.error(place, explain_flag(k, kr));
   }
   r.reduced_mass_kg = kr.reduced_mass_kg;
   r.approach_velocity_m_s = kr.approach_velocity_m_s;
@@ -131,7 +133,7 @@ ImpactResult solve_impact(const ImpactInput& in) {
   r.impactor_jump = kr.impactor_jump;
 
   r.history.compression = compression_phase(kr.reduced_mass_kg, kr.approach_velocity_m_s, kr.hertz_constant);
-  check_compression_range(r.history.compression);
+  check_compression_range(r.history.compression, in.context, in.input_keys);
   r.history.restitution = kr.restitution.coefficient;
 
   // Self-check 1 (Eq. 31): compression impulse by quadrature of the curve vs m_w v_w.

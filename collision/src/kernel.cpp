@@ -43,7 +43,7 @@ ContactCurvature ContactCurvature::sphere(double radius_m) {
 
 ContactCurvature ContactCurvature::flat() { return ContactCurvature{}; }
 
-KernelBody kernel_body(const RigidBody& b) {
+KernelBody kernel_body(const RigidBody& b, const InputContext& ctx) {
   KernelBody k;
   k.velocity_m_s = b.velocity_m_s;
   k.angular_velocity_rad_s = b.angular_velocity_rad_s;
@@ -51,20 +51,20 @@ KernelBody kernel_body(const RigidBody& b) {
   if (!(b.mass_kg > 0.0) || !std::isfinite(b.mass_kg)) {
     std::ostringstream s;
     s << "must be positive and finite, got " << b.mass_kg << " kg";
-    throw InputError("", "mass", s.str());
+    throw ctx.error("mass", s.str());
   }
   const Eigen::Matrix3d& I = b.inertia_kg_m2;
   const double scale = I.cwiseAbs().maxCoeff();
   if (!(scale > 0.0) || !I.allFinite() || (I - I.transpose()).cwiseAbs().maxCoeff() > 1e-9 * scale) {
-    throw InputError("", "inertia tensor", "must be finite, symmetric and non-zero");
+    throw ctx.error("inertia tensor", "must be finite, symmetric and non-zero");
   }
   Eigen::LLT<Eigen::Matrix3d> llt(I / scale);
-  if (llt.info() != Eigen::Success) throw InputError("", "inertia tensor", "is not positive definite");
+  if (llt.info() != Eigen::Success) throw ctx.error("inertia tensor", "is not positive definite");
   k.inverse_mass_per_kg = 1.0 / b.mass_kg;
   Eigen::Matrix3d inv = llt.solve(Eigen::Matrix3d::Identity()) / scale;
   k.inverse_inertia_world = 0.5 * (inv + inv.transpose());
   if (!std::isfinite(k.inverse_mass_per_kg) || !k.inverse_inertia_world.allFinite()) {
-    throw InputError("", "inertia tensor", "its inverse is not finite (mass or inertia too small)");
+    throw ctx.error("inertia tensor", "its inverse is not finite (mass or inertia too small)");
   }
   return k;
 }

@@ -66,28 +66,28 @@ const char* to_string(RestitutionModel::Kind k) {
   return "?";
 }
 
-void validate_restitution_table(const RestitutionTable& t) {
+void validate_restitution_table(const RestitutionTable& t, const InputContext& ctx) {
   const auto& v = t.approach_speed_m_s;
   const auto& r = t.value;
   if (v.size() != r.size()) {
-    throw InputError("", "restitution", "approach_speed_m_s has " + std::to_string(v.size()) +
-                                            " values but value has " + std::to_string(r.size()));
+    throw ctx.error("", "approach_speed_m_s has " + std::to_string(v.size()) + " values but value has " +
+                            std::to_string(r.size()));
   }
-  if (v.size() < 2) throw InputError("", "restitution", "a restitution table needs at least 2 points");
+  if (v.size() < 2) throw ctx.error("", "a restitution table needs at least 2 points");
   for (std::size_t i = 0; i < v.size(); ++i) {
     std::ostringstream s;
     if (!std::isfinite(v[i]) || v[i] < 0.0) {
       s << "approach_speed_m_s[" << i << "] = " << v[i] << " must be finite and >= 0";
-      throw InputError("", "restitution", s.str());
+      throw ctx.error("", s.str());
     }
     if (i > 0 && !(v[i] > v[i - 1])) {
       s << "approach_speed_m_s must be strictly increasing: element " << i << " (" << v[i]
         << ") follows " << v[i - 1];
-      throw InputError("", "restitution", s.str());
+      throw ctx.error("", s.str());
     }
     if (!(r[i] >= 0.0 && r[i] <= 1.0)) {
       s << "value[" << i << "] = " << r[i] << " must lie in [0, 1]";
-      throw InputError("", "restitution", s.str());
+      throw ctx.error("", s.str());
     }
   }
 }

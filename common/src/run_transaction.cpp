@@ -547,8 +547,8 @@ std::vector<fs::path> RunTransaction::commit() {
     }
   } catch (const InputError& e) {
     unlock_out();
-    throw InputError(e.where(), e.place(), e.reason() + "; the commit is incomplete: the next run into '" +
-                                               out_.string() + "' finishes it (journal " + kMarker + ")");
+    throw e.context().error(e.place(), e.reason() + "; the commit is incomplete: the next run into '" +
+                                           out_.string() + "' finishes it (journal " + kMarker + ")");
   }
   fsync_fd(out_fd_);
   ::unlink((out_ / kMarker).c_str());
@@ -597,7 +597,17 @@ std::string RunTransaction::public_text(std::string text) const {
 }
 
 InputError RunTransaction::public_error(const InputError& e) const {
-  return InputError(public_text(e.where()), public_text(e.place()), public_text(e.reason()));
+  const InputContext c = e.context();
+  const InputContext mapped{public_text(c.where), public_text(c.place)};
+  return mapped.error(public_text(e.place()), public_text(e.reason()));
+}
+
+void RunTransaction::rethrow_public(const Error& e) const {
+  if (const auto* input = dynamic_cast<const InputError*>(&e)) throw public_error(*input);
+  const std::string text = public_text(e.what());
+  if (dynamic_cast<const CheckFailed*>(&e)) throw CheckFailed(text);
+  if (dynamic_cast<const UsageError*>(&e)) throw UsageError(text);
+  throw Error(e.code(), text);
 }
 
 }  // namespace impactdeck

@@ -343,8 +343,8 @@ double run_ccx(const fs::path& work, const CheckOptions& o, double end_time_s, d
                              {"OMP_NUM_THREADS=" + threads, "CCX_NPROC_EQUATION_SOLVER=" + threads}, timeout_s, poll);
   } catch (const InputError& e) {
     if (e.reason().rfind("cannot run", 0) != 0) throw;
-    throw InputError(e.where(), e.place(), e.reason() + " (install the Debian package calculix-ccx, or name the "
-                                                        "solver with --ccx)");
+    throw e.context().error(e.place(), e.reason() + " (install the Debian package calculix-ccx, or name the "
+                                                    "solver with --ccx)");
   }
   // A run shorter than the 2 s between progress lines still shows where ccx ended.
   final_line = true;
@@ -448,7 +448,7 @@ CheckResult run_check(const fs::path& dir, const CheckOptions& o) {
     if (o.run_solver) scan_log(work / (std::string(kJobName) + ".log"), first_error, last_line);
     const std::string disk = o.run_solver ? disk_full_note(work, first_error + "\n" + last_line) : "";
     if (disk.empty()) throw;
-    throw InputError(e.where(), e.place(), e.reason() + "; " + disk);
+    throw e.context().error(e.place(), e.reason() + "; " + disk);
   }
 
   // FE mass, centroid and inertia of the mesh (exact for linear tetrahedra).

@@ -171,17 +171,17 @@ MeshResult mesh_body(const ContactBody& b, const MeshOptions& mo, const fs::path
 }  // namespace
 
 ContactDeck write_contact_deck(const ContactModelRequest& r, const fs::path& folder) {
-  const std::string where = folder.string();
+  const InputContext where = r.context.in_file(folder.string());
   const ContactModelOptions& o = r.options;
   if (!(r.semi_axis_b_m > 0) || !(r.semi_axis_a_m >= r.semi_axis_b_m) || !(r.compression_time_s > 0)) {
-    throw InputError(where, "contact model", "needs the Hertz contact semi-axes (a >= b > 0) and t_m > 0");
+    throw where.error("contact model", "needs the Hertz contact semi-axes (a >= b > 0) and t_m > 0");
   }
   if (!(o.contact_elements > 0) || o.contact_increments < 4 || !(o.penalty_factor > 0) || !(o.end_time_factor >= 1)) {
-    throw InputError(where, "contact model options", "contact_elements and penalty_factor > 0, increments >= 4, end factor >= 1");
+    throw where.error("contact model options", "contact_elements and penalty_factor > 0, increments >= 4, end factor >= 1");
   }
   for (const ContactBody* b : {&r.target, &r.impactor}) {
     if (!(b->material.youngs_modulus_Pa > 0) || !(b->material.density_kg_m3 > 0) || !(b->far_mesh_size_m > 0)) {
-      throw InputError(where, "body '" + b->name + "'", "modulus, density and mesh size must be > 0");
+      throw where.error("body '" + b->name + "'", "modulus, density and mesh size must be > 0");
     }
   }
   ContactDeck out;
@@ -196,7 +196,7 @@ ContactDeck write_contact_deck(const ContactModelRequest& r, const fs::path& fol
   out.penalty_N_m3 = o.penalty_factor * r.effective_modulus_Pa / hc;
 
   const fs::path parent = folder.parent_path().empty() ? fs::path(".") : folder.parent_path();
-  if (!fs::is_directory(parent)) throw InputError(where, "folder", "its parent folder does not exist");
+  if (!fs::is_directory(parent)) throw where.error("folder", "its parent folder does not exist");
   const fs::path stage = parent / ("." + folder.filename().string() + ".stage-" + std::to_string(::getpid()));
   std::error_code ec;
   fs::remove_all(stage, ec);
@@ -218,7 +218,8 @@ ContactDeck write_contact_deck(const ContactModelRequest& r, const fs::path& fol
       try {
         m = mesh_body(*bodies[i], mo, stage, names[i]);
       } catch (const InputError& e) {
-        throw InputError(where, "body '" + bodies[i]->name + "'", "meshing failed: " + e.reason());
+        // The mesher names its file in the private stage folder: name the deck folder and the body.
+        throw where.error("body '" + bodies[i]->name + "'", "meshing failed: " + e.reason());
       }
       q[i] = quadratic(m.mesh, *bodies[i], r.contact_point_m);
       // Probe nodes keep their numbers: the corner nodes come first in the quadratic mesh.
@@ -236,7 +237,7 @@ ContactDeck write_contact_deck(const ContactModelRequest& r, const fs::path& fol
                                 return (c / 3.0).norm() > surface_zone;
                               }),
                cf.end());
-      if (cf.empty()) throw InputError(where, "body '" + bodies[i]->name + "'", "no boundary face near the contact point");
+      if (cf.empty()) throw where.error("body '" + bodies[i]->name + "'", "no boundary face near the contact point");
       ContactBodyMesh& bm = *meshes[i];
       bm.node_count = q[i].nodes.size();
       bm.element_count = q[i].elements.size();

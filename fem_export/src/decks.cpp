@@ -38,48 +38,48 @@ std::size_t increments(const DeckOptions& o) {
   return static_cast<std::size_t>(std::ceil(o.end_time_s / o.time_step_s - 1e-9));
 }
 
-void validate(const DeckRequest& r, const std::string& where) {
+void validate(const DeckRequest& r, const InputContext& where) {
   const DeckOptions& o = r.options;
-  if (!(o.time_step_s > 0) || !std::isfinite(o.time_step_s)) throw InputError(where, "time_step_s", "must be > 0");
+  if (!(o.time_step_s > 0) || !std::isfinite(o.time_step_s)) throw where.error("time_step_s", "must be > 0");
   if (o.aster_cpus < 1 || o.aster_mpi_processes < 1) {
-    throw InputError(where, "aster_cpus", "Code_Aster CPUs and MPI processes must be >= 1");
+    throw where.error("aster_cpus", "Code_Aster CPUs and MPI processes must be >= 1");
   }
   if (!(o.end_time_s > o.time_step_s) || !std::isfinite(o.end_time_s)) {
-    throw InputError(where, "end_time_s", "must exceed time_step_s");
+    throw where.error("end_time_s", "must exceed time_step_s");
   }
-  if (increments(o) > 2000000) throw InputError(where, "time_step_s", "more than 2e6 increments");
+  if (increments(o) > 2000000) throw where.error("time_step_s", "more than 2e6 increments");
   if (r.force.time_s.size() < 2 || r.force.time_s.size() != r.force.force_N.size()) {
-    throw InputError(where, "force table", "needs at least two samples");
+    throw where.error("force table", "needs at least two samples");
   }
   if (r.force.time_s.back() > o.end_time_s) {
     std::ostringstream m;
     m << "end_time_s " << o.end_time_s << " s ends before the contact (" << r.force.time_s.back() << " s)";
-    throw InputError(where, "end_time_s", m.str());
+    throw where.error("end_time_s", m.str());
   }
-  if (std::abs(r.direction.norm() - 1.0) > 1e-9) throw InputError(where, "direction", "must be a unit vector");
+  if (std::abs(r.direction.norm() - 1.0) > 1e-9) throw where.error("direction", "must be a unit vector");
   if (!(r.material.youngs_modulus_Pa > 0) || !(r.material.density_kg_m3 > 0)) {
-    throw InputError(where, "material", "modulus and density must be > 0");
+    throw where.error("material", "modulus and density must be > 0");
   }
-  if (!(r.impulse_Ns > 0)) throw InputError(where, "impulse", "must be > 0");
+  if (!(r.impulse_Ns > 0)) throw where.error("impulse", "must be > 0");
   if (r.body.kind == BodyKind::part && r.body.surface.triangles.empty()) {
-    throw InputError(where, "body", "the part has no triangles");
+    throw where.error("body", "the part has no triangles");
   }
   if (o.load == LoadKind::hertz_patch) {
-    if (o.contact_elements < 1 || o.contact_elements > 64) throw InputError(where, "contact_elements", "must lie in [1, 64]");
+    if (o.contact_elements < 1 || o.contact_elements > 64) throw where.error("contact_elements", "must lie in [1, 64]");
     if (!(r.patch.a_max_m > 0) || !(r.patch.b_max_m > 0) || !(r.patch.max_force_N > 0)) {
-      throw InputError(where, "load", "hertz-patch needs the contact ellipse (a_max, b_max > 0) and its force");
+      throw where.error("load", "hertz-patch needs the contact ellipse (a_max, b_max > 0) and its force");
     }
   }
   if (!(o.contact_zone_factor > 0) || !std::isfinite(o.contact_zone_factor)) {
-    throw InputError(where, "contact_zone_factor", "must be > 0");
+    throw where.error("contact_zone_factor", "must be > 0");
   }
   const FemTolerances& t = o.tolerances;
   for (double v : {t.linear_momentum, t.angular_momentum, t.model_linear_velocity, t.model_angular_velocity, t.volume,
                    t.mass, t.inertia}) {
-    if (!(v > 0) || !std::isfinite(v)) throw InputError(where, "tolerances", "every tolerance must be > 0");
+    if (!(v > 0) || !std::isfinite(v)) throw where.error("tolerances", "every tolerance must be > 0");
   }
-  if (!(t.min_gamma >= 0 && t.min_gamma < 1)) throw InputError(where, "min_gamma", "must lie in [0, 1)");
-  if (r.yield_strength_Pa && !(*r.yield_strength_Pa > 0)) throw InputError(where, "yield_strength_Pa", "must be > 0");
+  if (!(t.min_gamma >= 0 && t.min_gamma < 1)) throw where.error("min_gamma", "must lie in [0, 1)");
+  if (r.yield_strength_Pa && !(*r.yield_strength_Pa > 0)) throw where.error("yield_strength_Pa", "must be > 0");
 }
 
 // The frd output interval of the free-vibration step: every increment unless nodes x increments
@@ -511,7 +511,7 @@ std::string code_aster_export(const DeckRequest& r, const TetMesh& m) {
 namespace {
 
 // The element count before meshing (estimate) and after it (real), against options.max_elements.
-void check_element_count(const DeckRequest& r, const std::string& where) {
+void check_element_count(const DeckRequest& r, const InputContext& where) {
   const double volume = r.body.volume_m3 > 0                  ? r.body.volume_m3
                         : r.model.volume_m3 > 0              ? r.model.volume_m3
                         : r.body.kind == BodyKind::ellipsoid ? 4.0 / 3.0 * M_PI * r.body.semi_axes_m.prod()
@@ -522,7 +522,7 @@ void check_element_count(const DeckRequest& r, const std::string& where) {
     m << "about " << std::setprecision(3) << est << " tetrahedra (estimated from the body's volume " << volume
       << " m^3 at mesh_size " << r.options.mesh.mesh_size_m << " m), more than max_elements = "
       << r.options.max_elements << ": use a larger mesh_size, or raise outputs.fem.max_elements";
-    throw InputError(where, "mesh_size", m.str());
+    throw where.error("mesh_size", m.str());
   }
 }
 
@@ -530,27 +530,28 @@ void check_element_count(const DeckRequest& r, const std::string& where) {
 
 DeckResult write_decks(const DeckRequest& r, const fs::path& folder) {
   const fs::path parent = folder.has_parent_path() ? folder.parent_path() : fs::path(".");
-  if (!fs::is_directory(parent)) throw InputError(folder.string(), "output folder", "parent folder does not exist");
+  if (!fs::is_directory(parent)) {
+    throw r.context.in_file(folder.string()).error("output folder", "parent folder does not exist");
+  }
   RunTransaction txn(parent, "deck folder");
-  try {
+  return txn.run([&] {
     DeckResult out = write_deck_files(r, txn.folder(folder.filename().string(), folder.string(), "deck folder"));
     txn.commit();
     out.folder = folder;
     for (auto& f : out.files) f = txn.public_path(f);
     return out;
-  } catch (const InputError& e) {
-    throw txn.public_error(e);
-  }
+  });
 }
 
 DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
-  const std::string where = folder.string();
+  // Errors name the request's context, then the deck folder (InputContext::in_file).
+  const InputContext where = r.context.in_file(folder.string());
   validate(r, where);
   check_element_count(r, where);
   const fs::path stage = folder;
   std::error_code ec;
   if (!fs::create_directory(stage, ec)) {
-    throw InputError(where, "output folder", "cannot create it: " + (ec ? ec.message() : "it exists already"));
+    throw where.error("output folder", "cannot create it: " + (ec ? ec.message() : "it exists already"));
   }
 
   DeckResult out;
@@ -558,6 +559,7 @@ DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
     // The mesh options this request needs: a hertz-patch load refines the surface so the largest
     // contact ellipse spans contact_elements elements along its short axis, evenly over the patch.
     MeshOptions mo = r.options.mesh;
+    mo.context = r.context;  // the mesher names its own file after it
     mo.quality_floor_gamma = r.options.tolerances.min_gamma;
     mo.output_unit = r.options.units.length;
     if (r.options.load == LoadKind::hertz_patch) {
@@ -608,7 +610,7 @@ DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
     out.mesh_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_mesh).count();
     TetMesh& m = mr.mesh;
     if (m.tets.size() > r.options.max_elements) {
-      throw InputError(where, "mesh", "Gmsh made " + std::to_string(m.tets.size()) +
+      throw where.error("mesh", "Gmsh made " + std::to_string(m.tets.size()) +
                                           " tetrahedra, more than max_elements = " +
                                           std::to_string(r.options.max_elements) +
                                           ": use a larger mesh_size, or raise outputs.fem.max_elements");
@@ -619,11 +621,7 @@ DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
     if (r.options.load == LoadKind::hertz_patch) {
       auto compute = [&] {
         const ScopedTimer timer([&](double sec) { out.decks_seconds += sec; });
-        try {
-          patch = hertz_patch_load(mr.mesh, mr.mesh.node_of("LOAD"), r.direction, r.patch, r.force);
-        } catch (const InputError& e) {
-          throw InputError(where, "load", e.place() + ": " + e.reason());
-        }
+        patch = hertz_patch_load(mr.mesh, mr.mesh.node_of("LOAD"), r.direction, r.patch, r.force, where.at("load"));
       };
       compute();
       // Gmsh's edges come out near, not below, the size asked for: until the largest ellipse

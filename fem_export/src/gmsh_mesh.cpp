@@ -65,7 +65,7 @@ class GmshSession {
 
 // Runs a Gmsh step; whatever Gmsh throws becomes an InputError naming the step and Gmsh's message.
 template <class F>
-void gmsh_step(const std::string& where, const std::string& step, F&& f) {
+void gmsh_step(const InputContext& where, const std::string& step, F&& f) {
   run_as_input_error(where, "gmsh " + step, std::forward<F>(f), &GmshSession::last_error);
 }
 
@@ -121,7 +121,7 @@ int add_size_field(const Eigen::Vector3d& p_mm, double h0_mm, double h_mm, doubl
 std::string probe_name(std::size_t i) { return "PROBE" + std::to_string(i + 1); }
 
 // Size field around the load point, then the 3D mesh (both routes).
-void generate_tets(const std::string& where, const MeshOptions& o, int algorithm_2d, const Eigen::Vector3d& p_mm,
+void generate_tets(const InputContext& where, const MeshOptions& o, int algorithm_2d, const Eigen::Vector3d& p_mm,
                    double h0, double h) {
   gmsh_step(where, "mesh", [&] {
     set_common_options(h, algorithm_2d, o.algorithm_3d);
@@ -162,21 +162,21 @@ std::string geo_size_field(const Eigen::Vector3d& p_mm, double h0_mm, double h_m
          "\";\nBackground Field = 1;\n";
 }
 
-void check_options(const MeshOptions& o, const std::string& where) {
+void check_options(const MeshOptions& o, const InputContext& where) {
   if (!(o.mesh_size_m > 0.0) || !std::isfinite(o.mesh_size_m)) {
-    throw InputError(where, "mesh_size", "must be > 0");
+    throw where.error("mesh_size", "must be > 0");
   }
   if (o.load_mesh_size_m < 0.0 || !std::isfinite(o.load_mesh_size_m)) {
-    throw InputError(where, "load_mesh_size", "must be >= 0");
+    throw where.error("load_mesh_size", "must be >= 0");
   }
-  if (o.algorithm_3d != 1 && o.algorithm_3d != 10) throw InputError(where, "algorithm_3d", "must be 1 or 10");
+  if (o.algorithm_3d != 1 && o.algorithm_3d != 10) throw where.error("algorithm_3d", "must be 1 or 10");
   if (o.algorithm_2d != 0 && o.algorithm_2d != 1 && o.algorithm_2d != 5 && o.algorithm_2d != 6) {
-    throw InputError(where, "algorithm_2d", "must be 0 (default), 1, 5 or 6");
+    throw where.error("algorithm_2d", "must be 0 (default), 1, 5 or 6");
   }
   if (o.load_zone_radius_m < 0.0 || !std::isfinite(o.load_zone_radius_m)) {
-    throw InputError(where, "load_zone_radius", "must be >= 0");
+    throw where.error("load_zone_radius", "must be >= 0");
   }
-  if (o.probes_m.size() > 99) throw InputError(where, "probes", "at most 99 probes");
+  if (o.probes_m.size() > 99) throw where.error("probes", "at most 99 probes");
 }
 
 double load_size(const MeshOptions& o) {
@@ -186,7 +186,7 @@ double load_size(const MeshOptions& o) {
 
 /// Reads the tetrahedra of the current model into a TetMesh (only nodes used by tetrahedra),
 /// oriented positively; returns the map gmsh node tag -> index.
-std::map<std::size_t, int> extract(TetMesh& m, const std::string& where) {
+std::map<std::size_t, int> extract(TetMesh& m, const InputContext& where) {
   std::vector<std::size_t> tags;
   std::vector<double> xyz, par;
   gmsh::model::mesh::getNodes(tags, xyz, par, -1, -1, true, false);
@@ -196,7 +196,7 @@ std::map<std::size_t, int> extract(TetMesh& m, const std::string& where) {
   std::vector<std::size_t> etags, enodes;
   gmsh::model::mesh::getElementsByType(4, etags, enodes);  // 4 = 4-node tetrahedron
   if (etags.empty()) {
-    throw InputError(where, "gmsh mesh", "Gmsh produced no tetrahedra (mesh size too large for "
+    throw where.error("gmsh mesh", "Gmsh produced no tetrahedra (mesh size too large for "
                      "the body, or an open/self-intersecting surface)");
   }
   std::map<std::size_t, int> index;
@@ -218,13 +218,13 @@ std::map<std::size_t, int> extract(TetMesh& m, const std::string& where) {
   return index;
 }
 
-int node_of_point_entity(int point_tag, const std::map<std::size_t, int>& index, const std::string& where,
+int node_of_point_entity(int point_tag, const std::map<std::size_t, int>& index, const InputContext& where,
                          const std::string& what) {
   std::vector<std::size_t> tags;
   std::vector<double> xyz, par;
   gmsh::model::mesh::getNodes(tags, xyz, par, 0, point_tag, false, false);
   if (tags.empty() || !index.count(tags[0])) {
-    throw InputError(where, "gmsh mesh", what + ": no mesh node on its geometry point");
+    throw where.error("gmsh mesh", what + ": no mesh node on its geometry point");
   }
   return index.at(tags[0]);
 }
@@ -232,7 +232,7 @@ int node_of_point_entity(int point_tag, const std::map<std::size_t, int>& index,
 // Node groups LOAD (node `load`) and PROBEk (the nodes on the embedded probe points), with their
 // distances to the requested points (both routes).
 void add_node_groups(MeshResult& r, int load, const Eigen::Vector3d& p_mm, const std::vector<int>& probe_tags,
-                     const std::map<std::size_t, int>& index, const MeshOptions& o, const std::string& where) {
+                     const std::map<std::size_t, int>& index, const MeshOptions& o, const InputContext& where) {
   r.mesh.node_groups.emplace_back("LOAD", load);
   r.quality.load_node_distance_m = (r.mesh.nodes_m[load] * kMmPerM - p_mm).norm() / kMmPerM;
   for (std::size_t i = 0; i < probe_tags.size(); ++i) {
@@ -260,12 +260,12 @@ void fill_quality(const TetMesh& m, MeshQuality& q) {
   q.volume_relative_difference = (q.fe_volume_m3 - q.part_volume_m3) / q.part_volume_m3;
 }
 
-void check_mesh(const MeshResult& r, const std::string& where) {
+void check_mesh(const MeshResult& r, const InputContext& where) {
   if (!(r.quality.min_quality > 1e-6)) {
     std::ostringstream s;
     s << "degenerate tetrahedron (radius ratio " << r.quality.min_quality
       << "): the solver would fail; change mesh_size";
-    throw InputError(where, "gmsh mesh", s.str());
+    throw where.error("gmsh mesh", s.str());
   }
 }
 
@@ -286,7 +286,7 @@ void write_msh(const fs::path& folder, const std::string& name, const MeshOption
 // After meshing a body whose load point and probes are geometry points (ellipsoid and CAD routes):
 // extract the tetrahedra, name LOAD and PROBEk, check and record the quality and the attempt,
 // write the .msh files.
-void finish_point_mesh(const std::string& where, const MeshOptions& o, const fs::path& folder,
+void finish_point_mesh(const InputContext& where, const MeshOptions& o, const fs::path& folder,
                        const std::string& name, int load_tag, const std::vector<int>& probe_tags,
                        const Eigen::Vector3d& p_mm, double h0_mm, int algorithm_2d, const char* route,
                        MeshResult& r) {
@@ -317,23 +317,23 @@ std::string geo_header(const std::string& what, const MeshOptions& o) {
 
 MeshResult mesh_ellipsoid_with_gmsh(const Eigen::Vector3d& semi_axes_m, const Eigen::Vector3d& load_point_m,
                           const MeshOptions& o, const fs::path& folder, const std::string& name) {
-  const std::string where = (folder / (name + ".geo")).string();
+  const InputContext where = o.context.in_file((folder / (name + ".geo")).string());
   check_options(o, where);
-  if (!((semi_axes_m.array() > 0).all())) throw InputError(where, "semi_axes", "must be > 0");
+  if (!((semi_axes_m.array() > 0).all())) throw where.error("semi_axes", "must be > 0");
   const Eigen::Vector3d ax = semi_axes_m * kMmPerM;
   const double size_mm = ax.maxCoeff();
   // Radial projection onto the surface through the unit sphere.
   const Eigen::Vector3d q = (load_point_m * kMmPerM).cwiseQuotient(ax);
-  if (!(q.norm() > 1e-9)) throw InputError(where, "load point", "must not be the centre");
+  if (!(q.norm() > 1e-9)) throw where.error("load point", "must not be the centre");
   const Eigen::Vector3d qhat = q.normalized();
   const Eigen::Vector3d p_mm = ax.cwiseProduct(qhat);
   if ((p_mm - load_point_m * kMmPerM).norm() > 0.01 * size_mm) {
-    throw InputError(where, "load point", "more than 1 % of the size away from the surface");
+    throw where.error("load point", "more than 1 % of the size away from the surface");
   }
   const double h = o.mesh_size_m * kMmPerM, h0 = load_size(o) * kMmPerM;
   for (std::size_t i = 0; i < o.probes_m.size(); ++i) {
     if (o.probes_m[i].cwiseQuotient(semi_axes_m).squaredNorm() >= 1.0) {
-      throw InputError(where, probe_name(i), "probe point is not inside the ellipsoid");
+      throw where.error(probe_name(i), "probe point is not inside the ellipsoid");
     }
   }
   // Rotation taking the north pole (0, 0, 1) onto qhat.
@@ -369,7 +369,7 @@ MeshResult mesh_ellipsoid_with_gmsh(const Eigen::Vector3d& semi_axes_m, const Ei
       if (dist < best) best = dist, load_tag = t;
     }
     if (load_tag < 0 || best > 1e-6 * size_mm) {
-      throw InputError(where, "gmsh geometry", "no sphere pole on the load point");
+      throw where.error("gmsh geometry", "no sphere pole on the load point");
     }
     gmsh::model::setPhysicalName(3, gmsh::model::addPhysicalGroup(3, {vol}), "BODY");
     gmsh::model::setPhysicalName(0, gmsh::model::addPhysicalGroup(0, {load_tag}), "LOAD");
@@ -450,15 +450,15 @@ double winding_number(const PartSurface& s, const Eigen::Vector3d& q) {
   return w / (4.0 * kPi);
 }
 
-void check_part_surface(const PartSurface& s, const std::string& where) {
-  if (s.triangles.empty() || s.vertices_m.empty()) throw InputError(where, "part surface", "no triangles");
+void check_part_surface(const PartSurface& s, const InputContext& where) {
+  if (s.triangles.empty() || s.vertices_m.empty()) throw where.error("part surface", "no triangles");
   for (const auto& v : s.vertices_m) {
-    if (!v.allFinite()) throw InputError(where, "part surface", "a vertex is not finite");
+    if (!v.allFinite()) throw where.error("part surface", "a vertex is not finite");
   }
   const int n = static_cast<int>(s.vertices_m.size());
   for (const auto& t : s.triangles) {
     for (int k : t) {
-      if (k < 0 || k >= n) throw InputError(where, "part surface", "a triangle names a vertex that does not exist");
+      if (k < 0 || k >= n) throw where.error("part surface", "a triangle names a vertex that does not exist");
     }
   }
 }
@@ -556,7 +556,8 @@ std::vector<Try> part_tries(const MeshOptions& o) {
 }  // namespace
 
 MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& load_point_m, const MeshOptions& o,
-                               const fs::path& folder, const std::string& name, const std::string& where) {
+                               const fs::path& folder, const std::string& name, const std::string& part) {
+  const InputContext where = o.context.in_file(part);
   check_options(o, where);
   check_part_surface(surf, where);
   Eigen::Vector3d lo = surf.vertices_m.front(), hi = lo;
@@ -564,10 +565,10 @@ MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& l
   const double size_m = (hi - lo).norm();
   const double size_mm = size_m * kMmPerM;
   const double part_volume = enclosed_volume_m3(surf);
-  if (!(part_volume > 0)) throw InputError(where, "part surface", "encloses no volume (open or inward-oriented?)");
+  if (!(part_volume > 0)) throw where.error("part surface", "encloses no volume (open or inward-oriented?)");
   for (std::size_t i = 0; i < o.probes_m.size(); ++i) {
     if (!(winding_number(surf, o.probes_m[i]) > 0.5)) {
-      throw InputError(where, probe_name(i), "probe point is not inside the part");
+      throw where.error(probe_name(i), "probe point is not inside the part");
     }
   }
   const Eigen::Vector3d p_mm = load_point_m * kMmPerM;
@@ -590,7 +591,7 @@ MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& l
       int at = -1;
       const PartSurface split = with_vertex_at(surf, load_point_m, size_m, at);
       if ((split.vertices_m[at] - load_point_m).norm() > 1e-6 * size_m) {
-        throw InputError(where, "load point", "is not on the part's surface");
+        throw where.error("load point", "is not on the part's surface");
       }
       write_file_atomically(stl_copy, part_stl(split));
     } else {
@@ -642,7 +643,7 @@ MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& l
         if (load_surface < 0 || !(best <= 1e-6 * size_mm)) {
           std::ostringstream m;
           m << "the load point is " << best / kMmPerM << " m from the part's surface (must lie on it)";
-          throw InputError(where, "load point", m.str());
+          throw where.error("load point", m.str());
         }
         gmsh::model::mesh::embed(0, {kLoadPointTag}, 2, load_surface);
       }
@@ -665,7 +666,7 @@ MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& l
           const double d = (Eigen::Vector3d(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]) - p_mm).norm();
           if (d < best && index.count(tags[i])) best = d, load_tag = tags[i];
         }
-        if (!(best <= 1e-6 * size_mm)) throw InputError(where, "gmsh mesh", "no mesh node at the load point");
+        if (!(best <= 1e-6 * size_mm)) throw where.error("gmsh mesh", "no mesh node at the load point");
         ln = index.at(load_tag);
         const int pt = gmsh::model::addDiscreteEntity(0);
         gmsh::model::mesh::addElementsByType(pt, 15, {}, {load_tag});
@@ -715,7 +716,7 @@ MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& l
   if (kept == tries.size()) {
     std::string why;
     for (const auto& a : attempts) why += (why.empty() ? "" : "; ") + describe(a) + ": " + a.outcome;
-    throw InputError(where, "gmsh mesh", "every try failed (" + why + ")");
+    throw where.error("gmsh mesh", "every try failed (" + why + ")");
   }
   if (!accepted) {
     // No try met the quality floor: keep the best one (the decks' quality check reports it).
@@ -730,7 +731,7 @@ MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& l
   const Try& t = tries[kept];
   const double h = h_first * t.size_factor, h0 = std::min(h0_first, h);
   std::ostringstream g;
-  g << geo_header("mesh part (" + where + ") from memory, written as " + stl_copy.filename().string() +
+  g << geo_header("mesh part (" + part + ") from memory, written as " + stl_copy.filename().string() +
                   " (mm)", o);
   if (attempts.size() > 1) g << "// Settings of try " << kept + 1 << " (see mesh_attempts in mesh_quality.json).\n";
   g << geo_options(h, t.own_triangles ? 6 : t.algorithm_2d, o.algorithm_3d);
@@ -760,7 +761,7 @@ MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& l
 // One try of the CAD route with Gmsh's 2D algorithm alg2, in a session of its own.
 MeshResult mesh_cad_once(const fs::path& cad, double cad_unit_m, const Eigen::Vector3d& load_point_m,
                          const MeshOptions& o, const fs::path& folder, const std::string& name, int alg2) {
-  const std::string where = cad.string();
+  const InputContext where = o.context.in_file(cad.string());
   // STEP and IGES come in mm (OpenCASCADE converts from the file's own unit); a BREP has no unit:
   // its coordinates are in cad_unit_m metres and are scaled to mm.
   const double scale = cad_unit_m * kMmPerM;
@@ -779,7 +780,7 @@ MeshResult mesh_cad_once(const fs::path& cad, double cad_unit_m, const Eigen::Ve
     gmsh::model::occ::importShapes(cad.string(), out, true);
     gmsh::vectorpair vols;
     gmsh::model::occ::getEntities(vols, 3);
-    if (vols.empty()) throw InputError(where, "solids", "the file holds no solid");
+    if (vols.empty()) throw where.error("solids", "the file holds no solid");
     if (scaled) gmsh::model::occ::dilate(vols, 0, 0, 0, scale, scale, scale);
     gmsh::model::occ::synchronize();
     gmsh::model::getEntities(vols, 3);
@@ -814,7 +815,7 @@ MeshResult mesh_cad_once(const fs::path& cad, double cad_unit_m, const Eigen::Ve
       size_mm = std::max({x1 - x0, y1 - y0, z1 - z0});
     }
     if (load_face < 0 || best > 0.01 * size_mm) {
-      throw InputError(where, "load point", "not within 1 % of the size of a face of the part");
+      throw where.error("load point", "not within 1 % of the size of a face of the part");
     }
     load_tag = gmsh::model::occ::addPoint(foot.x(), foot.y(), foot.z());
     for (const auto& pr : o.probes_m) {
@@ -860,9 +861,10 @@ MeshResult mesh_cad_once(const fs::path& cad, double cad_unit_m, const Eigen::Ve
 MeshResult mesh_cad_with_gmsh(const fs::path& cad, double cad_unit_m, const Eigen::Vector3d& load_point_m,
                               const MeshOptions& o, const fs::path& folder, const std::string& name) {
   // Bad options or a missing file fail once, before any try.
-  check_options(o, cad.string());
-  if (!fs::is_regular_file(cad)) throw InputError(cad.string(), "file", "cannot be opened (missing or unreadable)");
-  if (!(cad_unit_m > 0)) throw InputError(cad.string(), "unit", "must be > 0");
+  const InputContext file = o.context.in_file(cad.string());
+  check_options(o, file);
+  if (!fs::is_regular_file(cad)) throw file.error("file", "cannot be opened (missing or unreadable)");
+  if (!(cad_unit_m > 0)) throw file.error("unit", "must be > 0");
   const std::vector<int> algorithms = o.algorithm_2d ? std::vector<int>{o.algorithm_2d} : std::vector<int>{6, 1, 5};
   std::vector<MeshAttempt> failed;
   for (std::size_t k = 0;; ++k) {
@@ -875,7 +877,7 @@ MeshResult mesh_cad_with_gmsh(const fs::path& cad, double cad_unit_m, const Eige
         if (failed.empty()) throw;
         std::string why;
         for (const auto& a : failed) why += "2D algorithm " + std::to_string(a.algorithm_2d) + ": " + a.outcome + "; ";
-        throw InputError(e.where(), e.place(), why + "2D algorithm " + std::to_string(algorithms[k]) + ": " + e.reason());
+        throw e.context().error(e.place(), why + "2D algorithm " + std::to_string(algorithms[k]) + ": " + e.reason());
       }
       failed.push_back({"cad", algorithms[k], o.algorithm_3d, o.mesh_size_m, load_size(o), e.reason()});
     }

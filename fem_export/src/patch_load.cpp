@@ -68,17 +68,18 @@ std::vector<QuadPoint> quadrature(const Eigen::Vector2d p[3]) {
 }  // namespace
 
 PatchLoad hertz_patch_load(const TetMesh& mesh, int contact_node, const Eigen::Vector3d& direction,
-                           const ContactPatch& patch, const collision::ForceTable& force) {
+                           const ContactPatch& patch, const collision::ForceTable& force,
+                           const InputContext& ctx) {
   const std::string where = "hertz-patch load";
   if (!(patch.a_max_m > 0) || !(patch.b_max_m > 0) || !(patch.a_max_m >= patch.b_max_m) ||
       !std::isfinite(patch.a_max_m) || !(patch.max_force_N > 0) || !std::isfinite(patch.max_force_N)) {
     std::ostringstream m;
     m << "contact ellipse must have a_max >= b_max > 0 and a positive force (a_max " << patch.a_max_m
       << " m, b_max " << patch.b_max_m << " m, F " << patch.max_force_N << " N)";
-    throw InputError("", where, m.str());
+    throw ctx.error(where, m.str());
   }
   if (contact_node < 0 || contact_node >= static_cast<int>(mesh.nodes_m.size())) {
-    throw InputError("", where, "contact node is not a node of the mesh");
+    throw ctx.error(where, "contact node is not a node of the mesh");
   }
   const Eigen::Vector3d d = direction.normalized();
   Eigen::Vector3d ta = patch.axis_a - patch.axis_a.dot(d) * d;
@@ -123,7 +124,7 @@ PatchLoad hertz_patch_load(const TetMesh& mesh, int contact_node, const Eigen::V
       stack.push_back(static_cast<int>(t));
     }
   }
-  if (stack.empty()) throw InputError("", where, "no boundary triangle faces the load at the contact node");
+  if (stack.empty()) throw ctx.error(where, "no boundary triangle faces the load at the contact node");
   while (!stack.empty()) {
     const int t = stack.back();
     stack.pop_back();
@@ -159,7 +160,7 @@ PatchLoad hertz_patch_load(const TetMesh& mesh, int contact_node, const Eigen::V
     quad[r] = quadrature(p);
   }
   if (nodes.size() > kMaxLoadedNodes) {
-    throw InputError("", where, "the largest contact ellipse covers " + std::to_string(nodes.size()) +
+    throw ctx.error(where, "the largest contact ellipse covers " + std::to_string(nodes.size()) +
                                     " surface nodes (at most 9999): lower contact_elements");
   }
   const std::size_t nn = nodes.size();

@@ -16,12 +16,13 @@
 
 namespace impactdeck::geometry {
 
-Ellipsoid::Ellipsoid(double a, double b, double c) : e_(a, b, c), inv_e2_(Eigen::Vector3d::Zero()), abc2_(0) {
+Ellipsoid::Ellipsoid(double a, double b, double c, const InputContext& ctx)
+    : e_(a, b, c), inv_e2_(Eigen::Vector3d::Zero()), abc2_(0) {
   for (int i = 0; i < 3; ++i) {
     if (!(e_[i] > 0.0) || !std::isfinite(e_[i])) {
       std::ostringstream s;
       s << "semi-axes must be positive and finite, got (" << a << ", " << b << ", " << c << ") m";
-      throw InputError("", "semi_axes", s.str());
+      throw ctx.error("semi_axes", s.str());
     }
   }
   inv_e2_ = e_.cwiseProduct(e_).cwiseInverse();

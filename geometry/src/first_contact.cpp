@@ -33,12 +33,12 @@ std::string vector_text(const Eigen::Vector3d& v) {
   return s.str();
 }
 
-[[noreturn]] void never_touch(const Eigen::Vector3d& d) {
-  throw InputError("", "", "moving along " + vector_text(d) + " the bodies never touch");
+[[noreturn]] void never_touch(const InputContext& ctx, const Eigen::Vector3d& d) {
+  throw ctx.error("", "moving along " + vector_text(d) + " the bodies never touch");
 }
 
-[[noreturn]] void already_overlap(const std::string& why) {
-  throw InputError("", "", "the bodies already overlap (" + why + ")");
+[[noreturn]] void already_overlap(const InputContext& ctx, const std::string& why) {
+  throw ctx.error("", "the bodies already overlap (" + why + ")");
 }
 
 struct Body {
@@ -104,7 +104,8 @@ FirstContact dress(const Body& target, const Body& mover, const Eigen::Vector3d&
 // ---------------------------------------------------------------------------------------------
 // A plane against a bounded body: the body's support point along minus the plane's normal.
 
-Hit plane_first(const Body& plane_body, const Body& other, bool plane_moves, const Eigen::Vector3d& d, double tol) {
+Hit plane_first(const Body& plane_body, const Body& other, bool plane_moves, const Eigen::Vector3d& d, double tol,
+                const InputContext& ctx) {
   const Eigen::Vector3d n = plane_body.pose.direction_to_world(plane_body.plane->normal());
   auto sp = other.shape->support_point(other.pose.direction_to_own(-n));
   if (!sp) throw std::logic_error("first_contact: a bounded shape without a support point");
@@ -113,7 +114,7 @@ Hit plane_first(const Body& plane_body, const Body& other, bool plane_moves, con
   if (gap < -tol) {
     std::ostringstream s;
     s << "the " << other.shape->kind() << " reaches " << -gap << " m into the plane";
-    already_overlap(s.str());
+    already_overlap(ctx, s.str());
   }
   // A mesh touches with a vertex; on a smooth part of it the contact is the smoothed surface's
   // support point nearby (normal exactly -n, second-order accurate where the vertex is first
@@ -131,7 +132,7 @@ Hit plane_first(const Body& plane_body, const Body& other, bool plane_moves, con
   const double rate = plane_moves ? n.dot(d) : -n.dot(d);
   double s = 0.0;
   if (gap > tol) {
-    if (!(rate > 0.0)) never_touch(d);
+    if (!(rate > 0.0)) never_touch(ctx, d);
     s = gap / rate;
   } else if (rate > 0.0) {
     s = gap / rate;  // touching at travel 0, to the allowance
@@ -168,7 +169,8 @@ Hit plane_first(const Body& plane_body, const Body& other, bool plane_moves, con
 // root climbs to it monotonically; f' = n . d(q)/ds with n the outward normal of E' at the
 // closest point. The distance is the exact (Eberly) closest point on E' in its principal frame.
 
-Hit ellipsoid_pair(const Body& target, const Body& mover, const Eigen::Vector3d& d, double tol) {
+Hit ellipsoid_pair(const Body& target, const Body& mover, const Eigen::Vector3d& d, double tol,
+                   const InputContext& ctx) {
   const Eigen::Vector3d eT = target.ellipsoid->semi_axes_m(), eM = mover.ellipsoid->semi_axes_m();
   const Eigen::Matrix3d A = eT.cwiseInverse().asDiagonal() * target.pose.rotation.transpose();
   const Eigen::Vector3d m0 = A * (mover.pose.position_m - target.pose.position_m);
@@ -201,7 +203,7 @@ Hit ellipsoid_pair(const Body& target, const Body& mover, const Eigen::Vector3d&
   };
   double s = -tol;  // s is the world travel: the allowance applies as it is
   Eval e = eval(s);
-  if (e.f < 0.0) already_overlap("the two solids intersect at travel 0");
+  if (e.f < 0.0) already_overlap(ctx, "the two solids intersect at travel 0");
   // Newton from the left. Convexity: every step lands at or before the root; a non-negative
   // slope with f > 0 means the minimum of the distance was passed without touching.
   const double scale = std::max(mover.shape->size_m(), target.shape->size_m());
@@ -213,7 +215,7 @@ Hit ellipsoid_pair(const Body& target, const Body& mover, const Eigen::Vector3d&
   }
   // Touching leaves f at rounding level (a grazing pass converges linearly, still within the
   // 300 steps); a miss stops where the slope turns non-negative with f clearly above 0.
-  if (e.f > 64.0 * kEps * (1.0 + e.closest.norm())) never_touch(d);
+  if (e.f > 64.0 * kEps * (1.0 + e.closest.norm())) never_touch(ctx, d);
 
   // The contact point: on the unit sphere (target) and on E' (mover).
   const Eigen::Vector3d centre = m0 + s * w;
@@ -377,7 +379,7 @@ double edge_edge(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen
 // bounding box sweeps over (AABB tree), nearest first, pruned by the best travel so far.
 
 Hit mesh_ellipsoid(const Body& mesh_body, const Body& ell, bool ellipsoid_moves, const Eigen::Vector3d& d,
-                   double tol) {
+                   double tol, const InputContext& ctx) {
   const MeshShape& mesh = *mesh_body.mesh;
   const Eigen::Vector3d e = ell.ellipsoid->semi_axes_m();
   const Eigen::Vector3d centre = mesh_body.pose.to_own(ell.pose.position_m);
@@ -398,7 +400,7 @@ Hit mesh_ellipsoid(const Body& mesh_body, const Body& ell, bool ellipsoid_moves,
   // Overlap at travel -tol: the centre inside the mesh, or a triangle inside the unit ball.
   const Eigen::Vector3d c_back = -tol * w;
   if (mesh.contains(centre - tol * d_rel)) {
-    already_overlap("the centre of the " + ell.shape->kind() + " lies inside the mesh");
+    already_overlap(ctx, "the centre of the " + ell.shape->kind() + " lies inside the mesh");
   }
   bool crossing = false;
   mesh.sweep_faces(box, d_rel, -tol, -tol, [&](int f, double s_max) {
@@ -409,7 +411,7 @@ Hit mesh_ellipsoid(const Body& mesh_body, const Body& ell, bool ellipsoid_moves,
     }
     return s_max;
   });
-  if (crossing) already_overlap("the mesh surface enters the " + ell.shape->kind());
+  if (crossing) already_overlap(ctx, "the mesh surface enters the " + ell.shape->kind());
 
   SweptHit best;
   int best_face = -1;
@@ -421,7 +423,7 @@ Hit mesh_ellipsoid(const Body& mesh_body, const Body& ell, bool ellipsoid_moves,
     }
     return std::min(s_max, best.s);
   });
-  if (best_face < 0) never_touch(d);
+  if (best_face < 0) never_touch(ctx, d);
 
   const auto& t = F[best_face];
   const Eigen::Vector3d on_mesh = best.bary[0] * V[t[0]] + best.bary[1] * V[t[1]] + best.bary[2] * V[t[2]];
@@ -469,7 +471,8 @@ bool segment_crosses(const Eigen::Vector3d& p, const Eigen::Vector3d& q, const s
   return ray_triangle(p, q - p, T[0], T[1], T[2], 0.0, std::nextafter(1.0, 2.0), l) < kInf;
 }
 
-Hit mesh_pair(const Body& target, const Body& mover, const Eigen::Vector3d& d, double tol) {
+Hit mesh_pair(const Body& target, const Body& mover, const Eigen::Vector3d& d, double tol,
+              const InputContext& ctx) {
   const MeshShape& T = *target.mesh;
   const MeshShape& M = *mover.mesh;
   const Eigen::Matrix3d R = target.pose.rotation.transpose() * mover.pose.rotation;  // mover -> target frame
@@ -496,9 +499,9 @@ Hit mesh_pair(const Body& target, const Body& mover, const Eigen::Vector3d& d, d
       crossing = segment_crosses(B[k], B[(k + 1) % 3], A) || segment_crosses(A[k], A[(k + 1) % 3], B);
     return crossing ? -kInf : s_max;  // -inf stops the search
   });
-  if (crossing) already_overlap("the two surfaces cross");
-  if (T.contains(R * VM[FM[0][0]] + t - tol * dT)) already_overlap("the mover lies inside the target");
-  if (M.contains(R.transpose() * (VT[FT[0][0]] - t + tol * dT))) already_overlap("the target lies inside the mover");
+  if (crossing) already_overlap(ctx, "the two surfaces cross");
+  if (T.contains(R * VM[FM[0][0]] + t - tol * dT)) already_overlap(ctx, "the mover lies inside the target");
+  if (M.contains(R.transpose() * (VT[FT[0][0]] - t + tol * dT))) already_overlap(ctx, "the target lies inside the mover");
 
   MeshHit best;
   T.sweep_face_pairs(M, R, t, dT, pad, -tol, kInf, [&](int ft, int fm, double s_max) {
@@ -522,7 +525,7 @@ Hit mesh_pair(const Body& target, const Body& mover, const Eigen::Vector3d& d, d
       }
     return std::min(s_max, best.s);
   });
-  if (!(best.s < kInf)) never_touch(d);
+  if (!(best.s < kInf)) never_touch(ctx, d);
   Hit h;
   h.s = best.s;
   h.target_own = best.target_own;
@@ -535,33 +538,33 @@ Hit mesh_pair(const Body& target, const Body& mover, const Eigen::Vector3d& d, d
 }  // namespace
 
 FirstContact first_contact(const PlacedShape& target_in, const PlacedShape& mover_in,
-                           const Eigen::Vector3d& direction_world) {
+                           const Eigen::Vector3d& direction_world, const InputContext& ctx) {
   const Body target = classify(target_in), mover = classify(mover_in);
   const double largest = direction_world.cwiseAbs().maxCoeff();
   if (!direction_world.allFinite() || !(largest > 0.0)) {
-    throw InputError("", "direction", "must be a non-zero finite vector");
+    throw ctx.error("direction", "must be a non-zero finite vector");
   }
   const Eigen::Vector3d d = (direction_world / largest).normalized();
   if (!target.shape->bounded() && !mover.shape->bounded()) {
-    throw InputError("", "", "both bodies are unbounded (two planes): they have no first contact");
+    throw ctx.error("", "both bodies are unbounded (two planes): they have no first contact");
   }
   const double tol = kTouchRel * std::max(target.shape->size_m(), mover.shape->size_m());
 
   Hit h;
   if (target.plane && mover.shape->bounded()) {
-    h = plane_first(target, mover, false, d, tol);
+    h = plane_first(target, mover, false, d, tol, ctx);
   } else if (mover.plane && target.shape->bounded()) {
-    h = plane_first(mover, target, true, d, tol);
+    h = plane_first(mover, target, true, d, tol, ctx);
   } else if (target.ellipsoid && mover.ellipsoid) {
-    h = ellipsoid_pair(target, mover, d, tol);
+    h = ellipsoid_pair(target, mover, d, tol, ctx);
   } else if (target.mesh && mover.ellipsoid) {
-    h = mesh_ellipsoid(target, mover, true, d, tol);
+    h = mesh_ellipsoid(target, mover, true, d, tol, ctx);
   } else if (target.ellipsoid && mover.mesh) {
-    h = mesh_ellipsoid(mover, target, false, d, tol);
+    h = mesh_ellipsoid(mover, target, false, d, tol, ctx);
   } else if (target.mesh && mover.mesh) {
-    h = mesh_pair(target, mover, d, tol);
+    h = mesh_pair(target, mover, d, tol, ctx);
   } else {
-    throw InputError("", "", "no first-contact method for the shape kinds '" + mover.shape->kind() + "' (moving) and '" +
+    throw ctx.error("", "no first-contact method for the shape kinds '" + mover.shape->kind() + "' (moving) and '" +
                                  target.shape->kind() + "'");
   }
   return dress(target, mover, d, h);

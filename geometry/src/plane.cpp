@@ -11,9 +11,9 @@ namespace {
 constexpr double kEps = std::numeric_limits<double>::epsilon();
 }
 
-Plane::Plane(const Eigen::Vector3d& normal) {
+Plane::Plane(const Eigen::Vector3d& normal, const InputContext& ctx) {
   const double largest = normal.cwiseAbs().maxCoeff();
-  if (!normal.allFinite() || !(largest > 0.0)) throw InputError("", "normal", "must be a non-zero finite vector");
+  if (!normal.allFinite() || !(largest > 0.0)) throw ctx.error("normal", "must be a non-zero finite vector");
   n_ = (normal / largest).normalized();
   // Tangent pair: the coordinate axis least aligned with n, made orthogonal.
   Eigen::Index k = 0;

@@ -82,7 +82,9 @@ CompareReport compare_contact(const Scene& scene_in, const CompareOptions& o) {
   auto output = [&](const std::string& name, bool is_folder) {
     return o.place_output ? o.place_output(name, is_folder) : o.out_dir / name;
   };
-  if (scene_in.impacts.empty()) throw InputError(file, "impacts", "the scene has no impact");
+  // Errors about the scene name its file and places, after the caller's context (`run`'s key).
+  const InputContext ctx = o.context.where.empty() ? InputContext{file, ""} : o.context;
+  if (scene_in.impacts.empty()) throw ctx.error("impacts", "the scene has no impact");
   const ImpactSpec* spec = &scene_in.impacts.front();
   if (!o.impact.empty()) {
     spec = nullptr;
@@ -91,11 +93,11 @@ CompareReport compare_contact(const Scene& scene_in, const CompareOptions& o) {
     if (!spec) {
       std::vector<std::string> names;
       for (const auto& s : scene_in.impacts) names.push_back(s.name);
-      throw InputError(file, "--impact", "no impact named '" + o.impact + "' in the scene" + did_you_mean(o.impact, names));
+      throw ctx.error("--impact", "no impact named '" + o.impact + "' in the scene" + did_you_mean(o.impact, names));
     }
   }
   if (!(o.threshold > 0) || o.refine < 0 || o.refine > 6) {
-    throw InputError(file, "options", "--threshold must be > 0 and --refine within 0..6");
+    throw ctx.error("options", "--threshold must be > 0 and --refine within 0..6");
   }
   // The scene reduced to this impact, with the hybrid deck's settings (the scene's, or defaults).
   Scene scene = scene_in;
@@ -106,15 +108,15 @@ CompareReport compare_contact(const Scene& scene_in, const CompareOptions& o) {
   for (const std::string* name : {&s.target, &s.impactor}) {
     const BodySpec& b = scene.body(*name);
     if (b.shape == ShapeKind::plane) {
-      throw InputError(file, b.place.describe(),
-                       "impact '" + s.name + "': body '" + b.name +
-                           "' is an infinite plane: the full-contact model meshes both bodies and a plane cannot be "
+      throw ctx.error(b.place.describe(),
+                      "impact '" + s.name + "': body '" + b.name +
+                          "' is an infinite plane: the full-contact model meshes both bodies and a plane cannot be "
                            "meshed (give the floor as a finite part)");
     }
     if (b.fixed) {
-      throw InputError(file, b.place.describe(),
-                       "impact '" + s.name + "': body '" + b.name +
-                           "' is fixed: the full-contact model needs both bodies free, with their masses");
+      throw ctx.error(b.place.describe(),
+                      "impact '" + s.name + "': body '" + b.name +
+                          "' is fixed: the full-contact model needs both bodies free, with their masses");
     }
   }
   CompareReport rep;
@@ -129,8 +131,14 @@ CompareReport compare_contact(const Scene& scene_in, const CompareOptions& o) {
 
   const PreparedBody target = prepare_body(scene.body(s.target), scene);
   const PreparedBody impactor = prepare_body(scene.body(s.impactor), scene);
-  const double e_star = collision::effective_modulus_Pa(target.material, impactor.material, scene.modulus_convention);
-  const ContactModel model(target, impactor, s.contact_radius, e_star, s.restitution);
+  const InputContext impact_ctx = ctx.at(InputContext::joined(s.place.describe(), "impact '" + s.name + "'"));
+  const double e_star =
+      collision::effective_modulus_Pa(target.material, impactor.material, scene.modulus_convention, impact_ctx);
+  const ContactModel model(target, impactor, s.contact_radius, e_star, s.restitution, impact_ctx);
+  // The decks' errors: after the caller's context, or the scene and the impact.
+  auto deck_context = [&](const std::string& what) {
+    return o.context.where.empty() ? InputContext{file, "impact '" + s.name + "': " + what} : o.context.at(what);
+  };
   const ContactEvaluation ev = locate_impact_contact(scene, s, model);
   if (ev.result.flag != collision::ContactFlag::none) {
     rep.verdict = CompareVerdict::non_hertzian;
@@ -179,7 +187,7 @@ CompareReport compare_contact(const Scene& scene_in, const CompareOptions& o) {
   const double end_time = increments * dt;
 
   scene.outputs.fem = scene_in.outputs.fem ? *scene_in.outputs.fem : FemOutputs{};
-  ir.table = collision::sample_force_table(ir.result.history, scene.outputs.force_table);
+  ir.table = collision::sample_force_table(ir.result.history, force_table_options(scene_in, s));
   double target_far = scene.outputs.fem->mesh_size_m.value_or(default_mesh_size(*target.spec, target));
   fem_export::CheckOptions check_options;
   check_options.progress = o.progress;
@@ -188,6 +196,7 @@ CompareReport compare_contact(const Scene& scene_in, const CompareOptions& o) {
   const fem_export::DeckRequest target_req = hybrid_deck_request(scene, ir, target);
   if (o.run_hybrid) {
     fem_export::DeckRequest req = target_req;
+    req.context = deck_context("hybrid deck");
     req.options.code_aster = false;
     req.options.end_time_s = end_time;
     req.options.time_step_s = dt;
@@ -210,6 +219,7 @@ CompareReport compare_contact(const Scene& scene_in, const CompareOptions& o) {
   fem_export::ContactModelRequest cr;
   cr.source = scene.file.string();
   cr.impact = s.name;
+  cr.context = deck_context("contact model");
   cr.target = contact_body(target_req, target, ev.target_point, ev.input.target, Eigen::Vector3d::Zero(), target_far);
   cr.target.probes_own_m = scene.outputs.fem->probes_m;  // the hybrid deck's probes, target frame
   cr.impactor = contact_body(impactor_req, impactor, ev.impactor_point, ev.input.impactor, ev.impactor_translation_m,

@@ -46,19 +46,20 @@ PreparedBody body_of_mass(std::string name, std::shared_ptr<const geometry::Shap
 }
 
 ContactModel::ContactModel(const PreparedBody& target, const PreparedBody& impactor, collision::ContactRule rule,
-                           double effective_modulus_Pa, const collision::RestitutionModel& restitution)
+                           double effective_modulus_Pa, const collision::RestitutionModel& restitution,
+                           const InputContext& ctx)
     : target_(target),
       impactor_(impactor),
       rule_(rule),
       effective_modulus_Pa_(effective_modulus_Pa),
       restitution_(restitution),
-      target_body_(collision::kernel_body(target.rigid_body())),
-      impactor_body_(collision::kernel_body(impactor.rigid_body())),
+      target_body_(collision::kernel_body(target.rigid_body(), ctx.at("target '" + target.name + "'"))),
+      impactor_body_(collision::kernel_body(impactor.rigid_body(), ctx.at("impactor '" + impactor.name + "'"))),
       impactor_mesh_(dynamic_cast<const geometry::MeshShape*>(impactor.shape.get())),
       target_centroid_(target.centroid_world_m()),
       impactor_centroid_(impactor.centroid_world_m()) {
   if (target.fixed() && impactor.fixed()) {
-    throw InputError("", "bodies", "both bodies are fixed (infinite mass): nothing can move");
+    throw ctx.error("bodies", "both bodies are fixed (infinite mass): nothing can move");
   }
 }
 
@@ -140,15 +141,15 @@ ContactEvaluation ContactModel::at_surface_point(const geometry::SurfacePoint& a
   return e;
 }
 
-ContactEvaluation ContactModel::at_first_contact() const {
+ContactEvaluation ContactModel::at_first_contact(const InputContext& ctx) const {
   const Eigen::Vector3d u = impactor_.velocity_m_s - target_.velocity_m_s;
   if (!(u.norm() > 0.0)) {
-    throw InputError("", "", "point = \"first-contact\" needs the bodies to move relative to each other (the "
-                             "impactor's velocity equals the target's)");
+    throw ctx.error("", "point = \"first-contact\" needs the bodies to move relative to each other (the "
+                        "impactor's velocity equals the target's)");
   }
   geometry::PlacedShape t{target_.shape.get(), target_.pose};
   geometry::PlacedShape m{impactor_.shape.get(), impactor_.pose};
-  const geometry::FirstContact fc = geometry::first_contact(t, m, u);
+  const geometry::FirstContact fc = geometry::first_contact(t, m, u, ctx);
   ContactEvaluation e;
   e.target_point = fc.target_point;
   e.impactor_point = fc.mover_point;

@@ -24,14 +24,14 @@ struct Segment {
   std::vector<std::size_t> indices;  ///< `name[i][j]`
 };
 
-[[noreturn]] void bad_key(const std::string& where, const std::string& key, const std::string& reason) {
-  throw InputError(where, "--set " + key, reason);
+[[noreturn]] void bad_key(const InputContext& where, const std::string& key, const std::string& reason) {
+  throw where.error("--set " + key, reason);
 }
 
 bool bare_key_char(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-'; }
 
 // "a.b[1].c" -> {a}, {b,[1]}, {c}. Bare TOML keys only (letters, digits, '_' and '-').
-std::vector<Segment> split_key(const std::string& key, const std::string& where) {
+std::vector<Segment> split_key(const std::string& key, const InputContext& where) {
   std::vector<Segment> out;
   std::size_t i = 0;
   const std::string expect = "a dotted key path such as bodies[1].velocity_m_s";
@@ -67,22 +67,25 @@ std::string describe(const std::vector<Segment>& segs, std::size_t upto, std::si
   return s;
 }
 
-// The value text parsed as TOML: `v = VALUE`.
-toml::table parse_value(const Override& o, const std::string& where) {
-  const std::string doc = "v = " + o.value + "\n";
+// The value text parsed as TOML: `v = VALUE` (VALUE made ASCII first, its own line and column
+// named by a non-ASCII character outside a string).
+toml::table parse_value(const Override& o, const InputContext& where) {
+  const std::string ascii = detail::toml_ascii(o.value, where.at("--set " + o.key + ": value '" + o.value + "'"));
+  const std::string doc = "v = " + ascii + "\n";
+  toml::table t;
   try {
-    toml::table t = toml::parse(detail::toml_ascii(doc, "--set " + o.key), "--set " + o.key);
-    if (t.size() != 1 || !t.contains("v")) throw InputError("", "", "");
-    return t;
+    t = toml::parse(doc, "--set " + o.key);
   } catch (const toml::parse_error& e) {
     bad_key(where, o.key, "value '" + o.value + "' is not a TOML value (" + std::string(e.description()) +
                               "; strings need quotes: KEY='\"text\"')");
-  } catch (const InputError&) {
+  }
+  if (t.size() != 1 || !t.contains("v")) {
     bad_key(where, o.key, "value '" + o.value + "' is not one TOML value (strings need quotes: KEY='\"text\"')");
   }
+  return t;
 }
 
-void apply_one(toml::table& root, const Override& o, const std::string& where) {
+void apply_one(toml::table& root, const Override& o, const InputContext& where) {
   const std::vector<Segment> segs = split_key(o.key, where);
   toml::table value_doc = parse_value(o, where);
   toml::node& value = *value_doc.get("v");
@@ -117,15 +120,6 @@ void apply_one(toml::table& root, const Override& o, const std::string& where) {
     }
     cur = child;
   }
-}
-
-// The key named by an InputError's place ("line 3, key 'bodies[0].radius'"), or "".
-std::string error_key(const std::string& place) {
-  const std::string tag = "key '";
-  const std::size_t b = place.find(tag);
-  if (b == std::string::npos) return "";
-  const std::size_t e = place.find('\'', b + tag.size());
-  return e == std::string::npos ? "" : place.substr(b + tag.size(), e - b - tag.size());
 }
 
 bool under(const std::string& key, const std::string& root) {
@@ -230,37 +224,32 @@ std::string toml_document_text(const toml::table& root) {
 
 }  // namespace detail
 
-Override parse_override(const std::string& text) {
+Override parse_override(const std::string& text, const InputContext& ctx) {
   const std::size_t eq = text.find('=');
-  if (eq == std::string::npos) throw InputError("--set", text, "expected KEY=VALUE");
+  if (eq == std::string::npos) throw ctx.error(text, "expected KEY=VALUE");
   Override o{text.substr(0, eq), text.substr(eq + 1)};
   while (!o.key.empty() && std::isspace(static_cast<unsigned char>(o.key.back()))) o.key.pop_back();
   while (!o.key.empty() && std::isspace(static_cast<unsigned char>(o.key.front()))) o.key.erase(0, 1);
-  if (o.key.empty()) throw InputError("--set", text, "the key before '=' is empty");
-  split_key(o.key, "--set");  // syntax check now, where the message can name the flag
+  if (o.key.empty()) throw ctx.error(text, "the key before '=' is empty");
+  split_key(o.key, ctx);  // syntax check now, where the message can name the flag
   return o;
 }
 
 namespace detail {
 
-void apply_overrides(toml::table& root, const std::vector<Override>& overrides, const std::string& file) {
+void apply_overrides(toml::table& root, const std::vector<Override>& overrides, const InputContext& file) {
   for (const Override& o : overrides) apply_one(root, o, file);
 }
 
-void rethrow_naming_override(const std::vector<Override>& overrides) {
-  try {
-    throw;
-  } catch (const InputError& e) {
-    const std::string key = error_key(e.place());
-    // The last override wins, so it is the one to name.
-    for (auto o = overrides.rbegin(); !key.empty() && o != overrides.rend(); ++o) {
-      if (!under(key, o->key)) continue;
-      std::string place = "--set " + o->key;
-      if (key != o->key) place += " (key '" + key + "')";
-      throw InputError(e.where(), place, e.reason());
-    }
-    throw;
+std::string override_place(const std::vector<Override>& overrides, const std::string& key) {
+  // The last override wins, so it is the one to name.
+  for (auto o = overrides.rbegin(); !key.empty() && o != overrides.rend(); ++o) {
+    if (!under(key, o->key)) continue;
+    std::string place = "--set " + o->key;
+    if (key != o->key) place += " (key '" + key + "')";
+    return place;
   }
+  return "";
 }
 
 }  // namespace detail
@@ -275,7 +264,7 @@ std::string resolved_scene_text(const fs::path& file, const std::vector<Override
     place << "line " << e.source().begin.line << ", column " << e.source().begin.column;
     throw InputError(file.string(), place.str(), "TOML syntax error: " + std::string(e.description()));
   }
-  detail::apply_overrides(root, overrides, file.string());
+  detail::apply_overrides(root, overrides, InputContext{file.string(), ""});
   // Part paths are relative to the scene file: make them absolute so the text stands alone.
   const fs::path base = fs::absolute(file).parent_path();
   if (toml::array* bodies = root["bodies"].as_array()) {

@@ -5,14 +5,15 @@
 
 #include <toml++/toml.h>
 
+#include "impactdeck/common/error.hpp"
 #include "impactdeck/scene/overrides.hpp"
 
 namespace impactdeck::scene::detail {
 
 /// Sets each override's value at its key path in `root`, in order (a later one wins). Missing
-/// tables on the path are created; an array index must exist. Throws InputError(file, "--set KEY",
+/// tables on the path are created; an array index must exist. Throws file.error("--set KEY",
 /// reason).
-void apply_overrides(toml::table& root, const std::vector<Override>& overrides, const std::string& file);
+void apply_overrides(toml::table& root, const std::vector<Override>& overrides, const InputContext& file);
 
 /// A TOML value as one line of TOML text (inline tables and arrays): what `--set KEY=VALUE` takes.
 /// Written here rather than by toml++'s printer, whose column count casts a negative log10 to
@@ -26,8 +27,9 @@ std::string toml_float_text(double v);
 /// tables, with dotted headers.
 std::string toml_document_text(const toml::table& root);
 
-/// Rethrows an InputError raised while validating an overridden document so that it names the
-/// override it comes from: "--set KEY" as its place when the error's key is KEY or lies under it.
-[[noreturn]] void rethrow_naming_override(const std::vector<Override>& overrides);
+/// How an error about the value at `key` names the override it comes from: "--set KEY" (with
+/// " (key 'K')" when `key` lies under KEY) for the last override whose key is `key` or above it;
+/// "" when no override set it.
+std::string override_place(const std::vector<Override>& overrides, const std::string& key);
 
 }  // namespace impactdeck::scene::detail

@@ -77,45 +77,56 @@ class StageClock {
 
 std::string where(const Scene& s) { return s.file.string(); }
 
+// Contexts handed to the library code that checks what the scene gives it (InputContext): the
+// scene file, the line and key, and which body or impact.
+InputContext body_context(const Scene& scene, const BodySpec& b) {
+  return {where(scene), InputContext::joined(b.place.describe(), "body '" + b.name + "'")};
+}
+InputContext impact_context(const Scene& scene, const ImpactSpec& s, const std::string& key_suffix = "") {
+  return {where(scene),
+          InputContext::joined(Place{s.place.line, s.place.key + key_suffix}.describe(), "impact '" + s.name + "'")};
+}
+// Where an [outputs] key was given (the key alone when the scene leaves it out).
+Place output_place(const Scene& scene, const std::string& key) {
+  const auto it = scene.outputs.places.find(key);
+  return it != scene.outputs.places.end() ? it->second : Place{0, "outputs." + key};
+}
+
 }  // namespace
 
 std::shared_ptr<const geometry::Shape> make_shape(const BodySpec& b, const Scene& scene, RunReport* report) {
-  try {
-    switch (b.shape) {
-      case ShapeKind::sphere:
-        return std::make_shared<geometry::Ellipsoid>(geometry::Ellipsoid::sphere(b.radius_m));
-      case ShapeKind::ellipsoid:
-        return std::make_shared<geometry::Ellipsoid>(b.semi_axes_m.x(), b.semi_axes_m.y(),
-                                                     b.semi_axes_m.z());
-      case ShapeKind::plane:
-        return std::make_shared<geometry::Plane>(b.plane_normal);
-      case ShapeKind::mesh: {
-        if (geometry::cad_format(b.mesh_path)) {  // STEP / IGES / BREP: exact B-rep queries
-          auto cad = geometry::CadShape::load(b.mesh_path, scene.length_unit);
-          if (report) {
-            add_stage(*report, Stage::mesh_load, cad->load_seconds());
-            for (const auto& w : cad->warnings()) report->warnings.push_back("body '" + b.name + "': " + w);
-          }
-          return cad;
-        }
-        geometry::PartOptions opt;
-        opt.length_unit = scene.length_unit;  // the scene's unit applies to the part file too
-        opt.repair = b.mesh_repair;
-        opt.accept_approximate_mass = b.mesh_approximate_mass;
-        opt.validation.check_self_intersections = b.mesh_self_intersection_check;
-        geometry::Part part = geometry::load_part(b.mesh_path, opt);
+  // The shapes' own checks name the scene's body; a part file's errors name that file.
+  const InputContext ctx = body_context(scene, b);
+  switch (b.shape) {
+    case ShapeKind::sphere:
+      return std::make_shared<geometry::Ellipsoid>(geometry::Ellipsoid::sphere(b.radius_m, ctx));
+    case ShapeKind::ellipsoid:
+      return std::make_shared<geometry::Ellipsoid>(b.semi_axes_m.x(), b.semi_axes_m.y(), b.semi_axes_m.z(), ctx);
+    case ShapeKind::plane:
+      return std::make_shared<geometry::Plane>(b.plane_normal, ctx);
+    case ShapeKind::mesh: {
+      if (geometry::cad_format(b.mesh_path)) {  // STEP / IGES / BREP: exact B-rep queries
+        auto cad = geometry::CadShape::load(b.mesh_path, scene.length_unit);
         if (report) {
-          for (const auto& st : part.stages) add_stage(*report, st.name, st.seconds);  // as the loader measured them
-          for (const auto& w : part.warnings) report->warnings.push_back("body '" + b.name + "': " + w);
-          for (const auto& a : part.repairs.actions)
-            report->warnings.push_back("body '" + b.name + "': repaired: " + a);
+          add_stage(*report, Stage::mesh_load, cad->load_seconds());
+          for (const auto& w : cad->warnings()) report->warnings.push_back("body '" + b.name + "': " + w);
         }
-        return part.shape;
+        return cad;
       }
+      geometry::PartOptions opt;
+      opt.length_unit = scene.length_unit;  // the scene's unit applies to the part file too
+      opt.repair = b.mesh_repair;
+      opt.accept_approximate_mass = b.mesh_approximate_mass;
+      opt.validation.check_self_intersections = b.mesh_self_intersection_check;
+      geometry::Part part = geometry::load_part(b.mesh_path, opt);
+      if (report) {
+        for (const auto& st : part.stages) add_stage(*report, st.name, st.seconds);  // as the loader measured them
+        for (const auto& w : part.warnings) report->warnings.push_back("body '" + b.name + "': " + w);
+        for (const auto& a : part.repairs.actions)
+          report->warnings.push_back("body '" + b.name + "': repaired: " + a);
+      }
+      return part.shape;
     }
-  } catch (const InputError& e) {
-    if (!e.where().empty()) throw;
-    throw InputError(where(scene), b.place.describe(), "body '" + b.name + "': " + e.place() + ": " + e.reason());
   }
   throw Error(ExitCode::internal_error, "unknown shape kind");
 }
@@ -153,18 +164,6 @@ PreparedBody prepare_body(const BodySpec& b, const Scene& scene, RunReport* repo
 
 namespace {
 
-// Rethrows an InputError raised without a file (the collision core's) with the scene's place.
-template <class F>
-auto in_impact(const Scene& scene, const ImpactSpec& s, F&& f) {
-  try {
-    return f();
-  } catch (const InputError& e) {
-    if (!e.where().empty()) throw;
-    throw InputError(where(scene), s.place.describe(),
-                     "impact '" + s.name + "': " + (e.place().empty() ? "" : e.place() + ": ") + e.reason());
-  }
-}
-
 std::string text(const Eigen::Vector3d& v) {
   std::ostringstream s;
   s << "(" << v.x() + 0.0 << ", " << v.y() + 0.0 << ", " << v.z() + 0.0 << ")";
@@ -175,14 +174,8 @@ std::string text(const Eigen::Vector3d& v) {
 ContactEvaluation locate_contact(const Scene& scene, const ImpactSpec& s, const ContactModel& model) {
   const PreparedBody& target = model.target();
   if (s.first_contact) {
-    try {
-      return model.at_first_contact();
-    } catch (const InputError& e) {
-      if (!e.where().empty()) throw;
-      throw InputError(where(scene), Place{s.place.line, s.place.key + ".point"}.describe(),
-                       "impact '" + s.name + "': first contact of '" + s.impactor + "' with '" + s.target +
-                           "': " + e.reason());
-    }
+    return model.at_first_contact(
+        impact_context(scene, s, ".point").at("first contact of '" + s.impactor + "' with '" + s.target + "'"));
   }
   const geometry::SurfacePoint sp = target.shape->closest_point(s.point_m);
   const double size = target.shape->bounded() ? target.shape->size_m() : model.impactor().shape->size_m();
@@ -213,6 +206,8 @@ collision::ImpactInput impact_input(const Scene& scene, const ImpactSpec& s, con
   in.effective_modulus_Pa = e.input.effective_modulus_Pa;
   in.restitution = s.restitution;
   in.thresholds = scene.thresholds;
+  in.context = impact_context(scene, s);
+  in.input_keys = detail::impact_input_keys(scene, s);
   return in;
 }
 
@@ -245,6 +240,7 @@ fem_export::DeckRequest fem_request(const Scene& scene, const ImpactReport& ir, 
   fem_export::DeckRequest r;
   r.source = scene.file.string();
   r.impact = ir.spec->name;
+  r.context = {where(scene), place.describe() + ": impact '" + ir.spec->name + "': FEM deck"};
   switch (b.shape) {
     case ShapeKind::sphere:
       r.body.semi_axes_m = Eigen::Vector3d::Constant(b.radius_m);
@@ -328,6 +324,14 @@ ContactEvaluation locate_impact_contact(const Scene& scene, const ImpactSpec& s,
   return locate_contact(scene, s, model);
 }
 
+collision::ForceTableOptions force_table_options(const Scene& scene, const ImpactSpec& s) {
+  collision::ForceTableOptions o = scene.outputs.force_table;
+  const std::string impact = "impact '" + s.name + "'";
+  o.time_step_context = {where(scene), output_place(scene, "force_table_time_step_s").describe() + ": " + impact};
+  o.max_samples_context = {where(scene), output_place(scene, "force_table_max_samples").describe() + ": " + impact};
+  return o;
+}
+
 fem_export::DeckRequest hybrid_deck_request(const Scene& scene, const ImpactReport& ir, const PreparedBody& body) {
   return fem_request(scene, ir, body);
 }
@@ -347,10 +351,7 @@ StagedOutputs reserve_outputs(const Scene& scene, RunTransaction& txn) {
   StagedOutputs st;
   const std::string file = where(scene);
   const std::size_t n = scene.impacts.size();
-  auto place_of = [&](const char* key) {
-    const auto it = scene.outputs.places.find(key);
-    return (it != scene.outputs.places.end() ? it->second : Place{0, std::string("outputs.") + key}).describe();
-  };
+  auto place_of = [&](const char* key) { return output_place(scene, key).describe(); };
   // One file per impact; with several impacts the impact's name is appended to the stem.
   auto per_impact = [&](const fs::path& base, const ImpactSpec& s, const char* key) {
     if (n == 1) return base.string();
@@ -427,11 +428,11 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
     ir.spec = std::make_shared<const ImpactSpec>(s);
     const PreparedBody& target = bodies.at(s.target);
     const PreparedBody& impactor = bodies.at(s.impactor);
-    const ContactModel model = in_impact(scene, s, [&] {
-      return ContactModel(target, impactor, s.contact_radius,
-                          collision::effective_modulus_Pa(target.material, impactor.material, scene.modulus_convention),
-                          s.restitution);
-    });
+    const InputContext ctx = impact_context(scene, s);
+    const ContactModel model(
+        target, impactor, s.contact_radius,
+        collision::effective_modulus_Pa(target.material, impactor.material, scene.modulus_convention, ctx),
+        s.restitution, ctx);
     ir.contact = clock.run(Stage::contact_geometry, [&] { return locate_contact(scene, s, model); });
     if (ir.contact.result.flag != collision::ContactFlag::none) {
       const Place place{s.place.line, s.place.key + ".point"};
@@ -450,16 +451,9 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
       }
     }
     ir.result = clock.run(Stage::impact, [&] {
-      return in_impact(scene, s, [&] {
-        const collision::ImpactInput in = impact_input(scene, s, model, ir.contact);
-        detail::check_impact_magnitudes(scene, s, in, ir.contact.result.effective_radius_m);
-        try {
-          return collision::solve_impact(in);
-        } catch (const InputError& e) {
-          if (e.place() != "numeric range") throw;
-          throw InputError("", e.place(), e.reason() + "; check " + detail::impact_input_keys(scene, s));
-        }
-      });
+      const collision::ImpactInput in = impact_input(scene, s, model, ir.contact);
+      detail::check_impact_magnitudes(scene, s, in, ir.contact.result.effective_radius_m);
+      return collision::solve_impact(in);
     });
     ir.validity = collision::assess_validity(ir.contact.input, ir.result.kernel, target.yield_strength_Pa,
                                              impactor.yield_strength_Pa, scene.validity);
@@ -481,13 +475,7 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
   if (scene.outputs.force_table_csv || want_fem) {
     clock.run(Stage::force_table, [&] {
       for (auto& ir : report.impacts) {
-        try {
-          ir.table = collision::sample_force_table(ir.result.history, scene.outputs.force_table);
-        } catch (const InputError& e) {
-          const auto it = scene.outputs.places.find(e.place());
-          const Place place = it != scene.outputs.places.end() ? it->second : Place{0, "outputs." + e.place()};
-          throw InputError(where(scene), place.describe(), "impact '" + ir.spec->name + "': " + e.reason());
-        }
+        ir.table = collision::sample_force_table(ir.result.history, force_table_options(scene, *ir.spec));
         if (!ir.table->tolerance_met) {
           std::ostringstream m;
           m << "impact '" << ir.spec->name << "': force table impulse error "
@@ -505,15 +493,7 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
       auto& ir = report.impacts[k];
       fem_export::DeckRequest req = fem_request(scene, ir, bodies.at(ir.spec->target));
       req.options.units.length = report.output_length_unit;
-      try {
-        ir.fem_deck = fem_export::write_deck_files(req, staged.fem[k]);
-      } catch (const InputError& e) {
-        // One line naming the scene, the [outputs.fem] table, and what failed where.
-        std::string what = "impact '" + ir.spec->name + "': FEM deck " + txn.public_text(e.where()) + ": ";
-        if (!e.place().empty()) what += e.place() + ": ";
-        throw InputError(where(scene), Place{scene.outputs.fem->place.line, "outputs.fem"}.describe(),
-                         what + e.reason());
-      }
+      ir.fem_deck = fem_export::write_deck_files(req, staged.fem[k]);  // errors: req.context
       const auto& patch = ir.fem_deck->patch;
       if (ir.fem_deck->load == fem_export::LoadKind::hertz_patch &&
           patch.largest_ellipse_elements < scene.outputs.fem->contact_elements) {
@@ -562,13 +542,9 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
           co.solver_timeout_s = opt.solver_timeout_s;
           co.solver_threads = opt.solver_threads;
           co.progress = opt.progress;
-          try {
-            ir.compare = compare_contact(scene, co);
-          } catch (const InputError& e) {
-            throw InputError(where(scene), Place{scene.outputs.fem->place.line, "outputs.fem.compare_contact"}.describe(),
-                             "impact '" + ir.spec->name + "': " + txn.public_text(e.where()) +
-                                 (e.place().empty() ? "" : ": " + e.place()) + ": " + e.reason());
-          }
+          co.context = {where(scene), Place{scene.outputs.fem->place.line, "outputs.fem.compare_contact"}.describe() +
+                                          ": impact '" + ir.spec->name + "'"};
+          ir.compare = compare_contact(scene, co);
           if (ir.compare->verdict == CompareVerdict::disagree) {
             report.warnings.push_back("impact '" + ir.spec->name + "': full-contact F_max differs from the analytic one by " +
                                       std::to_string(100 * ir.compare->finest()->max_force_relative_difference) +
@@ -679,13 +655,7 @@ RunReport run_scene(const Scene& scene, const RunOptions& opt) {
   report.stages_run.push_back({stage_name(Stage::scene), 0.0});
   RunTransaction txn(opt.out_dir);
   for (const auto& w : txn.warnings()) report.warnings.push_back(w);
-  try {
-    run_stages(scene, opt, txn, report, clock);
-  } catch (const InputError& e) {
-    throw txn.public_error(e);  // name the final paths, not the staging folder
-  } catch (const Error& e) {
-    throw Error(e.code(), txn.public_text(e.what()));
-  }
+  txn.run([&] { run_stages(scene, opt, txn, report, clock); });  // messages name the final paths
   for (const auto& st : all_stages()) {
     bool ran = false;
     for (const auto& r : report.stages_run) ran = ran || r.name == st;

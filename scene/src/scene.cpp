@@ -42,11 +42,36 @@ const BodySpec& Scene::body(const std::string& name) const {
 
 namespace {
 
+// Where the scene's text comes from, named by every error about it: the file (inside the caller's
+// context, e.g. a campaign case) and the --set overrides, so that an error about a value an
+// override set names the override ("--set KEY") instead of a line of the file.
+class Source {
+ public:
+  Source(const std::string& name, const InputContext& context, const std::vector<Override>& overrides)
+      : name_(name), file_(context.in_file(name)), overrides_(overrides) {}
+
+  const std::string& name() const { return name_; }
+  /// The error about the value at `p`.
+  InputError error(const Place& p, const std::string& reason) const { return file_.error(describe(p), reason); }
+  /// The context of the value at `p`, for the library code that checks it.
+  InputContext at(const Place& p) const { return file_.at(describe(p)); }
+
+ private:
+  std::string describe(const Place& p) const {
+    const std::string o = detail::override_place(overrides_, p.key);
+    return o.empty() ? p.describe() : o;
+  }
+
+  std::string name_;
+  InputContext file_;
+  const std::vector<Override>& overrides_;
+};
+
 // Reads one TOML table, remembering which keys were used so that unknown keys are rejected, and
 // turning every problem into an InputError with file, line and dotted key.
 class Reader {
  public:
-  Reader(const toml::table& t, std::string prefix, const std::string& file)
+  Reader(const toml::table& t, std::string prefix, const Source& file)
       : t_(t), prefix_(std::move(prefix)), file_(file) {}
 
   std::string key_path(const std::string& k) const { return prefix_.empty() ? k : prefix_ + "." + k; }
@@ -56,7 +81,7 @@ class Reader {
   Place self() const { return Place{table_line(), prefix_}; }
 
   [[noreturn]] void fail(const std::string& k, const std::string& reason) const {
-    throw InputError(file_, place(k).describe(), reason);
+    throw file_.error(place(k), reason);
   }
 
   const toml::node* get(const std::string& k) {
@@ -152,7 +177,7 @@ class Reader {
   }
 
   [[noreturn]] void missing(const std::string& k) const {
-    throw InputError(file_, self().describe(), "missing required key '" + key_path(k) + "'");
+    throw file_.error(self(), "missing required key '" + key_path(k) + "'");
   }
 
   /// Rejects keys that are neither declared with allow() nor read, naming the allowed ones.
@@ -164,9 +189,9 @@ class Reader {
       all.insert(used_.begin(), used_.end());
       std::string list;
       for (const auto& u : all) list += (list.empty() ? "" : ", ") + u;
-      throw InputError(file_, Place{line_of(&node), key_path(k)}.describe(),
-                       "unknown key (allowed here: " + list + ")" +
-                           did_you_mean(k, std::vector<std::string>(all.begin(), all.end())));
+      throw file_.error(Place{line_of(&node), key_path(k)},
+                        "unknown key (allowed here: " + list + ")" +
+                            did_you_mean(k, std::vector<std::string>(all.begin(), all.end())));
     }
   }
 
@@ -190,13 +215,13 @@ class Reader {
  private:
   const toml::table& t_;
   std::string prefix_;
-  const std::string& file_;
+  const Source& file_;
   std::set<std::string> used_;
   std::set<std::string> allowed_;
 };
 
 // All keys a reader may see are declared by reading them; sub-tables are read by their own reader.
-Material read_material(const std::string& name, const toml::table& t, const std::string& file) {
+Material read_material(const std::string& name, const toml::table& t, const Source& file) {
   Reader r(t, "materials." + name, file);
   r.allow({"youngs_modulus_Pa", "poisson_ratio", "density_kg_m3", "yield_strength_Pa"});
   Material m;
@@ -213,7 +238,7 @@ Material read_material(const std::string& name, const toml::table& t, const std:
   return m;
 }
 
-BodySpec read_body(std::size_t index, const toml::table& t, const std::string& file,
+BodySpec read_body(std::size_t index, const toml::table& t, const Source& file,
                    double to_m, const fs::path& base_dir) {
   Reader r(t, "bodies[" + std::to_string(index) + "]", file);
   r.allow({"name", "shape", "radius", "semi_axes", "mesh", "normal", "material", "mass_kg", "fixed",
@@ -291,7 +316,7 @@ BodySpec read_body(std::size_t index, const toml::table& t, const std::string& f
 }
 
 // `restitution = { approach_speed_m_s = [...], value = [...] }`
-collision::RestitutionTable read_restitution_table(Reader& parent, const toml::table& t, const std::string& file) {
+collision::RestitutionTable read_restitution_table(Reader& parent, const toml::table& t, const Source& file) {
   Reader r(t, parent.key_path("restitution"), file);
   collision::RestitutionTable tab;
   auto list = [&](const char* k, std::vector<double>& out) {
@@ -310,16 +335,12 @@ collision::RestitutionTable read_restitution_table(Reader& parent, const toml::t
   };
   list("approach_speed_m_s", tab.approach_speed_m_s);
   list("value", tab.value);
-  try {
-    collision::validate_restitution_table(tab);
-  } catch (const InputError& e) {
-    throw InputError(file, r.self().describe(), e.reason());
-  }
+  collision::validate_restitution_table(tab, file.at(r.self()));
   r.reject_unknown();
   return tab;
 }
 
-ImpactSpec read_impact(std::size_t index, const toml::table& t, const std::string& file,
+ImpactSpec read_impact(std::size_t index, const toml::table& t, const Source& file,
                        double to_m, const collision::RestitutionModel& defaults) {
   Reader r(t, "impacts[" + std::to_string(index) + "]", file);
   r.allow({"name", "target", "impactor", "point", "restitution", "contact_radius",
@@ -385,9 +406,9 @@ ImpactSpec read_impact(std::size_t index, const toml::table& t, const std::strin
   return s;
 }
 
-const toml::table& sub_table(const toml::node* n, const std::string& key, const std::string& file);
+const toml::table& sub_table(const toml::node* n, const std::string& key, const Source& file);
 
-FemOutputs read_fem(const toml::table& t, const std::string& file, double to_m) {
+FemOutputs read_fem(const toml::table& t, const Source& file, double to_m) {
   Reader r(t, "outputs.fem", file);
   r.allow({"mesh_size", "load_mesh_size", "end_time_s", "time_step_s", "probes", "code_aster", "calculix", "run",
            "load", "contact_elements", "contact_zone_factor", "linear_momentum_tolerance",
@@ -492,7 +513,7 @@ FemOutputs read_fem(const toml::table& t, const std::string& file, double to_m) 
   return f;
 }
 
-Outputs read_outputs(const toml::table& t, const std::string& file, double to_m) {
+Outputs read_outputs(const toml::table& t, const Source& file, double to_m) {
   Reader r(t, "outputs", file);
   r.allow({"force_table_csv", "force_table_impulse_tolerance", "force_table_time_step_s", "force_table_max_samples"});
   Outputs o;
@@ -521,18 +542,18 @@ Outputs read_outputs(const toml::table& t, const std::string& file, double to_m)
   return o;
 }
 
-const toml::table& sub_table(const toml::node* n, const std::string& key, const std::string& file) {
+const toml::table& sub_table(const toml::node* n, const std::string& key, const Source& file) {
   if (!n->is_table()) {
-    throw InputError(file, Place{static_cast<int>(n->source().begin.line), key}.describe(),
+    throw file.error(Place{static_cast<int>(n->source().begin.line), key},
                      "must be a table");
   }
   return *n->as_table();
 }
 
-const toml::array& table_array(const toml::node* n, const std::string& key, const std::string& file) {
+const toml::array& table_array(const toml::node* n, const std::string& key, const Source& file) {
   const toml::array* a = n->as_array();
   if (!a || !a->is_array_of_tables()) {
-    throw InputError(file, Place{static_cast<int>(n->source().begin.line), key}.describe(),
+    throw file.error(Place{static_cast<int>(n->source().begin.line), key},
                      "must be an array of tables ([[" + key + "]])");
   }
   return *a;
@@ -544,9 +565,9 @@ std::vector<std::string> material_names(const Scene& sc) {
   return names;
 }
 
-Scene build(const toml::table& root, const std::string& file, const fs::path& base_dir) {
+Scene build(const toml::table& root, const Source& file, const fs::path& base_dir) {
   Scene sc;
-  sc.file = file;
+  sc.file = file.name();
   Reader r(root, "", file);
   r.allow({"length_unit", "modulus_convention", "energy_flux_unit", "restitution_range_policy",
            "checks", "validity", "materials", "bodies", "impacts", "outputs"});
@@ -610,18 +631,18 @@ Scene build(const toml::table& root, const std::string& file, const fs::path& ba
     BodySpec b = read_body(i, *ba.get(i)->as_table(), file, to_m, base_dir);
     for (const auto& other : sc.bodies) {
       if (other.name == b.name) {
-        throw InputError(file, Place{b.place.line, "bodies[" + std::to_string(i) + "].name"}.describe(),
+        throw file.error(Place{b.place.line, "bodies[" + std::to_string(i) + "].name"},
                          "duplicate body name '" + b.name + "'");
       }
     }
     auto m = sc.materials.find(b.material);
     if (m == sc.materials.end()) {
-      throw InputError(file, Place{b.place.line, "bodies[" + std::to_string(i) + "].material"}.describe(),
+      throw file.error(Place{b.place.line, "bodies[" + std::to_string(i) + "].material"},
                        "unknown material '" + b.material + "' (define it under [materials." + b.material + "])" +
                            did_you_mean(b.material, material_names(sc)));
     }
     if (!b.fixed && !b.mass_kg && !m->second.density_kg_m3) {
-      throw InputError(file, Place{b.place.line, "bodies[" + std::to_string(i) + "]"}.describe(),
+      throw file.error(Place{b.place.line, "bodies[" + std::to_string(i) + "]"},
                        "body '" + b.name + "' needs a mass: give mass_kg, fixed = true, or "
                        "density_kg_m3 in material '" + b.material + "'");
     }
@@ -640,21 +661,21 @@ Scene build(const toml::table& root, const std::string& file, const fs::path& ba
         const char* key = who == &s.target ? "target" : "impactor";
         std::vector<std::string> names;
         for (const auto& b : sc.bodies) names.push_back(b.name);
-        throw InputError(file, Place{s.place.line, "impacts[" + std::to_string(i) + "]." + key}.describe(),
+        throw file.error(Place{s.place.line, "impacts[" + std::to_string(i) + "]." + key},
                          "no body named '" + *who + "'" + did_you_mean(*who, names));
       }
     }
     if (!s.first_contact) {
       const BodySpec& imp = sc.body(s.impactor);
       if (imp.placed && imp.position_m != Eigen::Vector3d::Zero()) {
-        throw InputError(file, Place{s.place.line, "impacts[" + std::to_string(i) + "].point"}.describe(),
+        throw file.error(Place{s.place.line, "impacts[" + std::to_string(i) + "].point"},
                          "impactor '" + s.impactor + "' has a position, but with point = [x, y, z] it is placed "
                          "to touch the target there; use point = \"first-contact\" to keep both placements");
       }
     }
     for (const auto& other : sc.impacts) {
       if (other.name == s.name) {
-        throw InputError(file, Place{s.place.line, "impacts[" + std::to_string(i) + "].name"}.describe(),
+        throw file.error(Place{s.place.line, "impacts[" + std::to_string(i) + "].name"},
                          "duplicate impact name '" + s.name + "'");
       }
     }
@@ -670,29 +691,26 @@ Scene build(const toml::table& root, const std::string& file, const fs::path& ba
 }  // namespace
 
 Scene parse_scene(const std::string& text, const std::string& name, const fs::path& base_dir,
-                  const std::vector<Override>& overrides) {
+                  const std::vector<Override>& overrides, const InputContext& context) {
   toml::table root;
   try {
-    root = toml::parse(detail::toml_ascii(text, name), name);  // why ASCII: toml_ascii.hpp
+    root = toml::parse(detail::toml_ascii(text, context.in_file(name)), name);  // why ASCII: toml_ascii.hpp
   } catch (const toml::parse_error& e) {
     std::ostringstream place;
     place << "line " << e.source().begin.line << ", column " << e.source().begin.column;
-    throw InputError(name, place.str(), "TOML syntax error: " + std::string(e.description()));
+    throw context.in_file(name).error(place.str(), "TOML syntax error: " + std::string(e.description()));
   }
-  if (overrides.empty()) return build(root, name, base_dir);
-  detail::apply_overrides(root, overrides, name);  // before validation: checked like the file
-  try {
-    return build(root, name, base_dir);
-  } catch (const InputError&) {
-    detail::rethrow_naming_override(overrides);
-  }
+  // Overrides change the document before validation: an overridden value is checked like the
+  // file's, and its errors name the override (Source).
+  detail::apply_overrides(root, overrides, context.in_file(name));
+  return build(root, Source(name, context, overrides), base_dir);
 }
 
-Scene load_scene(const fs::path& file, const std::vector<Override>& overrides) {
+Scene load_scene(const fs::path& file, const std::vector<Override>& overrides, const InputContext& context) {
   // A regular file of at most 16 MiB: a FIFO, a device or a huge file is refused before reading.
   const std::string text = read_input_file(file, "scene file", kMaxSceneBytes);
   const fs::path base = file.has_parent_path() ? file.parent_path() : fs::path(".");
-  Scene s = parse_scene(text, file.string(), base, overrides);
+  Scene s = parse_scene(text, file.string(), base, overrides, context);
   s.file = file;
   return s;
 }

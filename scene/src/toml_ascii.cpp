@@ -37,7 +37,7 @@ std::string escape(std::uint32_t cp) {
 
 class Converter {
  public:
-  Converter(const std::string& text, const std::string& name) : s_(text), name_(name) {}
+  Converter(const std::string& text, const InputContext& where) : s_(text), where_(where) {}
 
   std::string run() {
     if (s_.compare(0, 3, "\xEF\xBB\xBF") == 0) i_ = 3;
@@ -60,8 +60,8 @@ class Converter {
  private:
   bool starts(const char* t) const { return s_.compare(i_, std::char_traits<char>::length(t), t) == 0; }
   [[noreturn]] void fail(const std::string& reason) const {
-    throw InputError(name_, "line " + std::to_string(line_) + ", column " + std::to_string(column_),
-                     "TOML syntax error: " + reason);
+    throw where_.error("line " + std::to_string(line_) + ", column " + std::to_string(column_),
+                       "TOML syntax error: " + reason);
   }
   // Advances over n input bytes of one code point (or n ASCII characters), keeping line/column.
   void advance(std::size_t n, bool one_code_point) {
@@ -171,18 +171,22 @@ class Converter {
   }
 
   const std::string& s_;
-  const std::string& name_;
+  const InputContext& where_;
   std::string out_;
   std::size_t i_ = 0, line_ = 1, column_ = 1;
 };
 
 }  // namespace
 
-std::string toml_ascii(const std::string& text, const std::string& name) {
+std::string toml_ascii(const std::string& text, const InputContext& where) {
   bool ascii = true;
   for (char c : text) ascii = ascii && static_cast<unsigned char>(c) < 0x80;
   if (ascii) return text;
-  return Converter(text, name).run();
+  return Converter(text, where).run();
+}
+
+std::string toml_ascii(const std::string& text, const std::string& name) {
+  return toml_ascii(text, InputContext{name, ""});
 }
 
 }  // namespace impactdeck::scene::detail

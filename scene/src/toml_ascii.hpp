@@ -16,9 +16,13 @@
 // A UTF-8 byte order mark at the start is dropped. Pure ASCII text comes back unchanged.
 #include <string>
 
+#include "impactdeck/common/error.hpp"
+
 namespace impactdeck::scene::detail {
 
-/// The ASCII form of `text` described above; throws InputError(name, "line L, column C", reason).
+/// The ASCII form of `text` described above; throws where.error("line L, column C", reason).
+std::string toml_ascii(const std::string& text, const InputContext& where);
+/// The same, naming the file `name`.
 std::string toml_ascii(const std::string& text, const std::string& name);
 
 }  // namespace impactdeck::scene::detail

@@ -71,11 +71,12 @@ std::vector<geometry::SurfacePoint> mesh_vertex_cloud(const geometry::Shape& tar
 
 std::vector<geometry::SurfacePoint> projected_grid_cloud(const geometry::Shape& target,
                                                          const Eigen::Vector3d& box_min_m,
-                                                         const Eigen::Vector3d& box_max_m, int steps) {
+                                                         const Eigen::Vector3d& box_max_m, int steps,
+                                                         const InputContext& context) {
   const Eigen::Vector3d half = 0.5 * (box_max_m - box_min_m), centre = 0.5 * (box_max_m + box_min_m);
-  if (!(half.minCoeff() > 0.0)) throw InputError("", "cloud", "the target's bounding box is flat");
+  if (!(half.minCoeff() > 0.0)) throw context.error("cloud", "the target's bounding box is flat");
   const geometry::Ellipsoid box(half.x(), half.y(), half.z());
-  std::vector<geometry::SurfacePoint> out = paper_grid_cloud(box, steps);
+  std::vector<geometry::SurfacePoint> out = paper_grid_cloud(box, steps, context);
   for (auto& sp : out) sp = target.closest_point(centre + sp.point_m);
   return out;
 }

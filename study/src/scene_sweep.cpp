@@ -39,15 +39,13 @@ SceneSweep sweep_from_scene(const scene::Scene& sc, const std::string& name) {
                      "impact '" + s.name + "': a sweep covers the target's surface; target '" + s.target +
                          "' is a plane (swap target and impactor)");
   }
+  // The sweep's errors name the scene, the impact's line and key, and the impact.
+  const InputContext ctx{file, InputContext::joined(s.place.describe(), "impact '" + s.name + "'")};
   out.setup.rule = s.contact_radius;
-  try {
-    out.setup.effective_modulus_Pa = collision::effective_modulus_Pa(out.setup.target.material,
-                                                                     out.setup.impactor.material, sc.modulus_convention);
-  } catch (const InputError& e) {
-    throw InputError(file, s.place.describe(), "impact '" + s.name + "': " + e.reason());
-  }
+  out.setup.effective_modulus_Pa = collision::effective_modulus_Pa(
+      out.setup.target.material, out.setup.impactor.material, sc.modulus_convention, ctx);
   out.setup.restitution = s.restitution;
-  out.setup.context = {file, "impact '" + s.name + "'"};
+  out.setup.context = ctx;
   if (s.approach_speed_m_s) {
     out.setup.approach_speed_m_s = *s.approach_speed_m_s;
   } else {

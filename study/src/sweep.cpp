@@ -84,9 +84,9 @@ SweepResult run_sweep(const SweepSetup& s, const std::vector<geometry::SurfacePo
   }
   if (o.curves && o.curve_samples < 2) throw s.context.error("curve samples", "must be at least 2");
   if (s.restitution.kind == collision::RestitutionModel::Kind::table) {
-    collision::validate_restitution_table(s.restitution.table);
+    collision::validate_restitution_table(s.restitution.table, s.context.at("restitution"));
   }
-  const scene::ContactModel model(s.target, s.impactor, s.rule, s.effective_modulus_Pa, s.restitution);
+  const scene::ContactModel model(s.target, s.impactor, s.rule, s.effective_modulus_Pa, s.restitution, s.context);
   SweepResult res;
   const std::size_t n = cloud.size();
   res.points.resize(n);  // every point writes only its own slot

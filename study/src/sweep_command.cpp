@@ -161,11 +161,7 @@ SweepReport run_sweep_command(const scene::Scene& sc, const SweepRequest& q) {
   }
   // One transaction: the sweep's files appear together when all are written, or not at all.
   RunTransaction txn(q.out_dir);
-  try {
-    sweep_stages(sc, q, &txn, rep);
-  } catch (const InputError& e) {
-    throw txn.public_error(e);  // name the final paths, not the staging folder
-  }
+  txn.run([&] { sweep_stages(sc, q, &txn, rep); });  // messages name the final paths, not the staging folder
   rep.warnings = txn.warnings();  // an interrupted commit finished, stale staging folders removed
   return rep;
 }

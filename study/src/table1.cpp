@@ -63,16 +63,17 @@ void bounding_box(const geometry::TriangleMesh& m, Eigen::Vector3d& lo, Eigen::V
 }
 
 // The cloud of a scene-driven row: the paper grid on a mesh is the projected grid of its box.
-std::vector<geometry::SurfacePoint> scene_cloud(const geometry::Shape& t, const Table1Options& o) {
+std::vector<geometry::SurfacePoint> scene_cloud(const geometry::Shape& t, const Table1Options& o,
+                                                const InputContext& ctx) {
   const auto* mesh = dynamic_cast<const geometry::MeshShape*>(&t);
   if (!mesh || (o.cloud != CloudKind::paper_grid && o.cloud != CloudKind::both)) {
-    return make_cloud(t, o.cloud, o.grid_steps, o.uniform_count, o.seed);
+    return make_cloud(t, o.cloud, o.grid_steps, o.uniform_count, o.seed, ctx);
   }
   Eigen::Vector3d lo, hi;
   bounding_box(mesh->mesh(), lo, hi);
-  std::vector<geometry::SurfacePoint> cloud = projected_grid_cloud(t, lo, hi, o.grid_steps);
+  std::vector<geometry::SurfacePoint> cloud = projected_grid_cloud(t, lo, hi, o.grid_steps, ctx);
   if (o.cloud == CloudKind::both) {
-    auto u = area_uniform_cloud(t, o.uniform_count, o.seed);
+    auto u = area_uniform_cloud(t, o.uniform_count, o.seed, ctx);
     cloud.insert(cloud.end(), u.begin(), u.end());
   }
   return cloud;
@@ -80,14 +81,15 @@ std::vector<geometry::SurfacePoint> scene_cloud(const geometry::Shape& t, const 
 
 }  // namespace
 
-std::shared_ptr<const geometry::Shape> stretched_target(const geometry::Shape& target, int axis, double g) {
-  if (axis < 0 || axis > 2) throw InputError("", "stretch axis", "must be 0 (x), 1 (y) or 2 (z)");
-  if (!(g > 0.0) || !std::isfinite(g)) throw InputError("", "geometric ratio", "must be positive and finite");
+std::shared_ptr<const geometry::Shape> stretched_target(const geometry::Shape& target, int axis, double g,
+                                                        const InputContext& ctx) {
+  if (axis < 0 || axis > 2) throw ctx.error("stretch axis", "must be 0 (x), 1 (y) or 2 (z)");
+  if (!(g > 0.0) || !std::isfinite(g)) throw ctx.error("geometric ratio", "must be positive and finite");
   const int ref = (axis + 1) % 3;
   if (const auto* e = dynamic_cast<const geometry::Ellipsoid*>(&target)) {
     Eigen::Vector3d semi = e->semi_axes_m();
     semi[axis] = g * semi[ref];
-    return std::make_shared<geometry::Ellipsoid>(semi.x(), semi.y(), semi.z());
+    return std::make_shared<geometry::Ellipsoid>(semi.x(), semi.y(), semi.z(), ctx);
   }
   if (const auto* m = dynamic_cast<const geometry::MeshShape*>(&target)) {
     geometry::TriangleMesh mesh = m->mesh();
@@ -95,7 +97,7 @@ std::shared_ptr<const geometry::Shape> stretched_target(const geometry::Shape& t
     bounding_box(mesh, lo, hi);
     const Eigen::Vector3d half = 0.5 * (hi - lo);
     if (!(half[axis] > 0.0) || !(half[ref] > 0.0)) {
-      throw InputError("", "stretch axis", "the part is flat along the stretch axis or the next axis");
+      throw ctx.error("stretch axis", "the part is flat along the stretch axis or the next axis");
     }
     // Affine stretch about the centroid (the body frame's origin stays where it was).
     const double factor = g * half[ref] / half[axis];
@@ -105,7 +107,7 @@ std::shared_ptr<const geometry::Shape> stretched_target(const geometry::Shape& t
     const geometry::MeshMassProperties mass = geometry::compute_mass_properties(mesh, shells);
     return std::make_shared<geometry::MeshShape>(std::move(mesh), mass, m->options());
   }
-  throw InputError("", "target", "a " + target.kind() + " cannot be stretched (use an ellipsoid or a mesh)");
+  throw ctx.error("target", "a " + target.kind() + " cannot be stretched (use an ellipsoid or a mesh)");
 }
 
 Table1Options table1_preset(const std::string& name) {
@@ -187,14 +189,11 @@ Table1Result run_table1(const Table1Options& o) {
     std::shared_ptr<const geometry::Shape> target;
     std::vector<geometry::SurfacePoint> cloud;
     if (o.scene) {
-      try {
-        target = stretched_target(*o.scene->setup.target.shape, o.scene->stretch_axis, g);
-        cloud = scene_cloud(*target, o);
-      } catch (const InputError& e) {
-        std::ostringstream place;
-        place << "target '" << o.scene->target << "' stretched to g = " << g;
-        throw InputError(o.scene->source, place.str(), (e.place().empty() ? "" : e.place() + ": ") + e.reason());
-      }
+      std::ostringstream place;
+      place << "target '" << o.scene->target << "' stretched to g = " << g;
+      const InputContext ctx{o.scene->source, place.str()};
+      target = stretched_target(*o.scene->setup.target.shape, o.scene->stretch_axis, g, ctx);
+      cloud = scene_cloud(*target, o, ctx);
     } else {
       const Eigen::Vector3d e = semi_axes(g, o.size_ratio);
       target = std::make_shared<geometry::Ellipsoid>(e.x(), e.y(), e.z());

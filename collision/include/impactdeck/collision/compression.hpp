@@ -12,6 +12,9 @@
 // Z^(3/2) has its own. Both are built once from the exact inverse of the incomplete beta function.
 
 #include <cstddef>
+#include <string>
+
+#include "impactdeck/common/error.hpp"
 
 namespace impactdeck::collision {
 
@@ -57,10 +60,12 @@ struct CompressionPhase {
 CompressionPhase compression_phase(double reduced_mass_kg, double approach_velocity_m_s,
                                    double hertz_constant) noexcept;
 
-/// Throws InputError (place "numeric range") when a number of `phase` lies outside
-/// [1e-100, 1e100] (common/numeric.hpp): beyond, the self-checks' products under- or overflow.
-/// compression_phase itself never throws (the kernel flags such a point instead).
-void check_compression_range(const CompressionPhase& phase);
+/// Throws ctx.error("numeric range", reason) when a number of `phase` lies outside [1e-100, 1e100]
+/// (common/numeric.hpp): beyond, the self-checks' products under- or overflow. `inputs`, when
+/// given, says where m_w, v_w and k_H come from (e.g. a scene's keys): the reason ends with
+/// "; check INPUTS". compression_phase itself never throws (the kernel flags such a point instead).
+void check_compression_range(const CompressionPhase& phase, const InputContext& ctx = {},
+                             const std::string& inputs = "");
 
 /// Closed-form compression phase. Throws InputError unless m_w > 0, v_w > 0, k_H > 0 (finite).
 CompressionPhase solve_compression(double reduced_mass_kg, double approach_velocity_m_s,

@@ -38,6 +38,10 @@ struct ForceTableOptions {
   /// more is refused (InputError naming force_table_time_step_s, never silently coarsened); the
   /// tolerance-driven doubling stops there (the table then reports tolerance_met = false).
   std::size_t max_samples = 1000000;
+  /// Where time_step_s and max_samples were given, named by the errors about them (a scene: its
+  /// file and the keys' lines; default: the option's key alone).
+  InputContext time_step_context{"", "force_table_time_step_s"};
+  InputContext max_samples_context{"", "force_table_max_samples"};
 };
 
 /// Piecewise-linear force table: uniform spacing in each phase, t_m always a node, first and last
@@ -51,7 +55,8 @@ struct ForceTable {
   bool tolerance_met = false;
 };
 
-/// Throws InputError("", "force_table_time_step_s", ...) when the step needs more than max_samples.
+/// Throws time_step_context.error("", ...) when the step needs more than max_samples, and
+/// max_samples_context.error("", ...) when max_samples is below the coarsest table's 17 samples.
 ForceTable sample_force_table(const ForceHistory& h, const ForceTableOptions& options = {});
 
 }  // namespace impactdeck::collision

@@ -4,6 +4,7 @@
 //   1/R* = 1/R1 + 1/R2 (a plane has curvature 0)                          (Eq. 29, Eq. 15)
 //   1/E* = (1-nu1^2)/E1 + (1-nu2^2)/E2   ("hertz" convention, default)
 //   1/E* = 1/E1 + 1/E2                   ("paper" convention, Eq. 28)
+#include "impactdeck/common/error.hpp"
 
 namespace impactdeck::collision {
 
@@ -18,9 +19,10 @@ enum class ModulusConvention {
   paper,  ///< the paper's Eq. 28: 1/E per body, no Poisson term
 };
 
-/// Effective (reduced) modulus E* in Pa. Throws InputError for E <= 0 or nu outside (-1, 0.5).
+/// Effective (reduced) modulus E* in Pa. Throws ctx.error("target material youngs_modulus_Pa", ...)
+/// (or poisson_ratio, or the impactor's) for E <= 0 or nu outside (-1, 0.5).
 double effective_modulus_Pa(const ElasticMaterial& a, const ElasticMaterial& b,
-                            ModulusConvention convention);
+                            ModulusConvention convention, const InputContext& ctx = {});
 
 /// Effective radius R* in m from the two bodies' curvatures at the contact point (1/m; 0 for a
 /// plane; each must be >= 0, their sum > 0). Throws InputError otherwise.

@@ -28,6 +28,12 @@ struct ImpactInput {
   double effective_modulus_Pa = 0;  ///< E* (Eq. 28 or Hertz)
   RestitutionModel restitution;
   CheckThresholds thresholds;
+  /// Where the input comes from (e.g. the scene file and "line 19, key 'impacts[0]': impact
+  /// 'fig4'"): named by every error solve_impact throws. Empty: the errors name no file.
+  InputContext context;
+  /// Where the masses, speeds and moduli come from (e.g. the scene keys), named by an error for
+  /// numbers beyond double precision's range ("; check ..."). Empty: not named.
+  std::string input_keys;
 };
 
 /// The paper's self-checks, run on every impact.
@@ -60,9 +66,9 @@ struct ImpactResult {
 };
 
 /// Solves the impact through the physics kernel (solve_kernel), then builds the force history and
-/// runs the paper's self-checks on it. Throws InputError for invalid input and where the kernel
-/// flags the point (no impact, not a Hertz contact, restitution refused), naming the reason and
-/// the curvatures. Check failures do not throw: see `checks.passed`.
+/// runs the paper's self-checks on it. Throws input.context.error(place, reason) for invalid input
+/// and where the kernel flags the point (no impact, not a Hertz contact, restitution refused),
+/// naming the reason and the curvatures. Check failures do not throw: see `checks.passed`.
 ImpactResult solve_impact(const ImpactInput& input);
 
 /// One line explaining a kernel flag at a point (the curvatures of both surfaces, the approach

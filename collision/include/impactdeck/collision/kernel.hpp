@@ -58,9 +58,10 @@ struct KernelBody {
 };
 
 /// The per-body invariants (inverse mass, inverse world inertia), computed once per body and
-/// reused for every contact point. Throws InputError unless mass > 0 (or +infinity: fixed) and the
-/// inertia is symmetric positive definite.
-KernelBody kernel_body(const RigidBody& body);
+/// reused for every contact point. Throws ctx.error("mass" / "inertia tensor", reason) unless
+/// mass > 0 (or +infinity: fixed) and the inertia is symmetric positive definite; `ctx` names the
+/// body (e.g. the scene, its impact and "target 'plate'").
+KernelBody kernel_body(const RigidBody& body, const InputContext& ctx = {});
 
 struct KernelInput {
   KernelBody target, impactor;

@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "impactdeck/common/error.hpp"
+
 namespace impactdeck::collision {
 
 enum class EnergyFluxUnit { J_per_m3, J_per_cm3, J_per_mm3 };
@@ -52,9 +54,10 @@ struct RestitutionTable {
   std::vector<double> value;
 };
 
-/// Throws InputError("", "restitution", reason) unless the table has >= 2 points, equal lengths,
-/// finite speeds >= 0 strictly increasing and values in [0, 1].
-void validate_restitution_table(const RestitutionTable& t);
+/// Throws ctx.error("", reason) unless the table has >= 2 points, equal lengths, finite speeds
+/// >= 0 strictly increasing and values in [0, 1]. `ctx` names the table (a scene: its file and
+/// key; default: place "restitution").
+void validate_restitution_table(const RestitutionTable& t, const InputContext& ctx = {"", "restitution"});
 
 /// How R is obtained for an impact.
 struct RestitutionModel {

@@ -10,9 +10,9 @@
 namespace impactdeck {
 
 /// Runs `f()`. impactdeck's own errors pass through; anything else thrown becomes
-/// InputError(where, step, what [+ " (" + last_error() + ")" when that differs]).
+/// where.error(step, what [+ " (" + last_error() + ")" when that differs]).
 template <class F, class LastError>
-void run_as_input_error(const std::string& where, const std::string& step, F&& f, LastError&& last_error) {
+void run_as_input_error(const InputContext& where, const std::string& step, F&& f, LastError&& last_error) {
   std::string what;
   try {
     std::forward<F>(f)();
@@ -28,7 +28,13 @@ void run_as_input_error(const std::string& where, const std::string& step, F&& f
   }
   const std::string last = last_error();
   if (!last.empty() && last != what) what += " (" + last + ")";
-  throw InputError(where, step, what);
+  throw where.error(step, what);
+}
+
+/// The same, naming the file `where` alone.
+template <class F, class LastError>
+void run_as_input_error(const std::string& where, const std::string& step, F&& f, LastError&& last_error) {
+  run_as_input_error(InputContext{where, ""}, step, std::forward<F>(f), std::forward<LastError>(last_error));
 }
 
 }  // namespace impactdeck

@@ -23,6 +23,7 @@
 // - Output names are relative and confined to `out` (check_name).
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "impactdeck/common/error.hpp"
@@ -63,6 +64,22 @@ class RunTransaction {
   std::string public_text(std::string text) const;
   /// An error with public_text applied to its parts (throw the result).
   InputError public_error(const InputError& e) const;
+
+  /// Runs `f()` and returns what it returns. An Error it throws is thrown again with the staging
+  /// paths in its message replaced by the final ones (rethrow_public), so that a run's messages
+  /// name the paths the user sees: the one place where a command maps its errors, around
+  /// everything it does inside this transaction.
+  template <class F>
+  decltype(auto) run(F&& f) const {
+    try {
+      return std::forward<F>(f)();
+    } catch (const Error& e) {
+      rethrow_public(e);
+    }
+  }
+  /// Throws `e` again, of the same type (InputError, CheckFailed, UsageError, Error) and exit code,
+  /// with public_text applied to its message (an InputError's three parts: public_error).
+  [[noreturn]] void rethrow_public(const Error& e) const;
 
   const std::filesystem::path& out_dir() const { return out_; }
   /// Notes about an interrupted commit this run completed, stale folders removed, ...

@@ -79,6 +79,9 @@ struct ContactModelRequest {
   double semi_axis_a_m = 0, semi_axis_b_m = 0;
   double compression_time_s = 0;
   ContactModelOptions options;
+  /// Where the request comes from (a scene's impact): its errors name it, then the deck folder.
+  /// Empty: the deck folder alone.
+  InputContext context;
 };
 
 struct ContactBodyMesh {

@@ -176,6 +176,10 @@ struct DeckRequest {
   RigidReference model;                     ///< the rigid model (FE-vs-model checks)
   std::optional<double> yield_strength_Pa;  ///< the target's material: the stress verdict
   DeckOptions options;
+  /// Where the request comes from (`run`: the scene file, its [outputs.fem] key and the impact):
+  /// an error about the request or its meshing names it, then the deck folder or the file meshed
+  /// (InputContext::in_file). Empty: the deck folder or that file alone.
+  InputContext context;
 };
 
 /// The FE body against the part of the rigid model: geometry only, known before any solver run.
@@ -254,7 +258,8 @@ double estimate_tet_count(double volume_m3, double mesh_size_m, double load_mesh
 /// Meshes the body and writes the decks into the staging folder `folder` (created here; its parent
 /// must exist): the caller publishes it (a RunTransaction). On failure the folder is removed.
 /// Throws InputError on bad input, a meshing failure, or an estimated or real element count
-/// above options.max_elements.
+/// above options.max_elements (after request.context, see there); a file that cannot be written
+/// is named by its own path.
 DeckResult write_deck_files(const DeckRequest& request, const std::filesystem::path& folder);
 
 /// write_deck_files in a transaction of its own on folder's parent (common/run_transaction.hpp):

@@ -17,6 +17,7 @@
 
 #include <Eigen/Dense>
 
+#include "impactdeck/common/error.hpp"
 #include "impactdeck/common/units.hpp"
 
 namespace impactdeck::fem_export {
@@ -114,6 +115,9 @@ struct MeshOptions {
   /// Smallest acceptable Gmsh gamma after optimisation (a try below it counts as failed when
   /// fallback is on; the decks' quality check compares the final mesh with its own floor).
   double quality_floor_gamma = 0.01;
+  /// Where the mesh is asked for (a scene's deck request): errors name it, then the file meshed
+  /// (the .geo written, the part or the CAD file). Empty: that file alone.
+  InputContext context;
 };
 
 struct MeshQuality {

@@ -54,8 +54,9 @@ struct PatchLoad {
 /// Only boundary triangles reachable from the contact node across edges, facing against the
 /// force (outward normal . direction < -0.5), are loaded. Throws InputError for a degenerate patch
 /// (a_max < b_max, non-positive sizes, no boundary triangle at the contact node) or more than 9999
-/// loaded nodes.
+/// loaded nodes: ctx.error("hertz-patch load", reason), `ctx` naming the deck it is for.
 PatchLoad hertz_patch_load(const TetMesh& mesh, int contact_node, const Eigen::Vector3d& direction,
-                           const ContactPatch& patch, const collision::ForceTable& force);
+                           const ContactPatch& patch, const collision::ForceTable& force,
+                           const InputContext& ctx = {});
 
 }  // namespace impactdeck::fem_export

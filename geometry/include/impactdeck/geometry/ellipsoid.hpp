@@ -2,15 +2,19 @@
 // Analytic ellipsoid x^2/a^2 + y^2/b^2 + z^2/c^2 = 1 centred at the origin of its frame (a sphere
 // when a = b = c). Exact volume, inertia, normal (Eq. 25), principal curvatures and the paper's
 // Eq. 26 averaged radius; closest point by a robust bisection on the Lagrange parameter.
+#include "impactdeck/common/error.hpp"
 #include "impactdeck/geometry/shape.hpp"
 
 namespace impactdeck::geometry {
 
 class Ellipsoid final : public Shape {
  public:
-  /// Semi-axes along x, y, z in metres; each positive and finite (InputError otherwise).
-  Ellipsoid(double a_m, double b_m, double c_m);
-  static Ellipsoid sphere(double radius_m) { return Ellipsoid(radius_m, radius_m, radius_m); }
+  /// Semi-axes along x, y, z in metres; each positive and finite (ctx.error("semi_axes", ...)
+  /// otherwise; `ctx` names where they come from, e.g. a scene's body).
+  Ellipsoid(double a_m, double b_m, double c_m, const InputContext& ctx = {});
+  static Ellipsoid sphere(double radius_m, const InputContext& ctx = {}) {
+    return Ellipsoid(radius_m, radius_m, radius_m, ctx);
+  }
 
   const Eigen::Vector3d& semi_axes_m() const { return e_; }
   bool is_sphere() const { return e_.x() == e_.y() && e_.y() == e_.z(); }

@@ -6,6 +6,7 @@
 
 #include <Eigen/Dense>
 
+#include "impactdeck/common/error.hpp"
 #include "impactdeck/geometry/pose.hpp"
 #include "impactdeck/geometry/shape.hpp"
 
@@ -44,9 +45,10 @@ struct FirstContact {
 };
 
 /// The first contact of `mover`, translating (no rotation) along `direction_world` (normalised
-/// here), with the fixed `target`. InputError (place "", one line) when the direction is zero or
-/// not finite, when the bodies never touch ("moving along (dx, dy, dz) the bodies never touch"),
-/// when they already overlap at travel 0 ("the bodies already overlap (...)"; a penetration up to
+/// here), with the fixed `target`. ctx.error("", reason) (one line; `ctx` names where the bodies
+/// and the direction come from, e.g. a scene's impact; place "direction" for the direction) when
+/// the direction is zero or not finite, when the bodies never touch ("moving along (dx, dy, dz) the
+/// bodies never touch"), when they already overlap at travel 0 ("the bodies already overlap (...)"; a penetration up to
 /// 1e-9 of the bounded bodies' size counts as touching at travel 0), when both are unbounded (two
 /// planes) and for a pair of shape kinds it does not know.
 /// Methods: two convex analytic bodies by their support functions and affine maps (a convex
@@ -54,6 +56,7 @@ struct FirstContact {
 /// ellipsoid or sphere by an exact swept sphere against the triangles (after the affine map that
 /// makes the ellipsoid a unit sphere); two meshes by exact continuous collision of a translation
 /// (vertex-face both ways and edge-edge), candidates from the AABB trees.
-FirstContact first_contact(const PlacedShape& target, const PlacedShape& mover, const Eigen::Vector3d& direction_world);
+FirstContact first_contact(const PlacedShape& target, const PlacedShape& mover, const Eigen::Vector3d& direction_world,
+                           const InputContext& ctx = {});
 
 }  // namespace impactdeck::geometry

@@ -3,6 +3,7 @@
 // through the own-frame origin with outward unit normal n. Unbounded: no mass, no size, no finite
 // surface to sample; the pipeline gives it infinite mass and takes its tolerances from the other
 // body.
+#include "impactdeck/common/error.hpp"
 #include "impactdeck/geometry/shape.hpp"
 
 namespace impactdeck::geometry {
@@ -10,8 +11,8 @@ namespace impactdeck::geometry {
 class Plane final : public Shape {
  public:
   /// `normal`: the outward normal (any non-zero finite length, normalised here);
-  /// InputError("", "normal", "must be a non-zero finite vector") otherwise.
-  explicit Plane(const Eigen::Vector3d& normal);
+  /// ctx.error("normal", "must be a non-zero finite vector") otherwise.
+  explicit Plane(const Eigen::Vector3d& normal, const InputContext& ctx = {});
 
   const Eigen::Vector3d& normal() const { return n_; }
 

@@ -35,6 +35,10 @@ struct CompareOptions {
   /// "compare_force.svg" (file). Unset: out_dir / name. `compare-contact` reserves the names in its
   /// run transaction (staged, published only when the comparison completed).
   std::function<std::filesystem::path(const std::string& name, bool is_folder)> place_output;
+  /// Where the comparison was asked for (`run`: the scene file, its [outputs.fem] compare_contact
+  /// key and the impact): every error about the scene and the decks comes after it. Empty: the
+  /// errors name the scene file and their own places (the compare-contact command).
+  InputContext context;
 };
 
 /// One rung of the refinement ladder.

@@ -8,6 +8,7 @@
 
 #include "impactdeck/collision/hertz.hpp"
 #include "impactdeck/collision/kernel.hpp"
+#include "impactdeck/common/error.hpp"
 #include "impactdeck/geometry/first_contact.hpp"
 #include "impactdeck/geometry/pose.hpp"
 #include "impactdeck/geometry/shape.hpp"
@@ -73,9 +74,11 @@ struct ContactEvaluation {
 /// restitution model must outlive it.
 class ContactModel {
  public:
-  /// Throws InputError (place "") for invalid masses or inertias.
+  /// Throws ctx.error(...) for invalid masses or inertias (place "target 'NAME': mass", ...) and
+  /// when both bodies are fixed (place "bodies"); `ctx` names the impact (a scene's file and place).
   ContactModel(const PreparedBody& target, const PreparedBody& impactor, collision::ContactRule rule,
-               double effective_modulus_Pa, const collision::RestitutionModel& restitution);
+               double effective_modulus_Pa, const collision::RestitutionModel& restitution,
+               const InputContext& ctx = {});
 
   /// Point mode (and sweeps): the target is hit at its surface point `at` (own frame, with its
   /// outward normal). The impactor keeps its orientation and is translated so that its support
@@ -86,9 +89,9 @@ class ContactModel {
                                      std::optional<double> approach_speed_m_s = std::nullopt) const;
 
   /// First-contact mode: the impactor, as placed, translates along the relative velocity of the
-  /// bodies until they touch (geometry::first_contact). Throws InputError (place "") when they
+  /// bodies until they touch (geometry::first_contact). Throws ctx.error("", reason) when they
   /// never touch, already overlap, or do not move relative to each other.
-  ContactEvaluation at_first_contact() const;
+  ContactEvaluation at_first_contact(const InputContext& ctx = {}) const;
 
   const PreparedBody& target() const { return target_; }
   const PreparedBody& impactor() const { return impactor_; }

@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "impactdeck/common/error.hpp"
+
 namespace impactdeck::scene {
 
 struct Override {
@@ -14,9 +16,10 @@ struct Override {
   std::string value;  ///< TOML value text, e.g. "[0, -3, 0]"
 };
 
-/// Splits "KEY=VALUE" at the first '='. Throws InputError("--set", text, reason) when there is no
-/// '=' or the key is empty or malformed.
-Override parse_override(const std::string& key_eq_value);
+/// Splits "KEY=VALUE" at the first '='. Throws ctx.error(text, reason) when there is no '=' or
+/// the key is empty, ctx.error("--set KEY", reason) when the key is malformed. `ctx` names where
+/// the text comes from (default: the flag "--set"; a campaign file and its key).
+Override parse_override(const std::string& key_eq_value, const InputContext& ctx = {"--set", ""});
 
 /// The scene file's TOML text after the overrides, with relative part paths (`bodies[i].mesh`)
 /// made absolute so that the text reads the same from any folder: a campaign case's scene.toml.

@@ -78,8 +78,13 @@ RunReport run_scene(const Scene& scene, const RunOptions& options = {});
 /// the first contact); a point where Hertz does not apply comes back flagged. Throws InputError.
 ContactEvaluation locate_impact_contact(const Scene& scene, const ImpactSpec& s, const ContactModel& model);
 
+/// The scene's force-table options for impact `s`, their errors naming the [outputs] keys' lines
+/// and the impact (ForceTableOptions' contexts).
+collision::ForceTableOptions force_table_options(const Scene& scene, const ImpactSpec& s);
+
 /// The hybrid deck request `run` builds for an impact (scene.outputs.fem must be set; `ir.table`
-/// sampled): the body `body` alone in its own frame with the force on the target. Throws InputError.
+/// sampled): the body `body` alone in its own frame with the force on the target; its context
+/// names the scene's [outputs.fem] key and the impact. Throws InputError.
 fem_export::DeckRequest hybrid_deck_request(const Scene& scene, const ImpactReport& ir, const PreparedBody& body);
 
 /// Every stage the tool knows, in pipeline order (for stages_run / stages_skipped).

@@ -13,6 +13,7 @@
 #include "impactdeck/collision/force_history.hpp"
 #include "impactdeck/collision/impact.hpp"
 #include "impactdeck/collision/validity.hpp"
+#include "impactdeck/common/error.hpp"
 #include "impactdeck/common/units.hpp"
 #include "impactdeck/scene/overrides.hpp"
 
@@ -144,12 +145,15 @@ struct Scene {
 
 /// Reads and validates a scene file. Throws InputError naming file, line, key and reason.
 /// `overrides` (`--set`) change the TOML document before validation; an error in an overridden
-/// value names the override ("--set KEY") as its place.
-Scene load_scene(const std::filesystem::path& file, const std::vector<Override>& overrides = {});
+/// value names the override ("--set KEY") as its place. `context`, when it names a file (a
+/// campaign file and "case 7"), comes first in every error, with the scene file after it.
+Scene load_scene(const std::filesystem::path& file, const std::vector<Override>& overrides = {},
+                 const InputContext& context = {});
 
 /// Same from text; `name` is used in messages and relative mesh paths resolve against `base_dir`.
 Scene parse_scene(const std::string& text, const std::string& name,
-                  const std::filesystem::path& base_dir = ".", const std::vector<Override>& overrides = {});
+                  const std::filesystem::path& base_dir = ".", const std::vector<Override>& overrides = {},
+                  const InputContext& context = {});
 
 const char* to_string(ShapeKind k);
 

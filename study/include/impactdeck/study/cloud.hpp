@@ -41,7 +41,8 @@ std::vector<geometry::SurfacePoint> mesh_vertex_cloud(const geometry::Shape& tar
 /// ellipsoid, the analytic grid's places. Used by `study table1 --scene` for mesh targets.
 std::vector<geometry::SurfacePoint> projected_grid_cloud(const geometry::Shape& target,
                                                          const Eigen::Vector3d& box_min_m,
-                                                         const Eigen::Vector3d& box_max_m, int steps);
+                                                         const Eigen::Vector3d& box_max_m, int steps,
+                                                         const InputContext& context = {});
 const char* to_string(CloudKind k);
 
 /// Points read from a CSV file (three numbers x, y, z per line in `metres_per_unit` metres, the

@@ -51,9 +51,11 @@ struct Table1Options {
   std::optional<Table1Scene> scene;
 };
 
-/// A scene target stretched for geometric ratio g (see Table1Scene). Throws InputError for a shape
-/// that is neither an analytic ellipsoid nor a mesh.
-std::shared_ptr<const geometry::Shape> stretched_target(const geometry::Shape& target, int axis, double g);
+/// A scene target stretched for geometric ratio g (see Table1Scene). Throws ctx.error(...) for a
+/// shape that is neither an analytic ellipsoid nor a mesh, a bad axis or ratio, or a part flat
+/// along the stretch axis; `ctx` names the scene and the stretched target.
+std::shared_ptr<const geometry::Shape> stretched_target(const geometry::Shape& target, int axis, double g,
+                                                        const InputContext& ctx = {});
 
 /// Named presets. "paper": the 9 x 9 grid {1e-4 ... 1e4}^2, size ratio 20, Eq. 26 radius, the
 /// 390-point grid (MODEL.md "Table 1"). Throws InputError for an unknown name.
