@@ -19,6 +19,7 @@
 #include "impactdeck/scene/scene.hpp"
 #include "impactdeck/study/scene_sweep.hpp"
 #include "impactdeck/study/progress.hpp"
+#include "impactdeck/study/sweep_command.hpp"
 #include "impactdeck/study/table1.hpp"
 #include "impactdeck/study/table1_output.hpp"
 
@@ -84,7 +85,7 @@ void register_study(CLI::App& app, Context& ctx) {
                   "With --scene: x | y | z, the target axis g stretches (default x; g = half-extent along it / "
                   "along the next axis)");
   cmd->add_option("--cloud", a->cloud,
-                  "grid | uniform | both | vertices (mesh only) (paper preset: grid; --scene: grid for an "
+                  "grid | uniform | both | vertices (mesh only) | auto (paper preset: grid; --scene: grid for an "
                   "ellipsoid, uniform for a mesh)");
   cmd->add_option("--grid-steps", a->grid_steps, "Grid step 1/N (paper preset: 8)");
   cmd->add_option("--count", a->count, "Area-uniform points per cell (default 2000)");
@@ -123,14 +124,6 @@ void register_study(CLI::App& app, Context& ctx) {
       else throw UsageError("--radius-rule: expected paper, mean or elliptical, got \"" + a->rule + "\"" +
                                 did_you_mean(a->rule, {"paper", "mean", "elliptical"}));
     }
-    if (!a->cloud.empty()) {
-      if (a->cloud == "grid") o.cloud = study::CloudKind::paper_grid;
-      else if (a->cloud == "uniform") o.cloud = study::CloudKind::area_uniform;
-      else if (a->cloud == "both") o.cloud = study::CloudKind::both;
-      else if (a->cloud == "vertices") o.cloud = study::CloudKind::vertices;
-      else throw UsageError("--cloud: expected grid, uniform, both or vertices, got \"" + a->cloud + "\"" +
-                                did_you_mean(a->cloud, {"grid", "uniform", "both", "vertices"}));
-    }
     if (!a->set.empty() && a->scene.empty()) throw UsageError("--set needs --scene");
     if (!a->scene.empty()) {
       int axis;
@@ -138,19 +131,19 @@ void register_study(CLI::App& app, Context& ctx) {
       else if (a->stretch_axis == "y") axis = 1;
       else if (a->stretch_axis == "z") axis = 2;
       else throw UsageError("--stretch-axis: expected x, y or z, got \"" + a->stretch_axis + "\"");  // one letter: no "did you mean"
-      study::Table1Scene ts = study::table1_scene_from(scene::load_scene(a->scene, overrides_from(a->set)), a->impact, axis);
-      const bool analytic = dynamic_cast<const geometry::Ellipsoid*>(ts.setup.target.shape.get()) != nullptr;
-      if (a->cloud.empty()) o.cloud = analytic ? study::CloudKind::paper_grid : study::CloudKind::area_uniform;
-      o.scene = std::move(ts);
+      o.scene = study::table1_scene_from(scene::load_scene(a->scene, overrides_from(a->set)), a->impact, axis);
     }
+    // --cloud as sweep's (study::parse_cloud_kind); no --cloud: the preset's on the paper's
+    // ellipsoid, "auto" on a scene's target (grid on an ellipsoid, else area-uniform).
+    const geometry::Ellipsoid unit(1, 1, 1);
+    const geometry::Shape& target = o.scene ? *o.scene->setup.target.shape : unit;
+    if (!a->cloud.empty() || o.scene) o.cloud = study::parse_cloud_kind(a->cloud.empty() ? "auto" : a->cloud, target);
     if (a->grid_steps != 0) o.grid_steps = a->grid_steps;
     if (a->count != 0) o.uniform_count = a->count;
     o.seed = a->seed;
     o.threads = a->threads;
     {
       // Bounded work: cells x points per cell, known before any is computed.
-      const geometry::Ellipsoid unit(1, 1, 1);
-      const geometry::Shape& target = o.scene ? *o.scene->setup.target.shape : unit;
       const double cells = static_cast<double>(o.geometric_ratios.size()) * static_cast<double>(o.mass_ratios.size());
       const double evaluations = cells * cloud_size(target, o.cloud, o.grid_steps, o.uniform_count);
       check_points(evaluations, a->max_points, a->scene.empty() ? "study table1" : a->scene,
