@@ -1,6 +1,5 @@
 #include "impactdeck/study/sweep_command.hpp"
 
-#include <chrono>
 #include <iomanip>
 #include <sstream>
 
@@ -39,19 +38,13 @@ nlohmann::json point_json(std::size_t index, const PointResult& p) {
           {"target_radius_m", p.target_radius_m}};
 }
 
-// The stages' wall times, measured where each runs.
+// The stages' wall times, measured around the work where it runs (ScopedTimer, as run's stages).
 class StageClock {
  public:
   explicit StageClock(SweepReport& report) : report_(report) {}
   template <class F>
   auto run(Stage s, F&& f) {
-    const auto t0 = std::chrono::steady_clock::now();
-    struct Record {  // by an exception too: a failed stage still ran
-      SweepReport& r;
-      Stage s;
-      std::chrono::steady_clock::time_point t0;
-      ~Record() { r.stage_times_s.emplace_back(s, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()); }
-    } record{report_, s, t0};
+    ScopedTimer timer([this, s](double seconds) { report_.stage_times_s.emplace_back(s, seconds); });
     return f();
   }
 
