@@ -182,12 +182,11 @@ CompressionPhase compression_phase(double m_w, double v_w, double k_h) noexcept 
   c.reduced_mass_kg = m_w;
   c.approach_velocity_m_s = v_w;
   c.hertz_constant = k_h;
-  const auto normal = [](double y) { return y > 1e-300 && y < 1e300; };
   // x_max^p = p m v^2 / (2 k): one log of the product where it is a normal number, else the sum of
   // the logs, so that extreme inputs neither overflow nor underflow in the intermediate product.
   const double q = (kP / 2.0) * m_w * v_w * v_w / k_h;
   const double log_xmax =
-      (normal(q) ? std::log(q) : std::log(kP / 2.0) + std::log(m_w) + 2.0 * std::log(v_w) - std::log(k_h)) / kP;
+      (is_moderate_positive(q) ? std::log(q) : std::log(kP / 2.0) + std::log(m_w) + 2.0 * std::log(v_w) - std::log(k_h)) / kP;
   const double x = std::exp(log_xmax);
   c.max_indentation_m = x;
   // F_max = k x^(3/2) and t_m = factor x / v directly where x and the products are normal numbers
@@ -195,7 +194,7 @@ CompressionPhase compression_phase(double m_w, double v_w, double k_h) noexcept 
   // or underflow.
   static_assert(kHertzExponent == 1.5, "x^n as x sqrt(x)");
   const double force = k_h * x * std::sqrt(x), time = compression_time_factor() * x / v_w;
-  const bool direct = normal(x) && normal(force) && normal(time);
+  const bool direct = is_moderate_positive(x) && is_moderate_positive(force) && is_moderate_positive(time);
   c.max_force_N = direct ? force : std::exp(std::log(k_h) + kHertzExponent * log_xmax);
   c.compression_time_s = direct ? time : compression_time_factor() * std::exp(log_xmax - std::log(v_w));
   c.impulse_Ns = m_w * v_w;

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/common/numeric.hpp"
 
 namespace impactdeck::collision {
 
@@ -104,7 +105,7 @@ RestitutionValue evaluate_restitution(const RestitutionModel& m, double m_w, dou
       // Phi = m v^2 / (2 r^3) and its log directly where it is a normal number (one log per sweep
       // point), from the sum of the logs where the product would over- or underflow.
       const double phi = m_w * v_w * v_w / (2.0 * r_w * r_w * r_w);
-      const bool direct = phi > 1e-300 && phi < 1e300;
+      const bool direct = is_moderate_positive(phi);
       const double ln_si =
           direct ? std::log(phi) : std::log(m_w) + 2.0 * std::log(v_w) - std::log(2.0) - 3.0 * std::log(r_w);
       out.energy_flux_density_J_m3 = direct ? phi : std::exp(ln_si);

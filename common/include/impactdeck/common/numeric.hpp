@@ -21,6 +21,11 @@ inline bool within_magnitude_range(double x) {
   return x == 0.0 || (std::abs(x) >= kMinMagnitude && std::abs(x) <= kMaxMagnitude);
 }
 
+/// A positive number far from double precision's limits (1e-300 < y < 1e300; false for NaN): a
+/// per-point formula may use it in a direct product or square root instead of its log form,
+/// which stays for the extreme inputs (compression_phase, the energy flux, fast_hypot).
+inline bool is_moderate_positive(double y) { return y > 1e-300 && y < 1e300; }
+
 inline bool is_finite_all() { return true; }
 template <class... T>
 bool is_finite_all(double x, T... rest) {
