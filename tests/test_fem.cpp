@@ -489,6 +489,7 @@ TEST(FemCheck, MeshPartFromStlEccentricHitConservesLinearAndAngularMomentum) {
 
 TEST(FemDecks, TimeScheduleRefinesThePulseAndDividesTheRest) {
   DeckOptions o;  // 0.02 s at 1e-5 s, 100 increments across the pulse
+  o.pulse_increments = 100;
   const TimeSchedule t = time_schedule(o, 6.9e-5);
   EXPECT_EQ(t.pulse_increments, 100u);
   EXPECT_DOUBLE_EQ(t.pulse_step_s * 100, 6.9e-5);
@@ -504,6 +505,60 @@ TEST(FemDecks, TimeScheduleRefinesThePulseAndDividesTheRest) {
   o.pulse_increments = 0;
   o.time_step_s = 1e-5;
   EXPECT_EQ(time_schedule(o, 6.9e-5).pulse_increments, 0u);
+}
+
+// The default ("auto") refined phase steps at the force table's own samples: every sample is an
+// increment end, so the increments carry the table's impulse and its peak exactly; a finer
+// time_step_s splits each interval; a table far finer than needed is bounded.
+TEST(FemDecks, AutoScheduleStepsAtTheForceTableSamples) {
+  const collision::CompressionPhase c = collision::solve_compression(0.0415, 1.0, 1.1e10);  // steel ball on steel
+  const collision::ForceHistory h{c, 0.9};
+  const collision::ForceTable table = collision::sample_force_table(h);
+  DeckOptions o;  // pulse_increments: auto
+  o.time_step_s = 1e-5;
+  o.end_time_s = 4e-4;
+  ASSERT_EQ(o.pulse_increments, kAutoPulseIncrements);
+  const TimeSchedule t = auto_pulse_schedule(o, table);
+  ASSERT_EQ(t.pulse_segments.size(), 2u);  // compression and restitution, each of equal spacing
+  EXPECT_EQ(t.pulse_increments, table.time_s.size() - 1);
+  EXPECT_DOUBLE_EQ(t.pulse_segments[0].end_s, c.compression_time_s);
+  EXPECT_DOUBLE_EQ(t.pulse_end_s, table.time_s.back());
+  // Each table time is an increment end (to round-off of the step sums).
+  std::vector<double> ends{0.0};
+  for (const TimeSegment& g : t.pulse_segments) {
+    const double begin = ends.back();
+    for (std::size_t k = 1; k <= g.increments; ++k) ends.push_back(begin + static_cast<double>(k) * g.step_s);
+  }
+  ASSERT_EQ(ends.size(), table.time_s.size());
+  for (std::size_t i = 0; i < ends.size(); ++i) EXPECT_NEAR(ends[i], table.time_s[i], 1e-12 * table.time_s.back());
+  const ForceSampling exact = force_sampling(table, t);
+  EXPECT_LT(exact.impulse_relative_error, 1e-12);
+  EXPECT_EQ(exact.peak_force_relative_error, 0.0);
+  DeckRequest request;
+  request.force = table;
+  request.options = o;
+  EXPECT_EQ(deck_schedule(request).pulse_increments, t.pulse_increments);
+  // The same count of equal steps misses the samples: it loses impulse and the peak.
+  DeckOptions uniform = o;
+  uniform.pulse_increments = static_cast<int>(t.pulse_increments);
+  const ForceSampling equal = force_sampling(table, time_schedule(uniform, table.time_s.back()));
+  EXPECT_GT(equal.impulse_relative_error, 1e-6);
+  EXPECT_GT(equal.peak_force_relative_error, 0.0);
+  // A time_step_s finer than the spacing splits every interval: still at every sample.
+  o.time_step_s = 0.4 * t.pulse_segments[0].step_s;
+  const TimeSchedule split = auto_pulse_schedule(o, table);
+  EXPECT_EQ(split.pulse_increments, 3 * t.pulse_increments);
+  EXPECT_LE(split.pulse_step_s, o.time_step_s);
+  EXPECT_LT(force_sampling(table, split).impulse_relative_error, 1e-12);
+  // A table of ~1e5 samples is stepped at every k-th sample, at most kMaxAutoPulseIncrements.
+  collision::ForceTableOptions fine;
+  fine.time_step_s = h.contact_time_s() / 1e5;
+  const collision::ForceTable big = collision::sample_force_table(h, fine);
+  o.time_step_s = 1e-5;
+  const TimeSchedule bounded = auto_pulse_schedule(o, big);
+  EXPECT_LE(bounded.pulse_increments, kMaxAutoPulseIncrements + 2);
+  EXPECT_GE(bounded.pulse_increments, kMaxAutoPulseIncrements / 2);
+  EXPECT_LT(force_sampling(big, bounded).impulse_relative_error, 1e-5);
 }
 
 // The quality floor (Gmsh gamma >= 0.01 after optimisation, FemTolerances::min_gamma) holds for

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <iomanip>
+#include <limits>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -48,6 +49,9 @@ void validate(const DeckRequest& r, const InputContext& where) {
     throw where.error("end_time_s", "must exceed time_step_s");
   }
   if (increments(o) > 2000000) throw where.error("time_step_s", "more than 2e6 increments");
+  if (o.pulse_increments < kAutoPulseIncrements || o.pulse_increments > 1000000) {
+    throw where.error("pulse_increments", "must be \"auto\" or a whole number in [0, 1e6]");
+  }
   if (r.force.time_s.size() < 2 || r.force.time_s.size() != r.force.force_N.size()) {
     throw where.error("force table", "needs at least two samples");
   }
@@ -280,20 +284,108 @@ CcxSolver ccx_solver_for(CcxSolver requested, std::size_t nodes) {
   return nodes >= kIterativeSolverMinNodes ? CcxSolver::iterative : CcxSolver::spooles;
 }
 
-TimeSchedule time_schedule(const DeckOptions& o, double contact_end_s) {
-  TimeSchedule t;
-  double start = 0;
-  if (o.pulse_increments > 0 && contact_end_s > 0 && contact_end_s / o.pulse_increments < o.time_step_s &&
-      contact_end_s < o.end_time_s) {
-    t.pulse_increments = static_cast<std::size_t>(o.pulse_increments);
-    t.pulse_step_s = contact_end_s / o.pulse_increments;
-    t.pulse_end_s = contact_end_s;
-    start = contact_end_s;
+namespace {
+// The main phase after the refined one: the user's step, adjusted down to divide the rest.
+void finish_schedule(TimeSchedule& t, const DeckOptions& o) {
+  for (const TimeSegment& g : t.pulse_segments) {
+    t.pulse_increments += g.increments;
+    t.pulse_step_s = t.pulse_step_s == 0 ? g.step_s : std::min(t.pulse_step_s, g.step_s);
+    t.pulse_end_s = g.end_s;
   }
-  const double rest = o.end_time_s - start;
+  const double rest = o.end_time_s - t.pulse_end_s;
   t.main_increments = std::max<std::size_t>(1, static_cast<std::size_t>(std::ceil(rest / o.time_step_s - 1e-9)));
   t.main_step_s = rest / static_cast<double>(t.main_increments);
+}
+}  // namespace
+
+TimeSchedule time_schedule(const DeckOptions& o, double contact_end_s) {
+  if (o.pulse_increments < 0) throw std::logic_error("time_schedule: pulse_increments is auto (auto_pulse_schedule)");
+  TimeSchedule t;
+  if (o.pulse_increments > 0 && contact_end_s > 0 && contact_end_s / o.pulse_increments < o.time_step_s &&
+      contact_end_s < o.end_time_s) {
+    t.pulse_segments.push_back({static_cast<std::size_t>(o.pulse_increments), contact_end_s / o.pulse_increments,
+                                contact_end_s});
+  }
+  finish_schedule(t, o);
   return t;
+}
+
+TimeSchedule auto_pulse_schedule(const DeckOptions& o, const collision::ForceTable& f) {
+  TimeSchedule t;
+  const std::vector<double>& x = f.time_s;
+  if (x.size() >= 2 && x.back() > 0 && x.back() < o.end_time_s) {
+    // Runs of equal spacing (to 1e-9 of it: the table's times are start + i h in each phase).
+    struct Run { std::size_t intervals; double start, end; };
+    std::vector<Run> runs;
+    for (std::size_t i = 1; i < x.size(); ++i) {
+      const double h = x[i] - x[i - 1];
+      if (!runs.empty()) {
+        Run& r = runs.back();
+        const double hr = (r.end - r.start) / static_cast<double>(r.intervals);
+        if (std::abs(h - hr) <= 1e-9 * hr) {
+          ++r.intervals;
+          r.end = x[i];
+          continue;
+        }
+      }
+      runs.push_back({1, x[i - 1], x[i]});
+    }
+    std::size_t total = 0;
+    for (const Run& r : runs) total += r.intervals;
+    // Every k-th sample when the table has more intervals than the bound (the run's last sample kept).
+    const std::size_t k = (total + kMaxAutoPulseIncrements - 1) / kMaxAutoPulseIncrements;
+    for (const Run& r : runs) {
+      const double length = r.end - r.start;
+      const std::size_t steps = (r.intervals + k - 1) / k;
+      const double h = length / static_cast<double>(steps);
+      // Each step split so that none exceeds time_step_s and the contact gets kMinAutoPulseIncrements.
+      const std::size_t split = std::max({std::size_t{1}, static_cast<std::size_t>(std::ceil(h / o.time_step_s - 1e-9)),
+                                          (kMinAutoPulseIncrements + total - 1) / total});
+      t.pulse_segments.push_back({steps * split, h / static_cast<double>(split), r.end});
+    }
+  }
+  finish_schedule(t, o);
+  return t;
+}
+
+TimeSchedule deck_schedule(const DeckRequest& r) {
+  return r.options.pulse_increments == kAutoPulseIncrements ? auto_pulse_schedule(r.options, r.force)
+                                                            : time_schedule(r.options, r.force.time_s.back());
+}
+
+ForceSampling force_sampling(const collision::ForceTable& f, const TimeSchedule& ts) {
+  const std::vector<double>& t = f.time_s;
+  const std::vector<double>& F = f.force_N;
+  // The table's value at time x (0 after it), its samples found by bisection.
+  auto at = [&](double x) {
+    if (x <= t.front()) return x == t.front() ? F.front() : 0.0;
+    if (x >= t.back()) return x == t.back() ? F.back() : 0.0;
+    const std::size_t i = static_cast<std::size_t>(std::upper_bound(t.begin(), t.end(), x) - t.begin());
+    const double w = (x - t[i - 1]) / (t[i] - t[i - 1]);
+    return F[i - 1] + w * (F[i] - F[i - 1]);
+  };
+  double impulse = 0, peak = 0, previous = at(0.0), start = 0;
+  // One segment: `n` increments of `dt` from `start`; only those up to the table's end carry force.
+  auto segment = [&](std::size_t n, double dt) {
+    for (std::size_t k = 1; k <= n; ++k) {
+      const double x = start + static_cast<double>(k) * dt;
+      const double v = at(x);
+      impulse += 0.5 * dt * (previous + v);
+      peak = std::max(peak, v);
+      previous = v;
+      if (x >= t.back()) break;
+    }
+  };
+  for (const TimeSegment& g : ts.pulse_segments) {
+    segment(g.increments, g.step_s);
+    start = g.end_s;
+  }
+  if (start < t.back()) segment(ts.main_increments, ts.main_step_s);
+  const double table_peak = *std::max_element(F.begin(), F.end());
+  ForceSampling s;
+  s.impulse_relative_error = f.impulse_Ns > 0 ? std::abs(impulse - f.impulse_Ns) / f.impulse_Ns : 0.0;
+  s.peak_force_relative_error = table_peak > 0 ? std::max(0.0, 1.0 - peak / table_peak) : 0.0;
+  return s;
 }
 
 std::string calculix_mesh_inp(const TetMesh& m, const DeckUnits& u) {
@@ -316,7 +408,7 @@ std::string calculix_mesh_inp(const TetMesh& m, const DeckUnits& u) {
 
 std::string calculix_inp(const DeckRequest& r, const TetMesh& m, const PatchLoad* patch) {
   const DeckOptions& o = r.options;
-  const TimeSchedule ts = time_schedule(o, r.force.time_s.back());
+  const TimeSchedule ts = deck_schedule(r);
   const std::size_t every = output_every(o, ts, m.nodes_m.size());
   std::ostringstream s;
   s << header_lines("**", r, "CalculiX deck (ccx 2.20), run: ccx -i impact");
@@ -325,6 +417,13 @@ std::string calculix_inp(const DeckRequest& r, const TetMesh& m, const PatchLoad
        "** increment" << (every > 1 ? " (every " + std::to_string(every) + "th after the contact)" : std::string()) << ".\n"
        "** Step 2: one increment printing every node's velocity and the total mass (the momentum check).\n"
        "** The amplitudes use TOTAL TIME and stay at their closing zero.\n";
+  {
+    const ForceSampling fs = force_sampling(r.force, ts);
+    s << "** Increments: " << ts.pulse_increments << " across the contact ("
+      << (o.pulse_increments == kAutoPulseIncrements ? "at the force table's samples" : "as asked") << "), then "
+      << ts.main_increments << "; at them the force's impulse and peak\n** differ from the table's by "
+      << std::setprecision(3) << fs.impulse_relative_error << " and " << fs.peak_force_relative_error << ".\n";
+  }
   if (patch) {
     s << "** Load: the Hertz pressure of each instant's contact ellipse as nodal forces on "
       << patch->nodes.size() << " surface nodes,\n** one amplitude per node (N), sum F(t), zero moment about the contact point.\n";
@@ -366,9 +465,17 @@ std::string calculix_inp(const DeckRequest& r, const TetMesh& m, const PatchLoad
     s << "*NODE FILE, FREQUENCY=" << frequency << "\nU\n*EL FILE, FREQUENCY=" << frequency << "\nS\n";
     s << "*END STEP\n";
   };
-  if (ts.pulse_increments > 0) {
-    step(ts.pulse_increments, ts.pulse_step_s, ts.pulse_end_s, "Step 1a: through the end of the contact, refined");
-    loads_and_output(1);
+  if (!ts.pulse_segments.empty()) {
+    double begin = 0;
+    for (std::size_t i = 0; i < ts.pulse_segments.size(); ++i) {
+      const TimeSegment& g = ts.pulse_segments[i];
+      const bool last = i + 1 == ts.pulse_segments.size();
+      step(g.increments, g.step_s, g.end_s - begin,
+           std::string("Step 1a") + (ts.pulse_segments.size() > 1 ? "." + std::to_string(i + 1) : std::string()) +
+               (last ? ": through the end of the contact, refined" : ": refined, while the force acts"));
+      loads_and_output(1);
+      begin = g.end_s;
+    }
     step(ts.main_increments, ts.main_step_s, o.end_time_s - ts.pulse_end_s, "Step 1b: free vibration through end_time_s");
   } else {
     step(ts.main_increments, ts.main_step_s, o.end_time_s, "Step 1: through end_time_s");
@@ -428,11 +535,11 @@ std::string code_aster_comm(const DeckRequest& r, const TetMesh& m, const PatchL
     s << "\n";
     excit = "_F(CHARGE=CHARGE, FONC_MULT=FHERTZ)";
   }
-  const TimeSchedule ts = time_schedule(o, r.force.time_s.back());
+  const TimeSchedule ts = deck_schedule(r);
   s << "# Time steps: refined through the end of the contact, then the main step.\n";
   s << "LINST = DEFI_LIST_REEL(DEBUT=0.0,\n                       INTERVALLE=(";
-  if (ts.pulse_increments > 0) {
-    s << "_F(JUSQU_A=" << num(ts.pulse_end_s) << ", PAS=" << num(ts.pulse_step_s) << "),\n                                   ";
+  for (const TimeSegment& g : ts.pulse_segments) {
+    s << "_F(JUSQU_A=" << num(g.end_s) << ", PAS=" << num(g.step_s) << "),\n                                   ";
   }
   s << "_F(JUSQU_A=" << num(o.end_time_s) << ", PAS=" << num(ts.main_step_s) << ")))\n\n";
   s << "ASSEMBLAGE(MODELE=MODELE,\n"
@@ -720,7 +827,19 @@ DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
       patch_json["max_sum_relative_error"] = pl->max_sum_relative_error;
       patch_json["max_moment_relative"] = pl->max_moment_relative;
     }
-    const TimeSchedule ts = time_schedule(r.options, r.force.time_s.back());
+    const TimeSchedule ts = deck_schedule(r);
+    const ForceSampling sampling = force_sampling(r.force, ts);
+    json segments = json::array();
+    for (const TimeSegment& g : ts.pulse_segments) {
+      segments.push_back({{"increments", g.increments}, {"step_s", g.step_s}, {"end_s", g.end_s}});
+    }
+    const json time_stepping = {
+        {"pulse_increments_source", r.options.pulse_increments == kAutoPulseIncrements ? "auto" : "given"},
+        {"pulse_segments", segments},
+        {"main_increments", ts.main_increments},
+        {"main_step_s", ts.main_step_s},
+        {"impulse_sampling_relative_error", sampling.impulse_relative_error},
+        {"peak_force_sampling_relative_error", sampling.peak_force_relative_error}};
     names.push_back("deck.json");
     json deck = {{"impactdeck_version", kVersion},
                  {"source", r.source},
@@ -743,6 +862,7 @@ DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
                  {"end_time_s", r.options.end_time_s},
                  {"time_step_s", r.options.time_step_s},
                  {"pulse_increments", ts.pulse_increments},
+                 {"time_stepping", time_stepping},
                  {"stress_output_every_increments", output_every(r.options, ts, m.nodes_m.size())},
                  {"youngs_modulus_Pa", r.material.youngs_modulus_Pa},
                  {"poisson_ratio", r.material.poisson_ratio},

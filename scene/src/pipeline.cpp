@@ -287,6 +287,7 @@ fem_export::DeckRequest fem_request(const Scene& scene, const ImpactReport& ir, 
       target.pose.direction_to_own(ir.result.target_jump.delta_angular_velocity_rad_s);
   r.options.end_time_s = f.end_time_s;
   r.options.time_step_s = f.time_step_s;
+  r.options.pulse_increments = f.pulse_increments.value_or(fem_export::kAutoPulseIncrements);
   r.options.code_aster = f.code_aster;
   r.options.calculix = f.calculix;
   r.options.solver = f.solver == FemOutputs::Solver::spooles     ? fem_export::CcxSolver::spooles

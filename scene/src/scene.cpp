@@ -411,7 +411,7 @@ const toml::table& sub_table(const toml::node* n, const std::string& key, const 
 FemOutputs read_fem(const toml::table& t, const Source& file, double to_m) {
   Reader r(t, "outputs.fem", file);
   r.allow({"mesh_size", "load_mesh_size", "end_time_s", "time_step_s", "probes", "code_aster", "calculix", "run",
-           "load", "contact_elements", "contact_zone_factor", "linear_momentum_tolerance",
+           "load", "pulse_increments", "contact_elements", "contact_zone_factor", "linear_momentum_tolerance",
            "angular_momentum_tolerance", "model_linear_velocity_tolerance", "model_angular_velocity_tolerance",
            "volume_tolerance", "mass_tolerance", "inertia_tolerance", "min_gamma", "max_elements", "solver",
            "aster_cpus", "aster_mpi_processes", "compare_contact", "compare_contact_threshold", "compare_contact_refine",
@@ -425,6 +425,13 @@ FemOutputs read_fem(const toml::table& t, const Source& file, double to_m) {
   if (!(f.time_step_s < f.end_time_s)) r.fail("time_step_s", "must be smaller than end_time_s");
   if (f.end_time_s / f.time_step_s > 2e6) r.fail("time_step_s", "more than 2e6 increments");
   if (r.has("max_elements")) f.max_elements = r.count("max_elements");
+  if (const toml::node* n = r.get("pulse_increments"); n && !(n->is_string() && n->value<std::string>() == "auto")) {
+    const double v = n->is_number() ? n->value<double>().value() : -1.0;
+    if (!(v >= 0 && v <= 1e6 && v == std::floor(v))) {
+      r.fail("pulse_increments", "must be \"auto\" or a whole number in [0, 1e6]");
+    }
+    f.pulse_increments = static_cast<int>(v);
+  }
   if (const toml::node* n = r.get("probes")) {
     const toml::array* a = n->as_array();
     if (!a) r.fail("probes", "must be an array of points [[x, y, z], ...]");

@@ -119,14 +119,27 @@ const char* to_string(CcxSolver s);
 /// The solver a deck of `nodes` nodes is written with (`automatic` resolved).
 CcxSolver ccx_solver_for(CcxSolver requested, std::size_t nodes);
 
+/// DeckOptions::pulse_increments: the increments at the force table's samples.
+inline constexpr int kAutoPulseIncrements = -1;
+/// Auto: a table with more intervals than this (a force_table_time_step_s far finer than the
+/// impulse needs) is stepped at every k-th sample, k the smallest keeping the count within it.
+inline constexpr std::size_t kMaxAutoPulseIncrements = 2000;
+/// Auto: a table of fewer intervals (a hand-made one) has each split so the contact gets at least
+/// this many increments. ccx starts a step at each change of spacing; with a few coarse steps the
+/// force's jump over one increment there shows in the momentum (a 3-sample triangle stepped at
+/// its samples: 1.5e-3; the default Hertz table has ~32 intervals and meets 1.1e-4, docs/fem.md).
+inline constexpr std::size_t kMinAutoPulseIncrements = 32;
+
 struct DeckOptions {
   double end_time_s = 0.02;    ///< simulated time (the paper: 0.02 s)
   double time_step_s = 1e-5;   ///< solver step after the contact (the paper: 1e-5 s)
-  /// Increments across the contact: while the force acts the step is contact_end / this (when
-  /// smaller than time_step_s). The solver samples the force at its increments: measured on the
-  /// paper's case (69 us pulse), 7 steps of 1e-5 s miss 0.5 % of the impulse, 40 steps 5.4e-4,
-  /// 160 steps 1.1e-4. 0 turns the refined phase off.
-  int pulse_increments = 100;
+  /// Increments across the contact. kAutoPulseIncrements (the default): the force table's own
+  /// samples, each interval split so no step exceeds time_step_s (the table's spacing is what its
+  /// impulse tolerance needed; ccx then meets every sample, so the increments carry the table's
+  /// impulse and peak exactly; auto_pulse_schedule). A number N: N equal steps across the contact
+  /// (when finer than time_step_s); measured on the paper's case (69 us pulse), 7 steps of 1e-5 s
+  /// miss 0.5 % of the impulse, 40 steps 5.4e-4, 160 steps 1.1e-4. 0 turns the refined phase off.
+  int pulse_increments = -1;
   bool code_aster = true;      ///< write impact.comm, impact.export and mesh.med
   bool calculix = true;        ///< write impact.inp and mesh.inp
   int aster_cpus = 1;           ///< impact.export `P ncpus` (OpenMP threads of each Code_Aster process)
@@ -239,15 +252,45 @@ struct DeckResult {
   BodyComparison body_check;
 };
 
-/// The time stepping of a deck: a refined phase through the end of the contact, then the user's
-/// step through end_time_s (its step adjusted down so that it divides the remaining time).
+/// Equal increments from the previous segment's end (or 0) through end_s.
+struct TimeSegment {
+  std::size_t increments = 0;
+  double step_s = 0, end_s = 0;
+};
+
+/// The time stepping of a deck: a refined phase through the end of the contact (one segment per
+/// run of equal steps), then the user's step through end_time_s (adjusted down so that it divides
+/// the remaining time).
 struct TimeSchedule {
-  std::size_t pulse_increments = 0;  ///< 0: no refined phase
-  double pulse_step_s = 0, pulse_end_s = 0;
+  std::vector<TimeSegment> pulse_segments;  ///< empty: no refined phase
+  std::size_t pulse_increments = 0;         ///< over pulse_segments
+  double pulse_step_s = 0;                  ///< the smallest step of pulse_segments
+  double pulse_end_s = 0;
   std::size_t main_increments = 0;
   double main_step_s = 0;
 };
+/// The schedule of options.pulse_increments equal steps across the contact (0 or more; the
+/// refined phase only when its step is finer than time_step_s).
 TimeSchedule time_schedule(const DeckOptions& options, double contact_end_s);
+/// The auto schedule (kAutoPulseIncrements): a segment per run of equal spacing of the table
+/// (a Hertz table has two, compression and restitution), each table interval split into
+/// ceil(spacing / time_step_s) increments (more if the table has under kMinAutoPulseIncrements
+/// intervals); kMaxAutoPulseIncrements bounds the count.
+TimeSchedule auto_pulse_schedule(const DeckOptions& options, const collision::ForceTable& force);
+/// The request's schedule: auto_pulse_schedule or time_schedule by options.pulse_increments.
+TimeSchedule deck_schedule(const DeckRequest& request);
+
+/// What the increments of a schedule make of the force table: ccx evaluates the amplitude (the
+/// table, linear between its samples) at the end of each increment, and for a free body its
+/// implicit scheme (HHT, any alpha) adds to the momentum the trapezoidal rule over the increment
+/// ends (the stiffness terms sum to zero; a change of step size where the force is F shifts it by
+/// ~ |alpha| (1 - gamma) |dt' - dt| |dF|, dF the force's change over a step: ~0 at the peak and
+/// at the contact's end, where the auto schedule changes step).
+struct ForceSampling {
+  double impulse_relative_error = 0;     ///< |sum over increments - table impulse| / table impulse
+  double peak_force_relative_error = 0;  ///< 1 - (largest force at an increment) / (table's largest)
+};
+ForceSampling force_sampling(const collision::ForceTable& force, const TimeSchedule& schedule);
 
 /// Tetrahedra Gmsh makes for a body of `volume_m3` at the global size `mesh_size_m`, refined to
 /// `load_mesh_size_m` (0: a third) around a surface load point as the decks' size field does.

@@ -86,6 +86,9 @@ struct FemOutputs {
   std::optional<double> load_mesh_size_m;  ///< default: mesh size / 3
   double end_time_s = 0.02;                ///< the paper's 0.02 s
   double time_step_s = 1e-5;               ///< the paper's 1e-5 s
+  /// Increments across the contact: unset ("auto"): at the force table's samples
+  /// (fem_export::auto_pulse_schedule); N: N equal steps; 0: no refined phase.
+  std::optional<int> pulse_increments;
   std::vector<Eigen::Vector3d> probes_m;   ///< in the target's frame
   bool code_aster = true;
   bool calculix = true;
