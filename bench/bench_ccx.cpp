@@ -2,14 +2,17 @@
 // bar 1000 x 20 x 20 mm hit on its end face by a steel ball r = 10 mm at 1 m/s (F_max 1723 N,
 // t_m 34.7 us), C3D4 at 5 mm (~5,100 nodes), a probe at mid-length, 100 increments across the
 // contact and ~150 after it (~250 in all, through 0.4 ms).
-//   1. Solver and threads: SPOOLES on one thread (the deck as it was) against each variant, wall
+//   1. The deck before (SPOOLES on one thread, 100 equal increments across the contact) against the
+//      deck now (solver auto, increments at the force table's samples, all cores), then the solver
+//      and threads alone on the deck before: SPOOLES on one thread against each variant, wall
 //      time of ccx, linear momentum error (fem-check) and the probe's von Mises history (peak and
 //      its time; the deck here asks ccx for the probe's nodal stresses, *EL FILE S).
 //   2. Time step: the same deck with the refined and the main steps scaled, against the finest,
 //      so the step the accuracy needs is measured rather than assumed.
 //   3. Where the iterative solver starts to win, over mesh sizes.
-//   bench_ccx [--repeats N] [--quick] [--crossover | --steps]
-//   (--quick: a 10 mm mesh and one repeat; --crossover: table 3 alone; --steps: table 2 alone)
+//   bench_ccx [--repeats N] [--quick] [--crossover | --steps | --goal]
+//   (--quick: a 10 mm mesh and one repeat; --crossover: table 3 alone; --steps: table 2 alone;
+//   --goal: the goal's pair alone, the deck before against the deck now)
 // Needs ccx (calculix-ccx) and the Gmsh plugin (it meshes through `impactdeck run`'s pipeline).
 #include <algorithm>
 #include <chrono>
@@ -95,7 +98,7 @@ std::vector<std::pair<double, double>> probe_von_mises(const fs::path& frd) {
 
 struct Variant {
   std::string name;
-  std::string dynamic;     // the *DYNAMIC line
+  std::string dynamic;     // the *DYNAMIC line (empty: the deck's own)
   int threads = 1;
   double step_scale = 1;   // refined and main steps multiplied by this
 };
@@ -122,7 +125,7 @@ Outcome run_variant(const fs::path& deck, const fs::path& work, const Variant& v
   bool after_dynamic = false;
   while (std::getline(in, line)) {
     if (line.rfind("*DYNAMIC", 0) == 0) {
-      out << v.dynamic << "\n";
+      out << (v.dynamic.empty() ? line : v.dynamic) << "\n";
       after_dynamic = true;
       continue;
     }
@@ -171,11 +174,12 @@ Outcome run_variant(const fs::path& deck, const fs::path& work, const Variant& v
 
 int main(int argc, char** argv) {
   int repeats = 3;
-  bool quick = false, crossover_only = false, steps_only = false;
+  bool quick = false, crossover_only = false, steps_only = false, goal_only = false;
   for (int i = 1; i < argc; ++i) {
     if (std::strcmp(argv[i], "--quick") == 0) quick = true;
     if (std::strcmp(argv[i], "--crossover") == 0) crossover_only = true;
     if (std::strcmp(argv[i], "--steps") == 0) steps_only = true;
+    if (std::strcmp(argv[i], "--goal") == 0) goal_only = true;
     if (std::strcmp(argv[i], "--repeats") == 0 && i + 1 < argc) repeats = std::atoi(argv[++i]);
   }
   if (quick) repeats = 1;
@@ -184,7 +188,7 @@ int main(int argc, char** argv) {
   write_bar_stl(dir / "bar.stl");
   const double mesh = quick ? 10 : 5;
   // The deck of the bar at a mesh size (its own folder, so decks of several sizes coexist).
-  auto make_deck = [&](double size, const std::string& name) {
+  auto make_deck = [&](double size, const std::string& name, const std::string& extra = "") {
     const fs::path d = dir / name;
     fs::create_directories(d);
     fs::copy_file(dir / "bar.stl", d / "bar.stl");
@@ -196,13 +200,17 @@ int main(int argc, char** argv) {
                                      "approach_speed_m_s = 1.0\nrestitution = 0.9\ncontact_radius = \"mean\"\n"
                                      "[outputs.fem]\nmesh_size = "
                                   << size << "\nload_mesh_size = " << size
-                                  << "\nend_time_s = 4e-4\ntime_step_s = 2.25e-6\nprobes = [[500, 10, 10]]\ncode_aster = false\n";
+                                  << "\nend_time_s = 4e-4\ntime_step_s = 2.25e-6\nprobes = [[500, 10, 10]]\ncode_aster = false\n"
+                                  << extra;
     scene::RunOptions ro;
     ro.out_dir = d;
     return scene::run_scene(scene::load_scene(d / "bar.toml"), ro);
   };
   const scene::RunReport rep = make_deck(mesh, "main");
   const auto& deck = *rep.impacts.at(0).fem_deck;
+  // The deck as it was before issue 15: SPOOLES, 100 equal increments across the contact.
+  const scene::RunReport rep_before = make_deck(mesh, "before", "solver = \"spooles\"\npulse_increments = 100\n");
+  const auto& deck_before = *rep_before.impacts.at(0).fem_deck;
   const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
   std::printf("bar 1000 x 20 x 20 mm, C3D4 at %g mm: %zu nodes, %zu tetrahedra; F_max %.4g N, contact %.4g us; "
               "%u cores; load average at the start: ",
@@ -216,28 +224,31 @@ int main(int argc, char** argv) {
   const int all = static_cast<int>(cores);
   if (!crossover_only) {
   // 1. Solvers and threads. The two that the goal compares alternate, best of `repeats`.
-  const Variant before{"SPOOLES, 1 thread (the deck before)", spooles, 1, 1};
+  const Variant before{"the deck before: SPOOLES, 100 equal increments across the contact, 1 thread", "", 1, 1};
+  const Variant now{"the deck now: solver auto (ITERATIVE SCALING), increments at the force table's samples, all cores", "", all, 1};
   const Variant chosen{"ITERATIVE SCALING, all cores (auto, default threads)", iterative, all, 1};
   std::vector<std::pair<Variant, Outcome>> rows;
   Outcome best_before, best_chosen;
   for (int k = 0; k < (steps_only ? 0 : repeats); ++k) {
-    for (const Variant* v : {&before, &chosen}) {
-      const Outcome o = run_variant(deck.folder, dir / "run", *v);
+    for (const Variant* v : {&before, &now}) {
+      const Outcome o = run_variant(v == &before ? deck_before.folder : deck.folder, dir / "run", *v);
       Outcome& best = v == &before ? best_before : best_chosen;
       if (best.wall_s == 0 || o.wall_s < best.wall_s) best = o;
       std::fprintf(stderr, "  %s: %.1f s (CPU %.1f s)\n", v->name.c_str(), o.wall_s, o.cpu_s);
     }
   }
   rows.emplace_back(before, best_before);
-  rows.emplace_back(chosen, best_chosen);
-  for (const Variant& v : {Variant{"SPOOLES, all cores", spooles, all, 1},
-                           Variant{"ITERATIVE SCALING, 1 thread", iterative, 1, 1},
-                           Variant{"ITERATIVE CHOLESKY, all cores", cholesky, all, 1}}) {
-    if (quick || steps_only) break;
-    rows.emplace_back(v, run_variant(deck.folder, dir / "run", v));
+  rows.emplace_back(now, best_chosen);
+  // The solver and threads alone, on the deck before (its 100 equal increments).
+  for (const Variant& v : {Variant{"deck before, ITERATIVE SCALING, all cores", iterative, all, 1},
+                           Variant{"deck before, SPOOLES, all cores", spooles, all, 1},
+                           Variant{"deck before, ITERATIVE SCALING, 1 thread", iterative, 1, 1},
+                           Variant{"deck before, ITERATIVE CHOLESKY, all cores", cholesky, all, 1}}) {
+    if (quick || steps_only || goal_only) break;
+    rows.emplace_back(v, run_variant(deck_before.folder, dir / "run", v));
   }
   if (!steps_only) {
-  std::printf("\n| solver, threads | increments | ccx wall time, s | speed-up | ccx CPU time, s | linear momentum error | probe first-passage peak von Mises, MPa | at, us | peak vs SPOOLES 1 thread |\n");
+  std::printf("\n| solver, threads | increments | ccx wall time, s | speed-up | ccx CPU time, s | linear momentum error | probe first-passage peak von Mises, MPa | at, us | peak vs the deck before |\n");
   std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   for (const auto& [v, o] : rows) {
     std::printf("| %s | %zu | %.1f | %.2fx | %.1f | %.2e | %.4f | %.1f | %+.1e |\n", v.name.c_str(), o.increments,
@@ -248,7 +259,8 @@ int main(int argc, char** argv) {
   }
 
   // 2. Time step: the chosen solver and threads; steps scaled against the finest (scale 0.5).
-  std::printf("\n| step scale (1 = 100 increments across the contact, 2.24 us after) | increments | ccx wall time, s | linear momentum error | probe first-passage peak von Mises, MPa | at, us | peak vs finest |\n");
+  if (!goal_only) {
+  std::printf("\n| step scale (1 = the deck now: at the force table's samples across the contact, 2.24 us after) | increments | ccx wall time, s | linear momentum error | probe first-passage peak von Mises, MPa | at, us | peak vs finest |\n");
   std::printf("|---:|---:|---:|---:|---:|---:|---:|\n");
   std::vector<double> scales = quick ? std::vector<double>{0.5, 1, 4} : std::vector<double>{0.5, 1, 2, 4};
   std::vector<std::pair<double, Outcome>> steps;
@@ -262,11 +274,12 @@ int main(int argc, char** argv) {
     std::printf("| %g | %zu | %.1f | %.2e | %.4f | %.1f | %+.1e |\n", s, o.increments, o.wall_s, o.momentum_error,
                 o.peak_mpa, 1e6 * o.peak_time_s, o.peak_mpa / finest.peak_mpa - 1);
   }
+  }  // !goal_only
   }  // !crossover_only
 
   // 3. Where the iterative solver starts to win: both solvers, all cores, on the bar at several
   // mesh sizes, a quarter of the increments (the cost is per increment).
-  if (!quick && !steps_only) {
+  if (!quick && !steps_only && !goal_only) {
     std::printf("\n| mesh size, mm | nodes | SPOOLES, s per increment | ITERATIVE SCALING, s per increment | SPOOLES / iterative |\n");
     std::printf("|---:|---:|---:|---:|---:|\n");
     for (double size : {40.0, 30.0, 20.0, 12.0, 8.0, 6.5}) {
