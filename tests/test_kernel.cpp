@@ -2,6 +2,7 @@
 // closed forms, the flags where Hertz does not apply, both bodies eccentric, restitution tables
 // and the validity report.
 #include <cmath>
+#include <cstring>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -177,6 +178,79 @@ TEST(Kernel, BothBodiesEccentricMatchTheClosedFormAndConserveMomentum) {
     };
     EXPECT_LT((L(a2) + L(b2) - L(a) - L(b)).norm(), 1e-9 * r.impulse_total_Ns * 1e3);
   }
+}
+
+TEST(Kernel, PerPointFormReadsThePointAndWritesEveryField) {
+  // solve_kernel(invariants, point, result), the form a sweep calls per point: the per-point fields
+  // of `invariants` (normal, lever arms, velocities, surfaces) are not read, `result` is fully
+  // written (a slot holding another point's numbers), and the numbers are those of
+  // solve_kernel(KernelInput), bit for bit: valid and flagged points.
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  RestitutionModel flux;
+  flux.kind = RestitutionModel::Kind::energy_flux;
+  flux.range_policy = RangePolicy::warn;
+  const auto same = [](const KernelResult& a, const KernelResult& b) {
+    const double x[] = {a.reduced_mass_kg, a.approach_velocity_m_s, a.relative_curvature_A_per_m,
+                        a.relative_curvature_B_per_m, a.effective_radius_m, a.contact_ellipse_axis_ratio,
+                        a.hertz_constant, a.max_indentation_m, a.max_force_N, a.compression_time_s,
+                        a.restitution.coefficient, a.impulse_total_Ns, a.contact_semi_axis_a_m,
+                        a.contact_semi_axis_b_m, a.peak_pressure_Pa};
+    const double y[] = {b.reduced_mass_kg, b.approach_velocity_m_s, b.relative_curvature_A_per_m,
+                        b.relative_curvature_B_per_m, b.effective_radius_m, b.contact_ellipse_axis_ratio,
+                        b.hertz_constant, b.max_indentation_m, b.max_force_N, b.compression_time_s,
+                        b.restitution.coefficient, b.impulse_total_Ns, b.contact_semi_axis_a_m,
+                        b.contact_semi_axis_b_m, b.peak_pressure_Pa};
+    return a.flag == b.flag && a.restitution.clamped == b.restitution.clamped &&
+           std::memcmp(x, y, sizeof x) == 0 && a.direction_A == b.direction_A &&
+           a.target_jump.delta_velocity_m_s == b.target_jump.delta_velocity_m_s &&
+           a.target_jump.delta_angular_velocity_rad_s == b.target_jump.delta_angular_velocity_rad_s &&
+           a.impactor_jump.delta_velocity_m_s == b.impactor_jump.delta_velocity_m_s &&
+           a.impactor_jump.delta_angular_velocity_rad_s == b.impactor_jump.delta_angular_velocity_rad_s;
+  };
+  int valid = 0, flagged = 0;
+  for (const ContactRule rule : {ContactRule::elliptical, ContactRule::mean, ContactRule::paper}) {
+    for (int trial = 0; trial < 100; ++trial) {
+      RigidBody a, b;
+      for (RigidBody* body : {&a, &b}) {
+        body->mass_kg = 1.0 + 9.0 * (u(rng) + 1.0);
+        body->inertia_kg_m2 = Eigen::Vector3d(1.0 + 0.5 * u(rng), 2.0, 3.0 + 0.5 * u(rng)).asDiagonal();
+        body->velocity_m_s = {u(rng), u(rng), u(rng)};
+        body->angular_velocity_rad_s = {u(rng), u(rng), u(rng)};
+      }
+      KernelInput in;
+      in.target = kernel_body(a);
+      in.impactor = kernel_body(b);
+      in.normal = Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized();
+      const Eigen::Vector3d t1 = in.normal.unitOrthogonal(), t2 = in.normal.cross(t1);
+      in.target.lever_arm_m = {u(rng), u(rng), u(rng)};
+      in.impactor.lever_arm_m = {u(rng), u(rng), u(rng)};
+      in.target.curvature = {10.0 + 5.0 * u(rng), 10.0 * u(rng), t1, t2, 8.0 + u(rng), trial % 17 == 0};
+      in.impactor.curvature = ContactCurvature::sphere(0.05 + 0.04 * u(rng));
+      in.impactor.velocity_m_s -= 2.0 * u(rng) * in.normal;  // some approach, some do not
+      in.rule = rule;
+      in.effective_modulus_Pa = 1e11;
+      in.restitution = &flux;
+      const KernelResult whole = solve_kernel(in);
+
+      KernelInput invariants = in;  // its per-point fields scrambled: they must not be read
+      const double nan = std::nan("");
+      for (KernelBody* k : {&invariants.target, &invariants.impactor}) {
+        k->lever_arm_m.setConstant(nan);
+        k->velocity_m_s.setConstant(nan);
+        k->curvature = ContactCurvature::sphere(nan);
+      }
+      invariants.normal.setConstant(nan);
+      KernelResult slot = whole;
+      slot.flag = ContactFlag::degenerate;
+      slot.max_force_N = slot.target_jump.delta_velocity_m_s.x() = nan;
+      solve_kernel(invariants, KernelPoint::of(in), slot);
+      EXPECT_TRUE(same(slot, whole)) << to_string(rule) << " trial " << trial << ": " << flag_word(whole.flag);
+      (whole.flag == ContactFlag::none ? valid : flagged) += 1;
+    }
+  }
+  EXPECT_GT(valid, 50);
+  EXPECT_GT(flagged, 20);  // sharp and no-approach points, their later fields left 0
 }
 
 TEST(Kernel, RestitutionTableInterpolatesAndObeysThePolicy) {

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <new>
@@ -383,6 +384,177 @@ class OpaqueShape final : public geometry::Shape {
  private:
   geometry::Ellipsoid e_;
 };
+
+TEST(Sweep, LeanPointIsTheFullEvaluation) {
+  // sweep_point's lean path (ContactModel::at_surface_point into a ContactPointResult, the kernel on
+  // the model's invariants and a KernelPoint, the PointResult written in place) gives bit for bit
+  // what the full ContactEvaluation of `run` gives: placed bodies moved far and rotated, moving and
+  // spinning, analytic and mesh bodies, every rule, flagged points included.
+  const std::string head = R"(
+length_unit = "mm"
+modulus_convention = "paper"
+energy_flux_unit = "J/cm3"
+restitution_range_policy = "warn"
+[materials.steel]
+youngs_modulus_Pa = 2.05e11
+poisson_ratio = 0.3
+density_kg_m3 = 7850
+)";
+  const std::string ellipsoid_target = R"(
+[[bodies]]
+name = "target"
+shape = "ellipsoid"
+semi_axes = [2000, 500, 400]
+material = "steel"
+position = [40000, -30000, 25000]
+orientation_axis = [1, 2, 3]
+orientation_angle_deg = 37
+velocity_m_s = [0.2, -0.1, 0.05]
+angular_velocity_rad_s = [0.3, 0.1, -0.2]
+)";
+  const std::string box_target = R"(
+[[bodies]]
+name = "target"
+shape = "mesh"
+mesh = "box_200x100x60mm.stl"
+material = "steel"
+position = [-30000, 20000, 50000]
+orientation_axis = [3, -1, 2]
+orientation_angle_deg = 71
+)";
+  const std::string ball = R"(
+[[bodies]]
+name = "impactor"
+shape = "sphere"
+radius = 50
+material = "steel"
+angular_velocity_rad_s = [0, 0, 4]
+)";
+  const std::string mesh_impactor = R"(
+[[bodies]]
+name = "impactor"
+shape = "mesh"
+mesh = "ellipsoid_200x50x50.stl"
+material = "steel"
+orientation_axis = [0, 1, 1]
+orientation_angle_deg = 20
+)";
+  const std::string impact = R"(
+[[impacts]]
+name = "hit"
+target = "target"
+impactor = "impactor"
+point = [0, 0, 30]
+approach_speed_m_s = 2.0
+restitution = "energy-flux"
+contact_radius = "RULE"
+)";
+  struct Case {
+    const char* name;
+    std::string bodies;
+    bool expect_flagged;
+  };
+  const Case cases[] = {{"ellipsoid and ball", ellipsoid_target + ball, false},
+                        {"box mesh and ball", box_target + ball, true},
+                        {"ellipsoid and mesh impactor", ellipsoid_target + mesh_impactor, false}};
+  for (const Case& c : cases) {
+    for (const char* rule : {"paper", "mean", "elliptical"}) {
+      SCOPED_TRACE(std::string(c.name) + ", " + rule);
+      std::string text = head + c.bodies + impact;
+      text.replace(text.find("RULE"), 4, rule);
+      const scene::Scene sc =
+          scene::parse_scene(text, "lean.toml", std::filesystem::path(IMPACTDECK_SOURCE_DIR) / "tests" / "data");
+      const SceneSweep ss = sweep_from_scene(sc);
+      const SweepSetup& s = ss.setup;
+      const scene::ContactModel model(s.target, s.impactor, s.rule, s.effective_modulus_Pa, s.restitution);
+      auto cloud = make_cloud(*s.target.shape, CloudKind::area_uniform, 8, 400, 13);
+      if (c.expect_flagged) {  // a mesh's vertices: its corners are sharp
+        const auto corners = make_cloud(*s.target.shape, CloudKind::vertices, 8, 0, 0);
+        cloud.insert(cloud.end(), corners.begin(), corners.end());
+      }
+      std::size_t flagged = 0, valid = 0, differing = 0;
+      for (const auto& sp : cloud) {
+        // A slot holding another point's numbers: every field must be written.
+        PointResult lean;
+        const double junk = std::nan("");
+        for (double* x : {&lean.target_k1_per_m, &lean.target_k2_per_m, &lean.target_radius_m, &lean.impactor_radius_m,
+                          &lean.effective_radius_m, &lean.contact_ellipse_axis_ratio, &lean.reduced_mass_kg,
+                          &lean.hertz_constant, &lean.max_indentation_m, &lean.max_force_N, &lean.compression_time_s,
+                          &lean.restitution, &lean.contact_time_s, &lean.impulse_total_Ns}) {
+          *x = junk;
+        }
+        lean.point_m.setConstant(junk);
+        lean.normal.setConstant(junk);
+        lean.target_delta_velocity_m_s.setConstant(junk);
+        lean.target_delta_angular_velocity_rad_s.setConstant(junk);
+        lean.flag = collision::ContactFlag::degenerate;
+        lean.sharp_feature = true;
+        lean.restitution_clamped = true;
+        sweep_point(model, s.approach_speed_m_s, sp, lean);
+
+        // The same point through the full evaluation.
+        const scene::ContactEvaluation e = model.at_surface_point(sp, s.approach_speed_m_s);
+        const collision::KernelResult& k = e.result;
+        PointResult full;
+        full.point_m = sp.point_m;
+        full.normal = sp.normal;
+        full.flag = k.flag;
+        full.sharp_feature = k.flag == collision::ContactFlag::sharp;
+        if (k.flag == collision::ContactFlag::none) {
+          const auto radius = [&](const collision::ContactCurvature& cc) {
+            return 1.0 / (s.rule == collision::ContactRule::paper ? cc.paper_curvature_per_m
+                                                                   : 0.5 * (cc.k1_per_m + cc.k2_per_m));
+          };
+          full.target_k1_per_m = e.input.target.curvature.k1_per_m;
+          full.target_k2_per_m = e.input.target.curvature.k2_per_m;
+          full.target_radius_m = radius(e.input.target.curvature);
+          full.impactor_radius_m = radius(e.input.impactor.curvature);
+          full.effective_radius_m = k.effective_radius_m;
+          full.contact_ellipse_axis_ratio = k.contact_ellipse_axis_ratio;
+          full.reduced_mass_kg = k.reduced_mass_kg;
+          full.hertz_constant = k.hertz_constant;
+          full.max_indentation_m = k.max_indentation_m;
+          full.max_force_N = k.max_force_N;
+          full.compression_time_s = k.compression_time_s;
+          full.restitution = k.restitution.coefficient;
+          full.restitution_clamped = k.restitution.clamped;
+          full.contact_time_s = (1.0 + full.restitution) * full.compression_time_s;
+          full.impulse_total_Ns = k.impulse_total_Ns;
+          full.target_delta_velocity_m_s = s.target.pose.direction_to_own(k.target_jump.delta_velocity_m_s);
+          full.target_delta_angular_velocity_rad_s =
+              s.target.pose.direction_to_own(k.target_jump.delta_angular_velocity_rad_s);
+          ++valid;
+        } else {
+          ++flagged;
+        }
+        differing += lean.flag != full.flag || lean.sharp_feature != full.sharp_feature ||
+                     lean.restitution_clamped != full.restitution_clamped;
+        const std::pair<double, double> pairs[] = {
+            {lean.target_k1_per_m, full.target_k1_per_m}, {lean.target_k2_per_m, full.target_k2_per_m},
+            {lean.target_radius_m, full.target_radius_m}, {lean.impactor_radius_m, full.impactor_radius_m},
+            {lean.effective_radius_m, full.effective_radius_m},
+            {lean.contact_ellipse_axis_ratio, full.contact_ellipse_axis_ratio},
+            {lean.reduced_mass_kg, full.reduced_mass_kg}, {lean.hertz_constant, full.hertz_constant},
+            {lean.max_indentation_m, full.max_indentation_m}, {lean.max_force_N, full.max_force_N},
+            {lean.compression_time_s, full.compression_time_s}, {lean.restitution, full.restitution},
+            {lean.contact_time_s, full.contact_time_s}, {lean.impulse_total_Ns, full.impulse_total_Ns}};
+        for (const auto& [a, b] : pairs) differing += !same_bits(a, b);
+        for (int i = 0; i < 3; ++i) {
+          differing += !same_bits(lean.point_m[i], full.point_m[i]) + !same_bits(lean.normal[i], full.normal[i]) +
+                       !same_bits(lean.target_delta_velocity_m_s[i], full.target_delta_velocity_m_s[i]) +
+                       !same_bits(lean.target_delta_angular_velocity_rad_s[i],
+                                  full.target_delta_angular_velocity_rad_s[i]);
+        }
+        // The value-returning form is the same function.
+        const PointResult again = sweep_point(model, s.approach_speed_m_s, sp);
+        differing += !same_bits(again.max_force_N, lean.max_force_N) || again.flag != lean.flag;
+      }
+      EXPECT_EQ(differing, 0u);
+      EXPECT_GT(valid, cloud.size() / 4);  // the comparison covers computed points ...
+      if (c.expect_flagged) EXPECT_GT(flagged, 0u);  // ... and flagged ones (the box's corners)
+    }
+  }
+}
 
 TEST(Sweep, AnyShapeThroughTheInterface) {
   SweepSetup s = ellipsoid_setup();

@@ -93,46 +93,62 @@ ContactFlag classify_non_hertzian(const ContactCurvature& a, const ContactCurvat
 
 }  // namespace
 
+KernelPoint KernelPoint::of(const KernelInput& in) noexcept {
+  return {&in.normal,           &in.target.lever_arm_m, &in.impactor.lever_arm_m, &in.target.velocity_m_s,
+          &in.impactor.velocity_m_s, &in.target.curvature, &in.impactor.curvature};
+}
+
 KernelResult solve_kernel(const KernelInput& in) noexcept {
   KernelResult r;
+  solve_kernel(in, KernelPoint::of(in), r);
+  return r;
+}
+
+void solve_kernel(const KernelInput& in, const KernelPoint& p, KernelResult& r) noexcept {
+  r = KernelResult{};
   const KernelBody& t = in.target;
   const KernelBody& i = in.impactor;
-  const Eigen::Vector3d& n = in.normal;
+  const Eigen::Vector3d& n = *p.normal;
+  const Eigen::Vector3d& t_arm = *p.target_lever_arm_m;
+  const Eigen::Vector3d& i_arm = *p.impactor_lever_arm_m;
+  const ContactCurvature& t_curv = *p.target_curvature;
+  const ContactCurvature& i_curv = *p.impactor_curvature;
   if (!n.allFinite() || !(std::abs(n.norm() - 1.0) < 1e-9) || !finite_positive(in.effective_modulus_Pa) ||
-      in.restitution == nullptr || !t.lever_arm_m.allFinite() || !i.lever_arm_m.allFinite()) {
+      in.restitution == nullptr || !t_arm.allFinite() || !i_arm.allFinite()) {
     r.flag = ContactFlag::degenerate;
-    return r;
+    return;
   }
   // Reduced mass at the contact point (tensor form of Eq. 21), both bodies eccentric.
-  const Eigen::Vector3d rt = t.lever_arm_m.cross(n), ri = i.lever_arm_m.cross(n);
+  const Eigen::Vector3d rt = t_arm.cross(n), ri = i_arm.cross(n);
   const double inv_m = t.inverse_mass_per_kg + rt.dot(t.inverse_inertia_world * rt) +
                        i.inverse_mass_per_kg + ri.dot(i.inverse_inertia_world * ri);
   r.reduced_mass_kg = 1.0 / inv_m;
   // Approach velocity: both bodies' v + w x r at the point.
-  const Eigen::Vector3d u = (i.velocity_m_s + i.angular_velocity_rad_s.cross(i.lever_arm_m)) -
-                            (t.velocity_m_s + t.angular_velocity_rad_s.cross(t.lever_arm_m));
+  const Eigen::Vector3d u = (*p.impactor_velocity_m_s + i.angular_velocity_rad_s.cross(i_arm)) -
+                            (*p.target_velocity_m_s + t.angular_velocity_rad_s.cross(t_arm));
   r.approach_velocity_m_s = -n.dot(u);
   if (!finite_positive(r.reduced_mass_kg) || !std::isfinite(r.approach_velocity_m_s)) {
     r.flag = ContactFlag::degenerate;
-    return r;
+    return;
   }
 
   // Contact curvature.
-  if (t.curvature.sharp || i.curvature.sharp) {
+  if (t_curv.sharp || i_curv.sharp) {
     r.flag = ContactFlag::sharp;
-    return r;
+    return;
   }
-  const RelativeCurvatures rc = kernel_relative_curvatures(in);
+  const RelativeCurvatures rc = relative_curvatures(t_curv.k1_per_m, t_curv.k2_per_m, t_curv.d1, t_curv.d2,
+                                                    i_curv.k1_per_m, i_curv.k2_per_m, i_curv.d1, i_curv.d2, n);
   r.relative_curvature_A_per_m = rc.A_per_m;
   r.relative_curvature_B_per_m = rc.B_per_m;
   r.direction_A = rc.direction_A;
   if (!std::isfinite(rc.A_per_m) || !std::isfinite(rc.B_per_m)) {
     r.flag = ContactFlag::degenerate;
-    return r;
+    return;
   }
   if (!(rc.A_per_m > 0.0)) {
-    r.flag = classify_non_hertzian(t.curvature, i.curvature, rc.B_per_m);
-    return r;
+    r.flag = classify_non_hertzian(t_curv, i_curv, rc.B_per_m);
+    return;
   }
   EllipticalContact ec;  // circular unless the rule is elliptical
   switch (in.rule) {
@@ -142,14 +158,14 @@ KernelResult solve_kernel(const KernelInput& in) noexcept {
       r.contact_ellipse_axis_ratio = ec.axis_ratio;
       break;
     case ContactRule::mean:
-      r.effective_radius_m = 1.0 / (0.5 * (t.curvature.k1_per_m + t.curvature.k2_per_m) +
-                                    0.5 * (i.curvature.k1_per_m + i.curvature.k2_per_m));
+      r.effective_radius_m = 1.0 / (0.5 * (t_curv.k1_per_m + t_curv.k2_per_m) +
+                                    0.5 * (i_curv.k1_per_m + i_curv.k2_per_m));
       break;
     case ContactRule::paper: {
-      const double k = t.curvature.paper_curvature_per_m + i.curvature.paper_curvature_per_m;
+      const double k = t_curv.paper_curvature_per_m + i_curv.paper_curvature_per_m;
       if (!(k > 0.0)) {
         r.flag = std::isfinite(k) ? ContactFlag::no_fit : ContactFlag::degenerate;
-        return r;
+        return;
       }
       r.effective_radius_m = 1.0 / k;
       break;
@@ -157,11 +173,11 @@ KernelResult solve_kernel(const KernelInput& in) noexcept {
   }
   if (!finite_positive(r.effective_radius_m)) {
     r.flag = ContactFlag::degenerate;
-    return r;
+    return;
   }
   if (!(r.approach_velocity_m_s > 0.0)) {
     r.flag = ContactFlag::no_approach;
-    return r;
+    return;
   }
 
   // Hertz: k_H, x_max, F_max, t_m (closed forms, Eq. 1-12, 27).
@@ -175,7 +191,7 @@ KernelResult solve_kernel(const KernelInput& in) noexcept {
       !finite_positive(r.max_force_N) || !finite_positive(r.compression_time_s) ||
       !finite_positive(r.impulse_compression_Ns)) {
     r.flag = ContactFlag::degenerate;
-    return r;
+    return;
   }
 
   // Contact ellipse at F_max and the peak pressure.
@@ -195,26 +211,25 @@ KernelResult solve_kernel(const KernelInput& in) noexcept {
                                        r.effective_radius_m);
   if (r.restitution.refused) {
     r.flag = ContactFlag::restitution_range;
-    return r;
+    return;
   }
   if (r.restitution.invalid) {
     r.flag = ContactFlag::restitution_invalid;
-    return r;
+    return;
   }
   r.impulse_total_Ns = (1.0 + r.restitution.coefficient) * r.impulse_compression_Ns;
 
   // Velocity jumps (Eq. 22-23): the impactor is pushed along +n, the target along -n.
   const Eigen::Vector3d P = r.impulse_total_Ns * n;
   r.target_jump.delta_velocity_m_s = -t.inverse_mass_per_kg * P;
-  r.target_jump.delta_angular_velocity_rad_s = t.inverse_inertia_world * t.lever_arm_m.cross(-P);
+  r.target_jump.delta_angular_velocity_rad_s = t.inverse_inertia_world * t_arm.cross(-P);
   r.impactor_jump.delta_velocity_m_s = i.inverse_mass_per_kg * P;
-  r.impactor_jump.delta_angular_velocity_rad_s = i.inverse_inertia_world * i.lever_arm_m.cross(P);
+  r.impactor_jump.delta_angular_velocity_rad_s = i.inverse_inertia_world * i_arm.cross(P);
   if (!r.target_jump.delta_velocity_m_s.allFinite() || !r.target_jump.delta_angular_velocity_rad_s.allFinite() ||
       !r.impactor_jump.delta_velocity_m_s.allFinite() || !r.impactor_jump.delta_angular_velocity_rad_s.allFinite() ||
       !std::isfinite(r.peak_pressure_Pa)) {
     r.flag = ContactFlag::degenerate;
   }
-  return r;
 }
 
 }  // namespace impactdeck::collision

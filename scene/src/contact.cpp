@@ -51,13 +51,14 @@ ContactModel::ContactModel(const PreparedBody& target, const PreparedBody& impac
     : target_(target),
       impactor_(impactor),
       rule_(rule),
-      effective_modulus_Pa_(effective_modulus_Pa),
-      restitution_(restitution),
-      target_body_(collision::kernel_body(target.rigid_body(), ctx.at("target '" + target.name + "'"))),
-      impactor_body_(collision::kernel_body(impactor.rigid_body(), ctx.at("impactor '" + impactor.name + "'"))),
       impactor_mesh_(dynamic_cast<const geometry::MeshShape*>(impactor.shape.get())),
       target_centroid_(target.centroid_world_m()),
       impactor_centroid_(impactor.centroid_world_m()) {
+  invariants_.target = collision::kernel_body(target.rigid_body(), ctx.at("target '" + target.name + "'"));
+  invariants_.impactor = collision::kernel_body(impactor.rigid_body(), ctx.at("impactor '" + impactor.name + "'"));
+  invariants_.rule = rule;
+  invariants_.effective_modulus_Pa = effective_modulus_Pa;
+  invariants_.restitution = &restitution;
   if (target.fixed() && impactor.fixed()) {
     throw ctx.error("bodies", "both bodies are fixed (infinite mass): nothing can move");
   }
@@ -83,43 +84,69 @@ collision::ContactCurvature ContactModel::surface(const PreparedBody& b, const g
   return c;
 }
 
-void ContactModel::evaluate(ContactEvaluation& e, const Eigen::Vector3d& impactor_centroid_world,
-                            std::optional<double> approach_speed_m_s) const {
-  collision::KernelInput& in = e.input;
+bool ContactModel::evaluate(const geometry::SurfacePoint& target_point, const geometry::SurfacePoint& impactor_point,
+                            const Eigen::Vector3d& point_m, const Eigen::Vector3d& normal,
+                            const Eigen::Vector3d& impactor_centroid_world, const Eigen::Vector3d& impactor_velocity_m_s,
+                            geometry::Curvature& target_curvature, geometry::Curvature& impactor_curvature,
+                            collision::ContactCurvature& target_surface, collision::ContactCurvature& impactor_surface,
+                            Eigen::Vector3d& target_lever_arm_m, Eigen::Vector3d& impactor_lever_arm_m,
+                            collision::KernelResult& result, std::string* problem) const {
   try {
-    e.target_curvature = target_.shape->curvature(e.target_point);
-    e.impactor_curvature = impactor_.shape->curvature(e.impactor_point);
+    target_curvature = target_.shape->curvature(target_point);
+    impactor_curvature = impactor_.shape->curvature(impactor_point);
   } catch (const InputError& err) {
     // A curvature fit that cannot be made (too few vertices around the point): flagged, so that a
     // sweep goes on and `run` names the reason.
-    e.curvature_problem = (err.place().empty() ? "" : err.place() + ": ") + err.reason();
-    e.result.flag = collision::ContactFlag::no_curvature;
-    return;
+    if (problem) *problem = (err.place().empty() ? "" : err.place() + ": ") + err.reason();
+    result = collision::KernelResult{};
+    result.flag = collision::ContactFlag::no_curvature;
+    return false;
   }
-  in.target = target_body_;
-  in.impactor = impactor_body_;
-  in.target.lever_arm_m = e.point_m - target_centroid_;
-  in.impactor.lever_arm_m = e.point_m - impactor_centroid_world;
-  in.target.curvature = surface(target_, e.target_point, e.target_curvature);
-  in.impactor.curvature = surface(impactor_, e.impactor_point, e.impactor_curvature);
-  in.normal = e.normal;
-  in.rule = rule_;
-  in.effective_modulus_Pa = effective_modulus_Pa_;
-  in.restitution = &restitution_;
-  // The paper's sweep setting: the impactor moves along the inward normal at the given speed.
-  if (approach_speed_m_s) in.impactor.velocity_m_s = -*approach_speed_m_s * e.normal;
-  e.result = collision::solve_kernel(in);
+  target_lever_arm_m = point_m - target_centroid_;
+  impactor_lever_arm_m = point_m - impactor_centroid_world;
+  target_surface = surface(target_, target_point, target_curvature);
+  impactor_surface = surface(impactor_, impactor_point, impactor_curvature);
+  const collision::KernelPoint p{&normal,
+                                 &target_lever_arm_m,
+                                 &impactor_lever_arm_m,
+                                 &invariants_.target.velocity_m_s,
+                                 &impactor_velocity_m_s,
+                                 &target_surface,
+                                 &impactor_surface};
+  collision::solve_kernel(invariants_, p, result);
+  return true;
 }
 
-ContactEvaluation ContactModel::at_surface_point(const geometry::SurfacePoint& at,
-                                                 std::optional<double> approach_speed_m_s) const {
-  ContactEvaluation e;
-  e.target_point = at;
-  e.point_m = target_.pose.to_world(at.point_m);
-  e.normal = target_.pose.direction_to_world(at.normal);
+void ContactModel::evaluate(ContactEvaluation& e, const Eigen::Vector3d& impactor_centroid_world,
+                            std::optional<double> approach_speed_m_s) const {
+  // The paper's sweep setting: the impactor moves along the inward normal at the given speed.
+  const Eigen::Vector3d velocity =
+      approach_speed_m_s ? Eigen::Vector3d(-*approach_speed_m_s * e.normal) : invariants_.impactor.velocity_m_s;
+  collision::ContactCurvature target_surface, impactor_surface;
+  Eigen::Vector3d target_arm, impactor_arm;
+  if (!evaluate(e.target_point, e.impactor_point, e.point_m, e.normal, impactor_centroid_world, velocity,
+                e.target_curvature, e.impactor_curvature, target_surface, impactor_surface, target_arm, impactor_arm,
+                e.result, &e.curvature_problem)) {
+    return;  // no curvature: no kernel input
+  }
+  // The kernel's input that the result stands for (reports, the paper's checks).
+  collision::KernelInput& in = e.input;
+  in = invariants_;
+  in.normal = e.normal;
+  in.impactor.velocity_m_s = velocity;
+  in.target.lever_arm_m = target_arm;
+  in.impactor.lever_arm_m = impactor_arm;
+  in.target.curvature = target_surface;
+  in.impactor.curvature = impactor_surface;
+}
+
+void ContactModel::place(const geometry::SurfacePoint& at, geometry::SurfacePoint& impactor_point,
+                         Eigen::Vector3d& point_m, Eigen::Vector3d& normal,
+                         Eigen::Vector3d& impactor_translation_m) const {
+  point_m = target_.pose.to_world(at.point_m);
+  normal = target_.pose.direction_to_world(at.normal);
   // The impactor touches with its support point along -n; a plane (unbounded) is laid tangent.
-  const Eigen::Vector3d down_own = impactor_.pose.direction_to_own(-e.normal);
-  const Eigen::Vector3d& placed_centroid = impactor_centroid_;
+  const Eigen::Vector3d down_own = impactor_.pose.direction_to_own(-normal);
   Eigen::Vector3d touch_world;
   std::optional<geometry::SurfacePoint> support;
   if (impactor_.shape->bounded()) {
@@ -128,17 +155,37 @@ ContactEvaluation ContactModel::at_surface_point(const geometry::SurfacePoint& a
     if (!support) support = impactor_.shape->support_point(down_own);
   }
   if (const auto& sp = support) {
-    e.impactor_point = *sp;
+    impactor_point = *sp;
     touch_world = impactor_.pose.to_world(sp->point_m);
   } else {
-    e.impactor_point.point_m = impactor_.pose.to_own(e.point_m);
-    e.impactor_point.normal = down_own;
-    touch_world = e.point_m;
+    impactor_point.point_m = impactor_.pose.to_own(point_m);
+    impactor_point.normal = down_own;
+    touch_world = point_m;
   }
-  e.impactor_translation_m = e.point_m - touch_world;
-  const Eigen::Vector3d centroid = placed_centroid + e.impactor_translation_m;
+  impactor_translation_m = point_m - touch_world;
+}
+
+ContactEvaluation ContactModel::at_surface_point(const geometry::SurfacePoint& at,
+                                                 std::optional<double> approach_speed_m_s) const {
+  ContactEvaluation e;
+  e.target_point = at;
+  place(at, e.impactor_point, e.point_m, e.normal, e.impactor_translation_m);
+  const Eigen::Vector3d centroid = impactor_centroid_ + e.impactor_translation_m;
   evaluate(e, centroid, approach_speed_m_s);  // in place: no copy of the evaluation per sweep point
   return e;
+}
+
+void ContactModel::at_surface_point(const geometry::SurfacePoint& at, double approach_speed_m_s,
+                                    ContactPointResult& out) const {
+  geometry::SurfacePoint impactor_point;
+  Eigen::Vector3d point_m, normal, translation, target_arm, impactor_arm;
+  place(at, impactor_point, point_m, normal, translation);
+  const Eigen::Vector3d centroid = impactor_centroid_ + translation;
+  // The paper's sweep setting, as the full evaluation sets it.
+  const Eigen::Vector3d impactor_velocity = -approach_speed_m_s * normal;
+  geometry::Curvature target_curvature, impactor_curvature;
+  evaluate(at, impactor_point, point_m, normal, centroid, impactor_velocity, target_curvature, impactor_curvature,
+           out.target_surface, out.impactor_surface, target_arm, impactor_arm, out.result, nullptr);
 }
 
 ContactEvaluation ContactModel::at_first_contact(const InputContext& ctx) const {

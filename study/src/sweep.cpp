@@ -20,19 +20,20 @@ double rule_radius(const collision::ContactCurvature& c, collision::ContactRule 
 
 }  // namespace
 
-PointResult sweep_point(const scene::ContactModel& model, double speed, const geometry::SurfacePoint& at) {
-  const scene::ContactEvaluation e = model.at_surface_point(at, speed);
+void sweep_point(const scene::ContactModel& model, double speed, const geometry::SurfacePoint& at, PointResult& r) {
+  scene::ContactPointResult e;
+  model.at_surface_point(at, speed, e);
   const collision::KernelResult& k = e.result;
-  PointResult r;
+  if (k.flag != collision::ContactFlag::none) r = PointResult{};  // nothing else of a flagged point is used
   r.point_m = at.point_m;  // the target's own frame: sweep files overlay the part and its FEM deck
   r.normal = at.normal;
   r.flag = k.flag;
   r.sharp_feature = k.flag == collision::ContactFlag::sharp;
-  if (r.flagged()) return r;
-  r.target_k1_per_m = e.input.target.curvature.k1_per_m;
-  r.target_k2_per_m = e.input.target.curvature.k2_per_m;
-  r.target_radius_m = rule_radius(e.input.target.curvature, model.rule());
-  r.impactor_radius_m = rule_radius(e.input.impactor.curvature, model.rule());
+  if (r.flagged()) return;
+  r.target_k1_per_m = e.target_surface.k1_per_m;
+  r.target_k2_per_m = e.target_surface.k2_per_m;
+  r.target_radius_m = rule_radius(e.target_surface, model.rule());
+  r.impactor_radius_m = rule_radius(e.impactor_surface, model.rule());
   r.effective_radius_m = k.effective_radius_m;
   r.contact_ellipse_axis_ratio = k.contact_ellipse_axis_ratio;
   r.reduced_mass_kg = k.reduced_mass_kg;
@@ -47,6 +48,11 @@ PointResult sweep_point(const scene::ContactModel& model, double speed, const ge
   const geometry::Pose& pose = model.target().pose;
   r.target_delta_velocity_m_s = pose.direction_to_own(k.target_jump.delta_velocity_m_s);
   r.target_delta_angular_velocity_rad_s = pose.direction_to_own(k.target_jump.delta_angular_velocity_rad_s);
+}
+
+PointResult sweep_point(const scene::ContactModel& model, double speed, const geometry::SurfacePoint& at) {
+  PointResult r;
+  sweep_point(model, speed, at, r);
   return r;
 }
 
@@ -98,7 +104,7 @@ SweepResult run_sweep(const SweepSetup& s, const std::vector<geometry::SurfacePo
   res.threads_used = detail::parallel_for(
       n, o.threads, o.chunk,
       [&](std::size_t i) {
-        res.points[i] = sweep_point(model, s.approach_speed_m_s, cloud[i]);
+        sweep_point(model, s.approach_speed_m_s, cloud[i], res.points[i]);  // in place
         if (o.curves && !res.points[i].flagged()) sample_curve(res.points[i], o.curve_samples, &res.curves_N[i * o.curve_samples]);
       },
       o.progress);

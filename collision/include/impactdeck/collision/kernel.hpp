@@ -114,8 +114,33 @@ struct KernelResult {
 };
 
 /// The kernel. Allocation-free and noexcept; `flag` says when the point is not a Hertz impact
-/// (the values computed up to that point are kept, the rest stay 0).
+/// (the values computed up to that point are kept, the rest stay 0). Runs solve_kernel(input,
+/// KernelPoint::of(input), result).
 KernelResult solve_kernel(const KernelInput& input) noexcept;
+
+/// What changes from one contact point to the next: the per-point fields of a KernelInput (normal,
+/// both lever arms, velocities and surfaces), by reference. A sweep keeps one KernelInput of
+/// invariants (inverse masses and inertias, angular velocities, rule, E*, restitution) and passes
+/// only this per point, instead of copying both KernelBody structs. The referenced values must
+/// outlive the call.
+struct KernelPoint {
+  const Eigen::Vector3d* normal;  ///< target's outward unit normal, world
+  const Eigen::Vector3d* target_lever_arm_m;
+  const Eigen::Vector3d* impactor_lever_arm_m;
+  const Eigen::Vector3d* target_velocity_m_s;
+  const Eigen::Vector3d* impactor_velocity_m_s;
+  const ContactCurvature* target_curvature;
+  const ContactCurvature* impactor_curvature;
+
+  /// The per-point fields of `input` itself.
+  static KernelPoint of(const KernelInput& input) noexcept;
+};
+
+/// The kernel on the invariants of `invariants` (both bodies' inverse mass, inverse inertia and
+/// angular velocity; rule, E*, restitution) and the point `point` (its normal, lever arms,
+/// velocities and surfaces; those fields of `invariants` are not read). Writes every field of
+/// `result`. This is the one implementation: solve_kernel(KernelInput) calls it.
+void solve_kernel(const KernelInput& invariants, const KernelPoint& point, KernelResult& result) noexcept;
 
 /// Relative curvatures of the two surfaces of a kernel input (A <= B, direction of A).
 RelativeCurvatures kernel_relative_curvatures(const KernelInput& input) noexcept;

@@ -69,6 +69,15 @@ struct ContactEvaluation {
   collision::KernelResult result;
 };
 
+/// What a sweep keeps of one contact point (ContactModel::at_surface_point's lean form, filled in
+/// place): both surfaces as the kernel saw them (world frame) and the kernel's result. The full
+/// ContactEvaluation adds the points, the fitted curvatures with their error estimates and the
+/// kernel's input, for `run`.
+struct ContactPointResult {
+  collision::ContactCurvature target_surface, impactor_surface;
+  collision::KernelResult result;
+};
+
 /// One impact's invariants: both bodies, the rule, E*, the restitution model and the kernel bodies
 /// (inverse mass, world inverse inertia: computed once). Keeps references: the bodies and the
 /// restitution model must outlive it.
@@ -87,6 +96,9 @@ class ContactModel {
   /// where the model does not apply comes back flagged (result.flag).
   ContactEvaluation at_surface_point(const geometry::SurfacePoint& at,
                                      std::optional<double> approach_speed_m_s = std::nullopt) const;
+  /// The same point, the same code and the same numbers, keeping only what a sweep needs: fills
+  /// `out` in place (no ContactEvaluation, no copy of the kernel bodies per point).
+  void at_surface_point(const geometry::SurfacePoint& at, double approach_speed_m_s, ContactPointResult& out) const;
 
   /// First-contact mode: the impactor, as placed, translates along the relative velocity of the
   /// bodies until they touch (geometry::first_contact). Throws ctx.error("", reason) when they
@@ -98,7 +110,22 @@ class ContactModel {
   collision::ContactRule rule() const { return rule_; }
 
  private:
-  /// Fills e's curvatures, kernel input and result (e's points, normal and translation set).
+  /// Point mode's placement: the impactor's touching point (own frame), the world point and normal,
+  /// and the impactor's translation.
+  void place(const geometry::SurfacePoint& at, geometry::SurfacePoint& impactor_point, Eigen::Vector3d& point_m,
+             Eigen::Vector3d& normal, Eigen::Vector3d& impactor_translation_m) const;
+  /// Both surfaces' curvatures at the placed points and the kernel there: the per-point work of
+  /// every mode. Fills the fitted curvatures, the kernel's surfaces (world), the lever arms and
+  /// the result; a fit that cannot be made flags the result no_curvature (reason in `problem` when
+  /// given) and returns false.
+  bool evaluate(const geometry::SurfacePoint& target_point, const geometry::SurfacePoint& impactor_point,
+                const Eigen::Vector3d& point_m, const Eigen::Vector3d& normal,
+                const Eigen::Vector3d& impactor_centroid_world_m, const Eigen::Vector3d& impactor_velocity_m_s,
+                geometry::Curvature& target_curvature, geometry::Curvature& impactor_curvature,
+                collision::ContactCurvature& target_surface, collision::ContactCurvature& impactor_surface,
+                Eigen::Vector3d& target_lever_arm_m, Eigen::Vector3d& impactor_lever_arm_m,
+                collision::KernelResult& result, std::string* problem) const;
+  /// The full evaluation: evaluate() into e, and e.input the kernel's input it stands for.
   void evaluate(ContactEvaluation& e, const Eigen::Vector3d& impactor_centroid_world_m,
                 std::optional<double> approach_speed_m_s) const;
   collision::ContactCurvature surface(const PreparedBody& b, const geometry::SurfacePoint& own,
@@ -107,9 +134,9 @@ class ContactModel {
   const PreparedBody& target_;
   const PreparedBody& impactor_;
   collision::ContactRule rule_;
-  double effective_modulus_Pa_;
-  const collision::RestitutionModel& restitution_;
-  collision::KernelBody target_body_, impactor_body_;
+  /// The kernel's invariants: both kernel bodies (inverse mass and world inverse inertia, computed
+  /// once; velocities), the rule, E* and the restitution model. Its per-point fields are unused.
+  collision::KernelInput invariants_;
   const geometry::MeshShape* impactor_mesh_;  ///< the impactor as a mesh (smooth support point), or null
   Eigen::Vector3d target_centroid_, impactor_centroid_;  ///< world, as placed
 };

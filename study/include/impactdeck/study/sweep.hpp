@@ -110,6 +110,9 @@ std::string flag_counts_text(const SweepResult& r);
 /// where the model does not apply comes back flagged.
 PointResult sweep_point(const scene::ContactModel& model, double approach_speed_m_s,
                         const geometry::SurfacePoint& at);
+/// The same, written in place into `out` (every field; a sweep's preallocated slot).
+void sweep_point(const scene::ContactModel& model, double approach_speed_m_s, const geometry::SurfacePoint& at,
+                 PointResult& out);
 
 /// The whole cloud. Throws InputError on bad input (bodies, speed), and when every point is flagged.
 SweepResult run_sweep(const SweepSetup& setup, const std::vector<geometry::SurfacePoint>& cloud,
