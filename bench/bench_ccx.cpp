@@ -31,6 +31,8 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <nlohmann/json.hpp>
+
 #include "impactdeck/fem_export/check.hpp"
 #include "impactdeck/fem_export/decks.hpp"
 #include "impactdeck/scene/pipeline.hpp"
@@ -70,7 +72,7 @@ void write_bar_stl(const fs::path& p) {
 // The probe's nodal stress history from a ccx .frd (blocks " -4  STRESS", lines " -1" + node id
 // (10 chars) + SXX SYY SZZ SXY SYZ SZX (12 chars each), MPa; the block's time on its "  100C"
 // line, columns 13-24): von Mises in MPa against time in s.
-std::vector<std::pair<double, double>> probe_von_mises(const fs::path& frd) {
+std::vector<std::pair<double, double>> probe_von_mises(const fs::path& frd, long probe_node) {
   std::vector<std::pair<double, double>> out;
   std::istringstream in(slurp(frd));
   std::string line;
@@ -84,7 +86,8 @@ std::vector<std::pair<double, double>> probe_von_mises(const fs::path& frd) {
       stress = true;
     } else if (line.rfind(" -3", 0) == 0) {
       stress = false;
-    } else if (stress && line.rfind(" -1", 0) == 0 && line.size() >= 13 + 72) {
+    } else if (stress && line.rfind(" -1", 0) == 0 && line.size() >= 13 + 72 &&
+               std::stol(line.substr(3, 10)) == probe_node) {  // the deck's own S of every node is there too
       double s[6];
       for (int k = 0; k < 6; ++k) s[k] = std::stod(line.substr(13 + 12 * k, 12));
       const double vm = std::sqrt(0.5 * ((s[0] - s[1]) * (s[0] - s[1]) + (s[1] - s[2]) * (s[1] - s[2]) +
@@ -159,7 +162,8 @@ Outcome run_variant(const fs::path& deck, const fs::path& work, const Variant& v
   o.wall_s = r.solver_wall_time_s;
   o.momentum_error = r.linear_momentum_relative_error;
   o.increments -= 1;  // the momentum step's single increment
-  o.history = probe_von_mises(work / "impact.frd");
+  const auto probes = nlohmann::json::parse(slurp(work / "deck.json")).at("probes");
+  o.history = probe_von_mises(work / "impact.frd", probes.at(0).at("node").get<long>());
   // The first passage of the wave at the probe: before the wave reflected at the far end returns
   // (t_m + 1.5 L / c = 0.33 ms at mid-length; the window ends at 0.25 ms).
   for (const auto& [t, s] : o.history)

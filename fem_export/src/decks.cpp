@@ -7,7 +7,6 @@
 #include <chrono>
 #include <cmath>
 #include <iomanip>
-#include <limits>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
