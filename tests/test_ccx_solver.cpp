@@ -81,4 +81,17 @@ TEST(CcxSolver, SceneKey) {
   } catch (const InputError& e) {
     EXPECT_TRUE(std::regex_search(std::string(e.what()), std::regex("s\\.toml: line .*solver.*pardiso"))) << e.what();
   }
+  // pulse_increments: unset and "auto" are the table-sample schedule, a whole number is kept, the rest refused.
+  EXPECT_FALSE(scene::parse_scene(base, "s.toml", ".").outputs.fem->pulse_increments.has_value());
+  EXPECT_FALSE(scene::parse_scene(base + "pulse_increments = \"auto\"\n", "s.toml", ".").outputs.fem->pulse_increments);
+  EXPECT_EQ(scene::parse_scene(base + "pulse_increments = 100\n", "s.toml", ".").outputs.fem->pulse_increments, 100);
+  EXPECT_EQ(scene::parse_scene(base + "pulse_increments = 0\n", "s.toml", ".").outputs.fem->pulse_increments, 0);
+  for (const char* bad : {"\"fast\"", "-3", "2.5", "true"}) {
+    try {
+      scene::parse_scene(base + "pulse_increments = " + bad + "\n", "s.toml", ".");
+      ADD_FAILURE() << "accepted " << bad;
+    } catch (const InputError& e) {
+      EXPECT_TRUE(std::regex_search(std::string(e.what()), std::regex("s\\.toml: line .*pulse_increments"))) << e.what();
+    }
+  }
 }
