@@ -36,6 +36,8 @@ std::string read_text(const fs::path& p, const std::string& what) {
 struct Deck {
   double impulse_Ns = 0, density_kg_m3 = 0, contact_end_s = 0, end_time_s = 0, time_step_s = 0;
   std::size_t pulse_increments = 0;
+  /// deck.json time_stepping.main_increments (decks written before it: derived from the steps).
+  std::optional<std::size_t> main_increments;
   Eigen::Vector3d direction = Eigen::Vector3d::Zero();
   std::size_t load_node = 0;  // 1-based
   std::vector<std::string> probes;
@@ -88,6 +90,13 @@ Deck read_deck(const fs::path& dir) {
     d.end_time_s = number("end_time_s", true);
     d.time_step_s = j.contains("time_step_s") ? number("time_step_s", true) : d.end_time_s;
     d.pulse_increments = j.contains("pulse_increments") ? whole("pulse_increments") : 0;
+    if (j.contains("time_stepping") && j.at("time_stepping").contains("main_increments")) {
+      const json& v = j.at("time_stepping").at("main_increments");
+      if (!v.is_number_unsigned() || v.get<std::size_t>() > 2000000) {
+        throw InputError(where, "time_stepping.main_increments", "must be a whole number in [0, 2e6], got " + v.dump());
+      }
+      d.main_increments = v.get<std::size_t>();
+    }
     const json& dir_j = j.at("direction");
     if (!dir_j.is_array() || dir_j.size() != 3 || !dir_j[0].is_number() || !dir_j[1].is_number() ||
         !dir_j[2].is_number()) {
@@ -399,13 +408,19 @@ CheckResult run_check(const fs::path& dir, const CheckOptions& o) {
   r.model_linear_velocity_tolerance = deck.tolerances.model_linear_velocity;
   r.model_angular_velocity_tolerance = deck.tolerances.model_angular_velocity;
   r.impulse_Ns = deck.impulse_Ns;
-  // The time limit: given, or from the deck's size.
-  DeckOptions schedule;
-  schedule.end_time_s = deck.end_time_s;
-  schedule.time_step_s = std::min(deck.time_step_s, deck.end_time_s);
-  schedule.pulse_increments = static_cast<int>(std::min<std::size_t>(deck.pulse_increments, 1000000));
-  const TimeSchedule ts = time_schedule(schedule, deck.contact_end_s);
-  const std::size_t increments = ts.pulse_increments + ts.main_increments + 1;
+  // The time limit: given, or from the deck's size (its increments as deck.json states them; a deck
+  // written before time_stepping: rebuilt from its equal steps).
+  std::size_t increments = 0;
+  if (deck.main_increments) {
+    increments = deck.pulse_increments + *deck.main_increments + 1;
+  } else {
+    DeckOptions schedule;
+    schedule.end_time_s = deck.end_time_s;
+    schedule.time_step_s = std::min(deck.time_step_s, deck.end_time_s);
+    schedule.pulse_increments = static_cast<int>(std::min<std::size_t>(deck.pulse_increments, 1000000));
+    const TimeSchedule ts = time_schedule(schedule, deck.contact_end_s);
+    increments = ts.pulse_increments + ts.main_increments + 1;
+  }
   if (o.timeout_s > 0) {
     r.solver_timeout_s = o.timeout_s;
     r.solver_timeout_source = "--solver-timeout-s";
