@@ -69,14 +69,27 @@ void BM_PointContact(benchmark::State& st) {
   }
   st.SetItemsProcessed(static_cast<int64_t>(st.iterations()) * static_cast<int64_t>(c.size()));
 }
+// The kernel alone on the contact inputs of every 16th point. Arg 0: one point at a time
+// (solve_kernel(KernelInput)); arg 1: the grouped form (kKernelLanes points per step).
 void BM_PointKernel(benchmark::State& st) {
   const study::SweepSetup s = setup();
   const scene::ContactModel model(s.target, s.impactor, s.rule, s.effective_modulus_Pa, s.restitution);
   const auto& c = cloud();
   std::vector<collision::KernelInput> inputs;
   for (std::size_t i = 0; i < c.size(); i += 16) inputs.push_back(model.at_surface_point(c[i], s.approach_speed_m_s).input);
+  std::vector<collision::KernelPoint> points;
+  for (const auto& in : inputs) points.push_back(collision::KernelPoint::of(in));
+  std::vector<collision::KernelResult> results(inputs.size());
+  std::vector<collision::KernelResult*> slots;
+  for (auto& r : results) slots.push_back(&r);
+  const bool grouped = st.range(0) != 0;
   for (auto _ : st) {
-    for (const auto& in : inputs) benchmark::DoNotOptimize(collision::solve_kernel(in).max_force_N);
+    if (grouped) {
+      collision::solve_kernel(inputs.front(), points.data(), slots.data(), points.size());  // shared invariants
+      benchmark::DoNotOptimize(results.back().max_force_N);
+    } else {
+      for (const auto& in : inputs) benchmark::DoNotOptimize(collision::solve_kernel(in).max_force_N);
+    }
   }
   st.SetItemsProcessed(static_cast<int64_t>(st.iterations()) * static_cast<int64_t>(inputs.size()));
 }
@@ -86,6 +99,26 @@ void BM_PointSweep(benchmark::State& st) {
   const auto& c = cloud();
   for (auto _ : st) {
     for (const auto& p : c) benchmark::DoNotOptimize(study::sweep_point(model, s.approach_speed_m_s, p).max_force_N);
+  }
+  st.SetItemsProcessed(static_cast<int64_t>(st.iterations()) * static_cast<int64_t>(c.size()));
+}
+
+// The same points in groups (study::sweep_points: the kernel's steps over kKernelLanes points), in
+// chunks of 64 as run_sweep hands them out. Arg 0: every chunk into one 64-record buffer (stays in
+// cache); arg 1: into a whole result array as run_sweep writes it (the records' memory traffic
+// included).
+void BM_PointSweepGrouped(benchmark::State& st) {
+  const study::SweepSetup s = setup();
+  const scene::ContactModel model(s.target, s.impactor, s.rule, s.effective_modulus_Pa, s.restitution);
+  const auto& c = cloud();
+  const bool whole_array = st.range(0) != 0;
+  std::vector<study::PointResult> out(whole_array ? c.size() : 64);
+  for (auto _ : st) {
+    for (std::size_t i = 0; i < c.size(); i += 64) {
+      study::sweep_points(model, s.approach_speed_m_s, &c[i], std::min<std::size_t>(64, c.size() - i),
+                          &out[whole_array ? i : 0]);
+    }
+    benchmark::DoNotOptimize(out.back().max_force_N);
   }
   st.SetItemsProcessed(static_cast<int64_t>(st.iterations()) * static_cast<int64_t>(c.size()));
 }
@@ -108,9 +141,10 @@ void BM_Table1Paper(benchmark::State& st) {
 }  // namespace
 
 BENCHMARK(BM_PointCurvature)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_PointKernel)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PointKernel)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_PointContact)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_PointSweep)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PointSweepGrouped)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_SweepFmax)->Arg(1)->Arg(kCores)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_SweepFullCurve)->Arg(1)->Arg(kCores)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Table1Paper)->Arg(1)->Arg(kCores)->Unit(benchmark::kMillisecond)->UseRealTime();

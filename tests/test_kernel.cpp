@@ -1,6 +1,7 @@
 // The physics kernel (collision::solve_kernel): conforming and concave Hertz contacts against
 // closed forms, the flags where Hertz does not apply, both bodies eccentric, restitution tables
 // and the validity report.
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <random>
@@ -180,6 +181,38 @@ TEST(Kernel, BothBodiesEccentricMatchTheClosedFormAndConserveMomentum) {
   }
 }
 
+namespace {
+
+// Eq. 30's restitution, clamped (with a warning) outside its range.
+RestitutionModel energy_flux_warn() {
+  RestitutionModel m;
+  m.kind = RestitutionModel::Kind::energy_flux;
+  m.range_policy = RangePolicy::warn;
+  return m;
+}
+
+// Every field of two kernel results, bit for bit (flag, numbers, directions, jumps).
+bool same_bits(const KernelResult& a, const KernelResult& b) {
+  const double x[] = {a.reduced_mass_kg, a.approach_velocity_m_s, a.relative_curvature_A_per_m,
+                      a.relative_curvature_B_per_m, a.effective_radius_m, a.contact_ellipse_axis_ratio,
+                      a.hertz_constant, a.max_indentation_m, a.max_force_N, a.compression_time_s,
+                      a.restitution.coefficient, a.impulse_total_Ns, a.contact_semi_axis_a_m,
+                      a.contact_semi_axis_b_m, a.peak_pressure_Pa};
+  const double y[] = {b.reduced_mass_kg, b.approach_velocity_m_s, b.relative_curvature_A_per_m,
+                      b.relative_curvature_B_per_m, b.effective_radius_m, b.contact_ellipse_axis_ratio,
+                      b.hertz_constant, b.max_indentation_m, b.max_force_N, b.compression_time_s,
+                      b.restitution.coefficient, b.impulse_total_Ns, b.contact_semi_axis_a_m,
+                      b.contact_semi_axis_b_m, b.peak_pressure_Pa};
+  return a.flag == b.flag && a.restitution.clamped == b.restitution.clamped &&
+         std::memcmp(x, y, sizeof x) == 0 && a.direction_A == b.direction_A &&
+         a.target_jump.delta_velocity_m_s == b.target_jump.delta_velocity_m_s &&
+         a.target_jump.delta_angular_velocity_rad_s == b.target_jump.delta_angular_velocity_rad_s &&
+         a.impactor_jump.delta_velocity_m_s == b.impactor_jump.delta_velocity_m_s &&
+         a.impactor_jump.delta_angular_velocity_rad_s == b.impactor_jump.delta_angular_velocity_rad_s;
+}
+
+}  // namespace
+
 TEST(Kernel, PerPointFormReadsThePointAndWritesEveryField) {
   // solve_kernel(invariants, point, result), the form a sweep calls per point: the per-point fields
   // of `invariants` (normal, lever arms, velocities, surfaces) are not read, `result` is fully
@@ -187,27 +220,7 @@ TEST(Kernel, PerPointFormReadsThePointAndWritesEveryField) {
   // solve_kernel(KernelInput), bit for bit: valid and flagged points.
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
-  RestitutionModel flux;
-  flux.kind = RestitutionModel::Kind::energy_flux;
-  flux.range_policy = RangePolicy::warn;
-  const auto same = [](const KernelResult& a, const KernelResult& b) {
-    const double x[] = {a.reduced_mass_kg, a.approach_velocity_m_s, a.relative_curvature_A_per_m,
-                        a.relative_curvature_B_per_m, a.effective_radius_m, a.contact_ellipse_axis_ratio,
-                        a.hertz_constant, a.max_indentation_m, a.max_force_N, a.compression_time_s,
-                        a.restitution.coefficient, a.impulse_total_Ns, a.contact_semi_axis_a_m,
-                        a.contact_semi_axis_b_m, a.peak_pressure_Pa};
-    const double y[] = {b.reduced_mass_kg, b.approach_velocity_m_s, b.relative_curvature_A_per_m,
-                        b.relative_curvature_B_per_m, b.effective_radius_m, b.contact_ellipse_axis_ratio,
-                        b.hertz_constant, b.max_indentation_m, b.max_force_N, b.compression_time_s,
-                        b.restitution.coefficient, b.impulse_total_Ns, b.contact_semi_axis_a_m,
-                        b.contact_semi_axis_b_m, b.peak_pressure_Pa};
-    return a.flag == b.flag && a.restitution.clamped == b.restitution.clamped &&
-           std::memcmp(x, y, sizeof x) == 0 && a.direction_A == b.direction_A &&
-           a.target_jump.delta_velocity_m_s == b.target_jump.delta_velocity_m_s &&
-           a.target_jump.delta_angular_velocity_rad_s == b.target_jump.delta_angular_velocity_rad_s &&
-           a.impactor_jump.delta_velocity_m_s == b.impactor_jump.delta_velocity_m_s &&
-           a.impactor_jump.delta_angular_velocity_rad_s == b.impactor_jump.delta_angular_velocity_rad_s;
-  };
+  const RestitutionModel flux = energy_flux_warn();
   int valid = 0, flagged = 0;
   for (const ContactRule rule : {ContactRule::elliptical, ContactRule::mean, ContactRule::paper}) {
     for (int trial = 0; trial < 100; ++trial) {
@@ -245,12 +258,79 @@ TEST(Kernel, PerPointFormReadsThePointAndWritesEveryField) {
       slot.flag = ContactFlag::degenerate;
       slot.max_force_N = slot.target_jump.delta_velocity_m_s.x() = nan;
       solve_kernel(invariants, KernelPoint::of(in), slot);
-      EXPECT_TRUE(same(slot, whole)) << to_string(rule) << " trial " << trial << ": " << flag_word(whole.flag);
+      EXPECT_TRUE(same_bits(slot, whole)) << to_string(rule) << " trial " << trial << ": " << flag_word(whole.flag);
       (whole.flag == ContactFlag::none ? valid : flagged) += 1;
     }
   }
   EXPECT_GT(valid, 50);
   EXPECT_GT(flagged, 20);  // sharp and no-approach points, their later fields left 0
+}
+
+TEST(Kernel, GroupedFormIsTheOnePointFormBitForBit) {
+  // solve_kernel(invariants, points, results, count) runs each step over up to kKernelLanes points
+  // before the next: every point must get the one-point numbers bit for bit, whatever its group
+  // holds (valid points next to sharp, no-approach and saddle ones) and however the count falls on
+  // the groups.
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const RestitutionModel flux = energy_flux_warn();
+  RigidBody a, b;
+  a.mass_kg = 12.0;
+  a.inertia_kg_m2 = Eigen::Vector3d(1.2, 2.0, 3.1).asDiagonal();
+  a.angular_velocity_rad_s = {0.3, -0.2, 0.1};
+  b.mass_kg = 3.0;
+  b.inertia_kg_m2 = Eigen::Vector3d(0.4, 0.5, 0.6).asDiagonal();
+  b.angular_velocity_rad_s = {0.0, 0.0, 4.0};
+  KernelInput invariants;
+  invariants.target = kernel_body(a);
+  invariants.impactor = kernel_body(b);
+  invariants.effective_modulus_Pa = 1e11;
+  invariants.restitution = &flux;
+  const std::size_t n = 203;  // not a multiple of kKernelLanes
+  struct Point {
+    Eigen::Vector3d normal, target_arm, impactor_arm, target_velocity, impactor_velocity;
+    ContactCurvature target_curvature, impactor_curvature;
+  };
+  std::vector<Point> pts(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    Point& p = pts[k];
+    p.normal = Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized();
+    const Eigen::Vector3d t1 = p.normal.unitOrthogonal(), t2 = p.normal.cross(t1);
+    p.target_arm = {u(rng), u(rng), u(rng)};
+    p.impactor_arm = {u(rng), u(rng), u(rng)};
+    p.target_velocity = {0.1 * u(rng), 0.1 * u(rng), 0.1 * u(rng)};
+    p.impactor_velocity = -2.0 * u(rng) * p.normal;  // some approach, some do not
+    // Convex, saddle (k2 < 0 beyond the ball's curvature) or sharp.
+    p.target_curvature = {10.0 + 5.0 * u(rng), k % 9 == 4 ? -40.0 : 10.0 * u(rng), t1, t2, 8.0 + u(rng), k % 13 == 0};
+    p.impactor_curvature = ContactCurvature::sphere(0.05 + 0.04 * u(rng));
+  }
+  std::vector<KernelPoint> points;
+  for (const Point& p : pts) {
+    points.push_back({&p.normal, &p.target_arm, &p.impactor_arm, &p.target_velocity, &p.impactor_velocity,
+                      &p.target_curvature, &p.impactor_curvature});
+  }
+  for (const ContactRule rule : {ContactRule::elliptical, ContactRule::mean, ContactRule::paper}) {
+    invariants.rule = rule;
+    std::vector<KernelResult> one(n), grouped(n);
+    for (std::size_t k = 0; k < n; ++k) solve_kernel(invariants, points[k], one[k]);
+    for (KernelResult& r : grouped) r.max_force_N = r.reduced_mass_kg = std::nan("");  // slots to overwrite
+    std::vector<KernelResult*> slots;
+    for (KernelResult& r : grouped) slots.push_back(&r);
+    // Runs of 1 to 2 kKernelLanes + 1 points: groups cut short anywhere.
+    for (std::size_t i = 0, len = 1; i < n; i += len, len = len % (2 * kKernelLanes + 1) + 1) {
+      solve_kernel(invariants, &points[i], &slots[i], std::min(len, n - i));
+    }
+    std::array<int, kContactFlagCount> flags{};
+    for (std::size_t k = 0; k < n; ++k) {
+      EXPECT_TRUE(same_bits(grouped[k], one[k]))
+          << to_string(rule) << " point " << k << ": " << flag_word(one[k].flag);
+      ++flags[static_cast<int>(one[k].flag)];
+    }
+    // The groups mixed valid and flagged points.
+    EXPECT_GT(flags[static_cast<int>(ContactFlag::none)], 60) << to_string(rule);
+    EXPECT_GT(flags[static_cast<int>(ContactFlag::sharp)], 5) << to_string(rule);
+    EXPECT_GT(flags[static_cast<int>(ContactFlag::no_approach)], 30) << to_string(rule);
+  }
 }
 
 TEST(Kernel, RestitutionTableInterpolatesAndObeysThePolicy) {

@@ -472,25 +472,50 @@ contact_radius = "RULE"
         const auto corners = make_cloud(*s.target.shape, CloudKind::vertices, 8, 0, 0);
         cloud.insert(cloud.end(), corners.begin(), corners.end());
       }
-      std::size_t flagged = 0, valid = 0, differing = 0;
-      for (const auto& sp : cloud) {
-        // A slot holding another point's numbers: every field must be written.
-        PointResult lean;
-        const double junk = std::nan("");
-        for (double* x : {&lean.target_k1_per_m, &lean.target_k2_per_m, &lean.target_radius_m, &lean.impactor_radius_m,
-                          &lean.effective_radius_m, &lean.contact_ellipse_axis_ratio, &lean.reduced_mass_kg,
-                          &lean.hertz_constant, &lean.max_indentation_m, &lean.max_force_N, &lean.compression_time_s,
-                          &lean.restitution, &lean.contact_time_s, &lean.impulse_total_Ns}) {
-          *x = junk;
+      // A slot holding another point's numbers: every field must be written.
+      PointResult junk_slot;
+      const double junk = std::nan("");
+      for (double* x : {&junk_slot.target_k1_per_m, &junk_slot.target_k2_per_m, &junk_slot.target_radius_m,
+                        &junk_slot.impactor_radius_m, &junk_slot.effective_radius_m,
+                        &junk_slot.contact_ellipse_axis_ratio, &junk_slot.reduced_mass_kg, &junk_slot.hertz_constant,
+                        &junk_slot.max_indentation_m, &junk_slot.max_force_N, &junk_slot.compression_time_s,
+                        &junk_slot.restitution, &junk_slot.contact_time_s, &junk_slot.impulse_total_Ns}) {
+        *x = junk;
+      }
+      junk_slot.point_m.setConstant(junk);
+      junk_slot.normal.setConstant(junk);
+      junk_slot.target_delta_velocity_m_s.setConstant(junk);
+      junk_slot.target_delta_angular_velocity_rad_s.setConstant(junk);
+      junk_slot.flag = collision::ContactFlag::degenerate;
+      junk_slot.sharp_feature = true;
+      junk_slot.restitution_clamped = true;
+      // Fields of two records that differ in their bits.
+      const auto differences = [](const PointResult& lean, const PointResult& full) {
+        std::size_t d = lean.flag != full.flag || lean.sharp_feature != full.sharp_feature ||
+                        lean.restitution_clamped != full.restitution_clamped;
+        const std::pair<double, double> pairs[] = {
+            {lean.target_k1_per_m, full.target_k1_per_m}, {lean.target_k2_per_m, full.target_k2_per_m},
+            {lean.target_radius_m, full.target_radius_m}, {lean.impactor_radius_m, full.impactor_radius_m},
+            {lean.effective_radius_m, full.effective_radius_m},
+            {lean.contact_ellipse_axis_ratio, full.contact_ellipse_axis_ratio},
+            {lean.reduced_mass_kg, full.reduced_mass_kg}, {lean.hertz_constant, full.hertz_constant},
+            {lean.max_indentation_m, full.max_indentation_m}, {lean.max_force_N, full.max_force_N},
+            {lean.compression_time_s, full.compression_time_s}, {lean.restitution, full.restitution},
+            {lean.contact_time_s, full.contact_time_s}, {lean.impulse_total_Ns, full.impulse_total_Ns}};
+        for (const auto& [a, b] : pairs) d += !same_bits(a, b);
+        for (int i = 0; i < 3; ++i) {
+          d += !same_bits(lean.point_m[i], full.point_m[i]) + !same_bits(lean.normal[i], full.normal[i]) +
+               !same_bits(lean.target_delta_velocity_m_s[i], full.target_delta_velocity_m_s[i]) +
+               !same_bits(lean.target_delta_angular_velocity_rad_s[i], full.target_delta_angular_velocity_rad_s[i]);
         }
-        lean.point_m.setConstant(junk);
-        lean.normal.setConstant(junk);
-        lean.target_delta_velocity_m_s.setConstant(junk);
-        lean.target_delta_angular_velocity_rad_s.setConstant(junk);
-        lean.flag = collision::ContactFlag::degenerate;
-        lean.sharp_feature = true;
-        lean.restitution_clamped = true;
+        return d;
+      };
+      std::size_t flagged = 0, valid = 0, differing = 0;
+      std::vector<PointResult> each;
+      for (const auto& sp : cloud) {
+        PointResult lean = junk_slot;
         sweep_point(model, s.approach_speed_m_s, sp, lean);
+        each.push_back(lean);
 
         // The same point through the full evaluation.
         const scene::ContactEvaluation e = model.at_surface_point(sp, s.approach_speed_m_s);
@@ -527,29 +552,22 @@ contact_radius = "RULE"
         } else {
           ++flagged;
         }
-        differing += lean.flag != full.flag || lean.sharp_feature != full.sharp_feature ||
-                     lean.restitution_clamped != full.restitution_clamped;
-        const std::pair<double, double> pairs[] = {
-            {lean.target_k1_per_m, full.target_k1_per_m}, {lean.target_k2_per_m, full.target_k2_per_m},
-            {lean.target_radius_m, full.target_radius_m}, {lean.impactor_radius_m, full.impactor_radius_m},
-            {lean.effective_radius_m, full.effective_radius_m},
-            {lean.contact_ellipse_axis_ratio, full.contact_ellipse_axis_ratio},
-            {lean.reduced_mass_kg, full.reduced_mass_kg}, {lean.hertz_constant, full.hertz_constant},
-            {lean.max_indentation_m, full.max_indentation_m}, {lean.max_force_N, full.max_force_N},
-            {lean.compression_time_s, full.compression_time_s}, {lean.restitution, full.restitution},
-            {lean.contact_time_s, full.contact_time_s}, {lean.impulse_total_Ns, full.impulse_total_Ns}};
-        for (const auto& [a, b] : pairs) differing += !same_bits(a, b);
-        for (int i = 0; i < 3; ++i) {
-          differing += !same_bits(lean.point_m[i], full.point_m[i]) + !same_bits(lean.normal[i], full.normal[i]) +
-                       !same_bits(lean.target_delta_velocity_m_s[i], full.target_delta_velocity_m_s[i]) +
-                       !same_bits(lean.target_delta_angular_velocity_rad_s[i],
-                                  full.target_delta_angular_velocity_rad_s[i]);
-        }
+        differing += differences(lean, full);
         // The value-returning form is the same function.
         const PointResult again = sweep_point(model, s.approach_speed_m_s, sp);
         differing += !same_bits(again.max_force_N, lean.max_force_N) || again.flag != lean.flag;
       }
       EXPECT_EQ(differing, 0u);
+      // The grouped form (a sweep's chunks: the kernel's steps over several points at once) gives
+      // the same bits as one point at a time, for runs of 1 to 11 points (groups cut short, flagged
+      // and valid points in one group).
+      std::vector<PointResult> grouped(cloud.size(), junk_slot);
+      for (std::size_t i = 0, len = 1; i < cloud.size(); i += len, len = len % 11 + 1) {
+        sweep_points(model, s.approach_speed_m_s, &cloud[i], std::min(len, cloud.size() - i), &grouped[i]);
+      }
+      std::size_t grouped_differing = 0;
+      for (std::size_t i = 0; i < cloud.size(); ++i) grouped_differing += differences(grouped[i], each[i]);
+      EXPECT_EQ(grouped_differing, 0u);
       EXPECT_GT(valid, cloud.size() / 4);  // the comparison covers computed points ...
       if (c.expect_flagged) EXPECT_GT(flagged, 0u);  // ... and flagged ones (the box's corners)
     }

@@ -1,6 +1,8 @@
 #include "impactdeck/collision/kernel.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "impactdeck/collision/compression.hpp"
@@ -78,7 +80,8 @@ RelativeCurvatures kernel_relative_curvatures(const KernelInput& in) noexcept {
 
 namespace {
 
-bool finite_positive(double x) { return x > 0.0 && std::isfinite(x); }
+// x > 0 and finite (NaN fails both comparisons).
+bool finite_positive(double x) { return x > 0.0 && x <= std::numeric_limits<double>::max(); }
 
 // Why the relative curvature tensor is not positive definite (A <= 0), from each body's shape.
 ContactFlag classify_non_hertzian(const ContactCurvature& a, const ContactCurvature& b, double B) {
@@ -105,53 +108,67 @@ KernelResult solve_kernel(const KernelInput& in) noexcept {
 }
 
 void solve_kernel(const KernelInput& in, const KernelPoint& p, KernelResult& r) noexcept {
+  KernelResult* const results[1] = {&r};
+  solve_kernel(in, &p, results, 1);
+}
+
+namespace {
+
+// The kernel's steps, one point each. solve_kernel runs each step over a group of points before
+// the next step (see kKernelLanes): a step returns false when it flags its point, which then
+// skips the later steps, so every point gets exactly the operations of a one-point solve.
+
+// The input's validity, the reduced mass at the contact point (tensor form of Eq. 21, both bodies
+// eccentric) and the approach velocity (both bodies' v + w x r at the point).
+inline bool step_motion(const KernelInput& in, const KernelPoint& p, KernelResult& r) {
   r = KernelResult{};
   const KernelBody& t = in.target;
   const KernelBody& i = in.impactor;
   const Eigen::Vector3d& n = *p.normal;
   const Eigen::Vector3d& t_arm = *p.target_lever_arm_m;
   const Eigen::Vector3d& i_arm = *p.impactor_lever_arm_m;
-  const ContactCurvature& t_curv = *p.target_curvature;
-  const ContactCurvature& i_curv = *p.impactor_curvature;
   if (!n.allFinite() || !(std::abs(n.norm() - 1.0) < 1e-9) || !finite_positive(in.effective_modulus_Pa) ||
       in.restitution == nullptr || !t_arm.allFinite() || !i_arm.allFinite()) {
     r.flag = ContactFlag::degenerate;
-    return;
+    return false;
   }
-  // Reduced mass at the contact point (tensor form of Eq. 21), both bodies eccentric.
   const Eigen::Vector3d rt = t_arm.cross(n), ri = i_arm.cross(n);
   const double inv_m = t.inverse_mass_per_kg + rt.dot(t.inverse_inertia_world * rt) +
                        i.inverse_mass_per_kg + ri.dot(i.inverse_inertia_world * ri);
   r.reduced_mass_kg = 1.0 / inv_m;
-  // Approach velocity: both bodies' v + w x r at the point.
   const Eigen::Vector3d u = (*p.impactor_velocity_m_s + i.angular_velocity_rad_s.cross(i_arm)) -
                             (*p.target_velocity_m_s + t.angular_velocity_rad_s.cross(t_arm));
   r.approach_velocity_m_s = -n.dot(u);
   if (!finite_positive(r.reduced_mass_kg) || !std::isfinite(r.approach_velocity_m_s)) {
     r.flag = ContactFlag::degenerate;
-    return;
+    return false;
   }
+  return true;
+}
 
-  // Contact curvature.
+// The contact curvature: relative curvatures A <= B and the effective radius by the rule.
+inline bool step_radius(const KernelInput& in, const KernelPoint& p, KernelResult& r, RelativeCurvatures& rc,
+                        EllipticalContact& ec) {
+  const ContactCurvature& t_curv = *p.target_curvature;
+  const ContactCurvature& i_curv = *p.impactor_curvature;
   if (t_curv.sharp || i_curv.sharp) {
     r.flag = ContactFlag::sharp;
-    return;
+    return false;
   }
-  const RelativeCurvatures rc = relative_curvatures(t_curv.k1_per_m, t_curv.k2_per_m, t_curv.d1, t_curv.d2,
-                                                    i_curv.k1_per_m, i_curv.k2_per_m, i_curv.d1, i_curv.d2, n);
+  rc = relative_curvatures(t_curv.k1_per_m, t_curv.k2_per_m, t_curv.d1, t_curv.d2, i_curv.k1_per_m,
+                           i_curv.k2_per_m, i_curv.d1, i_curv.d2, *p.normal);
   r.relative_curvature_A_per_m = rc.A_per_m;
   r.relative_curvature_B_per_m = rc.B_per_m;
   r.direction_A = rc.direction_A;
   if (!std::isfinite(rc.A_per_m) || !std::isfinite(rc.B_per_m)) {
     r.flag = ContactFlag::degenerate;
-    return;
+    return false;
   }
   if (!(rc.A_per_m > 0.0)) {
     r.flag = classify_non_hertzian(t_curv, i_curv, rc.B_per_m);
-    return;
+    return false;
   }
-  EllipticalContact ec;  // circular unless the rule is elliptical
-  switch (in.rule) {
+  switch (in.rule) {  // ec stays circular unless the rule is elliptical
     case ContactRule::elliptical:
       ec = elliptical_contact(rc);  // does not throw: 0 < A <= B, finite
       r.effective_radius_m = ec.equivalent_radius_m;
@@ -165,7 +182,7 @@ void solve_kernel(const KernelInput& in, const KernelPoint& p, KernelResult& r) 
       const double k = t_curv.paper_curvature_per_m + i_curv.paper_curvature_per_m;
       if (!(k > 0.0)) {
         r.flag = std::isfinite(k) ? ContactFlag::no_fit : ContactFlag::degenerate;
-        return;
+        return false;
       }
       r.effective_radius_m = 1.0 / k;
       break;
@@ -173,14 +190,17 @@ void solve_kernel(const KernelInput& in, const KernelPoint& p, KernelResult& r) 
   }
   if (!finite_positive(r.effective_radius_m)) {
     r.flag = ContactFlag::degenerate;
-    return;
+    return false;
   }
   if (!(r.approach_velocity_m_s > 0.0)) {
     r.flag = ContactFlag::no_approach;
-    return;
+    return false;
   }
+  return true;
+}
 
-  // Hertz: k_H, x_max, F_max, t_m (closed forms, Eq. 1-12, 27).
+// Hertz: k_H, x_max, F_max, t_m (closed forms, Eq. 1-12, 27).
+inline bool step_hertz(const KernelInput& in, KernelResult& r) {
   r.hertz_constant = hertz_constant(in.effective_modulus_Pa, r.effective_radius_m);
   const CompressionPhase c = compression_phase(r.reduced_mass_kg, r.approach_velocity_m_s, r.hertz_constant);
   r.max_indentation_m = c.max_indentation_m;
@@ -191,10 +211,14 @@ void solve_kernel(const KernelInput& in, const KernelPoint& p, KernelResult& r) 
       !finite_positive(r.max_force_N) || !finite_positive(r.compression_time_s) ||
       !finite_positive(r.impulse_compression_Ns)) {
     r.flag = ContactFlag::degenerate;
-    return;
+    return false;
   }
+  return true;
+}
 
-  // Contact ellipse at F_max and the peak pressure.
+// The contact ellipse at F_max and the peak pressure.
+inline void step_pressure(const KernelInput& in, const RelativeCurvatures& rc, const EllipticalContact& ec,
+                          KernelResult& r) {
   if (in.rule == ContactRule::elliptical) {
     const ContactEllipse e = contact_ellipse(rc, ec, in.effective_modulus_Pa, r.max_force_N);
     r.contact_semi_axis_a_m = e.a_m;
@@ -205,30 +229,64 @@ void solve_kernel(const KernelInput& in, const KernelPoint& p, KernelResult& r) 
     r.contact_semi_axis_a_m = r.contact_semi_axis_b_m = std::sqrt(r.effective_radius_m * r.max_indentation_m);
   }
   r.peak_pressure_Pa = 3.0 * r.max_force_N / (2.0 * M_PI * r.contact_semi_axis_a_m * r.contact_semi_axis_b_m);
+}
 
-  // Restitution and the total impulse (Eq. 13-15, 30).
+// Restitution and the total impulse (Eq. 13-15, 30).
+inline bool step_restitution(const KernelInput& in, KernelResult& r) {
   r.restitution = evaluate_restitution(*in.restitution, r.reduced_mass_kg, r.approach_velocity_m_s,
                                        r.effective_radius_m);
   if (r.restitution.refused) {
     r.flag = ContactFlag::restitution_range;
-    return;
+    return false;
   }
   if (r.restitution.invalid) {
     r.flag = ContactFlag::restitution_invalid;
-    return;
+    return false;
   }
   r.impulse_total_Ns = (1.0 + r.restitution.coefficient) * r.impulse_compression_Ns;
+  return true;
+}
 
-  // Velocity jumps (Eq. 22-23): the impactor is pushed along +n, the target along -n.
-  const Eigen::Vector3d P = r.impulse_total_Ns * n;
+// Velocity jumps (Eq. 22-23): the impactor is pushed along +n, the target along -n.
+inline void step_jumps(const KernelInput& in, const KernelPoint& p, KernelResult& r) {
+  const KernelBody& t = in.target;
+  const KernelBody& i = in.impactor;
+  const Eigen::Vector3d P = r.impulse_total_Ns * *p.normal;
   r.target_jump.delta_velocity_m_s = -t.inverse_mass_per_kg * P;
-  r.target_jump.delta_angular_velocity_rad_s = t.inverse_inertia_world * t_arm.cross(-P);
+  r.target_jump.delta_angular_velocity_rad_s = t.inverse_inertia_world * p.target_lever_arm_m->cross(-P);
   r.impactor_jump.delta_velocity_m_s = i.inverse_mass_per_kg * P;
-  r.impactor_jump.delta_angular_velocity_rad_s = i.inverse_inertia_world * i_arm.cross(P);
+  r.impactor_jump.delta_angular_velocity_rad_s = i.inverse_inertia_world * p.impactor_lever_arm_m->cross(P);
   if (!r.target_jump.delta_velocity_m_s.allFinite() || !r.target_jump.delta_angular_velocity_rad_s.allFinite() ||
       !r.impactor_jump.delta_velocity_m_s.allFinite() || !r.impactor_jump.delta_angular_velocity_rad_s.allFinite() ||
       !std::isfinite(r.peak_pressure_Pa)) {
     r.flag = ContactFlag::degenerate;
+  }
+}
+
+}  // namespace
+
+void solve_kernel(const KernelInput& in, const KernelPoint* points, KernelResult* const* results,
+                  std::size_t count) noexcept {
+  // Each step over a group of points before the next: the points' chains of square roots,
+  // divisions, logs and exps are independent, so the processor overlaps them (one point alone
+  // waits on its own chain).
+  for (std::size_t begin = 0; begin < count; begin += kKernelLanes) {
+    const std::size_t n = std::min(kKernelLanes, count - begin);
+    const KernelPoint* p = points + begin;
+    KernelResult* const* r = results + begin;
+    bool live[kKernelLanes];
+    RelativeCurvatures rc[kKernelLanes];
+    EllipticalContact ec[kKernelLanes];
+    for (std::size_t k = 0; k < n; ++k) live[k] = step_motion(in, p[k], *r[k]);
+    for (std::size_t k = 0; k < n; ++k) live[k] = live[k] && step_radius(in, p[k], *r[k], rc[k], ec[k]);
+    for (std::size_t k = 0; k < n; ++k) live[k] = live[k] && step_hertz(in, *r[k]);
+    for (std::size_t k = 0; k < n; ++k) {
+      if (live[k]) step_pressure(in, rc[k], ec[k], *r[k]);
+    }
+    for (std::size_t k = 0; k < n; ++k) live[k] = live[k] && step_restitution(in, *r[k]);
+    for (std::size_t k = 0; k < n; ++k) {
+      if (live[k]) step_jumps(in, p[k], *r[k]);
+    }
   }
 }
 

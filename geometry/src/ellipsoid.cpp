@@ -17,7 +17,7 @@
 namespace impactdeck::geometry {
 
 Ellipsoid::Ellipsoid(double a, double b, double c, const InputContext& ctx)
-    : e_(a, b, c), inv_e2_(Eigen::Vector3d::Zero()), abc2_(0) {
+    : e_(a, b, c), inv_e2_(Eigen::Vector3d::Zero()), abc2_(0), inv_radius_(0) {
   for (int i = 0; i < 3; ++i) {
     if (!(e_[i] > 0.0) || !std::isfinite(e_[i])) {
       std::ostringstream s;
@@ -27,6 +27,7 @@ Ellipsoid::Ellipsoid(double a, double b, double c, const InputContext& ctx)
   }
   inv_e2_ = e_.cwiseProduct(e_).cwiseInverse();
   abc2_ = e_.prod() * e_.prod();
+  inv_radius_ = 1.0 / e_.x();
 }
 
 double Ellipsoid::area_m2() const {
@@ -195,9 +196,10 @@ Curvature Ellipsoid::curvature(const SurfacePoint& at) const {
   c.error_estimate_per_m = 0.0;
   c.sharp_feature = false;
   if (is_sphere()) {  // an umbilic everywhere (a sweep's ball impactor): 1/r, any tangent pair
-    c.k1_per_m = c.k2_per_m = 1.0 / e_.x();
-    c.d1 = p.normalized().unitOrthogonal();
-    c.d2 = p.normalized().cross(c.d1);
+    c.k1_per_m = c.k2_per_m = inv_radius_;
+    const Eigen::Vector3d u = p.normalized();
+    c.d1 = u.unitOrthogonal();
+    c.d2 = u.cross(c.d1);
     return c;
   }
   const Eigen::Vector3d& inv2 = inv_e2_;

@@ -1,5 +1,6 @@
 #include "impactdeck/scene/contact.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -64,15 +65,19 @@ ContactModel::ContactModel(const PreparedBody& target, const PreparedBody& impac
   }
 }
 
-collision::ContactCurvature ContactModel::surface(const PreparedBody& b, const geometry::SurfacePoint& own,
-                                                  const geometry::Curvature& k) const {
-  collision::ContactCurvature c;
+void ContactModel::surface(const PreparedBody& b, const geometry::SurfacePoint& own, const geometry::Curvature& k,
+                           collision::ContactCurvature& c) const {
   c.sharp = k.sharp_feature;
-  if (c.sharp) return c;
+  if (c.sharp) {
+    c = collision::ContactCurvature{};
+    c.sharp = true;
+    return;
+  }
   c.k1_per_m = k.k1_per_m;
   c.k2_per_m = k.k2_per_m;
   c.d1 = b.pose.direction_to_world(k.d1);
   c.d2 = b.pose.direction_to_world(k.d2);
+  c.paper_curvature_per_m = 0;
   if (rule_ == collision::ContactRule::paper) {
     // Eq. 26 in the body's own axes; a sphere's radius is its radius; a plane's curvature is 0.
     try {
@@ -81,61 +86,99 @@ collision::ContactCurvature ContactModel::surface(const PreparedBody& b, const g
       c.paper_curvature_per_m = std::numeric_limits<double>::quiet_NaN();  // kernel: degenerate
     }
   }
-  return c;
 }
 
-bool ContactModel::evaluate(const geometry::SurfacePoint& target_point, const geometry::SurfacePoint& impactor_point,
-                            const Eigen::Vector3d& point_m, const Eigen::Vector3d& normal,
-                            const Eigen::Vector3d& impactor_centroid_world, const Eigen::Vector3d& impactor_velocity_m_s,
-                            geometry::Curvature& target_curvature, geometry::Curvature& impactor_curvature,
-                            collision::ContactCurvature& target_surface, collision::ContactCurvature& impactor_surface,
-                            Eigen::Vector3d& target_lever_arm_m, Eigen::Vector3d& impactor_lever_arm_m,
-                            collision::KernelResult& result, std::string* problem) const {
+// One contact point on its way through ContactModel: where it is (set by the caller: the target's
+// point, the impactor's touching point, the world point and normal, the impactor's centroid and
+// velocity), what prepare() adds (fitted curvatures, lever arms), and where the results go.
+struct ContactModel::PointWork {
+  const geometry::SurfacePoint* target_point = nullptr;  ///< target's own frame
+  geometry::SurfacePoint impactor_point;                  ///< impactor's own frame
+  Eigen::Vector3d point_m, normal, impactor_centroid_m, impactor_velocity_m_s;  ///< world
+  Eigen::Vector3d target_lever_arm_m, impactor_lever_arm_m;                     ///< world
+  geometry::Curvature target_curvature, impactor_curvature;  ///< own frames, as fitted
+  collision::ContactCurvature* target_surface = nullptr;      ///< out: the kernel's surfaces (world)
+  collision::ContactCurvature* impactor_surface = nullptr;
+  collision::KernelResult* result = nullptr;                  ///< out
+  std::string* problem = nullptr;  ///< out, optional: why a curvature fit could not be made
+};
+
+bool ContactModel::fit(const PreparedBody& b, const geometry::SurfacePoint& at, geometry::Curvature& k,
+                       PointWork& w) const {
   try {
-    target_curvature = target_.shape->curvature(target_point);
-    impactor_curvature = impactor_.shape->curvature(impactor_point);
+    k = b.shape->curvature(at);
+    return true;
   } catch (const InputError& err) {
     // A curvature fit that cannot be made (too few vertices around the point): flagged, so that a
     // sweep goes on and `run` names the reason.
-    if (problem) *problem = (err.place().empty() ? "" : err.place() + ": ") + err.reason();
-    result = collision::KernelResult{};
-    result.flag = collision::ContactFlag::no_curvature;
+    if (w.problem) *w.problem = (err.place().empty() ? "" : err.place() + ": ") + err.reason();
+    *w.result = collision::KernelResult{};
+    w.result->flag = collision::ContactFlag::no_curvature;
     return false;
   }
-  target_lever_arm_m = point_m - target_centroid_;
-  impactor_lever_arm_m = point_m - impactor_centroid_world;
-  target_surface = surface(target_, target_point, target_curvature);
-  impactor_surface = surface(impactor_, impactor_point, impactor_curvature);
-  const collision::KernelPoint p{&normal,
-                                 &target_lever_arm_m,
-                                 &impactor_lever_arm_m,
-                                 &invariants_.target.velocity_m_s,
-                                 &impactor_velocity_m_s,
-                                 &target_surface,
-                                 &impactor_surface};
-  collision::solve_kernel(invariants_, p, result);
-  return true;
+}
+
+void ContactModel::evaluate(PointWork* work, std::size_t count) const {
+  // Step by step over a group of points, as the kernel does: each step's calls for different
+  // points are independent, so the processor overlaps their chains.
+  for (std::size_t begin = 0; begin < count; begin += collision::kKernelLanes) {
+    const std::size_t n = std::min(collision::kKernelLanes, count - begin);
+    PointWork* w = work + begin;
+    bool fitted[collision::kKernelLanes];
+    for (std::size_t k = 0; k < n; ++k) fitted[k] = fit(target_, *w[k].target_point, w[k].target_curvature, w[k]);
+    for (std::size_t k = 0; k < n; ++k) {
+      fitted[k] = fitted[k] && fit(impactor_, w[k].impactor_point, w[k].impactor_curvature, w[k]);
+    }
+    collision::KernelPoint points[collision::kKernelLanes];
+    collision::KernelResult* results[collision::kKernelLanes];
+    std::size_t m = 0;
+    for (std::size_t k = 0; k < n; ++k) {
+      if (!fitted[k]) continue;  // flagged no_curvature: no kernel
+      PointWork& x = w[k];
+      x.target_lever_arm_m = x.point_m - target_centroid_;
+      x.impactor_lever_arm_m = x.point_m - x.impactor_centroid_m;
+      surface(target_, *x.target_point, x.target_curvature, *x.target_surface);
+      surface(impactor_, x.impactor_point, x.impactor_curvature, *x.impactor_surface);
+      points[m] = {&x.normal,
+                   &x.target_lever_arm_m,
+                   &x.impactor_lever_arm_m,
+                   &invariants_.target.velocity_m_s,
+                   &x.impactor_velocity_m_s,
+                   x.target_surface,
+                   x.impactor_surface};
+      results[m++] = x.result;
+    }
+    collision::solve_kernel(invariants_, points, results, m);
+  }
 }
 
 void ContactModel::evaluate(ContactEvaluation& e, const Eigen::Vector3d& impactor_centroid_world,
                             std::optional<double> approach_speed_m_s) const {
+  PointWork w;
+  w.target_point = &e.target_point;
+  w.impactor_point = e.impactor_point;
+  w.point_m = e.point_m;
+  w.normal = e.normal;
+  w.impactor_centroid_m = impactor_centroid_world;
   // The paper's sweep setting: the impactor moves along the inward normal at the given speed.
-  const Eigen::Vector3d velocity =
+  w.impactor_velocity_m_s =
       approach_speed_m_s ? Eigen::Vector3d(-*approach_speed_m_s * e.normal) : invariants_.impactor.velocity_m_s;
   collision::ContactCurvature target_surface, impactor_surface;
-  Eigen::Vector3d target_arm, impactor_arm;
-  if (!evaluate(e.target_point, e.impactor_point, e.point_m, e.normal, impactor_centroid_world, velocity,
-                e.target_curvature, e.impactor_curvature, target_surface, impactor_surface, target_arm, impactor_arm,
-                e.result, &e.curvature_problem)) {
-    return;  // no curvature: no kernel input
-  }
+  w.target_surface = &target_surface;
+  w.impactor_surface = &impactor_surface;
+  w.result = &e.result;
+  w.problem = &e.curvature_problem;
+  evaluate(&w, 1);
+  e.target_curvature = w.target_curvature;
+  e.impactor_curvature = w.impactor_curvature;
+  if (e.result.flag == collision::ContactFlag::no_curvature) return;  // no fit: no kernel input
   // The kernel's input that the result stands for (reports, the paper's checks).
   collision::KernelInput& in = e.input;
   in = invariants_;
   in.normal = e.normal;
-  in.impactor.velocity_m_s = velocity;
-  in.target.lever_arm_m = target_arm;
-  in.impactor.lever_arm_m = impactor_arm;
+  in.impactor.velocity_m_s = w.impactor_velocity_m_s;
+  in.target.lever_arm_m = w.target_lever_arm_m;
+  in.impactor.lever_arm_m = w.impactor_lever_arm_m;
   in.target.curvature = target_surface;
   in.impactor.curvature = impactor_surface;
 }
@@ -177,15 +220,29 @@ ContactEvaluation ContactModel::at_surface_point(const geometry::SurfacePoint& a
 
 void ContactModel::at_surface_point(const geometry::SurfacePoint& at, double approach_speed_m_s,
                                     ContactPointResult& out) const {
-  geometry::SurfacePoint impactor_point;
-  Eigen::Vector3d point_m, normal, translation, target_arm, impactor_arm;
-  place(at, impactor_point, point_m, normal, translation);
-  const Eigen::Vector3d centroid = impactor_centroid_ + translation;
-  // The paper's sweep setting, as the full evaluation sets it.
-  const Eigen::Vector3d impactor_velocity = -approach_speed_m_s * normal;
-  geometry::Curvature target_curvature, impactor_curvature;
-  evaluate(at, impactor_point, point_m, normal, centroid, impactor_velocity, target_curvature, impactor_curvature,
-           out.target_surface, out.impactor_surface, target_arm, impactor_arm, out.result, nullptr);
+  at_surface_points(&at, 1, approach_speed_m_s, &out);
+}
+
+void ContactModel::at_surface_points(const geometry::SurfacePoint* at, std::size_t count, double approach_speed_m_s,
+                                     ContactPointResult* out) const {
+  PointWork work[collision::kKernelLanes];
+  for (std::size_t begin = 0; begin < count; begin += collision::kKernelLanes) {
+    const std::size_t n = std::min(collision::kKernelLanes, count - begin);
+    for (std::size_t k = 0; k < n; ++k) {
+      PointWork& w = work[k];
+      w.target_point = &at[begin + k];
+      Eigen::Vector3d translation;
+      place(*w.target_point, w.impactor_point, w.point_m, w.normal, translation);
+      w.impactor_centroid_m = impactor_centroid_ + translation;
+      // The paper's sweep setting, as the full evaluation sets it.
+      w.impactor_velocity_m_s = -approach_speed_m_s * w.normal;
+      w.target_surface = &out[begin + k].target_surface;
+      w.impactor_surface = &out[begin + k].impactor_surface;
+      w.result = &out[begin + k].result;
+      w.problem = nullptr;
+    }
+    evaluate(work, n);
+  }
 }
 
 ContactEvaluation ContactModel::at_first_contact(const InputContext& ctx) const {

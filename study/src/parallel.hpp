@@ -35,9 +35,11 @@ inline unsigned resolve_threads(unsigned requested) {
   return hw > 0 ? hw : 1;
 }
 
-template <class Body>
-unsigned parallel_for(std::size_t n, unsigned threads, std::size_t chunk, Body&& body,
-                      const std::function<void(std::size_t, std::size_t)>& progress) {
+/// The same over whole chunks: body(begin, end) for each chunk [begin, end) (a body that works on
+/// groups of items, e.g. the sweep's grouped kernel).
+template <class RangeBody>
+unsigned parallel_for_ranges(std::size_t n, unsigned threads, std::size_t chunk, RangeBody&& body,
+                             const std::function<void(std::size_t, std::size_t)>& progress) {
   threads = resolve_threads(threads);
   chunk = std::max<std::size_t>(1, chunk);
   const std::size_t chunks = (n + chunk - 1) / chunk;
@@ -57,7 +59,7 @@ unsigned parallel_for(std::size_t n, unsigned threads, std::size_t chunk, Body&&
       if (c >= chunks) break;
       const std::size_t begin = c * chunk, end = std::min(n, begin + chunk);
       try {
-        for (std::size_t i = begin; i < end; ++i) body(i);
+        body(begin, end);
       } catch (...) {
         std::lock_guard<std::mutex> lock(m);
         first_error.keep(c, std::current_exception());
@@ -75,7 +77,7 @@ unsigned parallel_for(std::size_t n, unsigned threads, std::size_t chunk, Body&&
     auto last = std::chrono::steady_clock::now();
     for (std::size_t c = 0; c < chunks && !stop; ++c) {
       const std::size_t begin = c * chunk, end = std::min(n, begin + chunk);
-      for (std::size_t i = begin; i < end; ++i) body(i);
+      body(begin, end);
       done += end - begin;
       const auto now = std::chrono::steady_clock::now();
       if (progress && now - last > std::chrono::milliseconds(100)) {
@@ -105,6 +107,17 @@ unsigned parallel_for(std::size_t n, unsigned threads, std::size_t chunk, Body&&
   if (first_error.error) std::rethrow_exception(first_error.error);
   if (progress) progress(done.load(), n);
   return threads;
+}
+
+template <class Body>
+unsigned parallel_for(std::size_t n, unsigned threads, std::size_t chunk, Body&& body,
+                      const std::function<void(std::size_t, std::size_t)>& progress) {
+  return parallel_for_ranges(
+      n, threads, chunk,
+      [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i) body(i);
+      },
+      progress);
 }
 
 }  // namespace impactdeck::study::detail

@@ -20,9 +20,11 @@ double rule_radius(const collision::ContactCurvature& c, collision::ContactRule 
 
 }  // namespace
 
-void sweep_point(const scene::ContactModel& model, double speed, const geometry::SurfacePoint& at, PointResult& r) {
-  scene::ContactPointResult e;
-  model.at_surface_point(at, speed, e);
+namespace {
+
+// One point's record from its contact evaluation.
+void record(const scene::ContactModel& model, const geometry::SurfacePoint& at, const scene::ContactPointResult& e,
+            PointResult& r) {
   const collision::KernelResult& k = e.result;
   if (k.flag != collision::ContactFlag::none) r = PointResult{};  // nothing else of a flagged point is used
   r.point_m = at.point_m;  // the target's own frame: sweep files overlay the part and its FEM deck
@@ -48,6 +50,43 @@ void sweep_point(const scene::ContactModel& model, double speed, const geometry:
   const geometry::Pose& pose = model.target().pose;
   r.target_delta_velocity_m_s = pose.direction_to_own(k.target_jump.delta_velocity_m_s);
   r.target_delta_angular_velocity_rad_s = pose.direction_to_own(k.target_jump.delta_angular_velocity_rad_s);
+}
+
+// sweep_points asks for the cache lines of the records kPrefetchAhead points ahead of the group it
+// computes (within its own output range: another thread may write the next range). A sweep's result
+// array (224 bytes a point) is far larger than the caches and written once: without the hint each
+// first store to a line waits for that line to come from memory. bench_study BM_PointSweepGrouped,
+// 200 k points, 1 thread (2026-11-23): 47.7 ms into the whole array without the hint, 41.6 ms with
+// it, 39.2 ms into a buffer that stays in cache.
+constexpr std::size_t kPrefetchAhead = 32;
+
+void prefetch_for_write(const PointResult* first, const PointResult* end) {
+#if defined(__GNUC__)
+  const char* a = reinterpret_cast<const char*>(first);
+  const char* e = reinterpret_cast<const char*>(end);
+  for (; a < e; a += 64) __builtin_prefetch(a, 1);
+#else
+  (void)first, (void)end;
+#endif
+}
+
+}  // namespace
+
+void sweep_points(const scene::ContactModel& model, double speed, const geometry::SurfacePoint* at, std::size_t count,
+                  PointResult* out) {
+  scene::ContactPointResult e[collision::kKernelLanes];
+  prefetch_for_write(out, out + std::min(count, kPrefetchAhead));
+  for (std::size_t begin = 0; begin < count; begin += collision::kKernelLanes) {
+    const std::size_t n = std::min(collision::kKernelLanes, count - begin);
+    const std::size_t ahead = begin + kPrefetchAhead;
+    if (ahead < count) prefetch_for_write(out + ahead, out + std::min(count, ahead + n));
+    model.at_surface_points(at + begin, n, speed, e);
+    for (std::size_t k = 0; k < n; ++k) record(model, at[begin + k], e[k], out[begin + k]);
+  }
+}
+
+void sweep_point(const scene::ContactModel& model, double speed, const geometry::SurfacePoint& at, PointResult& r) {
+  sweep_points(model, speed, &at, 1, &r);
 }
 
 PointResult sweep_point(const scene::ContactModel& model, double speed, const geometry::SurfacePoint& at) {
@@ -101,11 +140,14 @@ SweepResult run_sweep(const SweepSetup& s, const std::vector<geometry::SurfacePo
     res.curves_N.resize(n * o.curve_samples);
   }
   const auto t0 = std::chrono::steady_clock::now();
-  res.threads_used = detail::parallel_for(
+  res.threads_used = detail::parallel_for_ranges(
       n, o.threads, o.chunk,
-      [&](std::size_t i) {
-        sweep_point(model, s.approach_speed_m_s, cloud[i], res.points[i]);  // in place
-        if (o.curves && !res.points[i].flagged()) sample_curve(res.points[i], o.curve_samples, &res.curves_N[i * o.curve_samples]);
+      [&](std::size_t begin, std::size_t end) {
+        sweep_points(model, s.approach_speed_m_s, &cloud[begin], end - begin, &res.points[begin]);  // in place
+        if (!o.curves) return;
+        for (std::size_t i = begin; i < end; ++i) {
+          if (!res.points[i].flagged()) sample_curve(res.points[i], o.curve_samples, &res.curves_N[i * o.curve_samples]);
+        }
       },
       o.progress);
   res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -15,6 +15,7 @@
 //   R     energy flux (Eq. 14, 30), a constant, or a measured table
 //   Pi    = (1 + R) m_w v_w,  dv_i = -+Pi n/m_i,  dw_i = I_i^-1 (r_i x -+Pi n)  (Eq. 13, 22-23)
 // Body 1 is the target, n its outward unit normal; body 2 the impactor, pushed along +n.
+#include <cstddef>
 #include <cstdint>
 
 #include <Eigen/Dense>
@@ -139,8 +140,19 @@ struct KernelPoint {
 /// The kernel on the invariants of `invariants` (both bodies' inverse mass, inverse inertia and
 /// angular velocity; rule, E*, restitution) and the point `point` (its normal, lever arms,
 /// velocities and surfaces; those fields of `invariants` are not read). Writes every field of
-/// `result`. This is the one implementation: solve_kernel(KernelInput) calls it.
+/// `result`. solve_kernel(KernelInput) calls it; it runs the grouped kernel below with one point.
 void solve_kernel(const KernelInput& invariants, const KernelPoint& point, KernelResult& result) noexcept;
+
+/// How many points the grouped kernel carries through each step together. Eight independent
+/// chains cover the latency of a chain's logs, exps, square roots and divisions.
+inline constexpr std::size_t kKernelLanes = 8;
+
+/// The kernel on `count` points of one sweep: the same as solve_kernel(invariants, points[k],
+/// *results[k]) for every k (bit for bit: the same operations per point), but each step runs over
+/// up to kKernelLanes points before the next, so that their dependency chains overlap. This is
+/// the one implementation: the one-point forms call it with count 1.
+void solve_kernel(const KernelInput& invariants, const KernelPoint* points, KernelResult* const* results,
+                  std::size_t count) noexcept;
 
 /// Relative curvatures of the two surfaces of a kernel input (A <= B, direction of A).
 RelativeCurvatures kernel_relative_curvatures(const KernelInput& input) noexcept;

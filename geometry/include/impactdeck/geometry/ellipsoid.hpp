@@ -46,6 +46,7 @@ class Ellipsoid final : public Shape {
   Eigen::Vector3d e_;
   Eigen::Vector3d inv_e2_;  ///< 1 / e_i^2, per-point invariants of the curvature
   double abc2_;             ///< (a b c)^2
+  double inv_radius_;       ///< 1 / a (a sphere's curvature)
 };
 
 /// Mean and Gaussian curvature of the ellipsoid at a surface point, closed forms (tests).

@@ -2,6 +2,7 @@
 // The geometric half of an impact: placed bodies, where they touch, and the physics kernel's
 // input built from both surfaces there. `run`, `sweep` and `study` all go through ContactModel, so
 // that one contact point gives bit for bit the same numbers whatever command asks for it.
+#include <cstddef>
 #include <memory>
 #include <optional>
 #include <string>
@@ -99,6 +100,11 @@ class ContactModel {
   /// The same point, the same code and the same numbers, keeping only what a sweep needs: fills
   /// `out` in place (no ContactEvaluation, no copy of the kernel bodies per point).
   void at_surface_point(const geometry::SurfacePoint& at, double approach_speed_m_s, ContactPointResult& out) const;
+  /// The same for `count` points (a sweep's group): out[k] is at_surface_point(at[k], speed, out[k])
+  /// bit for bit, with the kernel's steps run over up to collision::kKernelLanes points at a time so
+  /// that the points' dependency chains overlap.
+  void at_surface_points(const geometry::SurfacePoint* at, std::size_t count, double approach_speed_m_s,
+                         ContactPointResult* out) const;
 
   /// First-contact mode: the impactor, as placed, translates along the relative velocity of the
   /// bodies until they touch (geometry::first_contact). Throws ctx.error("", reason) when they
@@ -114,22 +120,21 @@ class ContactModel {
   /// and the impactor's translation.
   void place(const geometry::SurfacePoint& at, geometry::SurfacePoint& impactor_point, Eigen::Vector3d& point_m,
              Eigen::Vector3d& normal, Eigen::Vector3d& impactor_translation_m) const;
-  /// Both surfaces' curvatures at the placed points and the kernel there: the per-point work of
-  /// every mode. Fills the fitted curvatures, the kernel's surfaces (world), the lever arms and
-  /// the result; a fit that cannot be made flags the result no_curvature (reason in `problem` when
-  /// given) and returns false.
-  bool evaluate(const geometry::SurfacePoint& target_point, const geometry::SurfacePoint& impactor_point,
-                const Eigen::Vector3d& point_m, const Eigen::Vector3d& normal,
-                const Eigen::Vector3d& impactor_centroid_world_m, const Eigen::Vector3d& impactor_velocity_m_s,
-                geometry::Curvature& target_curvature, geometry::Curvature& impactor_curvature,
-                collision::ContactCurvature& target_surface, collision::ContactCurvature& impactor_surface,
-                Eigen::Vector3d& target_lever_arm_m, Eigen::Vector3d& impactor_lever_arm_m,
-                collision::KernelResult& result, std::string* problem) const;
-  /// The full evaluation: evaluate() into e, and e.input the kernel's input it stands for.
+  struct PointWork;  // one point's placement, geometry and result slots (contact.cpp)
+  /// One body's curvature at its point into k; a fit that cannot be made flags w's result
+  /// no_curvature (reason in w.problem when given) and returns false.
+  bool fit(const PreparedBody& b, const geometry::SurfacePoint& at, geometry::Curvature& k, PointWork& w) const;
+  /// The per-point work of every mode, on placed points: both surfaces' curvatures, the kernel's
+  /// surfaces (world) and lever arms, then the kernel (collision::solve_kernel's grouped form).
+  void evaluate(PointWork* work, std::size_t count) const;
+  /// The full evaluation: one point through evaluate() into e, and e.input the kernel's input it
+  /// stands for.
   void evaluate(ContactEvaluation& e, const Eigen::Vector3d& impactor_centroid_world_m,
                 std::optional<double> approach_speed_m_s) const;
-  collision::ContactCurvature surface(const PreparedBody& b, const geometry::SurfacePoint& own,
-                                      const geometry::Curvature& k) const;
+  /// The kernel's view of a body's surface at `own` (world directions, the rule's Eq. 26
+  /// curvature), written into `c` (every field).
+  void surface(const PreparedBody& b, const geometry::SurfacePoint& own, const geometry::Curvature& k,
+               collision::ContactCurvature& c) const;
 
   const PreparedBody& target_;
   const PreparedBody& impactor_;

@@ -113,6 +113,10 @@ PointResult sweep_point(const scene::ContactModel& model, double approach_speed_
 /// The same, written in place into `out` (every field; a sweep's preallocated slot).
 void sweep_point(const scene::ContactModel& model, double approach_speed_m_s, const geometry::SurfacePoint& at,
                  PointResult& out);
+/// `count` points at once, out[k] written in place as sweep_point(model, speed, at[k], out[k]) bit
+/// for bit; the kernel's steps run over groups of points (ContactModel::at_surface_points).
+void sweep_points(const scene::ContactModel& model, double approach_speed_m_s, const geometry::SurfacePoint* at,
+                  std::size_t count, PointResult* out);
 
 /// The whole cloud. Throws InputError on bad input (bodies, speed), and when every point is flagged.
 SweepResult run_sweep(const SweepSetup& setup, const std::vector<geometry::SurfacePoint>& cloud,
