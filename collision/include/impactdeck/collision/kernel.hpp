@@ -150,7 +150,8 @@ inline constexpr std::size_t kKernelLanes = 8;
 /// The kernel on `count` points of one sweep: the same as solve_kernel(invariants, points[k],
 /// *results[k]) for every k (bit for bit: the same operations per point), but each step runs over
 /// up to kKernelLanes points before the next, so that their dependency chains overlap. This is
-/// the one implementation: the one-point forms call it with count 1.
+/// the one implementation: the one-point forms call it with count 1. The count results must be
+/// distinct objects.
 void solve_kernel(const KernelInput& invariants, const KernelPoint* points, KernelResult* const* results,
                   std::size_t count) noexcept;
 
