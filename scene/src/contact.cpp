@@ -1,6 +1,7 @@
 #include "impactdeck/scene/contact.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -67,12 +68,12 @@ ContactModel::ContactModel(const PreparedBody& target, const PreparedBody& impac
 
 void ContactModel::surface(const PreparedBody& b, const geometry::SurfacePoint& own, const geometry::Curvature& k,
                            collision::ContactCurvature& c) const {
-  c.sharp = k.sharp_feature;
-  if (c.sharp) {
+  if (k.sharp_feature) {  // no curvature exists there: the defaults, flagged sharp
     c = collision::ContactCurvature{};
     c.sharp = true;
     return;
   }
+  c.sharp = false;
   c.k1_per_m = k.k1_per_m;
   c.k2_per_m = k.k2_per_m;
   c.d1 = b.pose.direction_to_world(k.d1);
@@ -90,7 +91,7 @@ void ContactModel::surface(const PreparedBody& b, const geometry::SurfacePoint& 
 
 // One contact point on its way through ContactModel: where it is (set by the caller: the target's
 // point, the impactor's touching point, the world point and normal, the impactor's centroid and
-// velocity), what prepare() adds (fitted curvatures, lever arms), and where the results go.
+// velocity), what evaluate() adds (fitted curvatures, lever arms), and where the results go.
 struct ContactModel::PointWork {
   const geometry::SurfacePoint* target_point = nullptr;  ///< target's own frame
   geometry::SurfacePoint impactor_point;                  ///< impactor's own frame
@@ -118,38 +119,35 @@ bool ContactModel::fit(const PreparedBody& b, const geometry::SurfacePoint& at, 
   }
 }
 
-void ContactModel::evaluate(PointWork* work, std::size_t count) const {
-  // Step by step over a group of points, as the kernel does: each step's calls for different
-  // points are independent, so the processor overlaps their chains.
-  for (std::size_t begin = 0; begin < count; begin += collision::kKernelLanes) {
-    const std::size_t n = std::min(collision::kKernelLanes, count - begin);
-    PointWork* w = work + begin;
-    bool fitted[collision::kKernelLanes];
-    for (std::size_t k = 0; k < n; ++k) fitted[k] = fit(target_, *w[k].target_point, w[k].target_curvature, w[k]);
-    for (std::size_t k = 0; k < n; ++k) {
-      fitted[k] = fitted[k] && fit(impactor_, w[k].impactor_point, w[k].impactor_curvature, w[k]);
-    }
-    collision::KernelPoint points[collision::kKernelLanes];
-    collision::KernelResult* results[collision::kKernelLanes];
-    std::size_t m = 0;
-    for (std::size_t k = 0; k < n; ++k) {
-      if (!fitted[k]) continue;  // flagged no_curvature: no kernel
-      PointWork& x = w[k];
-      x.target_lever_arm_m = x.point_m - target_centroid_;
-      x.impactor_lever_arm_m = x.point_m - x.impactor_centroid_m;
-      surface(target_, *x.target_point, x.target_curvature, *x.target_surface);
-      surface(impactor_, x.impactor_point, x.impactor_curvature, *x.impactor_surface);
-      points[m] = {&x.normal,
-                   &x.target_lever_arm_m,
-                   &x.impactor_lever_arm_m,
-                   &invariants_.target.velocity_m_s,
-                   &x.impactor_velocity_m_s,
-                   x.target_surface,
-                   x.impactor_surface};
-      results[m++] = x.result;
-    }
-    collision::solve_kernel(invariants_, points, results, m);
+void ContactModel::evaluate(PointWork* w, std::size_t n) const {
+  // Step by step over the group, as the kernel does: each step's calls for different points are
+  // independent, so the processor overlaps their chains.
+  assert(n <= collision::kKernelLanes);
+  bool fitted[collision::kKernelLanes];
+  for (std::size_t k = 0; k < n; ++k) fitted[k] = fit(target_, *w[k].target_point, w[k].target_curvature, w[k]);
+  for (std::size_t k = 0; k < n; ++k) {
+    fitted[k] = fitted[k] && fit(impactor_, w[k].impactor_point, w[k].impactor_curvature, w[k]);
   }
+  collision::KernelPoint points[collision::kKernelLanes];
+  collision::KernelResult* results[collision::kKernelLanes];
+  std::size_t m = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    if (!fitted[k]) continue;  // flagged no_curvature: no kernel
+    PointWork& x = w[k];
+    x.target_lever_arm_m = x.point_m - target_centroid_;
+    x.impactor_lever_arm_m = x.point_m - x.impactor_centroid_m;
+    surface(target_, *x.target_point, x.target_curvature, *x.target_surface);
+    surface(impactor_, x.impactor_point, x.impactor_curvature, *x.impactor_surface);
+    points[m] = {&x.normal,
+                 &x.target_lever_arm_m,
+                 &x.impactor_lever_arm_m,
+                 &invariants_.target.velocity_m_s,
+                 &x.impactor_velocity_m_s,
+                 x.target_surface,
+                 x.impactor_surface};
+    results[m++] = x.result;
+  }
+  collision::solve_kernel(invariants_, points, results, m);
 }
 
 void ContactModel::evaluate(ContactEvaluation& e, const Eigen::Vector3d& impactor_centroid_world,

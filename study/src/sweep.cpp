@@ -18,10 +18,6 @@ double rule_radius(const collision::ContactCurvature& c, collision::ContactRule 
   return 1.0 / (rule == collision::ContactRule::paper ? c.paper_curvature_per_m : 0.5 * (c.k1_per_m + c.k2_per_m));
 }
 
-}  // namespace
-
-namespace {
-
 // One point's record from its contact evaluation.
 void record(const scene::ContactModel& model, const geometry::SurfacePoint& at, const scene::ContactPointResult& e,
             PointResult& r) {

@@ -124,8 +124,9 @@ class ContactModel {
   /// One body's curvature at its point into k; a fit that cannot be made flags w's result
   /// no_curvature (reason in w.problem when given) and returns false.
   bool fit(const PreparedBody& b, const geometry::SurfacePoint& at, geometry::Curvature& k, PointWork& w) const;
-  /// The per-point work of every mode, on placed points: both surfaces' curvatures, the kernel's
-  /// surfaces (world) and lever arms, then the kernel (collision::solve_kernel's grouped form).
+  /// The per-point work of every mode, on a group of at most collision::kKernelLanes placed points:
+  /// both surfaces' curvatures, the kernel's surfaces (world) and lever arms, then the kernel
+  /// (collision::solve_kernel's grouped form).
   void evaluate(PointWork* work, std::size_t count) const;
   /// The full evaluation: one point through evaluate() into e, and e.input the kernel's input it
   /// stands for.
