@@ -252,6 +252,36 @@ TEST(Pose, MapsPointsDirectionsAndCurvatures) {
   EXPECT_LE((cw.d2 - q.rotation * c.d2).norm(), 1e-15);
 }
 
+// PoseMap skips the identity rotation: the same values as Pose's (== compares values: +0 == -0),
+// and a rotated pose (even by 1e-300 rad off the identity in one entry) goes through Pose itself.
+TEST(Pose, MapSkipsOnlyTheIdentityRotationWithTheSameValues) {
+  std::mt19937_64 rng(11);
+  Pose moved;  // unrotated, far from the origin
+  moved.position_m = {4e2, -2.5e2, 1.3e2};
+  Pose turned;
+  turned.rotation = random_rotation(rng);
+  turned.position_m = moved.position_m;
+  Pose barely = moved;
+  barely.rotation(0, 1) = 1e-300;
+  EXPECT_FALSE(PoseMap(moved).rotated());
+  EXPECT_FALSE(PoseMap(Pose{}).rotated());
+  EXPECT_TRUE(PoseMap(turned).rotated());
+  EXPECT_TRUE(PoseMap(barely).rotated());
+  for (const Pose* pose : {&moved, &turned, &barely}) {
+    const PoseMap map(*pose);
+    EXPECT_EQ(&map.pose(), pose);
+    for (int i = 0; i < 200; ++i) {
+      // Components of every sign and magnitude, zeros of both signs among them.
+      Vector3d x = random_unit(rng) * std::ldexp(1.0, static_cast<int>(rng() % 80) - 40);
+      if (i % 7 == 0) x[i % 3] = (i % 2) ? 0.0 : -0.0;
+      EXPECT_EQ(map.to_world(x), pose->to_world(x)) << i;
+      EXPECT_EQ(map.to_own(x), pose->to_own(x)) << i;
+      EXPECT_EQ(map.direction_to_world(x), pose->direction_to_world(x)) << i;
+      EXPECT_EQ(map.direction_to_own(x), pose->direction_to_own(x)) << i;
+    }
+  }
+}
+
 TEST(Pose, BadAxisAngleOrPositionIsRefused) {
   const double nan = std::nan("");
   expect_message(input_error_of([] { Pose::from_axis_angle({0, 0, 0}, {0, 0, 0}, 1.0); }),

@@ -1,6 +1,7 @@
 // The configuration study and the sweep: agreement with the paper's Table 1, the sphere row, the
 // analytic limit of Eq. 39-40, determinism over thread counts, no allocation per point, and the
 // sweep's kernel against the scene pipeline.
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstdlib>
@@ -8,7 +9,11 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <mutex>
 #include <new>
+#include <stdexcept>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -22,6 +27,7 @@
 #include "impactdeck/study/scene_sweep.hpp"
 #include "impactdeck/study/sweep.hpp"
 #include "impactdeck/study/table1.hpp"
+#include "parallel.hpp"  // study/src: the sweep's work hand-out
 #include "tolerances.hpp"
 
 // ---- Allocation counter: replaces the global operator new of this test executable. ----------
@@ -178,6 +184,72 @@ SweepSetup ellipsoid_setup(double mu = 1.0) {
 
 bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
+// The sweep's work hand-out (detail::parallel_for_ranges): guided ranges cover every item exactly
+// once, hold at most max_chunk items and at least chunk (only the last may hold fewer), shrink
+// toward the end, and do not depend on timing (the same ranges on every run); the exception
+// rethrown is that of the failing range with the lowest first item.
+TEST(Parallel, GuidedRangesCoverEveryItemOnceAndDoNotDependOnTiming) {
+  using Ranges = std::vector<std::pair<std::size_t, std::size_t>>;
+  auto ranges_of = [](std::size_t n, unsigned threads, std::size_t chunk, std::size_t max_chunk) {
+    Ranges r;
+    std::mutex m;
+    detail::parallel_for_ranges(
+        n, threads, chunk, max_chunk,
+        [&](std::size_t b, std::size_t e) {
+          std::lock_guard<std::mutex> lock(m);
+          r.emplace_back(b, e);
+        },
+        {});
+    std::sort(r.begin(), r.end());
+    return r;
+  };
+  for (unsigned threads : {1u, 2u, 3u}) {
+    for (std::size_t n : {0ul, 1ul, 63ul, 64ul, 1000ul, 100003ul}) {
+      SCOPED_TRACE(std::to_string(threads) + " threads, " + std::to_string(n) + " items");
+      const Ranges r = ranges_of(n, threads, 64, 4096);
+      std::size_t next = 0;
+      for (std::size_t k = 0; k < r.size(); ++k) {
+        const auto [b, e] = r[k];
+        ASSERT_EQ(b, next);
+        ASSERT_LT(b, e);
+        EXPECT_LE(e - b, 4096u);
+        if (e != n) EXPECT_GE(e - b, 64u);
+        if (k > 0) EXPECT_LE(e - b, r[k - 1].second - r[k - 1].first);
+        next = e;
+      }
+      EXPECT_EQ(next, n);
+      for (int again = 0; again < 3; ++again) EXPECT_EQ(ranges_of(n, threads, 64, 4096), r);
+      if (n == 100003) EXPECT_LT(r.size(), 200u);  // a long run: few hand-outs (1,563 of 64 unguided)
+    }
+  }
+  // max_chunk <= chunk: ranges of `chunk` items (parallel_for's hand-out).
+  const Ranges fixed = ranges_of(1000, 2, 64, 0);
+  ASSERT_EQ(fixed.size(), 16u);
+  for (std::size_t k = 0; k + 1 < fixed.size(); ++k) EXPECT_EQ(fixed[k].second - fixed[k].first, 64u);
+  // Every range from item 50,000 on fails: the one rethrown starts at the lowest first item.
+  const Ranges all = ranges_of(100003, 2, 64, 4096);
+  std::size_t first_failing = 0;
+  for (const auto& [b, e] : all) {
+    if (e > 50000) {
+      first_failing = b;
+      break;
+    }
+  }
+  for (unsigned threads : {1u, 2u, 3u}) {
+    try {
+      detail::parallel_for_ranges(
+          100003, threads, 64, 4096,
+          [](std::size_t b, std::size_t e) {
+            if (e > 50000) throw std::runtime_error(std::to_string(b));
+          },
+          {});
+      ADD_FAILURE() << "no exception";
+    } catch (const std::runtime_error& e) {
+      EXPECT_EQ(e.what(), std::to_string(first_failing));
+    }
+  }
+}
+
 TEST(Sweep, BitForBitWhateverTheThreadCount) {
  for (collision::ContactRule rule : {collision::ContactRule::paper, collision::ContactRule::elliptical}) {
   SCOPED_TRACE(to_string(rule));
@@ -187,11 +259,14 @@ TEST(Sweep, BitForBitWhateverTheThreadCount) {
   SweepOptions o;
   o.curves = true;
   o.curve_samples = 33;
-  o.chunk = 17;  // many chunks, so that threads interleave
+  o.chunk = 17;  // many ranges, so that threads interleave
+  o.max_chunk = 17;
   o.threads = 1;
   const SweepResult one = run_sweep(s, cloud, o);
-  for (unsigned threads : {2u, 3u}) {
+  // Fixed ranges of 17 points, then the default guided ranges (up to 4,096 points).
+  for (auto [threads, max_chunk] : {std::pair{2u, 17ul}, {3u, 17ul}, {2u, 4096ul}, {1u, 4096ul}}) {
     o.threads = threads;
+    o.max_chunk = max_chunk;
     const SweepResult many = run_sweep(s, cloud, o);
     EXPECT_EQ(many.threads_used, threads);
     ASSERT_EQ(many.points.size(), one.points.size());

@@ -118,17 +118,28 @@ namespace {
 // the next step (see kKernelLanes): a step returns false when it flags its point, which then
 // skips the later steps, so every point gets exactly the operations of a one-point solve.
 
-// The input's validity, the reduced mass at the contact point (tensor form of Eq. 21, both bodies
-// eccentric) and the approach velocity (both bodies' v + w x r at the point).
-inline bool step_motion(const KernelInput& in, const KernelPoint& p, KernelResult& r) {
+// What the kernel's steps read of the invariants, worked out once per call.
+struct CallInvariants {
+  bool valid;                          // E* finite and positive, a restitution model
+  bool target_spins, impactor_spins;  // a non-zero angular velocity (else w x r is left out: 0)
+  explicit CallInvariants(const KernelInput& in)
+      : valid(finite_positive(in.effective_modulus_Pa) && in.restitution != nullptr),
+        target_spins(!in.target.angular_velocity_rad_s.isZero(0)),
+        impactor_spins(!in.impactor.angular_velocity_rad_s.isZero(0)) {}
+};
+
+// The input's validity (the invariants' in `ci`), the reduced mass at the contact point (tensor form
+// of Eq. 21, both bodies eccentric) and the approach velocity (both bodies' v + w x r at the point).
+inline bool step_motion(const KernelInput& in, const CallInvariants& ci, const KernelPoint& p, KernelResult& r) {
   r = KernelResult{};
   const KernelBody& t = in.target;
   const KernelBody& i = in.impactor;
   const Eigen::Vector3d& n = *p.normal;
   const Eigen::Vector3d& t_arm = *p.target_lever_arm_m;
   const Eigen::Vector3d& i_arm = *p.impactor_lever_arm_m;
-  if (!n.allFinite() || !(std::abs(n.norm() - 1.0) < 1e-9) || !finite_positive(in.effective_modulus_Pa) ||
-      in.restitution == nullptr || !t_arm.allFinite() || !i_arm.allFinite()) {
+  // A unit normal: | |n|^2 - 1 | < 2e-9 is | |n| - 1 | < 1e-9 to first order, without a square root;
+  // a NaN or infinite component fails it too.
+  if (!ci.valid || !(std::abs(n.squaredNorm() - 1.0) < 2e-9) || !t_arm.allFinite() || !i_arm.allFinite()) {
     r.flag = ContactFlag::degenerate;
     return false;
   }
@@ -136,8 +147,12 @@ inline bool step_motion(const KernelInput& in, const KernelPoint& p, KernelResul
   const double inv_m = t.inverse_mass_per_kg + rt.dot(t.inverse_inertia_world * rt) +
                        i.inverse_mass_per_kg + ri.dot(i.inverse_inertia_world * ri);
   r.reduced_mass_kg = 1.0 / inv_m;
-  const Eigen::Vector3d u = (*p.impactor_velocity_m_s + i.angular_velocity_rad_s.cross(i_arm)) -
-                            (*p.target_velocity_m_s + t.angular_velocity_rad_s.cross(t_arm));
+  // v + w x r of each body; a body that does not spin adds nothing (the same values, up to the
+  // sign of a zero component).
+  Eigen::Vector3d vi = *p.impactor_velocity_m_s, vt = *p.target_velocity_m_s;
+  if (ci.impactor_spins) vi += i.angular_velocity_rad_s.cross(i_arm);
+  if (ci.target_spins) vt += t.angular_velocity_rad_s.cross(t_arm);
+  const Eigen::Vector3d u = vi - vt;
   r.approach_velocity_m_s = -n.dot(u);
   if (!finite_positive(r.reduced_mass_kg) || !std::isfinite(r.approach_velocity_m_s)) {
     r.flag = ContactFlag::degenerate;
@@ -270,6 +285,7 @@ void solve_kernel(const KernelInput& in, const KernelPoint* points, KernelResult
   // Each step over a group of points before the next: the points' chains of square roots,
   // divisions, logs and exps are independent, so the processor overlaps them (one point alone
   // waits on its own chain).
+  const CallInvariants ci(in);
   for (std::size_t begin = 0; begin < count; begin += kKernelLanes) {
     const std::size_t n = std::min(kKernelLanes, count - begin);
     const KernelPoint* p = points + begin;
@@ -277,7 +293,7 @@ void solve_kernel(const KernelInput& in, const KernelPoint* points, KernelResult
     bool live[kKernelLanes];
     RelativeCurvatures rc[kKernelLanes];
     EllipticalContact ec[kKernelLanes];
-    for (std::size_t k = 0; k < n; ++k) live[k] = step_motion(in, p[k], *r[k]);
+    for (std::size_t k = 0; k < n; ++k) live[k] = step_motion(in, ci, p[k], *r[k]);
     for (std::size_t k = 0; k < n; ++k) live[k] = live[k] && step_radius(in, p[k], *r[k], rc[k], ec[k]);
     for (std::size_t k = 0; k < n; ++k) live[k] = live[k] && step_hertz(in, *r[k]);
     for (std::size_t k = 0; k < n; ++k) {

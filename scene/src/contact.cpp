@@ -52,6 +52,8 @@ ContactModel::ContactModel(const PreparedBody& target, const PreparedBody& impac
                            const InputContext& ctx)
     : target_(target),
       impactor_(impactor),
+      target_frame_(target.pose),
+      impactor_frame_(impactor.pose),
       rule_(rule),
       impactor_mesh_(dynamic_cast<const geometry::MeshShape*>(impactor.shape.get())),
       target_centroid_(target.centroid_world_m()),
@@ -66,8 +68,8 @@ ContactModel::ContactModel(const PreparedBody& target, const PreparedBody& impac
   }
 }
 
-void ContactModel::surface(const PreparedBody& b, const geometry::SurfacePoint& own, const geometry::Curvature& k,
-                           collision::ContactCurvature& c) const {
+void ContactModel::surface(const PreparedBody& b, const geometry::PoseMap& frame, const geometry::SurfacePoint& own,
+                           const geometry::Curvature& k, collision::ContactCurvature& c) const {
   if (k.sharp_feature) {  // no curvature exists there: the defaults, flagged sharp
     c = collision::ContactCurvature{};
     c.sharp = true;
@@ -76,8 +78,8 @@ void ContactModel::surface(const PreparedBody& b, const geometry::SurfacePoint& 
   c.sharp = false;
   c.k1_per_m = k.k1_per_m;
   c.k2_per_m = k.k2_per_m;
-  c.d1 = b.pose.direction_to_world(k.d1);
-  c.d2 = b.pose.direction_to_world(k.d2);
+  c.d1 = frame.direction_to_world(k.d1);
+  c.d2 = frame.direction_to_world(k.d2);
   c.paper_curvature_per_m = 0;
   if (rule_ == collision::ContactRule::paper) {
     // Eq. 26 in the body's own axes; a sphere's radius is its radius; a plane's curvature is 0.
@@ -136,8 +138,8 @@ void ContactModel::evaluate(PointWork* w, std::size_t n) const {
     PointWork& x = w[k];
     x.target_lever_arm_m = x.point_m - target_centroid_;
     x.impactor_lever_arm_m = x.point_m - x.impactor_centroid_m;
-    surface(target_, *x.target_point, x.target_curvature, *x.target_surface);
-    surface(impactor_, x.impactor_point, x.impactor_curvature, *x.impactor_surface);
+    surface(target_, target_frame_, *x.target_point, x.target_curvature, *x.target_surface);
+    surface(impactor_, impactor_frame_, x.impactor_point, x.impactor_curvature, *x.impactor_surface);
     points[m] = {&x.normal,
                  &x.target_lever_arm_m,
                  &x.impactor_lever_arm_m,
@@ -184,10 +186,10 @@ void ContactModel::evaluate(ContactEvaluation& e, const Eigen::Vector3d& impacto
 void ContactModel::place(const geometry::SurfacePoint& at, geometry::SurfacePoint& impactor_point,
                          Eigen::Vector3d& point_m, Eigen::Vector3d& normal,
                          Eigen::Vector3d& impactor_translation_m) const {
-  point_m = target_.pose.to_world(at.point_m);
-  normal = target_.pose.direction_to_world(at.normal);
+  point_m = target_frame_.to_world(at.point_m);
+  normal = target_frame_.direction_to_world(at.normal);
   // The impactor touches with its support point along -n; a plane (unbounded) is laid tangent.
-  const Eigen::Vector3d down_own = impactor_.pose.direction_to_own(-normal);
+  const Eigen::Vector3d down_own = impactor_frame_.direction_to_own(-normal);
   Eigen::Vector3d touch_world;
   std::optional<geometry::SurfacePoint> support;
   if (impactor_.shape->bounded()) {
@@ -197,9 +199,9 @@ void ContactModel::place(const geometry::SurfacePoint& at, geometry::SurfacePoin
   }
   if (const auto& sp = support) {
     impactor_point = *sp;
-    touch_world = impactor_.pose.to_world(sp->point_m);
+    touch_world = impactor_frame_.to_world(sp->point_m);
   } else {
-    impactor_point.point_m = impactor_.pose.to_own(point_m);
+    impactor_point.point_m = impactor_frame_.to_own(point_m);
     impactor_point.normal = down_own;
     touch_world = point_m;
   }

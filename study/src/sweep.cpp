@@ -43,9 +43,9 @@ void record(const scene::ContactModel& model, const geometry::SurfacePoint& at, 
   r.restitution_clamped = k.restitution.clamped;
   r.contact_time_s = (1.0 + r.restitution) * r.compression_time_s;
   r.impulse_total_Ns = k.impulse_total_Ns;
-  const geometry::Pose& pose = model.target().pose;
-  r.target_delta_velocity_m_s = pose.direction_to_own(k.target_jump.delta_velocity_m_s);
-  r.target_delta_angular_velocity_rad_s = pose.direction_to_own(k.target_jump.delta_angular_velocity_rad_s);
+  const geometry::PoseMap& frame = model.target_frame();
+  r.target_delta_velocity_m_s = frame.direction_to_own(k.target_jump.delta_velocity_m_s);
+  r.target_delta_angular_velocity_rad_s = frame.direction_to_own(k.target_jump.delta_angular_velocity_rad_s);
 }
 
 // sweep_points asks for the cache lines of the records kPrefetchAhead points ahead of the group it
@@ -137,7 +137,7 @@ SweepResult run_sweep(const SweepSetup& s, const std::vector<geometry::SurfacePo
   }
   const auto t0 = std::chrono::steady_clock::now();
   res.threads_used = detail::parallel_for_ranges(
-      n, o.threads, o.chunk,
+      n, o.threads, o.chunk, o.max_chunk,
       [&](std::size_t begin, std::size_t end) {
         sweep_points(model, s.approach_speed_m_s, &cloud[begin], end - begin, &res.points[begin]);  // in place
         if (!o.curves) return;

@@ -112,6 +112,8 @@ class ContactModel {
   ContactEvaluation at_first_contact(const InputContext& ctx = {}) const;
 
   const PreparedBody& target() const { return target_; }
+  /// The target's pose as the model applies it (the identity rotation skipped).
+  const geometry::PoseMap& target_frame() const { return target_frame_; }
   const PreparedBody& impactor() const { return impactor_; }
   collision::ContactRule rule() const { return rule_; }
 
@@ -134,11 +136,12 @@ class ContactModel {
                 std::optional<double> approach_speed_m_s) const;
   /// The kernel's view of a body's surface at `own` (world directions, the rule's Eq. 26
   /// curvature), written into `c` (every field).
-  void surface(const PreparedBody& b, const geometry::SurfacePoint& own, const geometry::Curvature& k,
-               collision::ContactCurvature& c) const;
+  void surface(const PreparedBody& b, const geometry::PoseMap& frame, const geometry::SurfacePoint& own,
+               const geometry::Curvature& k, collision::ContactCurvature& c) const;
 
   const PreparedBody& target_;
   const PreparedBody& impactor_;
+  geometry::PoseMap target_frame_, impactor_frame_;  ///< both poses, unrotated ones skipped
   collision::ContactRule rule_;
   /// The kernel's invariants: both kernel bodies (inverse mass and world inverse inertia, computed
   /// once; velocities), the rule, E* and the restitution model. Its per-point fields are unused.

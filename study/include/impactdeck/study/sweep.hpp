@@ -5,9 +5,10 @@
 // approach speed, so that only the configuration (reduced mass at the point, local radius)
 // varies over the map.
 //
-// Speed and determinism: points are independent, so they run on all cores (std::thread, chunks
-// handed out by an atomic counter). Each point writes only its own slot of preallocated arrays:
-// no allocation per point, and the result is bit for bit the same whatever the thread count.
+// Speed and determinism: points are independent, so they run on all cores (std::thread, guided
+// ranges of points handed out by an atomic counter). Each point writes only its own slot of
+// preallocated arrays: no allocation per point, and the result is bit for bit the same whatever
+// the thread count.
 #include <array>
 #include <cstddef>
 #include <functional>
@@ -46,7 +47,10 @@ struct SweepOptions {
   unsigned threads = 0;             ///< 0: std::thread::hardware_concurrency()
   bool curves = false;              ///< also sample F(t) at every point
   std::size_t curve_samples = 201;  ///< samples per curve, uniform over [0, contact time], >= 2
-  std::size_t chunk = 64;           ///< points per work item
+  /// Points per work item: guided, a thread takes max(chunk, min(max_chunk, remaining / (4 threads)))
+  /// points at a time (few hand-outs on a long sweep, small ones at its end to balance the threads).
+  std::size_t chunk = 64;
+  std::size_t max_chunk = 4096;
   ProgressFn progress;              ///< optional
 };
 
