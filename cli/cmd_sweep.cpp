@@ -18,7 +18,7 @@ namespace impactdeck::cli {
 
 void register_sweep(CLI::App& app, Context& ctx) {
   struct Args {
-    std::string scene, impact, cloud = "auto", out = ".", prefix, azimuth, elevation, points;
+    std::string scene, impact, cloud = "auto", out = ".", prefix, points;
     std::string formats = "csv,vtp,pos,svg,png";
     int grid_steps = 8;
     std::size_t count = 2000;
