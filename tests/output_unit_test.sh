@@ -123,9 +123,20 @@ for l in open(o + "/fem_hit/mesh.inp"):
     if l.startswith("*"): blk = l.split(",")[0].strip(); continue
     if blk == "*NODE":
         f = [float(v) for v in l.split(",")]; inp[int(f[0])] = f[1:]
-# (numbered apart: ccx's nodes follow the tetrahedra's index, Gmsh's its tags)
+# (numbered apart: ccx's nodes follow the tetrahedra's index, Gmsh's its tags; each .inp node is
+# matched to its nearest .msh node, one to one: sorting the two lists pairs them wrongly when two
+# nodes mirror each other and their x differ only in digits the .inp's 12 do not keep)
 assert len(inp) == len(nodes)
-diff = max(max(abs(a - b) for a, b in zip(p, q)) for p, q in zip(sorted(inp.values()), sorted(nodes.values())))
+mpts = vtk.vtkPoints(); mpts.SetDataTypeToDouble()
+for t in ids: mpts.InsertNextPoint(*nodes[t])
+mset = vtk.vtkPolyData(); mset.SetPoints(mpts)
+near = vtk.vtkKdTreePointLocator(); near.SetDataSet(mset); near.BuildLocator()
+matched = set(); diff = 0.0
+for q in inp.values():
+    k = near.FindClosestPoint(q)
+    matched.add(k)
+    diff = max(diff, max(abs(a - b) for a, b in zip(q, nodes[ids[k]])))
+assert len(matched) == len(nodes), (len(matched), len(nodes))
 assert diff <= 1e-9 * size, diff
 print("%s: %d sweep points, farthest from the deck surface %.3g (size %.4g %s); corners' box matches to %.3g"
       % (u, sweep.GetNumberOfPoints(), worst, size, u,
