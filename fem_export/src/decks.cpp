@@ -224,6 +224,7 @@ nlohmann::json to_json(const std::vector<MeshAttempt>& attempts) {
                  {"mesh_size_m", a.mesh_size_m},
                  {"load_mesh_size_m", a.load_mesh_size_m},
                  {"outcome", a.outcome}});
+    if (!a.patches.empty()) j.back()["surface_patches"] = a.patches;
   }
   return j;
 }

@@ -535,6 +535,71 @@ PartSurface with_vertex_at(const PartSurface& s, const Eigen::Vector3d& p, doubl
 }
 
 // The tries of the mesh-part route (MeshOptions::fallback).
+// Whether every surface Gmsh's angle classification made of the current model (classifySurfaces
+// without its split into parametrizable patches) is planar: within 1e-9 of its own size, stricter
+// than Gmsh's own planarity test (1e-8 of the face's bounding box), so Gmsh maps each face by
+// projection whatever its holes. Gmsh 4.8's split instead cuts the closed part surface in two
+// before it looks at the feature edges, so the cut runs across faces along the triangles'
+// diagonals; on a long planar face (a CAD export's two triangles of a 1000 x 20 mm side) its nodes
+// lie 0.1-1 mm from the face's edge and leave slivers (min gamma 0.043 on the bench bar at 5 mm;
+// 0.221 without the split, and ccx's conjugate gradients need 20 iterations a solve instead of 53).
+// Curved faces keep the split: taken whole (as discs), fandisk.off's meshed worse (min gamma 0.015
+// against 0.168 at 2 mm).
+bool faces_all_planar() {
+  gmsh::vectorpair surfaces;
+  gmsh::model::getEntities(surfaces, 2);
+  if (surfaces.empty()) return false;
+  for (const auto& [dim, tag] : surfaces) {
+    std::vector<std::size_t> triangle_tags, corners;
+    gmsh::model::mesh::getElementsByType(2, triangle_tags, corners, tag);  // 2 = 3-node triangle
+    if (triangle_tags.empty()) return false;
+    std::vector<std::size_t> node_tags;
+    std::vector<double> xyz, par;
+    gmsh::model::mesh::getNodes(node_tags, xyz, par, 2, tag, true, false);
+    std::map<std::size_t, Eigen::Vector3d> at;
+    for (std::size_t i = 0; i < node_tags.size(); ++i) at[node_tags[i]] = {xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]};
+    Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+    for (std::size_t t = 0; t < triangle_tags.size(); ++t) {
+      for (std::size_t k = 0; k < 3; ++k) {
+        if (!at.count(corners[3 * t + k])) return false;
+      }
+      const Eigen::Vector3d &a = at[corners[3 * t]], &b = at[corners[3 * t + 1]], &c = at[corners[3 * t + 2]];
+      normal += (b - a).cross(c - a);
+    }
+    Eigen::Vector3d lo = at.begin()->second, hi = lo;
+    for (const auto& [v, p] : at) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+    const double diagonal = (hi - lo).norm(), nn = normal.norm();
+    // A closed or folded face has (almost) no net area vector: not planar.
+    if (!(diagonal > 0) || !(nn > 1e-6 * diagonal * diagonal)) return false;
+    const Eigen::Vector3d unit = normal / nn, origin = at.begin()->second;
+    for (const auto& [v, p] : at) {
+      if (!(std::abs((p - origin).dot(unit)) <= 1e-9 * diagonal)) return false;
+    }
+  }
+  return true;
+}
+
+// Gmsh's feature classification of the merged part, then its geometry: the faces as classified
+// when all are planar (above), else Gmsh's split into parametrizable patches. Returns whether the
+// split was used (the .geo repeats the choice).
+bool classify_part_surfaces(double feature_angle_rad, const fs::path& stl, const std::string& name) {
+  gmsh::model::mesh::classifySurfaces(feature_angle_rad, true, false, kPi);
+  if (faces_all_planar()) {
+    try {
+      gmsh::model::mesh::createGeometry();
+      return false;
+    } catch (const std::exception&) {
+      // Gmsh could not parametrize a face after all: the split below, as for any other part.
+    }
+  }
+  gmsh::clear();
+  gmsh::model::add(name);
+  gmsh::merge(stl.string());
+  gmsh::model::mesh::classifySurfaces(feature_angle_rad, true, true, kPi);
+  gmsh::model::mesh::createGeometry();
+  return true;
+}
+
 struct Try {
   bool own_triangles;
   int algorithm_2d;
@@ -582,6 +647,7 @@ MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& l
   std::size_t load_tag = 0;    // part triangles: the Gmsh node at the load point
   std::vector<int> probe_tags;
   std::string stl_written;     // which surface the STL copy holds now ("remeshed" / "part triangles")
+  bool split_patches = false;  // remeshed: Gmsh split the surface into parametrizable patches
 
   // Writes the STL copy the try merges (the .geo merges the same file).
   auto write_stl = [&](bool own) {
@@ -608,6 +674,7 @@ MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& l
     r.quality.mesh_size_m = h / kMmPerM;
     r.quality.load_mesh_size_m = h0 / kMmPerM;
     probe_tags.clear();
+    split_patches = false;
     write_stl(t.own_triangles);
     gmsh_step(where, "read part", [&] {
       gmsh::clear();
@@ -617,8 +684,7 @@ MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& l
     gmsh_step(where, t.own_triangles ? "volume" : "classify surfaces", [&] {
       std::vector<int> st;
       if (!t.own_triangles) {
-        gmsh::model::mesh::classifySurfaces(o.feature_angle_deg * kPi / 180.0, true, true, kPi);
-        gmsh::model::mesh::createGeometry();
+        split_patches = classify_part_surfaces(o.feature_angle_deg * kPi / 180.0, stl_copy, name);
       }
       gmsh::vectorpair surfs;
       gmsh::model::getEntities(surfs, 2);
@@ -691,6 +757,7 @@ MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& l
     try {
       MeshResult ri;
       mesh_try(t, ri);
+      if (!t.own_triangles) a.patches = split_patches ? "parametrizable patches" : "feature faces";
       if (o.fallback && ri.quality.min_gamma < o.quality_floor_gamma) {
         std::ostringstream m;
         m << "min gamma " << ri.quality.min_gamma << " below " << o.quality_floor_gamma;
@@ -723,7 +790,8 @@ MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& l
     mesh_try(tries[kept], r);
     attempts.push_back({tries[kept].own_triangles ? "part triangles" : "remeshed", tries[kept].algorithm_2d,
                         o.algorithm_3d, o.mesh_size_m * tries[kept].size_factor, r.quality.load_mesh_size_m,
-                        "kept: the best min gamma of the tries"});
+                        "kept: the best min gamma of the tries",
+                        tries[kept].own_triangles ? "" : (split_patches ? "parametrizable patches" : "feature faces")});
   }
   r.quality.attempts = attempts;
   gmsh_step(where, "write", [&] { write_msh(folder, name, o, r); });
@@ -741,7 +809,9 @@ MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& l
       << ", " << fmt(p_mm.y()) << ", " << fmt(p_mm.z()) << ") mm\n// (impactdeck writes it into the .msh files).\n"
       << "Surface Loop(1) = Surface{:};\nVolume(1) = {1};\n";
   } else {
-    g << "ClassifySurfaces{" << fmt(o.feature_angle_deg * kPi / 180.0) << ", 1, 1, " << fmt(kPi) << "};\n"
+    if (!split_patches) g << "// Every classified face is planar: no split into parametrizable patches.\n";
+    g << "ClassifySurfaces{" << fmt(o.feature_angle_deg * kPi / 180.0) << ", 1, " << (split_patches ? 1 : 0) << ", "
+      << fmt(kPi) << "};\n"
       << "CreateGeometry;\n"
       << "Surface Loop(1) = Surface{:};\nVolume(1) = {1};\n";
     g << "Point(" << kLoadPointTag << ") = {" << fmt(p_mm.x()) << ", " << fmt(p_mm.y()) << ", " << fmt(p_mm.z())

@@ -80,6 +80,9 @@ struct MeshAttempt {
   double mesh_size_m = 0;
   double load_mesh_size_m = 0;
   std::string outcome;  ///< "ok", or why this try was rejected (Gmsh's message, quality)
+  /// A remeshed try that meshed: "feature faces" (the faces of Gmsh's angle classification, all
+  /// planar) or "parametrizable patches" (Gmsh split the surface further); else empty.
+  std::string patches;
 };
 
 /// "Mesh.Algorithm 6, size 25 mm" / "part triangles, size 25 mm" / "analytic, size 250 mm".
