@@ -534,7 +534,6 @@ PartSurface with_vertex_at(const PartSurface& s, const Eigen::Vector3d& p, doubl
   return r;  // an open edge: the part is validated closed, so this does not happen
 }
 
-// The tries of the mesh-part route (MeshOptions::fallback).
 // Whether every surface Gmsh's angle classification made of the current model (classifySurfaces
 // without its split into parametrizable patches) is planar: within 1e-9 of its own size, stricter
 // than Gmsh's own planarity test (1e-8 of the face's bounding box), so Gmsh maps each face by
@@ -588,7 +587,7 @@ bool classify_part_surfaces(double feature_angle_rad, const fs::path& stl, const
     try {
       gmsh::model::mesh::createGeometry();
       return false;
-    } catch (const std::exception&) {
+    } catch (...) {  // Gmsh 4.8 throws strings as well as exceptions
       // Gmsh could not parametrize a face after all: the split below, as for any other part.
     }
   }
@@ -600,6 +599,7 @@ bool classify_part_surfaces(double feature_angle_rad, const fs::path& stl, const
   return true;
 }
 
+// The tries of the mesh-part route (MeshOptions::fallback).
 struct Try {
   bool own_triangles;
   int algorithm_2d;
