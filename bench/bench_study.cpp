@@ -104,9 +104,9 @@ void BM_PointSweep(benchmark::State& st) {
 }
 
 // The same points in groups (study::sweep_points: the kernel's steps over kKernelLanes points), in
-// chunks of 64 (run_sweep's smallest range; it hands out up to 4,096). Arg 0: every chunk into one 64-record buffer (stays in
-// cache); arg 1: into a whole result array as run_sweep writes it (the records' memory traffic
-// included).
+// chunks of 64 (run_sweep's smallest range; it hands out up to 4,096). Arg 0: every chunk into one
+// 64-record buffer (stays in cache); arg 1: into a whole result array as run_sweep writes it (the
+// records' memory traffic included).
 void BM_PointSweepGrouped(benchmark::State& st) {
   const study::SweepSetup s = setup();
   const scene::ContactModel model(s.target, s.impactor, s.rule, s.effective_modulus_Pa, s.restitution);

@@ -1,5 +1,7 @@
 #pragma once
-// Helpers shared by the FEM test files: a fresh output folder under the build tree, a file's text.
+// Helpers shared by the FEM test files: a fresh output folder under the build tree, a file's text,
+// a box as a CAD export writes it.
+#include <array>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -21,6 +23,30 @@ inline std::string slurp(const std::filesystem::path& p) {
   std::ostringstream s;
   s << in.rdbuf();
   return s.str();
+}
+
+/// The box [lo, hi] (file units) as an ASCII STL of 12 outward triangles: each face two triangles
+/// meeting along a diagonal, as a CAD export writes a box.
+inline void write_box_stl(const std::filesystem::path& p, const std::array<double, 3>& lo,
+                          const std::array<double, 3>& hi) {
+  const double x0 = lo[0], y0 = lo[1], z0 = lo[2], x1 = hi[0], y1 = hi[1], z1 = hi[2];
+  const double q[6][4][3] = {{{x0, y0, z0}, {x0, y0, z1}, {x0, y1, z1}, {x0, y1, z0}},
+                             {{x1, y0, z0}, {x1, y1, z0}, {x1, y1, z1}, {x1, y0, z1}},
+                             {{x0, y0, z0}, {x1, y0, z0}, {x1, y0, z1}, {x0, y0, z1}},
+                             {{x0, y1, z0}, {x0, y1, z1}, {x1, y1, z1}, {x1, y1, z0}},
+                             {{x0, y0, z0}, {x0, y1, z0}, {x1, y1, z0}, {x1, y0, z0}},
+                             {{x0, y0, z1}, {x1, y0, z1}, {x1, y1, z1}, {x0, y1, z1}}};
+  const int tri[2][3] = {{0, 1, 2}, {0, 2, 3}};
+  std::ofstream stl(p);
+  stl << "solid box\n";
+  for (const auto& f : q) {
+    for (const auto& t : tri) {
+      stl << "facet normal 0 0 0\nouter loop\n";
+      for (int k = 0; k < 3; ++k) stl << "vertex " << f[t[k]][0] << " " << f[t[k]][1] << " " << f[t[k]][2] << "\n";
+      stl << "endloop\nendfacet\n";
+    }
+  }
+  stl << "endsolid box\n";
 }
 
 }  // namespace impactdeck::test

@@ -2,7 +2,6 @@
 // failures that leave no deck, and a CalculiX run of the mesh-part (STL) deck with the checks.
 #include <gtest/gtest.h>
 
-#include <array>
 #include <cstdio>
 #include <fstream>
 #include <map>
@@ -629,21 +628,7 @@ TEST(FemMesh, FallbackTriesEachSettingInTurnAndKeepsTheBest) {
 // still gets the split.
 TEST(FemMesh, PlanarFacesAreKeptWholeAndCurvedClosedPartsAreSplit) {
   const fs::path d = fresh_dir("planar_faces");
-  {
-    const double L = 400, W = 20, H = 20;
-    auto v = [&](int i) { return Eigen::Vector3d((i & 4) ? L : 0, (i & 2) ? W : 0, (i & 1) ? H : 0); };
-    const int quads[6][4] = {{0, 1, 3, 2}, {4, 6, 7, 5}, {0, 4, 5, 1}, {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 5, 7, 3}};
-    std::ofstream stl(d / "bar.stl");
-    stl << "solid bar\n";
-    for (const auto& q : quads) {
-      for (const auto& t : {std::array<int, 3>{q[0], q[1], q[2]}, std::array<int, 3>{q[0], q[2], q[3]}}) {
-        stl << "facet normal 0 0 0\nouter loop\n";
-        for (int k : t) stl << "vertex " << v(k).x() << " " << v(k).y() << " " << v(k).z() << "\n";
-        stl << "endloop\nendfacet\n";
-      }
-    }
-    stl << "endsolid bar\n";
-  }
+  test::write_box_stl(d / "bar.stl", {0, 0, 0}, {400, 20, 20});
   const PartSurface bar = part_surface(d / "bar.stl", LengthUnit::mm);
   MeshOptions o;
   o.mesh_size_m = 0.005;

@@ -155,26 +155,7 @@ INSTANTIATE_TEST_SUITE_P(
 TEST(FemWave, MidLengthProbeSeesForceOverAreaAfterTheWaveTransit) {
   const fs::path out = fresh_dir("bar");
   const double L = 400, w = 20;  // mm
-  {
-    std::ofstream stl(out / "bar.stl");
-    const double h = w / 2;
-    const double q[6][4][3] = {{{0, -h, -h}, {0, -h, h}, {0, h, h}, {0, h, -h}},
-                               {{L, -h, -h}, {L, h, -h}, {L, h, h}, {L, -h, h}},
-                               {{0, -h, -h}, {L, -h, -h}, {L, -h, h}, {0, -h, h}},
-                               {{0, h, -h}, {0, h, h}, {L, h, h}, {L, h, -h}},
-                               {{0, -h, -h}, {0, h, -h}, {L, h, -h}, {L, -h, -h}},
-                               {{0, -h, h}, {L, -h, h}, {L, h, h}, {0, h, h}}};
-    const int tri[2][3] = {{0, 1, 2}, {0, 2, 3}};
-    stl << "solid bar\n";
-    for (const auto& f : q) {
-      for (const auto& t : tri) {
-        stl << "facet normal 0 0 0\nouter loop\n";
-        for (int k = 0; k < 3; ++k) stl << "vertex " << f[t[k]][0] << " " << f[t[k]][1] << " " << f[t[k]][2] << "\n";
-        stl << "endloop\nendfacet\n";
-      }
-    }
-    stl << "endsolid bar\n";
-  }
+  test::write_box_stl(out / "bar.stl", {0, -w / 2, -w / 2}, {L, w / 2, w / 2});
   const std::string fem =
       "mesh_size = 10\nend_time_s = 1e-4\ntime_step_s = 1e-6\nprobes = [[200, 0, 0]]\nrun = \"calculix\"\n";
   std::string text = part_scene("mm", (out / "bar.stl").string(), false, "-1, 0, 0", 10, 1, fem);

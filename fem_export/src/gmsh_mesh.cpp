@@ -559,11 +559,13 @@ bool faces_all_planar() {
     for (std::size_t i = 0; i < node_tags.size(); ++i) at[node_tags[i]] = {xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]};
     Eigen::Vector3d normal = Eigen::Vector3d::Zero();
     for (std::size_t t = 0; t < triangle_tags.size(); ++t) {
+      const Eigen::Vector3d* v[3];
       for (std::size_t k = 0; k < 3; ++k) {
-        if (!at.count(corners[3 * t + k])) return false;
+        const auto it = at.find(corners[3 * t + k]);
+        if (it == at.end()) return false;
+        v[k] = &it->second;
       }
-      const Eigen::Vector3d &a = at[corners[3 * t]], &b = at[corners[3 * t + 1]], &c = at[corners[3 * t + 2]];
-      normal += (b - a).cross(c - a);
+      normal += (*v[1] - *v[0]).cross(*v[2] - *v[0]);
     }
     Eigen::Vector3d lo = at.begin()->second, hi = lo;
     for (const auto& [v, p] : at) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
@@ -576,6 +578,13 @@ bool faces_all_planar() {
     }
   }
   return true;
+}
+
+// A fresh model `name` holding the part's STL copy (its triangles, not yet classified).
+void merge_part(const fs::path& stl, const std::string& name) {
+  gmsh::clear();
+  gmsh::model::add(name);
+  gmsh::merge(stl.string());
 }
 
 // Gmsh's feature classification of the merged part, then its geometry: the faces as classified
@@ -591,9 +600,7 @@ bool classify_part_surfaces(double feature_angle_rad, const fs::path& stl, const
       // Gmsh could not parametrize a face after all: the split below, as for any other part.
     }
   }
-  gmsh::clear();
-  gmsh::model::add(name);
-  gmsh::merge(stl.string());
+  merge_part(stl, name);
   gmsh::model::mesh::classifySurfaces(feature_angle_rad, true, true, kPi);
   gmsh::model::mesh::createGeometry();
   return true;
@@ -676,11 +683,7 @@ MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& l
     probe_tags.clear();
     split_patches = false;
     write_stl(t.own_triangles);
-    gmsh_step(where, "read part", [&] {
-      gmsh::clear();
-      gmsh::model::add(name);
-      gmsh::merge(stl_copy.string());
-    });
+    gmsh_step(where, "read part", [&] { merge_part(stl_copy, name); });
     gmsh_step(where, t.own_triangles ? "volume" : "classify surfaces", [&] {
       std::vector<int> st;
       if (!t.own_triangles) {
