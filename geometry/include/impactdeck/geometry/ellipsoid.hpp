@@ -2,6 +2,8 @@
 // Analytic ellipsoid x^2/a^2 + y^2/b^2 + z^2/c^2 = 1 centred at the origin of its frame (a sphere
 // when a = b = c). Exact volume, inertia, normal (Eq. 25), principal curvatures and the paper's
 // Eq. 26 averaged radius; closest point by a robust bisection on the Lagrange parameter.
+#include <array>
+
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/geometry/shape.hpp"
 
@@ -47,6 +49,11 @@ class Ellipsoid final : public Shape {
   Eigen::Vector3d inv_e2_;  ///< 1 / e_i^2, per-point invariants of the curvature
   double abc2_;             ///< (a b c)^2
   double inv_radius_;       ///< 1 / a (a sphere's curvature)
+  /// Eq. 26's section x_i = const (paper_radius_m), j = i + 1, k = i + 2 (mod 3): 1 / e_i,
+  /// (e_j / e_k)^2 and (e_k / e_j)^2, e_j e_k.
+  double inv_e_[3] = {};
+  std::array<double, 2> section_ratio2_[3] = {};
+  double section_axes_[3] = {};
 };
 
 /// Mean and Gaussian curvature of the ellipsoid at a surface point, closed forms (tests).
