@@ -213,7 +213,9 @@ Curvature Ellipsoid::curvature(const SurfacePoint& at) const {
   const double g2 = grad.squaredNorm(), inv_g = 1.0 / std::sqrt(g2);
   const Eigen::Vector3d n = grad * inv_g;
   const double K = 1.0 / (abc2_ * g2 * g2);
-  const Eigen::Vector3d t1 = n.unitOrthogonal(), t2 = n.cross(t1);
+  // t1 from the gradient (the same direction as n's): its square root and division run beside
+  // those of |g| instead of after them.
+  const Eigen::Vector3d t1 = grad.unitOrthogonal(), t2 = n.cross(t1);
   const double s11 = t1.cwiseProduct(t1).dot(inv2) * inv_g, s12 = t1.cwiseProduct(t2).dot(inv2) * inv_g,
                s22 = t2.cwiseProduct(t2).dot(inv2) * inv_g;
   c.k1_per_m = symmetric2_eigenvalues(s11, s12, s22).hi;
