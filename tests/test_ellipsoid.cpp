@@ -106,6 +106,7 @@ TEST(Ellipsoid, PaperRadiusEq26) {
 // Eq. 26 as the paper writes it, section by section: the ellipse x_i = p_i with semi-axes
 // alpha = e_j s, beta = e_k s, the parametric angle of p on it, R = (alpha^2 sin^2 g +
 // beta^2 cos^2 g)^(3/2) / (alpha beta). paper_radius_m uses a closed form of the same value.
+namespace {
 double paper_radius_parametric(const Eigen::Vector3d& e, const Eigen::Vector3d& p) {
   double sum = 0;
   int count = 0;
@@ -121,6 +122,7 @@ double paper_radius_parametric(const Eigen::Vector3d& e, const Eigen::Vector3d& 
   }
   return sum / count;
 }
+}  // namespace
 
 TEST(Ellipsoid, PaperRadiusClosedFormIsTheParametricOne) {
   // Both forms round differently (the parametric one through atan2, sin and cos): a few ulp per

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <map>
 #include <string>
 
@@ -34,13 +35,27 @@ std::map<int, ModelState>& models() {
   return m;
 }
 
-std::string last_gmsh_error() {
+std::string raw_last_gmsh_error() {
   std::string e;
   try {
     gmsh::logger::getLastError(e);
   } catch (...) {
   }
   return e;
+}
+
+// The error Gmsh logged for ensure_initialized's own probe of a finalized Gmsh ("Gmsh has not been
+// initialized"): Gmsh 4.8 keeps it as its last error after initialize, so a later step's failure
+// without a message of its own would be reported with it.
+std::string& probe_error() {
+  static std::string e;
+  return e;
+}
+
+// Gmsh's last logged error, unless it is the probe's.
+std::string last_gmsh_error() {
+  const std::string e = raw_last_gmsh_error();
+  return e == probe_error() ? std::string() : e;
 }
 
 // Runs a Gmsh step; whatever Gmsh throws becomes an InputError naming the file and step.
@@ -60,6 +75,7 @@ void ensure_initialized() {
   }
   if (!alive) {
     gmsh::initialize(0, nullptr, false);
+    probe_error() = raw_last_gmsh_error();
   }
   gmsh::option::setNumber("General.Terminal", 0);
   gmsh::option::setNumber("General.NumThreads", 1);
@@ -70,8 +86,21 @@ void import_into(const ModelState& st) {
   gmsh::option::setString("Geometry.OCCTargetUnit", "MM");
   gmsh::logger::start();
   gmsh::vectorpair out;
-  gmsh::model::occ::importShapes(st.file.string(), out, true);
-  gmsh::model::occ::synchronize();
+  try {
+    gmsh::model::occ::importShapes(st.file.string(), out, true);
+    gmsh::model::occ::synchronize();
+  } catch (const std::exception&) {
+    throw;
+  } catch (const std::string&) {
+    throw;
+  } catch (...) {
+    // OpenCASCADE's own exceptions (Standard_Failure) pass through Gmsh 4.8 unconverted, without a
+    // message we can read: say what failed instead of "unknown error".
+    throw InputError(st.file.string(), "read",
+                     "OpenCASCADE stopped with an error of its own while building the shapes (for example a "
+                     "solid without faces, whose bounding box is empty): the file is damaged or holds a shape "
+                     "OpenCASCADE cannot rebuild");
+  }
 }
 
 // Makes the part's model current, reading the file again when Gmsh lost it.
