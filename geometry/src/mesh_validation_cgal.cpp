@@ -289,7 +289,10 @@ ValidationReport validate_mesh(const TriangleMesh& m, const ValidationOptions& o
   r.consistently_oriented = r.orientation_conflicts == 0;
   side.join();
   r.degenerate_triangles = degenerate;
-  {
+  // The vertex fans on a second thread beside the shells and mass integrals below (they read the
+  // mesh and the edge table; the fans own the corner union-find, released when they are done).
+  std::size_t non_manifold_vertices = 0;
+  detail::SideTask fans(m.triangles.size() >= 20000, [&] {
     std::vector<int> fan_of_vertex(m.vertices_m.size(), -1);
     std::vector<char> counted(m.vertices_m.size(), 0);
     for (int c = 0; c < nc; ++c) {
@@ -298,13 +301,13 @@ ValidationReport validate_mesh(const TriangleMesh& m, const ValidationOptions& o
       if (fan_of_vertex[v] < 0) fan_of_vertex[v] = root;
       else if (fan_of_vertex[v] != root && !counted[v]) {
         counted[v] = 1;
-        ++r.non_manifold_vertices;
+        ++non_manifold_vertices;
       }
     }
-  }
+    std::vector<int>().swap(parent);
+  });
 
   // Shells, their signed volumes and nesting (winding number of one vertex w.r.t. the others).
-  std::vector<int>().swap(parent);
   ShellLabels shells = label_shells(m, records);
   if (out) out->edges = std::move(records);
   records = EdgeTable();
@@ -342,6 +345,9 @@ ValidationReport validate_mesh(const TriangleMesh& m, const ValidationOptions& o
     // the total signed volume.
     r.outward_oriented = r.consistently_oriented && mp.volume.volume_m3 > 0;
   }
+
+  fans.join();
+  r.non_manifold_vertices = non_manifold_vertices;
 
   if (opt.check_self_intersections) {
     r.self_intersections_checked = true;

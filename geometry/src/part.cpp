@@ -5,6 +5,7 @@
 
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/common/stage.hpp"
+#include "side_task.hpp"
 #include "text_mesh_readers.hpp"
 
 namespace impactdeck::geometry {
@@ -110,10 +111,14 @@ Part load_part(const std::filesystem::path& file, const PartOptions& opt) {
   if (!opt.build_surface_index) {
     // Only what a report needs; the mesh is released with this function.
     timed(part.stages, Stage::sharp_edges, [&] {
+      // The mean edge length on a second thread beside the count (a large mesh).
+      double mean_edge = 0;
+      detail::SideTask side(mesh.triangles.size() >= 20000, [&] { mean_edge = mesh.mean_edge_length_m(); });
       // The validation's edge table (a reversal above keeps its undirected edges and their faces).
       part.sharp_edges = count_sharp_edges(mesh, by.edges, opt.shape.sharp_angle_deg);
+      side.join();
       by.edges = EdgeTable();
-      part.mean_edge_length_m = mesh.mean_edge_length_m();
+      part.mean_edge_length_m = mean_edge;
     });
     part.stages_skipped.push_back(stage_name(Stage::curvature_index));
     return part;

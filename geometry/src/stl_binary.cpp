@@ -44,29 +44,41 @@ std::optional<LoadedMesh> read_binary_stl(const std::filesystem::path& file, con
   VertexIndex index(out.file_vertices / 4 + 16);
   const double to_m = metres_per(unit);
   std::vector<unsigned char> buf(kChunkTriangles * kTriangleBytes);
+  // A chunk's corners, converted and hashed first, so that the merge below can ask for the table
+  // slots (and then the vertices) of corners kSlotAhead and kVertexAhead ahead of the one it looks
+  // up: the lookups' memory waits overlap instead of following one another. The same ids, in the
+  // same order, as one lookup after the other.
+  constexpr std::size_t kSlotAhead = 32, kVertexAhead = 16;
+  std::vector<Eigen::Vector3d> corner(3 * kChunkTriangles);
+  std::vector<std::uint64_t> hash(3 * kChunkTriangles);
   for (std::size_t first = 0; first < count;) {
     const std::size_t n = std::min<std::size_t>(kChunkTriangles, count - first);
     if (std::fread(buf.data(), kTriangleBytes, n, f.get()) != n) {
       throw InputError(where, "triangle " + std::to_string(first), "cannot read the file (it changed while being read?)");
     }
-    for (std::size_t t = 0; t < n; ++t) {
-      const unsigned char* rec = buf.data() + t * kTriangleBytes + 12;  // after the normal
-      std::array<int, 3> tri{};
-      for (int k = 0; k < 3; ++k) {
-        float p[3];
-        std::memcpy(p, rec + 12 * k, sizeof p);
-        Eigen::Vector3d x(static_cast<double>(p[0]), static_cast<double>(p[1]), static_cast<double>(p[2]));
-        if (!x.allFinite()) {
-          // assimp numbers the vertices of a binary STL 3 f + k, in one mesh.
-          throw InputError(where, "vertex " + std::to_string(3 * (first + t) + k) + " of mesh 0",
-                           "coordinate is not a finite number");
-        }
-        x *= to_m;
-        bool inserted = false;
-        tri[k] = index.find_or_add(x, out.mesh.vertices_m, inserted);
-        if (!inserted) ++out.merged_vertices;
+    const std::size_t corners = 3 * n;
+    for (std::size_t c = 0; c < corners; ++c) {
+      const unsigned char* rec = buf.data() + (c / 3) * kTriangleBytes + 12 + 12 * (c % 3);  // after the normal
+      float p[3];
+      std::memcpy(p, rec, sizeof p);
+      Eigen::Vector3d x(static_cast<double>(p[0]), static_cast<double>(p[1]), static_cast<double>(p[2]));
+      if (!x.allFinite()) {
+        // assimp numbers the vertices of a binary STL 3 f + k, in one mesh.
+        throw InputError(where, "vertex " + std::to_string(3 * first + c) + " of mesh 0",
+                         "coordinate is not a finite number");
       }
-      out.mesh.triangles.push_back(tri);
+      corner[c] = x * to_m;
+      hash[c] = position_hash(corner[c]);
+    }
+    for (std::size_t c = 0; c < std::min(corners, kSlotAhead); ++c) index.prefetch_slot(hash[c]);
+    std::array<int, 3> tri{};
+    for (std::size_t c = 0; c < corners; ++c) {
+      if (c + kSlotAhead < corners) index.prefetch_slot(hash[c + kSlotAhead]);
+      if (c + kVertexAhead < corners) index.prefetch_vertex(hash[c + kVertexAhead], out.mesh.vertices_m);
+      bool inserted = false;
+      tri[c % 3] = index.find_or_add(corner[c], hash[c], out.mesh.vertices_m, inserted);
+      if (!inserted) ++out.merged_vertices;
+      if (c % 3 == 2) out.mesh.triangles.push_back(tri);
     }
     first += n;
   }

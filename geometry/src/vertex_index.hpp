@@ -33,8 +33,13 @@ class VertexIndex {
   }
   // Id of the vertex at x in `vertices`, appending it when new; `inserted` says which.
   int find_or_add(const Eigen::Vector3d& x, std::vector<Eigen::Vector3d>& vertices, bool& inserted) {
+    return find_or_add(x, position_hash(x), vertices, inserted);
+  }
+  // The same with x's position_hash computed beforehand (a reader that prefetches, below).
+  int find_or_add(const Eigen::Vector3d& x, std::uint64_t hash, std::vector<Eigen::Vector3d>& vertices,
+                  bool& inserted) {
     if (2 * (vertices.size() + 1) > slots_.size()) grow(vertices);
-    std::size_t i = position_hash(x) & mask_;
+    std::size_t i = hash & mask_;
     while (slots_[i] >= 0) {
       if (vertices[slots_[i]] == x) {
         inserted = false;
@@ -46,6 +51,25 @@ class VertexIndex {
     vertices.push_back(x);
     inserted = true;
     return slots_[i];
+  }
+
+  // Hints for a lookup a few corners ahead (a large mesh's table and vertices are far larger than
+  // the caches, and each lookup would otherwise wait for memory twice): the slot of `hash`, and
+  // once that is in cache, the vertex it holds. Only hints: the lookup does not depend on them.
+  void prefetch_slot(std::uint64_t hash) const {
+#if defined(__GNUC__)
+    __builtin_prefetch(&slots_[hash & mask_]);
+#else
+    (void)hash;
+#endif
+  }
+  void prefetch_vertex(std::uint64_t hash, const std::vector<Eigen::Vector3d>& vertices) const {
+#if defined(__GNUC__)
+    const int id = slots_[hash & mask_];
+    if (id >= 0) __builtin_prefetch(&vertices[static_cast<std::size_t>(id)]);
+#else
+    (void)hash, (void)vertices;
+#endif
   }
 
  private:
