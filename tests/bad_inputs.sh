@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Runs every case of tests/data/bad/cases.tsv through the CLI: the exit code must match, stderr
-# must be exactly one line matching the case's pattern, and the output folder must stay empty.
+# must be exactly one line matching the case's pattern, stdout must stay empty (`--json` readers
+# rely on it), and the output folder must stay empty.
 # A case expecting exit 0 (a tricky input that must be read correctly) must print nothing on
 # stderr instead, and its pattern must match a line of stdout. A `run` of a scene whose expected
 # message is about the scene itself (the pattern begins with the scene's file name) must begin with
@@ -36,6 +37,7 @@ while IFS=$'\t' read -r name args code pattern; do
     grep -Eq -- "$pattern" "$out.stdout" || problems="$problems no stdout line matches /$pattern/;"
   else
     [ "$lines" -eq 1 ] || problems="$problems $lines stderr lines (expected 1);"
+    [ ! -s "$out.stdout" ] || problems="$problems stdout not empty: $(head -c 80 "$out.stdout");"
     printf '%s' "$msg" | grep -Eq -- "$pattern" || problems="$problems message does not match /$pattern/;"
     # shellcheck disable=SC2086
     set -- $a

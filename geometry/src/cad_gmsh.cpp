@@ -10,7 +10,9 @@
 #include <algorithm>
 #include <cmath>
 #include <exception>
+#include <iostream>
 #include <map>
+#include <sstream>
 #include <string>
 
 #include "cad_plugin.hpp"
@@ -81,11 +83,38 @@ void ensure_initialized() {
   gmsh::option::setNumber("General.NumThreads", 1);
 }
 
-void import_into(const ModelState& st) {
+// OpenCASCADE's BREP reader writes its complaints ("Not a surface table") to std::cout, which is
+// the tool's own output (`--json`): while a file is imported they go to a string instead, which
+// the caller reports with the read's warnings or error.
+class CoutCapture {
+ public:
+  CoutCapture() : saved_(std::cout.rdbuf(text_.rdbuf())) {}
+  ~CoutCapture() { std::cout.rdbuf(saved_); }
+  CoutCapture(const CoutCapture&) = delete;
+  CoutCapture& operator=(const CoutCapture&) = delete;
+  /// The captured lines joined by "; " ("" when none).
+  std::string lines() const {
+    std::istringstream in(text_.str());
+    std::string line, all;
+    while (std::getline(in, line)) {
+      if (line.empty()) continue;
+      all += (all.empty() ? "" : "; ") + line;
+    }
+    return all;
+  }
+
+ private:
+  std::ostringstream text_;
+  std::streambuf* saved_;
+};
+
+// Reads the file into a new model; returns what OpenCASCADE wrote to std::cout meanwhile.
+std::string import_into(const ModelState& st) {
   gmsh::model::add(st.name);
   gmsh::option::setString("Geometry.OCCTargetUnit", "MM");
   gmsh::logger::start();
   gmsh::vectorpair out;
+  CoutCapture occt;
   try {
     gmsh::model::occ::importShapes(st.file.string(), out, true);
     gmsh::model::occ::synchronize();
@@ -101,6 +130,7 @@ void import_into(const ModelState& st) {
                      "solid without faces, whose bounding box is empty): the file is damaged or holds a shape "
                      "OpenCASCADE cannot rebuild");
   }
+  return occt.lines();
 }
 
 // Makes the part's model current, reading the file again when Gmsh lost it.
@@ -170,10 +200,12 @@ CadLoaded load_model(const fs::path& file, double unit_m, double mesh_size_relat
   out.model = model;
   const std::string where = file.string();
   models()[out.model] = st;
+  std::string occt_said;  // OpenCASCADE's own complaints while reading (usually none)
   gmsh_step(file, "read", [&] {
     ensure_initialized();
-    import_into(st);
+    occt_said = import_into(st);
   });
+  const std::string occt_note = occt_said.empty() ? "" : " (OpenCASCADE while reading: " + occt_said + ")";
   gmsh::vectorpair vols, faces, edges;
   double x0 = 0, y0 = 0, z0 = 0, size = 0;
   gmsh_step(file, "mass properties", [&] {
@@ -183,7 +215,7 @@ CadLoaded load_model(const fs::path& file, double unit_m, double mesh_size_relat
     out.solids = static_cast<int>(vols.size());
     if (vols.empty()) {
       throw InputError(where, "solids", "the file holds no solid (" + std::to_string(faces.size()) +
-                       " faces, none closing a volume): mass properties need a closed solid");
+                       " faces, none closing a volume): mass properties need a closed solid" + occt_note);
     }
     size = model_size(x0, y0, z0);
     // Mass properties about the part's centre of mass (summed over the solids: first moments,
@@ -224,6 +256,7 @@ CadLoaded load_model(const fs::path& file, double unit_m, double mesh_size_relat
     }
     out.volume.area_m2 = area * L * L;
   });
+  if (!occt_said.empty()) out.warnings.push_back(where + ": OpenCASCADE while reading: " + occt_said);
   if (out.solids > 1) {
     out.warnings.push_back(where + ": " + std::to_string(out.solids) +
                            " solids taken as one body (mass properties summed; overlaps would count twice)");
