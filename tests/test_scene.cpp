@@ -167,6 +167,17 @@ TEST(SceneText, NonAsciiOutsideStringsIsASyntaxErrorWithItsPlace) {
   expect_error(kBase + "x = \"caf\xc3\n", R"(line 21, column 9: TOML syntax error: Encountered invalid utf-8 sequence)");
 }
 
+TEST(Scene, IntegersADoubleCannotHoldAreReadAsTheNearestDouble) {
+  // toml++'s value<double>() has no value for such an integer; the reader used to throw
+  // bad_optional_access out of parse_scene (fuzz_scene, radius = 8888888888888888850).
+  const Scene s = parse_scene(replace(kBase, "radius = 50", "radius = 9007199254740993"), "big.toml");
+  EXPECT_EQ(s.bodies[1].radius_m, 9007199254740992.0 * 1e-3);  // 2^53 + 1 -> 2^53, then mm -> m
+  EXPECT_EQ(parse_scene(replace(kBase, "[0, -1, 0]", "[0, -9007199254740993, 0]"), "v.toml").bodies[1].velocity_m_s.y(),
+            -9007199254740992.0);
+  const Scene f = parse_scene(replace(kBase, "radius = 50", "radius = 8888888888888888850"), "fuzz.toml");
+  EXPECT_EQ(f.bodies[1].radius_m, 8888888888888888850.0 * 1e-3);
+}
+
 TEST(SceneErrors, NameFileLineKeyAndReason) {
   expect_error(replace(kBase, "youngs_modulus_Pa = 2.05e11", "youngs_modulus_Pa = -2e11"),
                R"(line 3, key 'materials\.steel\.youngs_modulus_Pa': must be > 0)");

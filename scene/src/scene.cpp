@@ -42,6 +42,14 @@ const BodySpec& Scene::body(const std::string& name) const {
 
 namespace {
 
+// The value of a TOML number node (is_number()) as a double: a float as it is, an integer rounded
+// to the nearest double. toml++'s value<double>() gives no value for an integer that a double
+// cannot hold exactly (8888888888888888850), which crashed the reader (found by fuzz_scene).
+double number_of(const toml::node& n) {
+  if (const auto* f = n.as_floating_point()) return f->get();
+  return static_cast<double>(n.as_integer()->get());
+}
+
 // Where the scene's text comes from, named by every error about it: the file (inside the caller's
 // context, e.g. a campaign case) and the --set overrides, so that an error about a value an
 // override set names the override ("--set KEY") instead of a line of the file.
@@ -98,7 +106,7 @@ class Reader {
     const toml::node* n = get(k);
     if (!n) return std::nullopt;
     if (!n->is_number()) fail(k, "must be a number, got " + type_name(*n));
-    const double v = n->value<double>().value() + 0.0;  // + 0.0: -0 is 0
+    const double v = number_of(*n) + 0.0;  // + 0.0: -0 is 0
     check_magnitude(k, v);
     return v;
   }
@@ -153,7 +161,7 @@ class Reader {
     for (int i = 0; i < 3; ++i) {
       const toml::node& e = *a->get(static_cast<std::size_t>(i));
       if (!e.is_number()) fail(k, "must be an array of 3 numbers, element " + std::to_string(i) + " is " + type_name(e));
-      v[i] = e.value<double>().value() + 0.0;
+      v[i] = number_of(e) + 0.0;
       check_magnitude(k, v[i]);
     }
     return v;
@@ -328,7 +336,7 @@ collision::RestitutionTable read_restitution_table(Reader& parent, const toml::t
     for (std::size_t i = 0; i < a->size(); ++i) {
       const toml::node* e = a->get(i);
       if (!e->is_number()) r.fail(k, "element " + std::to_string(i) + " must be a number");
-      const double v = e->value<double>().value();
+      const double v = number_of(*e);
       if (!std::isfinite(v)) r.fail(k, "element " + std::to_string(i) + " must be finite");
       out.push_back(v);
     }
@@ -372,7 +380,7 @@ ImpactSpec read_impact(std::size_t index, const toml::table& t, const Source& fi
       }
       s.restitution.kind = collision::RestitutionModel::Kind::energy_flux;
     } else if (n->is_number()) {
-      const double R = n->value<double>().value() + 0.0;
+      const double R = number_of(*n) + 0.0;
       if (!(R >= 0.0 && R <= 1.0)) r.fail("restitution", "must lie in [0, 1], got " + Reader::fmt(R));
       s.restitution.kind = collision::RestitutionModel::Kind::constant;
       s.restitution.constant = R;
@@ -426,7 +434,7 @@ FemOutputs read_fem(const toml::table& t, const Source& file, double to_m) {
   if (f.end_time_s / f.time_step_s > 2e6) r.fail("time_step_s", "more than 2e6 increments");
   if (r.has("max_elements")) f.max_elements = r.count("max_elements");
   if (const toml::node* n = r.get("pulse_increments"); n && !(n->is_string() && n->value<std::string>() == "auto")) {
-    const double v = n->is_number() ? n->value<double>().value() : -1.0;
+    const double v = n->is_number() ? number_of(*n) : -1.0;
     if (!(v >= 0 && v <= 1e6 && v == std::floor(v))) {
       r.fail("pulse_increments", "must be \"auto\" or a whole number in [0, 1e6]");
     }
@@ -442,7 +450,7 @@ FemOutputs read_fem(const toml::table& t, const Source& file, double to_m) {
       for (int k = 0; k < 3; ++k) {
         const toml::node* e = p->get(static_cast<std::size_t>(k));
         if (!e->is_number()) r.fail("probes", "element " + std::to_string(i) + " must hold 3 numbers");
-        v[k] = e->value<double>().value() + 0.0;
+        v[k] = number_of(*e) + 0.0;
         r.check_magnitude("probes", v[k], "element " + std::to_string(i) + ": ");
         v[k] *= to_m;
       }
