@@ -153,10 +153,12 @@ RunTransaction::RunTransaction(const fs::path& out_dir, std::string flag) : out_
       if (!S_ISDIR(st.st_mode)) throw InputError(where, flag_, "exists and is " + kind_of(st) + ", not a folder");
     } else if (errno == ENOTDIR) {
       throw InputError(where, flag_, "cannot create the output folder: Not a directory (a part of the path is a file)");
+    } else if (errno == ENOENT && ::lstat(out_.c_str(), &st) == 0) {
+      // There now: a dangling symbolic link, or a folder another run created since the stat above
+      // (two runs racing into a new --out; that run's folder is used below, as if it had been
+      // there all along).
+      if (S_ISLNK(st.st_mode)) throw InputError(where, flag_, "is a symbolic link to a folder that does not exist");
     } else if (errno == ENOENT) {
-      if (::lstat(out_.c_str(), &st) == 0) {
-        throw InputError(where, flag_, "is a symbolic link to a folder that does not exist");
-      }
       std::vector<fs::path> missing;
       fs::path p = out_;
       while (!p.empty() && ::stat(p.c_str(), &st) != 0 && errno == ENOENT) {
@@ -165,11 +167,14 @@ RunTransaction::RunTransaction(const fs::path& out_dir, std::string flag) : out_
         p = p.parent_path();
       }
       for (auto it = missing.rbegin(); it != missing.rend(); ++it) {
-        if (::mkdir(it->c_str(), 0777) != 0 && errno != EEXIST) {
+        if (::mkdir(it->c_str(), 0777) == 0) {
+          created_.push_back(*it);  // ours: rollback removes it again if it stays empty
+        } else if (errno != EEXIST) {
           throw InputError(where, flag_, "cannot create the output folder: " + errno_text(errno) + " ('" +
                                              it->string() + "')");
         }
-        created_.push_back(*it);
+        // EEXIST: another run created it meanwhile; it is not ours to remove (it may be about to
+        // stage its outputs there).
       }
     } else {
       throw InputError(where, flag_, "cannot use the output folder: " + errno_text(errno));
