@@ -606,6 +606,11 @@ bool classify_part_surfaces(double feature_angle_rad, const fs::path& stl, const
   return true;
 }
 
+// MeshAttempt::patches of a remeshed try that meshed (classify_part_surfaces' choice).
+const char* patches_word(bool split_patches) {
+  return split_patches ? "parametrizable patches" : "feature faces";
+}
+
 // The tries of the mesh-part route (MeshOptions::fallback).
 struct Try {
   bool own_triangles;
@@ -760,7 +765,7 @@ MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& l
     try {
       MeshResult ri;
       mesh_try(t, ri);
-      if (!t.own_triangles) a.patches = split_patches ? "parametrizable patches" : "feature faces";
+      if (!t.own_triangles) a.patches = patches_word(split_patches);
       if (o.fallback && ri.quality.min_gamma < o.quality_floor_gamma) {
         std::ostringstream m;
         m << "min gamma " << ri.quality.min_gamma << " below " << o.quality_floor_gamma;
@@ -794,7 +799,7 @@ MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& l
     attempts.push_back({tries[kept].own_triangles ? "part triangles" : "remeshed", tries[kept].algorithm_2d,
                         o.algorithm_3d, o.mesh_size_m * tries[kept].size_factor, r.quality.load_mesh_size_m,
                         "kept: the best min gamma of the tries",
-                        tries[kept].own_triangles ? "" : (split_patches ? "parametrizable patches" : "feature faces")});
+                        tries[kept].own_triangles ? "" : patches_word(split_patches)});
   }
   r.quality.attempts = attempts;
   gmsh_step(where, "write", [&] { write_msh(folder, name, o, r); });
