@@ -41,7 +41,7 @@ void register_inspect(CLI::App& app, Context& ctx) {
   cmd->callback([args, &ctx] {
     auto unit = parse_length_unit(args->unit);
     if (!unit) throw UsageError("--length-unit '" + args->unit + "': expected m, cm, mm or in" +
-                                        did_you_mean(args->unit, length_unit_names()));
+                                        length_unit_suggestion(args->unit));
     // > 0 and within [1e-100, 1e100] (numeric.hpp): mass and inertia then stay finite.
     if (args->density && !(*args->density > 0 && within_magnitude_range(*args->density)))
       throw UsageError("--density-kg-m3 must be > 0 and within 1e-100 .. 1e+100");

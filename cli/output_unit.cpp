@@ -14,7 +14,7 @@ void add_output_length_unit_option(CLI::App* cmd, std::string& text) {
 std::optional<LengthUnit> parse_output_length_unit(const std::string& text, const std::string& scene) {
   if (text.empty()) return std::nullopt;
   if (auto u = parse_length_unit(text)) return u;
-  throw InputError(scene, "--output-length-unit", "'" + text + "' is not a length unit: one of m, cm, mm, in");
+  throw InputError(scene, "--output-length-unit", "'" + text + "' is not a length unit: one of m, cm, mm, in" + length_unit_suggestion(text));
 }
 
 }  // namespace impactdeck::cli

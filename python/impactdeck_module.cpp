@@ -41,7 +41,7 @@ py::object to_python(const nlohmann::json& j) { return py::module_::import("json
 
 LengthUnit unit_of(const std::string& s) {
   const auto u = parse_length_unit(s);
-  if (!u) throw UsageError("length_unit '" + s + "': expected m, cm, mm or in");
+  if (!u) throw UsageError("length_unit '" + s + "': expected m, cm, mm or in" + length_unit_suggestion(s));
   return *u;
 }
 

@@ -54,6 +54,37 @@ TEST(Suggest, NearestNameOnlyForATypo) {
   EXPECT_EQ(did_you_mean("colour", {"mass_kg", "name"}), "");
 }
 
+// Issue 29: a unit spelled out ("--length-unit millimetre") is a unit the user meant, not a typo.
+TEST(Suggest, SpelledOutLengthUnitsNameTheirSymbol) {
+  EXPECT_EQ(length_unit_suggestion("millimetre"), "; did you mean 'mm'?");
+  EXPECT_EQ(length_unit_suggestion("Millimeters"), "; did you mean 'mm'?");
+  EXPECT_EQ(length_unit_suggestion("MM"), "; did you mean 'mm'?");
+  EXPECT_EQ(length_unit_suggestion("metres"), "; did you mean 'm'?");
+  EXPECT_EQ(length_unit_suggestion("centimeter"), "; did you mean 'cm'?");
+  EXPECT_EQ(length_unit_suggestion("inches"), "; did you mean 'in'?");
+  EXPECT_EQ(length_unit_suggestion("Inch"), "; did you mean 'in'?");
+  EXPECT_EQ(length_unit_suggestion("mmm"), "; did you mean 'mm'?");  // a near miss, as did_you_mean
+  EXPECT_EQ(length_unit_suggestion("furlong"), "");
+  EXPECT_EQ(length_unit_suggestion(""), "");
+}
+
+// Issue 29: a mesh declared in the wrong unit (a 50 mm steel part read as 0.05 mm) is said, with the
+// unit that makes it plausible.
+TEST(Suggest, ImplausiblePartSizeNamesThePlausibleUnit) {
+  const std::string small = implausible_size_warning(5e-5, LengthUnit::mm);  // numbers 0.05, read in mm
+  EXPECT_NE(small.find("0.05 mm across, implausibly small"), std::string::npos) << small;
+  EXPECT_NE(small.find("in m it would be 50 mm across"), std::string::npos) << small;
+  const std::string large = implausible_size_warning(250.0, LengthUnit::m);  // numbers 250, read in m
+  EXPECT_NE(large.find("implausibly large"), std::string::npos) << large;
+  EXPECT_NE(large.find("in mm it would be 250 mm across"), std::string::npos) << large;
+  EXPECT_EQ(implausible_size_warning(0.2, LengthUnit::mm), "");       // a 200 mm part
+  EXPECT_EQ(implausible_size_warning(kPlausiblePartSizeMin_m, LengthUnit::mm), "");
+  // 1e-9 m in mm: no unit makes it plausible; the warning says so without a suggestion.
+  const std::string none = implausible_size_warning(1e-9, LengthUnit::mm);
+  EXPECT_NE(none.find("implausibly small"), std::string::npos);
+  EXPECT_EQ(none.find("it would be"), std::string::npos) << none;
+}
+
 TEST(CsvSidecar, UnitsFromColumnNames) {
   EXPECT_EQ(csv_column_unit("time_s"), "s");
   EXPECT_EQ(csv_column_unit("force_N"), "N");

@@ -502,3 +502,24 @@ TEST(FileErrors, LinesAreIgnoredWithAWarningAndSelfIntersectionsAreFound) {
   for (const auto& w : p.warnings) said = said || w.find("not checked") != std::string::npos;
   EXPECT_TRUE(said);
 }
+
+// Issue 29: --repair on a part it cannot make solid says what it did and what is left, instead of
+// asking for --repair again.
+TEST(Part, RepairThatCannotCloseThePartSaysWhatItDid) {
+  PartOptions opt;
+  opt.length_unit = LengthUnit::mm;
+  opt.repair = true;
+  const std::string msg = [&] {
+    try {
+      load_part(data("open_cube.off"), opt);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  }();
+  EXPECT_EQ(msg.find("rerun with --repair"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("after --repair (it "), std::string::npos) << msg;
+  EXPECT_NE(msg.find("--accept-approximate"), std::string::npos) << msg;
+  opt.repair = false;
+  expect_input_error([&] { load_part(data("open_cube.off"), opt); }, "rerun with --repair");
+}

@@ -34,6 +34,18 @@ const std::vector<std::string>& part_stages() {
   return names;
 }
 
+namespace {
+
+// What --repair did, for the messages about what it could not fix.
+std::string repairs_text(const RepairLog& log) {
+  if (log.actions.empty()) return "it changed nothing";
+  std::string t = "it did: ";
+  for (std::size_t i = 0; i < log.actions.size(); ++i) t += (i ? "; " : "") + log.actions[i];
+  return t;
+}
+
+}  // namespace
+
 Part load_part(const std::filesystem::path& file, const PartOptions& opt) {
   Part part;
   part.file = file;
@@ -41,6 +53,14 @@ Part load_part(const std::filesystem::path& file, const PartOptions& opt) {
   part.loaded = timed(part.stages, Stage::mesh_load, [&] { return load_mesh(file, opt.length_unit); });
   detail::check_part_extent(part.loaded, where);  // size range, memory for the stages below
   part.warnings = part.loaded.warnings;
+  {
+    const auto& v = part.loaded.mesh.vertices_m;
+    Eigen::Vector3d lo = v.empty() ? Eigen::Vector3d::Zero() : v.front(), hi = lo;
+    for (const auto& p : v) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+    if (std::string w = implausible_size_warning((hi - lo).norm(), opt.length_unit); !w.empty()) {
+      part.warnings.push_back(where + ": " + w);
+    }
+  }
   TriangleMesh mesh = std::move(part.loaded.mesh);
   part.loaded.mesh = TriangleMesh();
 
@@ -73,17 +93,23 @@ Part load_part(const std::filesystem::path& file, const PartOptions& opt) {
     } else {
       s << "the surface is oriented inward (negative signed volume)";
     }
-    s << "; rerun with --repair (scene: repair = true) to orient it outward";
+    if (opt.repair) {
+      s << " after --repair (" << repairs_text(part.repairs) << "), which could not orient it outward";
+    } else {
+      s << "; rerun with --repair (scene: repair = true) to orient it outward";
+    }
     throw InputError(where, "orientation", s.str());
   }
   if (!report.valid_solid()) {
     part.approximation_reason = report.approximation_reason();
     if (!opt.accept_approximate_mass) {
+      const std::string fix = opt.repair ? "; this is what is left after --repair (" + repairs_text(part.repairs) +
+                                               "): accept the approximation with --accept-approximate (scene: "
+                                               "approximate_mass_properties = true)"
+                                         : "; rerun with --repair, or accept the approximation with "
+                                           "--accept-approximate (scene: approximate_mass_properties = true)";
       throw InputError(where, "mass properties",
-                       part.approximation_reason +
-                           ": volume, mass and inertia would be approximate; rerun with --repair, or "
-                           "accept the approximation with --accept-approximate (scene: "
-                           "approximate_mass_properties = true)");
+                       part.approximation_reason + ": volume, mass and inertia would be approximate" + fix);
     }
     part.approximate_mass = true;
     part.warnings.push_back(where + ": APPROXIMATE mass properties: " + part.approximation_reason);

@@ -590,7 +590,7 @@ Scene build(const toml::table& root, const Source& file, const fs::path& base_di
   auto unit = parse_length_unit(unit_text);
   if (!unit)
     r.fail("length_unit", "unknown unit \"" + unit_text + "\" (expected m, cm, mm or in)" +
-                              did_you_mean(unit_text, length_unit_names()));
+                              length_unit_suggestion(unit_text));
   sc.length_unit = *unit;
   const double to_m = metres_per(*unit);
 
