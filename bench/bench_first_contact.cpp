@@ -12,12 +12,13 @@
 
 #include "impactdeck/geometry/ellipsoid.hpp"
 #include "impactdeck/geometry/ellipsoid_mesh.hpp"
-#include "impactdeck/geometry/first_contact.hpp"
+#include "impactdeck/contact/first_contact.hpp"
 #include "impactdeck/geometry/mass_properties.hpp"
 #include "impactdeck/geometry/mesh_shape.hpp"
 #include "impactdeck/geometry/plane.hpp"
 
 using namespace impactdeck::geometry;
+using namespace impactdeck::contact;
 using Clock = std::chrono::steady_clock;
 
 namespace {

@@ -20,8 +20,8 @@ study::SweepSetup setup() {
   study::SweepSetup s;
   auto target = std::make_shared<geometry::Ellipsoid>(2.0, 0.5, 0.5);
   auto ball = std::make_shared<geometry::Ellipsoid>(geometry::Ellipsoid::sphere(0.05));
-  s.target = scene::body_of_mass("target", target, 7850 * target->volume_properties().volume_m3);
-  s.impactor = scene::body_of_mass("ball", ball, 7850 * ball->volume_properties().volume_m3);
+  s.target = contact::body_of_mass("target", target, 7850 * target->volume_properties().volume_m3);
+  s.impactor = contact::body_of_mass("ball", ball, 7850 * ball->volume_properties().volume_m3);
   s.rule = collision::ContactRule::paper;
   s.effective_modulus_Pa = 1.025e11;
   s.approach_speed_m_s = 1.0;
@@ -62,7 +62,7 @@ void BM_PointCurvature(benchmark::State& st) {
 }
 void BM_PointContact(benchmark::State& st) {
   const study::SweepSetup s = setup();
-  const scene::ContactModel model(s.target, s.impactor, s.rule, s.effective_modulus_Pa, s.restitution);
+  const contact::ContactModel model(s.target, s.impactor, s.rule, s.effective_modulus_Pa, s.restitution);
   const auto& c = cloud();
   for (auto _ : st) {
     for (const auto& p : c) benchmark::DoNotOptimize(model.at_surface_point(p, s.approach_speed_m_s).result.max_force_N);
@@ -73,7 +73,7 @@ void BM_PointContact(benchmark::State& st) {
 // (solve_kernel(KernelInput)); arg 1: the grouped form (kKernelLanes points per step).
 void BM_PointKernel(benchmark::State& st) {
   const study::SweepSetup s = setup();
-  const scene::ContactModel model(s.target, s.impactor, s.rule, s.effective_modulus_Pa, s.restitution);
+  const contact::ContactModel model(s.target, s.impactor, s.rule, s.effective_modulus_Pa, s.restitution);
   const auto& c = cloud();
   std::vector<collision::KernelInput> inputs;
   for (std::size_t i = 0; i < c.size(); i += 16) inputs.push_back(model.at_surface_point(c[i], s.approach_speed_m_s).input);
@@ -95,7 +95,7 @@ void BM_PointKernel(benchmark::State& st) {
 }
 void BM_PointSweep(benchmark::State& st) {
   const study::SweepSetup s = setup();
-  const scene::ContactModel model(s.target, s.impactor, s.rule, s.effective_modulus_Pa, s.restitution);
+  const contact::ContactModel model(s.target, s.impactor, s.rule, s.effective_modulus_Pa, s.restitution);
   const auto& c = cloud();
   for (auto _ : st) {
     for (const auto& p : c) benchmark::DoNotOptimize(study::sweep_point(model, s.approach_speed_m_s, p).max_force_N);
@@ -109,7 +109,7 @@ void BM_PointSweep(benchmark::State& st) {
 // records' memory traffic included).
 void BM_PointSweepGrouped(benchmark::State& st) {
   const study::SweepSetup s = setup();
-  const scene::ContactModel model(s.target, s.impactor, s.rule, s.effective_modulus_Pa, s.restitution);
+  const contact::ContactModel model(s.target, s.impactor, s.rule, s.effective_modulus_Pa, s.restitution);
   const auto& c = cloud();
   const bool whole_array = st.range(0) != 0;
   std::vector<study::PointResult> out(whole_array ? c.size() : 64);

@@ -212,7 +212,7 @@ double hertz_axis_von_mises(double zeta, double nu) {
   return std::abs(sz - sr);
 }
 
-void contact(const fs::path& work, const fs::path& figs) {
+void contact_study(const fs::path& work, const fs::path& figs) {
   std::printf("## 3. Point against Hertz-patch load near the contact\n\n");
   // The quasi-static Hertz maximum on the axis.
   double zmax = 0, vmax = 0;
@@ -316,7 +316,7 @@ int main(int argc, char** argv) {
   try {
     if (want("wave")) wave(work, figs);
     if (want("convergence")) convergence(src, work);
-    if (want("contact")) contact(work, figs);
+    if (want("contact")) contact_study(work, figs);
   } catch (const Error& e) {
     std::fprintf(stderr, "validation_fem: %s\n", e.what());
     return 1;

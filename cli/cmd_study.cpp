@@ -17,7 +17,7 @@
 #include "impactdeck/geometry/ellipsoid.hpp"
 #include "impactdeck/plot/drawing.hpp"
 #include "impactdeck/scene/scene.hpp"
-#include "impactdeck/study/scene_sweep.hpp"
+#include "impactdeck/scene/sweep_case.hpp"
 #include "impactdeck/study/progress.hpp"
 #include "impactdeck/study/sweep_command.hpp"
 #include "impactdeck/study/table1.hpp"
@@ -131,7 +131,7 @@ void register_study(CLI::App& app, Context& ctx) {
       else if (a->stretch_axis == "y") axis = 1;
       else if (a->stretch_axis == "z") axis = 2;
       else throw UsageError("--stretch-axis: expected x, y or z, got \"" + a->stretch_axis + "\"");  // one letter: no "did you mean"
-      o.scene = study::table1_scene_from(scene::load_scene(a->scene, overrides_from(a->set)), a->impact, axis);
+      o.scene = scene::table1_scene(scene::load_scene(a->scene, overrides_from(a->set)), a->impact, axis);
     }
     // --cloud as sweep's (study::parse_cloud_kind); no --cloud: the preset's on the paper's
     // ellipsoid, "auto" on a scene's target (grid on an ellipsoid, else area-uniform).

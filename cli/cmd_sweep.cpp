@@ -11,6 +11,7 @@
 #include "set_option.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/scene/scene.hpp"
+#include "impactdeck/scene/sweep_case.hpp"
 #include "impactdeck/study/progress.hpp"
 #include "impactdeck/study/sweep_command.hpp"
 
@@ -95,7 +96,7 @@ void register_sweep(CLI::App& app, Context& ctx) {
         write_bar.update(done, total);
       }
     };
-    const study::SweepReport rep = study::run_sweep_command(sc, q);
+    const study::SweepReport rep = study::run_sweep_command(scene::sweep_case(sc, q.impact), q);
     sweep_bar.finish();
     write_bar.finish();
     for (const auto& [stage, seconds] : rep.stage_times_s) {

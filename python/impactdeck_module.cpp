@@ -28,7 +28,7 @@
 #include "impactdeck/scene/pipeline.hpp"
 #include "impactdeck/scene/report.hpp"
 #include "impactdeck/study/cloud.hpp"
-#include "impactdeck/study/scene_sweep.hpp"
+#include "impactdeck/scene/sweep_case.hpp"
 #include "impactdeck/study/sweep_command.hpp"
 
 namespace py = pybind11;
@@ -404,7 +404,7 @@ PYBIND11_MODULE(impactdeck, m) {
           q.grid_steps = grid_steps;
           q.max_points = std::numeric_limits<std::size_t>::max();  // a script sizes its own sweep
           q.sweep.threads = threads;
-          r = study::run_sweep_command(sc, q).result;
+          r = study::run_sweep_command(scene::sweep_case(sc, impact), q).result;
         }
         const std::size_t N = r.points.size();
         py::array_t<double> point({N, std::size_t{3}}), normal({N, std::size_t{3}});

@@ -11,7 +11,7 @@
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/scene/scene.hpp"
 #include "impactdeck/study/cloud.hpp"
-#include "impactdeck/study/scene_sweep.hpp"
+#include "impactdeck/scene/sweep_case.hpp"
 #include "impactdeck/study/sweep_output.hpp"
 
 namespace fs = std::filesystem;
@@ -37,13 +37,13 @@ int main(int argc, char** argv) {
     fs::create_directories(out);
     {
       const scene::Scene sc = scene::load_scene(src / "samples" / "fig4_sweep.toml");
-      const study::SceneSweep ss = study::sweep_from_scene(sc);
+      const study::SweepCase ss = scene::sweep_case(sc);
       const auto cloud = study::make_cloud(*ss.setup.target.shape, study::CloudKind::both, 8, 500, 3);
       write(out, "ellipsoid", study::run_sweep(ss.setup, cloud));
     }
     {
       const scene::Scene sc = scene::load_scene(src / "tests" / "data" / "bad" / "scenes" / "mesh_sharp_edge.toml");
-      const study::SceneSweep ss = study::sweep_from_scene(sc);
+      const study::SweepCase ss = scene::sweep_case(sc);
       auto cloud = study::make_cloud(*ss.setup.target.shape, study::CloudKind::vertices, 8, 0, 1);
       const auto faces = study::make_cloud(*ss.setup.target.shape, study::CloudKind::area_uniform, 8, 200, 5);
       cloud.insert(cloud.end(), faces.begin(), faces.end());

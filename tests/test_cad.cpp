@@ -19,7 +19,7 @@
 #include "impactdeck/scene/pipeline.hpp"
 #include "impactdeck/scene/scene.hpp"
 #include "impactdeck/study/cloud.hpp"
-#include "impactdeck/study/scene_sweep.hpp"
+#include "impactdeck/scene/sweep_case.hpp"
 #include "impactdeck/common/numeric.hpp"
 #include "expect_error.hpp"
 #include "tolerances.hpp"
@@ -423,7 +423,7 @@ TEST(Cad, SweepOverACadTargetOnTwoThreads) {
   mean.replace(mean.find("\"elliptical\""), 12, "\"mean\"");
   mean.replace(mean.find("[30, 20, 35.70714214271425]"), 27, "[20, 0, 30]");
   const scene::Scene sc = scene::parse_scene(mean, "sweep");
-  const study::SceneSweep ss = study::sweep_from_scene(sc);
+  const study::SweepCase ss = scene::sweep_case(sc);
   const auto cloud = study::make_cloud(*ss.setup.target.shape, study::CloudKind::area_uniform, 8, 120, 5);
   study::SweepOptions one, two;
   one.threads = 1;

@@ -202,7 +202,10 @@ TEST(FemWave, MidLengthProbeSeesForceOverAreaAfterTheWaveTransit) {
   const auto& v = y.stress->verdict;
   EXPECT_EQ(v.kind, fem_export::VerdictKind::yields);
   EXPECT_NEAR(v.governing.von_mises_Pa, 2 * yield, 1e-6 * yield);
-  EXPECT_EQ(v.governing.point_m, st.outside_zone.point_m);
+  // `run` checks the mesh as meshed (in memory), fem-check the mesh as mesh.inp prints it: 12
+  // significant digits per coordinate, so the same node within 1e-12 of the bar's length.
+  constexpr double kInpDigitsRel = 1e-12;
+  EXPECT_LT((v.governing.point_m - st.outside_zone.point_m).norm(), kInpDigitsRel * 0.4);
   EXPECT_EQ(v.governing.time_s, st.outside_zone.time_s);
   ASSERT_TRUE(v.first_yield_time_s.has_value());
   EXPECT_LE(*v.first_yield_time_s, v.governing.time_s);

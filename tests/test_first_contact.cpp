@@ -15,7 +15,7 @@
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/geometry/ellipsoid.hpp"
 #include "impactdeck/geometry/ellipsoid_mesh.hpp"
-#include "impactdeck/geometry/first_contact.hpp"
+#include "impactdeck/contact/first_contact.hpp"
 #include "impactdeck/geometry/mass_properties.hpp"
 #include "impactdeck/geometry/mesh_io.hpp"
 #include "impactdeck/geometry/mesh_shape.hpp"
@@ -25,6 +25,7 @@
 
 using namespace impactdeck;
 using namespace impactdeck::geometry;
+using namespace impactdeck::contact;
 using impactdeck::test::sci;
 using Eigen::Vector3d;
 

@@ -19,6 +19,7 @@
 
 using namespace impactdeck;
 using namespace impactdeck::scene;
+using namespace impactdeck::contact;
 namespace fs = std::filesystem;
 
 namespace {
@@ -288,7 +289,7 @@ struct PlacedEllipsoid {
 // the entry of the ray s d into D = T - I is s* = max over u (d.u < 0) of h_D(u)/(d.u), with
 // h_D(u) = h_T(u) + h_I(-u). With u = -d + x e1 + y e2 this is min over (x, y) of the convex
 // h_D(u), whose gradient in u is p_T(u) - p_I(-u): Newton on the 2-D gradient (Hessian by central
-// differences of the exact gradient). Written independently of geometry::first_contact.
+// differences of the exact gradient). Written independently of contact::first_contact.
 struct SeparatingPlane {
   Eigen::Vector3d normal, point;
   double travel;

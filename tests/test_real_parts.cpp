@@ -12,7 +12,7 @@
 #include "impactdeck/scene/pipeline.hpp"
 #include "impactdeck/scene/scene.hpp"
 #include "impactdeck/study/cloud.hpp"
-#include "impactdeck/study/scene_sweep.hpp"
+#include "impactdeck/scene/sweep_case.hpp"
 #include "impactdeck/study/sweep.hpp"
 
 namespace impactdeck::study {
@@ -65,7 +65,7 @@ TEST(RealParts, SweepsFlagAndGoOnOverConcaveParts) {
                             PartCase{"cgal_joint.off", 0.1}}) {
     SCOPED_TRACE(c.file);
     const scene::Scene sc = scene::parse_scene(part_scene(c.file, c.ball_mm), "part.toml");
-    const SceneSweep ss = sweep_from_scene(sc);
+    const SweepCase ss = scene::sweep_case(sc);
     const auto cloud = area_uniform_cloud(*ss.setup.target.shape, 4000, 7);
     SweepResult r;
     ASSERT_NO_THROW(r = run_sweep(ss.setup, cloud));
@@ -92,7 +92,7 @@ bool same(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
 TEST(RealParts, RunAndSweepAreBitIdenticalAtAThousandPoints) {
   const scene::Scene base = scene::parse_scene(part_scene("cgal_anchor.off", 0.15), "anchor.toml");
-  const SceneSweep ss = sweep_from_scene(base);
+  const SweepCase ss = scene::sweep_case(base);
   // 1000 points near the surface in the part's own frame, through a CSV as a user would give them.
   const auto samples = area_uniform_cloud(*ss.setup.target.shape, 1000, 99);
   const fs::path csv = fs::temp_directory_path() / "impactdeck_anchor_points.csv";

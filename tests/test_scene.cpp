@@ -140,7 +140,7 @@ TEST(Scene, AnalyticSceneRunsOnlyWhatItNeeds) {
   }
 }
 
-// Non-ASCII text reaches toml++ as ASCII (scene/src/toml_ascii.hpp: toml++ 3.3.0 has undefined
+// Non-ASCII text reaches toml++ as ASCII (scene/toml_ascii.hpp: toml++ 3.3.0 has undefined
 // behaviour on most non-ASCII code points where it tests for whitespace). The values must be the
 // ones TOML gives: names in basic, literal and multi-line strings, comments, keys.
 TEST(SceneText, NonAsciiStringsKeepTheirValue) {

@@ -24,7 +24,7 @@
 #include "impactdeck/scene/scene.hpp"
 #include "impactdeck/study/cloud.hpp"
 #include "impactdeck/study/progress.hpp"
-#include "impactdeck/study/scene_sweep.hpp"
+#include "impactdeck/scene/sweep_case.hpp"
 #include "impactdeck/study/sweep.hpp"
 #include "impactdeck/study/table1.hpp"
 #include "parallel.hpp"  // study/src: the sweep's work hand-out
@@ -171,8 +171,8 @@ SweepSetup ellipsoid_setup(double mu = 1.0) {
   auto target = std::make_shared<geometry::Ellipsoid>(2.0, 0.5, 0.5);
   auto ball = std::make_shared<geometry::Ellipsoid>(geometry::Ellipsoid::sphere(0.05));
   const double m2 = 7850 * ball->volume_properties().volume_m3, m1 = mu * m2;
-  s.target = scene::body_of_mass("target", target, m1);
-  s.impactor = scene::body_of_mass("ball", ball, m2);
+  s.target = contact::body_of_mass("target", target, m1);
+  s.impactor = contact::body_of_mass("ball", ball, m2);
   s.rule = collision::ContactRule::paper;
   s.effective_modulus_Pa = 1.0e11;
   s.approach_speed_m_s = 3.0;
@@ -399,7 +399,7 @@ contact_radius = "RULE"
     std::string with_point = probe;
     with_point.replace(with_point.find("POINT"), 5, "0, 500, 0");
     const scene::Scene sc0 = scene::parse_scene(with_point, "kernel.toml");
-    const SceneSweep ss = sweep_from_scene(sc0);
+    const SweepCase ss = scene::sweep_case(sc0);
     const auto cloud = make_cloud(*ss.setup.target.shape, CloudKind::area_uniform, 8, 25, 11);
     for (const auto& sp : cloud) {
       std::string s = probe;
@@ -409,7 +409,7 @@ contact_radius = "RULE"
       s.replace(s.find("POINT"), 5, buf);
       const scene::Scene sc = scene::parse_scene(s, "kernel.toml");
       const scene::RunReport rep = scene::run_scene(sc);
-      const scene::ContactModel model(ss.setup.target, ss.setup.impactor, ss.setup.rule,
+      const contact::ContactModel model(ss.setup.target, ss.setup.impactor, ss.setup.rule,
                                       ss.setup.effective_modulus_Pa, ss.setup.restitution);
       const PointResult p = sweep_point(model, ss.setup.approach_speed_m_s, sp);
       const auto& res = rep.impacts.at(0).result;
@@ -539,9 +539,9 @@ contact_radius = "RULE"
       text.replace(text.find("RULE"), 4, rule);
       const scene::Scene sc =
           scene::parse_scene(text, "lean.toml", std::filesystem::path(IMPACTDECK_SOURCE_DIR) / "tests" / "data");
-      const SceneSweep ss = sweep_from_scene(sc);
+      const SweepCase ss = scene::sweep_case(sc);
       const SweepSetup& s = ss.setup;
-      const scene::ContactModel model(s.target, s.impactor, s.rule, s.effective_modulus_Pa, s.restitution);
+      const contact::ContactModel model(s.target, s.impactor, s.rule, s.effective_modulus_Pa, s.restitution);
       auto cloud = make_cloud(*s.target.shape, CloudKind::area_uniform, 8, 400, 13);
       if (c.expect_flagged) {  // a mesh's vertices: its corners are sharp
         const auto corners = make_cloud(*s.target.shape, CloudKind::vertices, 8, 0, 0);
@@ -593,7 +593,7 @@ contact_radius = "RULE"
         each.push_back(lean);
 
         // The same point through the full evaluation.
-        const scene::ContactEvaluation e = model.at_surface_point(sp, s.approach_speed_m_s);
+        const contact::ContactEvaluation e = model.at_surface_point(sp, s.approach_speed_m_s);
         const collision::KernelResult& k = e.result;
         PointResult full;
         full.point_m = sp.point_m;
@@ -697,7 +697,7 @@ TEST(Sweep, BadInputIsOneLineWithThePlace) {
 TEST(Sweep, SceneSetupErrorsNameTheScene) {
   const scene::Scene sc = scene::load_scene(std::string(IMPACTDECK_SOURCE_DIR) + "/samples/fig4_sweep.toml");
   try {
-    sweep_from_scene(sc, "nope");
+    scene::sweep_case(sc, "nope");
     FAIL() << "no throw";
   } catch (const InputError& e) {
     const std::string m = e.what();
@@ -705,8 +705,8 @@ TEST(Sweep, SceneSetupErrorsNameTheScene) {
     EXPECT_NE(m.find("no impact named 'nope'"), std::string::npos) << m;
     EXPECT_NE(m.find("'fig4'"), std::string::npos) << m;
   }
-  const SceneSweep ss = sweep_from_scene(sc);
-  EXPECT_EQ(ss.impact->name, "fig4");
+  const SweepCase ss = scene::sweep_case(sc);
+  EXPECT_EQ(ss.impact, "fig4");
   EXPECT_DOUBLE_EQ(ss.setup.approach_speed_m_s, 1.0);
 }
 

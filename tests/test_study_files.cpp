@@ -21,7 +21,7 @@
 #include "impactdeck/scene/pipeline.hpp"
 #include "impactdeck/scene/scene.hpp"
 #include "impactdeck/study/cloud.hpp"
-#include "impactdeck/study/scene_sweep.hpp"
+#include "impactdeck/scene/sweep_case.hpp"
 #include "impactdeck/study/sweep_output.hpp"
 #include "impactdeck/study/table1.hpp"
 #include "impactdeck/study/table1_output.hpp"
@@ -128,7 +128,7 @@ struct SweepFiles : ::testing::Test {
   static void SetUpTestSuite() {
     dir = new fs::path(temp_dir("sweep"));
     sc = new scene::Scene(scene::load_scene(std::string(IMPACTDECK_SOURCE_DIR) + "/samples/fig4_sweep.toml"));
-    ss = new SceneSweep(sweep_from_scene(*sc));
+    ss = new SweepCase(scene::sweep_case(*sc));
     const auto cloud = make_cloud(*ss->setup.target.shape, CloudKind::both, 8, 300, 1);
     SweepOptions o;
     o.curves = true;
@@ -152,7 +152,7 @@ struct SweepFiles : ::testing::Test {
   }
   static inline fs::path* dir = nullptr;
   static inline scene::Scene* sc = nullptr;
-  static inline SceneSweep* ss = nullptr;
+  static inline SweepCase* ss = nullptr;
   static inline SweepResult* result = nullptr;
 };
 

@@ -31,8 +31,8 @@ SweepSetup setup(std::shared_ptr<const geometry::Shape> target) {
   SweepSetup s;
   auto ball = std::make_shared<geometry::Ellipsoid>(geometry::Ellipsoid::sphere(0.05));
   const double m2 = 7850 * ball->volume_properties().volume_m3, m1 = 0.3 * m2;  // light target: mass and curvature both vary
-  s.target = scene::body_of_mass("target", target, m1);
-  s.impactor = scene::body_of_mass("ball", ball, m2);
+  s.target = contact::body_of_mass("target", target, m1);
+  s.impactor = contact::body_of_mass("ball", ball, m2);
   s.rule = collision::ContactRule::mean;
   s.effective_modulus_Pa = 1.0e11;
   s.approach_speed_m_s = 1.0;

@@ -17,7 +17,7 @@
 #include "impactdeck/geometry/mesh_shape.hpp"
 #include "impactdeck/scene/scene.hpp"
 #include "impactdeck/study/cloud.hpp"
-#include "impactdeck/study/scene_sweep.hpp"
+#include "impactdeck/scene/sweep_case.hpp"
 #include "impactdeck/study/sweep_output.hpp"
 #include "impactdeck/study/table1.hpp"
 #include "impactdeck/study/table1_output.hpp"
@@ -52,7 +52,7 @@ std::string scene_text(const std::string& target_body, const std::string& contac
          "approach_speed_m_s = 1.0\nrestitution = 0.8\ncontact_radius = \"" + contact_radius + "\"\n";
 }
 
-Table1Scene table_scene(const scene::Scene& sc) { return table1_scene_from(sc); }
+Table1Scene table_scene(const scene::Scene& sc) { return scene::table1_scene(sc); }
 
 // ---------------------------------------------------------------------------------------------
 // Sharp features in the sweep
@@ -63,7 +63,7 @@ TEST(SweepSharp, BoxCornersAndEdgesAreFlaggedAndLeftOut) {
   const std::string box = std::string(IMPACTDECK_SOURCE_DIR) + "/tests/data/box.obj";
   write_text(scene_file, scene_text("shape = \"mesh\"\nmesh = \"" + box + "\"\n", "paper"));
   const scene::Scene sc = scene::load_scene(scene_file);
-  const SceneSweep ss = sweep_from_scene(sc);
+  const SweepCase ss = scene::sweep_case(sc);
   const auto& part = dynamic_cast<const geometry::MeshShape&>(*ss.setup.target.shape);
   ASSERT_EQ(part.sharp_edge_count(), 12u);  // the cube's edges (the face diagonals are flat)
 
@@ -155,7 +155,7 @@ TEST(SweepElliptical, AxisRatioIsReportedPerPoint) {
   const fs::path f = dir.path / "e.toml";
   write_text(f, scene_text("shape = \"ellipsoid\"\nsemi_axes = [0.3, 0.2, 0.1]\n", "elliptical"));
   const scene::Scene sc = scene::load_scene(f);
-  const SceneSweep ss = sweep_from_scene(sc);
+  const SweepCase ss = scene::sweep_case(sc);
   const geometry::Ellipsoid& e = dynamic_cast<const geometry::Ellipsoid&>(*ss.setup.target.shape);
   const SweepResult r = run_sweep(ss.setup, paper_grid_cloud(e, 4));
   double lo = 1e300, hi = 0;

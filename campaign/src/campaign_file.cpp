@@ -16,8 +16,8 @@
 #include "impactdeck/scene/pipeline.hpp"
 #include "impactdeck/scene/scene.hpp"
 #include "impactdeck/study/cloud.hpp"
-#include "overrides_toml.hpp"  // scene/src: the TOML value writer
-#include "toml_ascii.hpp"  // scene/src: toml++ never sees non-ASCII text (why: that header)
+#include "impactdeck/scene/toml_text.hpp"
+#include "impactdeck/scene/toml_ascii.hpp"  // toml++ never sees non-ASCII text (why: that header)
 
 namespace impactdeck::campaign {
 namespace fs = std::filesystem;
@@ -125,7 +125,7 @@ Campaign read_campaign(const fs::path& file) {
   const std::string text = read_input_file(file, "campaign file", kMaxSceneBytes);  // regular files only
   toml::table root;
   try {
-    root = toml::parse(scene::detail::toml_ascii(text, fr.name()), fr.name());
+    root = toml::parse(scene::toml_ascii(text, fr.name()), fr.name());
   } catch (const toml::parse_error& e) {
     std::ostringstream p;
     p << "line " << e.source().begin.line << ", column " << e.source().begin.column;

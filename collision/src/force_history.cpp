@@ -17,7 +17,7 @@ double ForceHistory::force_N(double t) const {
   if (!(t > 0.0)) return 0.0;
   if (t <= tm) return compression.force_N(t);
   if (restitution <= 0.0 || t >= contact_time_s()) return 0.0;
-  return compression.force_N(tm - (t - tm) / restitution);
+  return compression.force_N(restitution_mirror_s(t, tm, restitution));
 }
 
 double integrate_force_Ns(const ForceHistory& h, double t0, double t1) {

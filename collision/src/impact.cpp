@@ -67,7 +67,10 @@ std::string explain_flag(const KernelInput& in, const KernelResult& r, const std
   return s.str();
 }
 
-ImpactResult solve_impact(const ImpactInput& in) {
+namespace {
+
+// The checks of solve_impact's and complete_impact's input (InputError naming the place).
+void validate(const ImpactInput& in) {
   const double nn = in.contact.normal.norm();
   if (!(nn > 0.0) || !std::isfinite(nn)) {
     throw in.context.error("contact normal", "must be a non-zero finite vector");
@@ -88,10 +91,25 @@ ImpactResult solve_impact(const ImpactInput& in) {
     validate_restitution_table(in.restitution.table, in.context.at("restitution"));
   }
 
+}
+
+// The contact as the kernel takes it: a unit normal is used as given (bit for bit what the kernel
+// sees in a sweep); others are normalised.
+Contact unit_contact(const ImpactInput& in) {
   Contact c = in.contact;
-  // A unit normal is used as given (bit for bit what the kernel sees in a sweep); others are
-  // normalised.
+  const double nn = c.normal.norm();
   if (std::abs(nn - 1.0) > 1e-12) c.normal /= nn;
+  return c;
+}
+
+// The rest of the impact after the kernel (complete_impact), its input already validated.
+ImpactResult complete(const ImpactInput& in, const KernelInput& k, const KernelResult& kernel);
+
+}  // namespace
+
+ImpactResult solve_impact(const ImpactInput& in) {
+  validate(in);
+  const Contact c = unit_contact(in);
   KernelInput k;
   k.target = kernel_body(in.target, in.context.at("target"));
   k.impactor = kernel_body(in.impactor, in.context.at("impactor"));
@@ -104,8 +122,20 @@ ImpactResult solve_impact(const ImpactInput& in) {
   k.effective_modulus_Pa = in.effective_modulus_Pa;
   k.restitution = &in.restitution;
 
+  return complete(in, k, solve_kernel(k));
+}
+
+ImpactResult complete_impact(const ImpactInput& in, const KernelInput& k, const KernelResult& kernel) {
+  validate(in);
+  return complete(in, k, kernel);
+}
+
+namespace {
+
+ImpactResult complete(const ImpactInput& in, const KernelInput& k, const KernelResult& kernel) {
+  const Contact c = unit_contact(in);
   ImpactResult r;
-  r.kernel = solve_kernel(k);
+  r.kernel = kernel;
   const KernelResult& kr = r.kernel;
   if (kr.flag != ContactFlag::none) {
     const char* place = kr.flag == ContactFlag::no_approach ? "velocity"
@@ -162,5 +192,7 @@ ImpactResult solve_impact(const ImpactInput& in) {
               ch.energy_relative_error <= ch.thresholds.energy_relative;
   return r;
 }
+
+}  // namespace
 
 }  // namespace impactdeck::collision

@@ -190,11 +190,11 @@ inline bool step_radius(const KernelInput& in, const KernelPoint& p, KernelResul
       r.contact_ellipse_axis_ratio = ec.axis_ratio;
       break;
     case ContactRule::mean:
-      r.effective_radius_m = 1.0 / (0.5 * (t_curv.k1_per_m + t_curv.k2_per_m) +
-                                    0.5 * (i_curv.k1_per_m + i_curv.k2_per_m));
+      r.effective_radius_m =
+          1.0 / (t_curv.rule_curvature_per_m(ContactRule::mean) + i_curv.rule_curvature_per_m(ContactRule::mean));
       break;
     case ContactRule::paper: {
-      const double k = t_curv.paper_curvature_per_m + i_curv.paper_curvature_per_m;
+      const double k = t_curv.rule_curvature_per_m(ContactRule::paper) + i_curv.rule_curvature_per_m(ContactRule::paper);
       if (!(k > 0.0)) {
         r.flag = std::isfinite(k) ? ContactFlag::no_fit : ContactFlag::degenerate;
         return false;
@@ -243,7 +243,7 @@ inline void step_pressure(const KernelInput& in, const RelativeCurvatures& rc, c
     // root instead of a cube root per point.
     r.contact_semi_axis_a_m = r.contact_semi_axis_b_m = std::sqrt(r.effective_radius_m * r.max_indentation_m);
   }
-  r.peak_pressure_Pa = 3.0 * r.max_force_N / (2.0 * M_PI * r.contact_semi_axis_a_m * r.contact_semi_axis_b_m);
+  r.peak_pressure_Pa = hertz_peak_pressure_Pa(r.max_force_N, r.contact_semi_axis_a_m, r.contact_semi_axis_b_m);
 }
 
 // Restitution and the total impulse (Eq. 13-15, 30).

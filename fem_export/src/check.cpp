@@ -62,13 +62,10 @@ Eigen::Matrix3d mat3(const json& j) {
   return m;
 }
 
-Deck read_deck(const fs::path& dir) {
+// The deck description (deck.json's contents `j`; `where` names that file) without the mesh.
+Deck deck_from(const json& j, const std::string& where) {
   Deck d;
-  const fs::path jp = dir / "deck.json";
-  const std::string where = jp.string();
-  json j;
   try {
-    j = json::parse(read_text(jp, "deck description"));
     // Every number checked: a hand-edited deck.json is input like any other.
     auto number = [&](const char* key, bool positive) {
       const json& v = j.at(key);
@@ -156,6 +153,27 @@ Deck read_deck(const fs::path& dir) {
   } catch (const json::exception& e) {
     throw InputError(where, "json", std::string("not a deck description: ") + e.what());
   }
+  return d;
+}
+
+void check_load_node(const Deck& d, const std::string& where) {
+  if (d.load_node < 1 || d.load_node > d.mesh.nodes_m.size()) {
+    throw InputError(where, "load_node", "node " + std::to_string(d.load_node) + " is not in mesh.inp (" +
+                                             std::to_string(d.mesh.nodes_m.size()) + " nodes)");
+  }
+}
+
+// A deck folder on disk (`fem-check DIR`): deck.json and mesh.inp read and checked.
+Deck read_deck(const fs::path& dir) {
+  const fs::path jp = dir / "deck.json";
+  const std::string where = jp.string();
+  json j;
+  try {
+    j = json::parse(read_text(jp, "deck description"));
+  } catch (const json::exception& e) {
+    throw InputError(where, "json", std::string("not a deck description: ") + e.what());
+  }
+  Deck d = deck_from(j, where);
   // mesh.inp: *NODE, *ELEMENT and *NSET blocks as calculix_mesh_inp writes them.
   const fs::path mp = dir / "mesh.inp";
   std::istringstream in(read_text(mp, "mesh"));
@@ -196,10 +214,16 @@ Deck read_deck(const fs::path& dir) {
   for (const auto& x : d.mesh.nodes_m) {
     if (!x.allFinite()) throw InputError(mp.string(), "*NODE", "a coordinate is not a finite number");
   }
-  if (d.load_node < 1 || d.load_node > d.mesh.nodes_m.size()) {
-    throw InputError(where, "load_node", "node " + std::to_string(d.load_node) + " is not in mesh.inp (" +
-                                             std::to_string(d.mesh.nodes_m.size()) + " nodes)");
-  }
+  check_load_node(d, where);
+  return d;
+}
+
+// The deck just written (write_decks' result, in memory): nothing is read back from its files.
+Deck deck_of(const DeckResult& written) {
+  const std::string where = (written.folder / "deck.json").string();
+  Deck d = deck_from(written.description, where);
+  d.mesh = written.mesh;
+  check_load_node(d, where);
   return d;
 }
 
@@ -399,9 +423,28 @@ double run_ccx_job(const fs::path& dir, const CheckOptions& o, double end_time_s
                  "default for " + std::to_string(nodes) + " nodes and " + std::to_string(solves) + " solves");
 }
 
+namespace {
+
+CheckResult check_deck(const fs::path& dir, const Deck& deck, const CheckOptions& o);
+
+}  // namespace
+
 CheckResult run_check(const fs::path& dir, const CheckOptions& o) {
   if (!fs::is_directory(dir)) throw InputError(dir.string(), "deck folder", "does not exist");
-  const Deck deck = read_deck(dir);
+  return check_deck(dir, read_deck(dir), o);
+}
+
+CheckResult run_check(const DeckResult& written, const CheckOptions& o) {
+  if (!written.calculix) {
+    throw InputError((written.folder / "deck.json").string(), "calculix",
+                     "the deck has no CalculiX input (calculix = false)");
+  }
+  return check_deck(written.folder, deck_of(written), o);
+}
+
+namespace {
+
+CheckResult check_deck(const fs::path& dir, const Deck& deck, const CheckOptions& o) {
   CheckResult r;
   r.linear_tolerance = o.linear_tolerance > 0 ? o.linear_tolerance : deck.tolerances.linear_momentum;
   r.angular_tolerance = o.angular_tolerance > 0 ? o.angular_tolerance : deck.tolerances.angular_momentum;
@@ -651,6 +694,8 @@ CheckResult run_check(const fs::path& dir, const CheckOptions& o) {
   }
   return r;
 }
+
+}  // namespace
 
 double default_solver_timeout_s(std::size_t nodes, std::size_t increments) {
   const double n = static_cast<double>(nodes);

@@ -367,6 +367,7 @@ ContactDeck write_contact_deck(const ContactModelRequest& r, const fs::path& fol
     }
     cj["probes"] = probes;
     write_file_atomically(stage / "contact.json", cj.dump() + "\n");
+    out.description = std::move(cj);
 
     const fs::path old = parent / ("." + folder.filename().string() + ".old-" + std::to_string(::getpid()));
     fs::remove_all(old, ec);
@@ -454,6 +455,12 @@ ContactDat read_contact_dat(const fs::path& p) {
 
 }  // namespace
 
+namespace {
+
+ContactRunResult run_contact(const fs::path& folder, const json& cj, const CheckOptions& options);
+
+}  // namespace
+
 ContactRunResult run_contact_model(const fs::path& folder, const CheckOptions& options) {
   const fs::path cj_path = folder / "contact.json";
   std::ifstream cin(cj_path);
@@ -464,6 +471,16 @@ ContactRunResult run_contact_model(const fs::path& folder, const CheckOptions& o
   } catch (const std::exception& e) {
     throw InputError(cj_path.string(), "contact deck", std::string("unreadable: ") + e.what());
   }
+  return run_contact(folder, cj, options);
+}
+
+ContactRunResult run_contact_model(const ContactDeck& written, const CheckOptions& options) {
+  return run_contact(written.folder, written.description, options);
+}
+
+namespace {
+
+ContactRunResult run_contact(const fs::path& folder, const json& cj, const CheckOptions& options) {
   ContactRunResult r;
   const double end = cj.at("end_time_s");
   if (options.run_solver) {
@@ -577,5 +594,7 @@ ContactRunResult run_contact_model(const fs::path& folder, const CheckOptions& o
   r.angular_momentum_relative_error = (l_after - l_before).norm() / (scale * std::max(size, 1e-300));
   return r;
 }
+
+}  // namespace
 
 }  // namespace impactdeck::fem_export

@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "impactdeck/collision/elliptical.hpp"
 #include "impactdeck/common/atomic_file.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/common/stage.hpp"
@@ -817,7 +818,7 @@ DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
                        {"b_max_m", r.patch.b_max_m},
                        {"axis_a", v3(r.patch.axis_a)},
                        {"max_force_N", r.patch.max_force_N},
-                       {"max_pressure_Pa", 3.0 * r.patch.max_force_N / (2.0 * M_PI * r.patch.a_max_m * r.patch.b_max_m)}};
+                       {"max_pressure_Pa", collision::hertz_peak_pressure_Pa(r.patch.max_force_N, r.patch.a_max_m, r.patch.b_max_m)}};
     if (pl) {
       patch_json["contact_elements"] = r.options.contact_elements;
       patch_json["largest_ellipse_elements"] = pl->largest_ellipse_elements;
@@ -889,7 +890,10 @@ DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
                  {"mesh", quality},
                  {"files", names}};
     write_file_atomically(stage / "deck.json", deck.dump(2) + "\n");
+    out.calculix = r.options.calculix;
+    out.description = std::move(deck);
 
+    out.mesh = std::move(m);  // the check takes it from here (run_check(DeckResult))
     out.folder = folder;
     for (const auto& n : names) out.files.push_back(folder / n);
     out.quality = q;

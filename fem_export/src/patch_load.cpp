@@ -6,6 +6,7 @@
 #include <map>
 #include <sstream>
 
+#include "impactdeck/collision/elliptical.hpp"
 #include "impactdeck/common/error.hpp"
 
 namespace impactdeck::fem_export {
@@ -179,7 +180,7 @@ PatchLoad hertz_patch_load(const TetMesh& mesh, int contact_node, const Eigen::V
     if (!(F > 0)) continue;
     const double s = std::cbrt(F / patch.max_force_N);
     const double a = s * patch.a_max_m, b = s * patch.b_max_m;
-    const double p0 = 3.0 * F / (2.0 * kPi * a * b);
+    const double p0 = collision::hertz_peak_pressure_Pa(F, a, b);
     std::fill(q.begin(), q.end(), 0.0);
     for (std::size_t r = 0; r < region.size(); ++r) {
       for (const QuadPoint& qp : quad[r]) {

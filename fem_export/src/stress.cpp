@@ -399,7 +399,8 @@ void write_stress_files(const fs::path& dir, const TetMesh& m, StressResult& r, 
     po.title = title;
     po.yield_strength_Pa = r.verdict.yield_strength_Pa;
     po.log_scale = lo > 0 && hi / lo > 30;  // a point load's node dwarfs the probes
-    plot::write_svg(svg, plot::stress_time_drawing(ps, po));
+    r.von_mises_svg = plot::to_svg(plot::stress_time_drawing(ps, po));
+    write_file_atomically(svg, r.von_mises_svg);
     r.files.push_back(svg);
   }
   r.files.insert(r.files.begin(), {csv, csv_sidecar_path(csv), vtu, msh});

@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <iomanip>
 #include <limits>
+#include <memory>
 #include <sstream>
 
 #include <assimp/Importer.hpp>
@@ -26,6 +28,10 @@ namespace {
 
 bool is_identity(const aiMatrix4x4& m) { return m.IsIdentity(); }
 
+struct FileCloser {
+  void operator()(std::FILE* f) const { std::fclose(f); }
+};
+
 }  // namespace
 
 LoadedMesh load_mesh(const fs::path& file, LengthUnit unit) {
@@ -38,15 +44,31 @@ LoadedMesh load_mesh(const fs::path& file, LengthUnit unit) {
   if (ext != ".stl" && ext != ".obj" && ext != ".ply" && ext != ".off") {
     throw InputError(where, "file", "unsupported format '" + ext + "' (expected .stl, .obj, .ply or .off)");
   }
+  if (ext == ".stl") {
+    // Opened once: the first 84 bytes tell binary from ASCII, and the same stream reads on. A
+    // binary STL is read directly (float32 records, no assimp, no per-triangle allocation); an
+    // ASCII one by the own reader. A read that comes up short goes to the general route below,
+    // which says why.
+    std::unique_ptr<std::FILE, FileCloser> f(std::fopen(file.c_str(), "rb"));
+    std::string head(static_cast<std::size_t>(std::min<std::uintmax_t>(84, bytes)), '\0');
+    if (f && std::fread(head.data(), 1, head.size(), f.get()) == head.size()) {
+      if (!detail::is_ascii_stl(head, bytes)) {
+        if (auto binary = detail::read_binary_stl(f.get(), head, where, unit, bytes)) {
+          detail::finish_loaded(*binary, where);
+          return std::move(*binary);
+        }
+      } else {
+        std::string text = std::move(head);
+        const std::size_t done = text.size();
+        text.resize(static_cast<std::size_t>(bytes));
+        if (std::fread(text.data() + done, 1, text.size() - done, f.get()) == text.size() - done)
+          return std::move(*detail::read_own_text(std::move(text), file, ext, unit));
+      }
+    }
+  }
   // OFF, OBJ, PLY and ASCII STL: own readers in double precision (text_mesh_readers.hpp); assimp
   // (float32) reads binary STL only, which is float32 anyway.
   if (auto own = detail::read_own_format(file, ext, unit, bytes)) return std::move(*own);
-  // Binary STL: read directly (float32 records, no assimp, no per-triangle allocation).
-  if (ext == ".stl")
-    if (auto binary = detail::read_binary_stl(file, where, unit, bytes)) {
-      detail::finish_loaded(*binary, where);
-      return std::move(*binary);
-    }
 
   LoadedMesh out;
   out.format = ext.substr(1);

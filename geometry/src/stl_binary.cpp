@@ -17,21 +17,13 @@ namespace {
 constexpr std::size_t kHeaderBytes = 84, kTriangleBytes = 50;
 // Triangles per fread: ~0.8 MB, so the file is never held whole in memory.
 constexpr std::size_t kChunkTriangles = 16384;
-
-struct FileCloser {
-  void operator()(std::FILE* f) const { std::fclose(f); }
-};
 }  // namespace
 
-std::optional<LoadedMesh> read_binary_stl(const std::filesystem::path& file, const std::string& where,
+std::optional<LoadedMesh> read_binary_stl(std::FILE* f, const std::string& head, const std::string& where,
                                           LengthUnit unit, std::uintmax_t bytes) {
-  if (bytes < kHeaderBytes + kTriangleBytes) return std::nullopt;
-  std::unique_ptr<std::FILE, FileCloser> f(std::fopen(file.c_str(), "rb"));
-  if (!f) return std::nullopt;  // the general route reports why
-  unsigned char head[kHeaderBytes];
-  if (std::fread(head, 1, kHeaderBytes, f.get()) != kHeaderBytes) return std::nullopt;
+  if (bytes < kHeaderBytes + kTriangleBytes || head.size() != kHeaderBytes) return std::nullopt;
   std::uint32_t count = 0;
-  std::memcpy(&count, head + 80, 4);
+  std::memcpy(&count, head.data() + 80, 4);
   if (count == 0 || kHeaderBytes + kTriangleBytes * static_cast<std::uintmax_t>(count) != bytes) return std::nullopt;
 
   LoadedMesh out;
@@ -53,7 +45,7 @@ std::optional<LoadedMesh> read_binary_stl(const std::filesystem::path& file, con
   std::vector<std::uint64_t> hash(3 * kChunkTriangles);
   for (std::size_t first = 0; first < count;) {
     const std::size_t n = std::min<std::size_t>(kChunkTriangles, count - first);
-    if (std::fread(buf.data(), kTriangleBytes, n, f.get()) != n) {
+    if (std::fread(buf.data(), kTriangleBytes, n, f) != n) {
       throw InputError(where, "triangle " + std::to_string(first), "cannot read the file (it changed while being read?)");
     }
     const std::size_t corners = 3 * n;

@@ -781,6 +781,8 @@ LoadedMesh build(Raw& raw, const std::string& format, LengthUnit unit, const std
   return out;
 }
 
+}  // namespace
+
 // An ASCII STL starts with "solid" and does not have the binary size 84 + 50 n (a binary STL's
 // 80-byte header may start with "solid" too; assimp and every reader use the same test).
 bool is_ascii_stl(const std::string& head, std::uintmax_t bytes) {
@@ -794,13 +796,16 @@ bool is_ascii_stl(const std::string& head, std::uintmax_t bytes) {
   return true;
 }
 
-}  // namespace
-
 std::optional<LoadedMesh> read_own_format(const fs::path& file, const std::string& ext, LengthUnit unit,
                                           std::uintmax_t bytes) {
-  const std::string where = file.string();
   std::string text = read_input_file(file, "part file", bytes);
   if (ext == ".stl" && !is_ascii_stl(text.substr(0, 84), text.size())) return std::nullopt;
+  return read_own_text(std::move(text), file, ext, unit);
+}
+
+std::optional<LoadedMesh> read_own_text(std::string text, const fs::path& file, const std::string& ext,
+                                        LengthUnit unit) {
+  const std::string where = file.string();
   std::size_t points = 0, lines = 0;
   Raw raw;
   if (ext == ".off") raw = read_off(text, where);

@@ -22,6 +22,15 @@ namespace impactdeck::geometry::detail {
 std::optional<LoadedMesh> read_own_format(const std::filesystem::path& file, const std::string& ext, LengthUnit unit,
                                           std::uintmax_t bytes);
 
+/// The same from the file's whole text `text` (already read): OFF, OBJ, PLY or ASCII STL by `ext`.
+std::optional<LoadedMesh> read_own_text(std::string text, const std::filesystem::path& file, const std::string& ext,
+                                        LengthUnit unit);
+
+/// An ASCII STL starts with "solid" and does not have the binary size 84 + 50 n (a binary STL's
+/// 80-byte header may start with "solid" too; assimp and every reader use the same test). `head`:
+/// the file's first (up to) 84 bytes; `bytes`: its size.
+bool is_ascii_stl(const std::string& head, std::uintmax_t bytes);
+
 /// The end of every reader: a warning for the points and lines skipped, an InputError(file,
 /// "faces", ...) when no triangle is left.
 void finish_loaded(LoadedMesh& mesh, const std::string& where);

@@ -10,11 +10,15 @@
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/common/suggest.hpp"
 #include "impactdeck/plot/stress_plot.hpp"
-#include "impactdeck/scene/contact.hpp"
+#include "impactdeck/contact/contact_model.hpp"
 #include "impactdeck/scene/pipeline.hpp"
 #include "impactdeck/common/json_number.hpp"
 
 namespace impactdeck::scene {
+
+using contact::ContactEvaluation;
+using contact::ContactModel;
+using contact::PreparedBody;
 namespace fs = std::filesystem;
 using nlohmann::json;
 
@@ -51,13 +55,6 @@ const fem_export::ProbeStress* hybrid_probe(const CompareReport& r, const std::s
 
 double rel(double value, double reference) { return reference != 0 ? value / reference - 1.0 : 0.0; }
 
-// The part's default far-field size, as the hybrid deck picks it (pipeline.cpp fem_request).
-double default_mesh_size(const BodySpec& b, const PreparedBody& p) {
-  if (b.shape == ShapeKind::mesh) return 0.25 * p.shape->size_m();
-  const Eigen::Vector3d ax = b.shape == ShapeKind::sphere ? Eigen::Vector3d::Constant(b.radius_m) : b.semi_axes_m;
-  return 0.5 * ax.minCoeff();
-}
-
 fem_export::ContactBody contact_body(const fem_export::DeckRequest& own, const PreparedBody& p,
                                      const geometry::SurfacePoint& point, const collision::KernelBody& k,
                                      const Eigen::Vector3d& translation_m, double far_size_m) {
@@ -75,36 +72,9 @@ fem_export::ContactBody contact_body(const fem_export::DeckRequest& own, const P
   return b;
 }
 
-}  // namespace
-
-CompareReport compare_contact(const Scene& scene_in, const CompareOptions& o) {
-  const std::string file = scene_in.file.string();
-  auto output = [&](const std::string& name, bool is_folder) {
-    return o.place_output ? o.place_output(name, is_folder) : o.out_dir / name;
-  };
-  // Errors about the scene name its file and places, after the caller's context (`run`'s key).
-  const InputContext ctx = o.context.where.empty() ? InputContext{file, ""} : o.context;
-  if (scene_in.impacts.empty()) throw ctx.error("impacts", "the scene has no impact");
-  const ImpactSpec* spec = &scene_in.impacts.front();
-  if (!o.impact.empty()) {
-    spec = nullptr;
-    for (const auto& s : scene_in.impacts)
-      if (s.name == o.impact) spec = &s;
-    if (!spec) {
-      std::vector<std::string> names;
-      for (const auto& s : scene_in.impacts) names.push_back(s.name);
-      throw ctx.error("--impact", "no impact named '" + o.impact + "' in the scene" + did_you_mean(o.impact, names));
-    }
-  }
-  if (!(o.threshold > 0) || o.refine < 0 || o.refine > 6) {
-    throw ctx.error("options", "--threshold must be > 0 and --refine within 0..6");
-  }
-  // The scene reduced to this impact, with the hybrid deck's settings (the scene's, or defaults).
-  Scene scene = scene_in;
-  scene.impacts = {*spec};
-  scene.outputs = Outputs{};
-  scene.outputs.force_table = scene_in.outputs.force_table;
-  const ImpactSpec& s = scene.impacts.front();
+// The full-contact model meshes both bodies and needs both masses: planes and fixed bodies are
+// refused, naming the body's place after `ctx`.
+void check_compare_bodies(const Scene& scene, const ImpactSpec& s, const InputContext& ctx) {
   for (const std::string* name : {&s.target, &s.impactor}) {
     const BodySpec& b = scene.body(*name);
     if (b.shape == ShapeKind::plane) {
@@ -119,41 +89,113 @@ CompareReport compare_contact(const Scene& scene_in, const CompareOptions& o) {
                           "' is fixed: the full-contact model needs both bodies free, with their masses");
     }
   }
-  CompareReport rep;
-  rep.impact = s.name;
-  rep.target = s.target;
-  rep.impactor = s.impactor;
-  rep.threshold = o.threshold;
-  if (scene.modulus_convention != collision::ModulusConvention::hertz) {
-    rep.warnings.push_back("modulus_convention is not \"hertz\": the analytic force leaves out the Poisson terms "
-                           "that the FE models contain, so they differ by design");
-  }
+}
 
-  const PreparedBody target = prepare_body(scene.body(s.target), scene);
-  const PreparedBody impactor = prepare_body(scene.body(s.impactor), scene);
+void check_compare_options(const CompareOptions& o, const InputContext& ctx) {
+  if (!(o.threshold > 0) || o.refine < 0 || o.refine > 6) {
+    throw ctx.error("options", "--threshold must be > 0 and --refine within 0..6");
+  }
+}
+
+// The modulus convention's caveat, first among the report's warnings.
+std::vector<std::string> compare_warnings(const Scene& scene) {
+  if (scene.modulus_convention == collision::ModulusConvention::hertz) return {};
+  return {"modulus_convention is not \"hertz\": the analytic force leaves out the Poisson terms that the FE models "
+          "contain, so they differ by design"};
+}
+
+}  // namespace
+
+CompareInput compare_input(const Scene& scene, const ImpactReport& ir, const PreparedBody& target,
+                           const PreparedBody& impactor, const InputContext& ctx) {
+  check_compare_bodies(scene, *ir.spec, ctx);
+  CompareInput in;
+  in.source = scene.file.string();
+  in.impact_name = ir.spec->name;
+  in.impact = &ir;
+  in.target = &target;
+  in.impactor = &impactor;
+  in.target_deck = hybrid_deck_request(scene, ir, target);
+  in.impactor_deck = hybrid_deck_request(scene, ir, impactor);
+  in.impactor_mesh_size_m = default_mesh_size_m(scene.body(ir.spec->impactor), impactor);
+  in.warnings = compare_warnings(scene);
+  return in;
+}
+
+CompareReport compare_contact(const Scene& scene_in, const CompareOptions& o) {
+  const std::string file = scene_in.file.string();
+  // Errors about the scene name its file and places, after the caller's context.
+  const InputContext ctx = o.context.where.empty() ? InputContext{file, ""} : o.context;
+  if (scene_in.impacts.empty()) throw ctx.error("impacts", "the scene has no impact");
+  const ImpactSpec* spec = &scene_in.impacts.front();
+  if (!o.impact.empty()) {
+    spec = nullptr;
+    for (const auto& s : scene_in.impacts)
+      if (s.name == o.impact) spec = &s;
+    if (!spec) {
+      std::vector<std::string> names;
+      for (const auto& s : scene_in.impacts) names.push_back(s.name);
+      throw ctx.error("--impact", "no impact named '" + o.impact + "' in the scene" + did_you_mean(o.impact, names));
+    }
+  }
+  check_compare_options(o, ctx);
+  // The hybrid deck's settings: the scene's, or the defaults.
+  Scene scene = scene_in;
+  if (!scene.outputs.fem) scene.outputs.fem = FemOutputs{};
+  const ImpactSpec& s = *spec;
+  check_compare_bodies(scene, s, ctx);
+
+  // Each body prepared once, the impact located and solved once, as `run` does.
+  RunReport notes;
+  const PreparedBody target = prepare_body(scene.body(s.target), scene, &notes);
+  const PreparedBody impactor = prepare_body(scene.body(s.impactor), scene, &notes);
   const InputContext impact_ctx = ctx.at(InputContext::joined(s.place.describe(), "impact '" + s.name + "'"));
   const double e_star =
       collision::effective_modulus_Pa(target.material, impactor.material, scene.modulus_convention, impact_ctx);
   const ContactModel model(target, impactor, s.contact_radius, e_star, s.restitution, impact_ctx);
-  // The decks' errors: after the caller's context, or the scene and the impact.
-  auto deck_context = [&](const std::string& what) {
-    return o.context.where.empty() ? InputContext{file, "impact '" + s.name + "': " + what} : o.context.at(what);
-  };
-  const ContactEvaluation ev = locate_impact_contact(scene, s, model);
+  ContactEvaluation ev = locate_impact_contact(scene, s, model);
   if (ev.result.flag != collision::ContactFlag::none) {
+    CompareReport rep;
+    rep.impact = s.name;
+    rep.target = s.target;
+    rep.impactor = s.impactor;
+    rep.threshold = o.threshold;
+    rep.warnings = compare_warnings(scene);
     rep.verdict = CompareVerdict::non_hertzian;
     rep.non_hertzian_reason = collision::explain_flag(ev.input, ev.result, "'" + s.target + "'", "'" + s.impactor + "'");
     rep.explanation = std::string("the contact is not Hertzian (") + collision::flag_word(ev.result.flag) +
                       "): there is no analytic force to compare with and no hybrid deck to build";
     return rep;
   }
+  ImpactReport ir = solve_located_impact(scene, s, model, std::move(ev), notes.warnings);
+  ir.table = collision::sample_force_table(ir.result.history, force_table_options(scene, s));
+  CompareInput in = compare_input(scene, ir, target, impactor, ctx);
+  for (const auto& w : notes.warnings) in.warnings.push_back(w);
+  return compare_contact(in, o);
+}
 
-  // The analytic impact (run's own pipeline, no output files).
-  RunOptions ro;
-  ro.out_dir = o.out_dir;
-  RunReport run = run_scene(scene, ro);
-  ImpactReport& ir = run.impacts.front();
-  for (const auto& w : run.warnings) rep.warnings.push_back(w);
+CompareReport compare_contact(const CompareInput& in, const CompareOptions& o) {
+  auto output = [&](const std::string& name, bool is_folder) {
+    return o.place_output ? o.place_output(name, is_folder) : o.out_dir / name;
+  };
+  check_compare_options(o, o.context.where.empty() ? InputContext{in.source, ""} : o.context);
+  const contact::Impact& ir = *in.impact;
+  const PreparedBody& target = *in.target;
+  const PreparedBody& impactor = *in.impactor;
+  const ContactEvaluation& ev = ir.contact;
+  const collision::ForceTable& table = in.target_deck.force;
+  CompareReport rep;
+  rep.impact = in.impact_name;
+  rep.target = target.name;
+  rep.impactor = impactor.name;
+  rep.threshold = o.threshold;
+  rep.warnings = in.warnings;
+  // The decks' errors: after the caller's context, or the scene and the impact.
+  auto deck_context = [&](const std::string& what) {
+    return o.context.where.empty() ? InputContext{in.source, "impact '" + in.impact_name + "': " + what}
+                                   : o.context.at(what);
+  };
+
   const collision::KernelResult& k = ir.result.kernel;
   const double R = k.restitution.coefficient;
   rep.restitution = R;
@@ -171,12 +213,13 @@ CompareReport compare_contact(const Scene& scene_in, const CompareOptions& o) {
   rep.analytic_impactor_dv = elastic * ir.result.impactor_jump.delta_velocity_m_s;
   rep.analytic_impactor_dw = elastic * ir.result.impactor_jump.delta_angular_velocity_rad_s;
   {
-    const double tm = k.compression_time_s;
+    collision::ForceHistory elastic = ir.result.history;  // the same pulse with R = 1
+    elastic.restitution = 1.0;
     const int n = 200;
     for (int i = 0; i <= n; ++i) {
-      const double t = 2.0 * tm * i / n;
+      const double t = elastic.contact_time_s() * i / n;
       rep.analytic_time_s.push_back(t);
-      rep.analytic_force_N.push_back(ir.result.history.force_N(t <= tm ? t : 2.0 * tm - t));
+      rep.analytic_force_N.push_back(elastic.force_N(t));
     }
   }
 
@@ -186,28 +229,26 @@ CompareReport compare_contact(const Scene& scene_in, const CompareOptions& o) {
   const std::size_t increments = static_cast<std::size_t>(std::ceil(co.end_time_factor * co.contact_increments - 1e-9));
   const double end_time = increments * dt;
 
-  scene.outputs.fem = scene_in.outputs.fem ? *scene_in.outputs.fem : FemOutputs{};
-  ir.table = collision::sample_force_table(ir.result.history, force_table_options(scene_in, s));
-  double target_far = scene.outputs.fem->mesh_size_m.value_or(default_mesh_size(*target.spec, target));
+  double target_far = in.target_deck.options.mesh.mesh_size_m;
   fem_export::CheckOptions check_options;
   check_options.progress = o.progress;
   check_options.timeout_s = o.solver_timeout_s;
   check_options.threads = o.solver_threads;
-  const fem_export::DeckRequest target_req = hybrid_deck_request(scene, ir, target);
+  const fem_export::DeckRequest& target_req = in.target_deck;
   if (o.run_hybrid) {
     fem_export::DeckRequest req = target_req;
     req.context = deck_context("hybrid deck");
     req.options.code_aster = false;
     req.options.end_time_s = end_time;
     req.options.time_step_s = dt;
-    req.options.pulse_increments = static_cast<int>(std::ceil(ir.table->time_s.back() / dt - 1e-9));
+    req.options.pulse_increments = static_cast<int>(std::ceil(table.time_s.back() / dt - 1e-9));
     rep.hybrid_deck = fem_export::write_decks(req, output("hybrid", true));
     target_far = rep.hybrid_deck->quality.mesh_size_m;  // after any adaptive refinement
-    const fem_export::TimeSchedule ts = fem_export::time_schedule(req.options, ir.table->time_s.back());
+    const fem_export::TimeSchedule ts = fem_export::time_schedule(req.options, table.time_s.back());
     rep.hybrid_increments = ts.pulse_increments + ts.main_increments;
-    for (double f : ir.table->force_N) rep.hybrid_max_force_N = std::max(rep.hybrid_max_force_N, f);
+    for (double f : table.force_N) rep.hybrid_max_force_N = std::max(rep.hybrid_max_force_N, f);
     if (o.progress) *o.progress << "compare-contact: running the hybrid deck (" << rep.hybrid_deck->node_count << " nodes)\n";
-    rep.hybrid_check = fem_export::run_check(rep.hybrid_deck->folder, check_options);
+    rep.hybrid_check = fem_export::run_check(*rep.hybrid_deck, check_options);
     // The deck's frame is the target's own: rotate its jumps into the world.
     rep.hybrid_target_dv = target.pose.rotation * rep.hybrid_check->fe_rigid_velocity_m_s;
     rep.hybrid_target_dw = target.pose.rotation * rep.hybrid_check->angular_velocity_fe_rad_s;
@@ -215,15 +256,15 @@ CompareReport compare_contact(const Scene& scene_in, const CompareOptions& o) {
   }
 
   // The full-contact model: the impactor's own deck request gives its body and material.
-  const fem_export::DeckRequest impactor_req = hybrid_deck_request(scene, ir, impactor);
+  const fem_export::DeckRequest& impactor_req = in.impactor_deck;
   fem_export::ContactModelRequest cr;
-  cr.source = scene.file.string();
-  cr.impact = s.name;
+  cr.source = in.source;
+  cr.impact = in.impact_name;
   cr.context = deck_context("contact model");
   cr.target = contact_body(target_req, target, ev.target_point, ev.input.target, Eigen::Vector3d::Zero(), target_far);
-  cr.target.probes_own_m = scene.outputs.fem->probes_m;  // the hybrid deck's probes, target frame
+  cr.target.probes_own_m = target_req.options.mesh.probes_m;  // the hybrid deck's probes, target frame
   cr.impactor = contact_body(impactor_req, impactor, ev.impactor_point, ev.input.impactor, ev.impactor_translation_m,
-                             default_mesh_size(*impactor.spec, impactor));
+                             in.impactor_mesh_size_m);
   cr.contact_point_m = ev.point_m;
   cr.normal = ev.normal;
   cr.effective_modulus_Pa = collision::effective_modulus_Pa(target.material, impactor.material,
@@ -242,7 +283,7 @@ CompareReport compare_contact(const Scene& scene_in, const CompareOptions& o) {
       *o.progress << "compare-contact: running the full-contact model, " << L.contact_elements
                   << " elements across the contact semi-axis (" << L.deck.node_count << " nodes)\n";
     }
-    L.run = fem_export::run_contact_model(folder, check_options);
+    L.run = fem_export::run_contact_model(L.deck, check_options);
     L.max_force_relative_difference = rel(L.run.max_force_N, rep.analytic_max_force_N);
     rep.ladder.push_back(std::move(L));
   }
@@ -289,9 +330,9 @@ CompareReport compare_contact(const Scene& scene_in, const CompareOptions& o) {
     series.push_back({lab.str(), L.run.time_s, L.run.force_N, -1, false});
     series.back().colour = 1 + static_cast<int>(&L - &rep.ladder.front()) % 4;
   }
-  if (o.run_hybrid) series.push_back({"hybrid applied load", ir.table->time_s, ir.table->force_N, plot::kVermilion, false});
+  if (o.run_hybrid) series.push_back({"hybrid applied load", table.time_s, table.force_N, plot::kVermilion, false});
   plot::StressPlotOptions po;
-  po.title = "Contact force, impact '" + s.name + "': full contact against the hybrid load";
+  po.title = "Contact force, impact '" + in.impact_name + "': full contact against the hybrid load";
   po.quantity = "contact force";
   po.force_N = true;
   const fs::path svg = output("compare_force.svg", false);

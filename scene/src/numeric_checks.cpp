@@ -8,6 +8,9 @@
 #include "impactdeck/common/numeric.hpp"
 
 namespace impactdeck::scene::detail {
+
+using contact::PreparedBody;
+
 namespace {
 
 bool in_range(double x) { return std::isfinite(x) && x != 0.0 && within_magnitude_range(x); }

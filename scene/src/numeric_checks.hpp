@@ -12,7 +12,7 @@
 namespace impactdeck::scene::detail {
 
 /// Volume, mass and principal inertia of a prepared (free) body.
-void check_body_magnitudes(const Scene& scene, const BodySpec& body, const PreparedBody& prepared);
+void check_body_magnitudes(const Scene& scene, const BodySpec& body, const contact::PreparedBody& prepared);
 
 /// E*, R* (the contact kernel's effective radius), the reduced mass and the approach velocity of
 /// an impact, before it is solved.

@@ -12,7 +12,7 @@
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/common/input_file.hpp"
 #include "overrides_toml.hpp"
-#include "toml_ascii.hpp"
+#include "impactdeck/scene/toml_ascii.hpp"
 
 namespace impactdeck::scene {
 namespace fs = std::filesystem;
@@ -70,7 +70,7 @@ std::string describe(const std::vector<Segment>& segs, std::size_t upto, std::si
 // The value text parsed as TOML: `v = VALUE` (VALUE made ASCII first, its own line and column
 // named by a non-ASCII character outside a string).
 toml::table parse_value(const Override& o, const InputContext& where) {
-  const std::string ascii = detail::toml_ascii(o.value, where.at("--set " + o.key + ": value '" + o.value + "'"));
+  const std::string ascii = toml_ascii(o.value, where.at("--set " + o.key + ": value '" + o.value + "'"));
   const std::string doc = "v = " + ascii + "\n";
   toml::table t;
   try {
@@ -258,7 +258,7 @@ std::string resolved_scene_text(const fs::path& file, const std::vector<Override
   const std::string text = read_input_file(file, "scene file", kMaxSceneBytes);
   toml::table root;
   try {
-    root = toml::parse(detail::toml_ascii(text, file.string()), file.string());
+    root = toml::parse(toml_ascii(text, file.string()), file.string());
   } catch (const toml::parse_error& e) {
     std::ostringstream place;
     place << "line " << e.source().begin.line << ", column " << e.source().begin.column;

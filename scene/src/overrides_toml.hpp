@@ -7,6 +7,7 @@
 
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/scene/overrides.hpp"
+#include "impactdeck/scene/toml_text.hpp"
 
 namespace impactdeck::scene::detail {
 
@@ -14,14 +15,6 @@ namespace impactdeck::scene::detail {
 /// tables on the path are created; an array index must exist. Throws file.error("--set KEY",
 /// reason).
 void apply_overrides(toml::table& root, const std::vector<Override>& overrides, const InputContext& file);
-
-/// A TOML value as one line of TOML text (inline tables and arrays): what `--set KEY=VALUE` takes.
-/// Written here rather than by toml++'s printer, whose column count casts a negative log10 to
-/// size_t (undefined behaviour, UBSan) for every float of magnitude below 1 inside an array.
-std::string toml_value_text(const toml::node& n);
-
-/// The shortest decimal text of a float that reads back as exactly `v` ("0.8", "1.0", "1e-05").
-std::string toml_float_text(double v);
 
 /// A whole document as TOML text: each table's plain keys, then its tables, then its arrays of
 /// tables, with dotted headers.

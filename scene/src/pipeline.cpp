@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <fstream>
-#include <iterator>
 #include <functional>
 #include <limits>
 #include <optional>
@@ -27,6 +25,10 @@
 #include "numeric_checks.hpp"
 
 namespace impactdeck::scene {
+
+using contact::ContactEvaluation;
+using contact::ContactModel;
+using contact::PreparedBody;
 namespace fs = std::filesystem;
 
 const std::vector<std::string>& all_stages() {
@@ -134,7 +136,6 @@ std::shared_ptr<const geometry::Shape> make_shape(const BodySpec& b, const Scene
 PreparedBody prepare_body(const BodySpec& b, const Scene& scene, RunReport* report) {
   PreparedBody p;
   p.name = b.name;
-  p.spec = &b;
   p.shape = make_shape(b, scene, report);  // a part's own stages, mass integrals included
   // The body's mass and inertia (an analytic or CAD shape's integrals here): timed where they run.
   std::optional<ScopedTimer<std::function<void(double)>>> timer;
@@ -189,22 +190,11 @@ ContactEvaluation locate_contact(const Scene& scene, const ImpactSpec& s, const 
   return model.at_surface_point(sp, s.approach_speed_m_s);
 }
 
-// The impact solved by `run` from the located contact: the kernel's input as rigid bodies, so that
-// solve_impact adds the force curve and the paper's checks.
+// The impact's rigid-body input (contact::impact_input) with the scene's thresholds and the
+// contexts its errors name.
 collision::ImpactInput impact_input(const Scene& scene, const ImpactSpec& s, const ContactModel& model,
                                     const ContactEvaluation& e) {
-  collision::ImpactInput in;
-  in.target = model.target().rigid_body();
-  in.impactor = model.impactor().rigid_body();
-  in.impactor.center_of_mass_m += e.impactor_translation_m;
-  in.impactor.velocity_m_s = e.input.impactor.velocity_m_s;  // -speed n with approach_speed_m_s
-  in.contact.point_m = e.point_m;
-  in.contact.normal = e.normal;
-  in.target_curvature = e.input.target.curvature;
-  in.impactor_curvature = e.input.impactor.curvature;
-  in.rule = s.contact_radius;
-  in.effective_modulus_Pa = e.input.effective_modulus_Pa;
-  in.restitution = s.restitution;
+  collision::ImpactInput in = contact::impact_input(model, e);
   in.thresholds = scene.thresholds;
   in.context = impact_context(scene, s);
   in.input_keys = detail::impact_input_keys(scene, s);
@@ -231,7 +221,7 @@ fem_export::ContactPatch contact_patch(const ImpactReport& ir, const PreparedBod
 // Everything in the target's frame (DeckRequest).
 fem_export::DeckRequest fem_request(const Scene& scene, const ImpactReport& ir, const PreparedBody& target) {
   const FemOutputs& f = *scene.outputs.fem;
-  const BodySpec& b = *target.spec;
+  const BodySpec& b = scene.body(target.name);  // the body of the request (the impactor too, for compare_contact)
   const Place place{f.place.line, "outputs.fem"};
   if (b.fixed) {
     throw InputError(where(scene), place.describe(), "impact '" + ir.spec->name + "': target '" + b.name +
@@ -295,8 +285,7 @@ fem_export::DeckRequest fem_request(const Scene& scene, const ImpactReport& ir, 
                                                                  : fem_export::CcxSolver::automatic;
   r.options.aster_cpus = f.aster_cpus;
   r.options.aster_mpi_processes = f.aster_mpi_processes;
-  r.options.mesh.mesh_size_m = f.mesh_size_m.value_or(
-      b.shape == ShapeKind::mesh ? 0.25 * target.shape->size_m() : 0.5 * r.body.semi_axes_m.minCoeff());
+  r.options.mesh.mesh_size_m = f.mesh_size_m.value_or(default_mesh_size_m(b, target));
   r.options.adapt_mesh_size = !f.mesh_size_m;
   r.options.mesh.load_mesh_size_m = f.load_mesh_size_m.value_or(0.0);
   r.options.mesh.probes_m = f.probes_m;
@@ -331,6 +320,41 @@ collision::ForceTableOptions force_table_options(const Scene& scene, const Impac
   o.time_step_context = {where(scene), output_place(scene, "force_table_time_step_s").describe() + ": " + impact};
   o.max_samples_context = {where(scene), output_place(scene, "force_table_max_samples").describe() + ": " + impact};
   return o;
+}
+
+ImpactReport solve_located_impact(const Scene& scene, const ImpactSpec& s, const ContactModel& model,
+                                  ContactEvaluation located, std::vector<std::string>& warnings) {
+  if (s.contact_radius == ContactRadiusRule::paper) {
+    for (const PreparedBody* b : {&model.target(), &model.impactor()}) {
+      if (scene.body(b->name).shape == ShapeKind::mesh) {
+        warnings.push_back("impact '" + s.name + "': contact_radius = \"paper\" on mesh body '" + b->name +
+                           "': Eq. 26 cuts the part with planes normal to its file's axes, so the radius "
+                           "depends on the part's coordinate frame; \"elliptical\" does not");
+      }
+    }
+  }
+  ImpactReport ir;
+  ir.spec = std::make_shared<const ImpactSpec>(s);
+  // The kernel solved this point when it was located; it is completed here, not solved again.
+  const collision::ImpactInput in = impact_input(scene, s, model, located);
+  detail::check_impact_magnitudes(scene, s, in, located.result.effective_radius_m);
+  static_cast<contact::Impact&>(ir) = contact::complete_impact(model, std::move(located), in, scene.validity);
+  for (const auto& w : ir.validity.warnings) warnings.push_back("impact '" + s.name + "': validity of the Hertz model: " + w);
+  for (const auto& w : ir.result.warnings) warnings.push_back("impact '" + s.name + "': " + w);
+  if (const std::string w = detail::indentation_warning(scene, s, ir.result); !w.empty()) {
+    warnings.push_back("impact '" + s.name + "': " + w);
+  }
+  return ir;
+}
+
+double default_mesh_size_m(const BodySpec& b, const PreparedBody& p) {
+  switch (b.shape) {
+    case ShapeKind::sphere: return 0.5 * b.radius_m;
+    case ShapeKind::ellipsoid: return 0.5 * b.semi_axes_m.minCoeff();
+    case ShapeKind::mesh: return 0.25 * p.shape->size_m();
+    case ShapeKind::plane: break;
+  }
+  return 0.0;
 }
 
 fem_export::DeckRequest hybrid_deck_request(const Scene& scene, const ImpactReport& ir, const PreparedBody& body) {
@@ -425,8 +449,6 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
       if (!bodies.count(*name)) bodies.emplace(*name, prepare_body(scene.body(*name), scene, &report));
 
   for (const auto& s : scene.impacts) {
-    ImpactReport ir;
-    ir.spec = std::make_shared<const ImpactSpec>(s);
     const PreparedBody& target = bodies.at(s.target);
     const PreparedBody& impactor = bodies.at(s.impactor);
     const InputContext ctx = impact_context(scene, s);
@@ -434,37 +456,18 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
         target, impactor, s.contact_radius,
         collision::effective_modulus_Pa(target.material, impactor.material, scene.modulus_convention, ctx),
         s.restitution, ctx);
-    ir.contact = clock.run(Stage::contact_geometry, [&] { return locate_contact(scene, s, model); });
-    if (ir.contact.result.flag != collision::ContactFlag::none) {
+    ContactEvaluation located = clock.run(Stage::contact_geometry, [&] { return locate_contact(scene, s, model); });
+    if (located.result.flag != collision::ContactFlag::none) {
       const Place place{s.place.line, s.place.key + ".point"};
       throw InputError(where(scene), place.describe(),
-                       "impact '" + s.name + "': at " + text(ir.contact.point_m) + " m (normal " +
-                           text(ir.contact.normal) + "): " + collision::explain_flag(ir.contact.input, ir.contact.result, "'" + s.target + "'", "'" + s.impactor + "'") +
-                           (ir.contact.curvature_problem.empty() ? "" : " (" + ir.contact.curvature_problem + ")"));
+                       "impact '" + s.name + "': at " + text(located.point_m) + " m (normal " + text(located.normal) +
+                           "): " +
+                           collision::explain_flag(located.input, located.result, "'" + s.target + "'",
+                                                   "'" + s.impactor + "'") +
+                           (located.curvature_problem.empty() ? "" : " (" + located.curvature_problem + ")"));
     }
-    if (s.contact_radius == ContactRadiusRule::paper) {
-      for (const PreparedBody* b : {&target, &impactor}) {
-        if (b->spec && b->spec->shape == ShapeKind::mesh) {
-          report.warnings.push_back("impact '" + s.name + "': contact_radius = \"paper\" on mesh body '" + b->name +
-                                    "': Eq. 26 cuts the part with planes normal to its file's axes, so the radius "
-                                    "depends on the part's coordinate frame; \"elliptical\" does not");
-        }
-      }
-    }
-    ir.result = clock.run(Stage::impact, [&] {
-      const collision::ImpactInput in = impact_input(scene, s, model, ir.contact);
-      detail::check_impact_magnitudes(scene, s, in, ir.contact.result.effective_radius_m);
-      return collision::solve_impact(in);
-    });
-    ir.validity = collision::assess_validity(ir.contact.input, ir.result.kernel, target.yield_strength_Pa,
-                                             impactor.yield_strength_Pa, scene.validity);
-    for (const auto& w : ir.validity.warnings) {
-      report.warnings.push_back("impact '" + s.name + "': validity of the Hertz model: " + w);
-    }
-    for (const auto& w : ir.result.warnings) report.warnings.push_back("impact '" + s.name + "': " + w);
-    if (const std::string w = detail::indentation_warning(scene, s, ir.result); !w.empty()) {
-      report.warnings.push_back("impact '" + s.name + "': " + w);
-    }
+    ImpactReport ir = clock.run(
+        Stage::impact, [&] { return solve_located_impact(scene, s, model, std::move(located), report.warnings); });
     report.impacts.push_back(std::move(ir));
   }
 
@@ -519,7 +522,7 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
           co.progress = opt.progress;
           co.timeout_s = opt.solver_timeout_s;
           co.threads = opt.solver_threads;
-          ir.fem_check = fem_export::run_check(ir.fem_deck->folder, co);
+          ir.fem_check = fem_export::run_check(*ir.fem_deck, co);
         }
       });
     }
@@ -545,7 +548,9 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
           co.progress = opt.progress;
           co.context = {where(scene), Place{scene.outputs.fem->place.line, "outputs.fem.compare_contact"}.describe() +
                                           ": impact '" + ir.spec->name + "'"};
-          ir.compare = compare_contact(scene, co);
+          const CompareInput in =
+              compare_input(scene, ir, bodies.at(ir.spec->target), bodies.at(ir.spec->impactor), co.context);
+          ir.compare = compare_contact(in, co);
           if (ir.compare->verdict == CompareVerdict::disagree) {
             report.warnings.push_back("impact '" + ir.spec->name + "': full-contact F_max differs from the analytic one by " +
                                       std::to_string(100 * ir.compare->finest()->max_force_relative_difference) +
@@ -590,14 +595,14 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
     for (std::size_t k = 0; k < report.impacts.size(); ++k) {
       const auto& ir = report.impacts[k];
       if (!ir.fem_check || !ir.fem_check->stress) continue;
-      for (const auto& f : ir.fem_check->stress->files) {
-        if (f.extension() != ".svg") continue;
-        ReportPicture p;
+      const fem_export::StressResult& st = *ir.fem_check->stress;
+      for (const auto& f : st.files) {
+        if (f.extension() != ".svg" || st.von_mises_svg.empty()) continue;
+        ReportPicture p;  // the picture as drawn, not read back from its file
         p.caption = "Von Mises stress against time at the probes and the contact node (the paper's Fig. 15), " +
                     txn.public_path(f).string();
-        std::ifstream in(f, std::ios::binary);
-        p.svg.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-        if (!p.svg.empty()) pictures[k].push_back(std::move(p));
+        p.svg = st.von_mises_svg;
+        pictures[k].push_back(std::move(p));
       }
     }
   }

@@ -26,11 +26,6 @@ nlohmann::json body_json(const std::string& name, const collision::VelocityJump&
           {"principal_curvatures_1_per_m", {json_number(k.curvature.k1_per_m), json_number(k.curvature.k2_per_m)}}};
 }
 
-// The 1/R a rule assigns to one body (reported; the elliptical rule uses both tensors).
-double rule_curvature(const collision::ContactCurvature& c, collision::ContactRule rule) {
-  return rule == collision::ContactRule::paper ? c.paper_curvature_per_m : 0.5 * (c.k1_per_m + c.k2_per_m);
-}
-
 nlohmann::json validity_json(const collision::ValidityReport& v) {
   nlohmann::json j = {{"indentation_over_radius", json_number(v.indentation_over_radius)},
                       {"max_indentation_over_radius", v.limits.max_indentation_over_radius},
@@ -76,8 +71,8 @@ nlohmann::json to_json(const Scene& scene, const RunReport& rep) {
     i["projection_distance_m"] = json_number(ir.contact.target_point.distance_m);
     i["contact_radius_rule"] = to_string(ir.spec->contact_radius);
     i["target_principal_curvatures_1_per_m"] = {json_number(kin.target.curvature.k1_per_m), json_number(kin.target.curvature.k2_per_m)};
-    i["target_contact_curvature_1_per_m"] = json_number(rule_curvature(kin.target.curvature, ir.spec->contact_radius));
-    i["impactor_contact_curvature_1_per_m"] = json_number(rule_curvature(kin.impactor.curvature, ir.spec->contact_radius));
+    i["target_contact_curvature_1_per_m"] = json_number(kin.target.curvature.rule_curvature_per_m(ir.spec->contact_radius));
+    i["impactor_contact_curvature_1_per_m"] = json_number(kin.impactor.curvature.rule_curvature_per_m(ir.spec->contact_radius));
     i["relative_curvatures_1_per_m"] = {json_number(kr.relative_curvature_A_per_m), json_number(kr.relative_curvature_B_per_m)};
     i["contact_ellipse_axis_ratio"] = json_number(kr.contact_ellipse_axis_ratio);
     i["validity"] = validity_json(ir.validity);

@@ -12,7 +12,7 @@
 #include "overrides_toml.hpp"
 #include "impactdeck/common/input_file.hpp"
 #include "impactdeck/common/numeric.hpp"
-#include "toml_ascii.hpp"
+#include "impactdeck/scene/toml_ascii.hpp"
 
 namespace impactdeck::scene {
 namespace fs = std::filesystem;
@@ -709,7 +709,7 @@ Scene parse_scene(const std::string& text, const std::string& name, const fs::pa
                   const std::vector<Override>& overrides, const InputContext& context) {
   toml::table root;
   try {
-    root = toml::parse(detail::toml_ascii(text, context.in_file(name)), name);  // why ASCII: toml_ascii.hpp
+    root = toml::parse(toml_ascii(text, context.in_file(name)), name);  // why ASCII: toml_ascii.hpp
   } catch (const toml::parse_error& e) {
     std::ostringstream place;
     place << "line " << e.source().begin.line << ", column " << e.source().begin.column;

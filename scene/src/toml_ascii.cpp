@@ -1,11 +1,11 @@
-#include "toml_ascii.hpp"
+#include "impactdeck/scene/toml_ascii.hpp"
 
 #include <cstdint>
 #include <cstdio>
 
 #include "impactdeck/common/error.hpp"
 
-namespace impactdeck::scene::detail {
+namespace impactdeck::scene {
 
 namespace {
 
@@ -189,4 +189,4 @@ std::string toml_ascii(const std::string& text, const std::string& name) {
   return toml_ascii(text, InputContext{name, ""});
 }
 
-}  // namespace impactdeck::scene::detail
+}  // namespace impactdeck::scene

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "impactdeck/collision/compression.hpp"
+#include "impactdeck/collision/force_history.hpp"
 #include "impactdeck/common/error.hpp"
 #include "parallel.hpp"
 
@@ -13,13 +14,8 @@ namespace impactdeck::study {
 
 namespace {
 
-// The radius a rule assigns to one body (reported only: the kernel works with curvatures).
-double rule_radius(const collision::ContactCurvature& c, collision::ContactRule rule) {
-  return 1.0 / (rule == collision::ContactRule::paper ? c.paper_curvature_per_m : 0.5 * (c.k1_per_m + c.k2_per_m));
-}
-
 // One point's record from its contact evaluation.
-void record(const scene::ContactModel& model, const geometry::SurfacePoint& at, const scene::ContactPointResult& e,
+void record(const contact::ContactModel& model, const geometry::SurfacePoint& at, const contact::ContactPointResult& e,
             PointResult& r) {
   const collision::KernelResult& k = e.result;
   if (k.flag != collision::ContactFlag::none) r = PointResult{};  // nothing else of a flagged point is used
@@ -30,8 +26,8 @@ void record(const scene::ContactModel& model, const geometry::SurfacePoint& at, 
   if (r.flagged()) return;
   r.target_k1_per_m = e.target_surface.k1_per_m;
   r.target_k2_per_m = e.target_surface.k2_per_m;
-  r.target_radius_m = rule_radius(e.target_surface, model.rule());
-  r.impactor_radius_m = rule_radius(e.impactor_surface, model.rule());
+  r.target_radius_m = 1.0 / e.target_surface.rule_curvature_per_m(model.rule());
+  r.impactor_radius_m = 1.0 / e.impactor_surface.rule_curvature_per_m(model.rule());
   r.effective_radius_m = k.effective_radius_m;
   r.contact_ellipse_axis_ratio = k.contact_ellipse_axis_ratio;
   r.reduced_mass_kg = k.reduced_mass_kg;
@@ -41,7 +37,7 @@ void record(const scene::ContactModel& model, const geometry::SurfacePoint& at, 
   r.compression_time_s = k.compression_time_s;
   r.restitution = k.restitution.coefficient;
   r.restitution_clamped = k.restitution.clamped;
-  r.contact_time_s = (1.0 + r.restitution) * r.compression_time_s;
+  r.contact_time_s = collision::contact_time_s(r.compression_time_s, r.restitution);
   r.impulse_total_Ns = k.impulse_total_Ns;
   const geometry::PoseMap& frame = model.target_frame();
   r.target_delta_velocity_m_s = frame.direction_to_own(k.target_jump.delta_velocity_m_s);
@@ -68,9 +64,9 @@ void prefetch_for_write(const PointResult* first, const PointResult* end) {
 
 }  // namespace
 
-void sweep_points(const scene::ContactModel& model, double speed, const geometry::SurfacePoint* at, std::size_t count,
+void sweep_points(const contact::ContactModel& model, double speed, const geometry::SurfacePoint* at, std::size_t count,
                   PointResult* out) {
-  scene::ContactPointResult e[collision::kKernelLanes];
+  contact::ContactPointResult e[collision::kKernelLanes];
   prefetch_for_write(out, out + std::min(count, kPrefetchAhead));
   for (std::size_t begin = 0; begin < count; begin += collision::kKernelLanes) {
     const std::size_t n = std::min(collision::kKernelLanes, count - begin);
@@ -81,11 +77,11 @@ void sweep_points(const scene::ContactModel& model, double speed, const geometry
   }
 }
 
-void sweep_point(const scene::ContactModel& model, double speed, const geometry::SurfacePoint& at, PointResult& r) {
+void sweep_point(const contact::ContactModel& model, double speed, const geometry::SurfacePoint& at, PointResult& r) {
   sweep_points(model, speed, &at, 1, &r);
 }
 
-PointResult sweep_point(const scene::ContactModel& model, double speed, const geometry::SurfacePoint& at) {
+PointResult sweep_point(const contact::ContactModel& model, double speed, const geometry::SurfacePoint& at) {
   PointResult r;
   sweep_point(model, speed, at, r);
   return r;
@@ -98,7 +94,7 @@ void sample_curve(const PointResult& p, std::size_t samples, double* out) {
   for (std::size_t k = 0; k < samples; ++k) {
     const double t = tc * static_cast<double>(k) / last;
     double tau = t / tm;
-    if (t > tm) tau = R > 0.0 ? (tm - (t - tm) / R) / tm : 0.0;
+    if (t > tm) tau = R > 0.0 ? collision::restitution_mirror_s(t, tm, R) / tm : 0.0;
     const double z = collision::compression_shape(tau);
     out[k] = p.max_force_N * z * std::sqrt(z);
   }
@@ -127,7 +123,7 @@ SweepResult run_sweep(const SweepSetup& s, const std::vector<geometry::SurfacePo
   if (s.restitution.kind == collision::RestitutionModel::Kind::table) {
     collision::validate_restitution_table(s.restitution.table, s.context.at("restitution"));
   }
-  const scene::ContactModel model(s.target, s.impactor, s.rule, s.effective_modulus_Pa, s.restitution, s.context);
+  const contact::ContactModel model(s.target, s.impactor, s.rule, s.effective_modulus_Pa, s.restitution, s.context);
   SweepResult res;
   const std::size_t n = cloud.size();
   res.points.resize(n);  // every point writes only its own slot

@@ -8,7 +8,6 @@
 #include "impactdeck/common/run_transaction.hpp"
 #include "impactdeck/common/suggest.hpp"
 #include "impactdeck/geometry/ellipsoid.hpp"
-#include "impactdeck/study/scene_sweep.hpp"
 
 namespace impactdeck::study {
 namespace fs = std::filesystem;
@@ -53,15 +52,14 @@ class StageClock {
 };
 
 // The sweep proper, inside the transaction `txn` (null: no files).
-void sweep_stages(const scene::Scene& sc, const SweepRequest& q, RunTransaction* txn, SweepReport& rep) {
+void sweep_stages(const SweepCase& ss, const SweepRequest& q, RunTransaction* txn, SweepReport& rep) {
   StageClock clock(rep);
-  const SceneSweep ss = clock.run(Stage::scene, [&] { return sweep_from_scene(sc, q.impact); });
-  const scene::ImpactSpec& imp = *ss.impact;
-  rep.impact = imp.name;
-  rep.target = imp.target;
-  rep.impactor = imp.impactor;
+  rep.stage_times_s.emplace_back(Stage::scene, ss.prepare_seconds);
+  rep.impact = ss.impact;
+  rep.target = ss.target;
+  rep.impactor = ss.impactor;
   rep.approach_speed_m_s = ss.setup.approach_speed_m_s;
-  const std::string where = sc.file.string();
+  const std::string& where = ss.source;
   const geometry::Shape& target = *ss.setup.target.shape;
 
   std::optional<CloudKind> kind;
@@ -79,7 +77,7 @@ void sweep_stages(const scene::Scene& sc, const SweepRequest& q, RunTransaction*
   formats.curves = q.sweep.curves;  // PREFIX_curves.csv exactly when the curves are computed
   std::optional<fs::path> staged_base;
   if (txn) {
-    const std::string prefix = q.prefix.empty() ? "sweep_" + imp.name : q.prefix;
+    const std::string prefix = q.prefix.empty() ? "sweep_" + ss.impact : q.prefix;
     const std::string prefix_place = q.prefix.empty() ? "--prefix (default sweep_<impact name>)" : "--prefix";
     for (const auto& [wanted, suffix] : {std::pair{formats.csv, ".csv"}, std::pair{formats.curves, "_curves.csv"},
                                          std::pair{formats.pos, ".pos"}, std::pair{formats.vtp, ".vtp"},
@@ -99,14 +97,14 @@ void sweep_stages(const scene::Scene& sc, const SweepRequest& q, RunTransaction*
   const std::vector<geometry::SurfacePoint> cloud = clock.run(Stage::cloud, [&] {
     if (!q.points_csv.empty()) {
       // Projected as `run` projects an impact point, with the same distance limit.
-      const double tol = imp.max_projection_distance_m.value_or(0.01 * target.size_m());
-      auto pts = csv_point_cloud(target, q.points_csv, metres_per(sc.length_unit), tol);
+      const double tol = ss.max_projection_distance_m.value_or(0.01 * target.size_m());
+      auto pts = csv_point_cloud(target, q.points_csv, metres_per(ss.length_unit), tol);
       const double points = static_cast<double>(pts.size());
       check_points(points, q.max_points, q.points_csv.string(), "--points", "its rows");
       if (q.sweep.curves) check_curve_samples(points, q.sweep.curve_samples, q.max_curve_samples, where);
       return pts;
     }
-    return make_cloud(target, *kind, q.grid_steps, q.count, q.seed, {where, "target '" + imp.target + "'"});
+    return make_cloud(target, *kind, q.grid_steps, q.count, q.seed, {where, "target '" + ss.target + "'"});
   });
   if (!q.points_csv.empty()) {
     rep.cloud = "points of " + q.points_csv.string();
@@ -125,14 +123,14 @@ void sweep_stages(const scene::Scene& sc, const SweepRequest& q, RunTransaction*
   clock.run(Stage::write_outputs, [&] {
     SweepMeta meta;
     meta.source = where;
-    meta.impact = imp.name;
-    meta.target = imp.target;
-    meta.impactor = imp.impactor;
+    meta.impact = ss.impact;
+    meta.target = ss.target;
+    meta.impactor = ss.impactor;
     meta.cloud = rep.cloud;
     SweepPicture picture;
     picture.target = &target;
     picture.centroid_m = ss.setup.target.volume.centroid_m;
-    picture.options.title = "Maximal collision force: " + imp.impactor + " hits " + imp.target + " (impact '" + imp.name + "')";
+    picture.options.title = "Maximal collision force: " + ss.impactor + " hits " + ss.target + " (impact '" + ss.impact + "')";
     SweepWriteOptions wo;
     wo.threads = q.sweep.threads;
     wo.length_unit = rep.output_length_unit;
@@ -144,17 +142,17 @@ void sweep_stages(const scene::Scene& sc, const SweepRequest& q, RunTransaction*
 
 }  // namespace
 
-SweepReport run_sweep_command(const scene::Scene& sc, const SweepRequest& q) {
+SweepReport run_sweep_command(const SweepCase& ss, const SweepRequest& q) {
   SweepReport rep;
-  rep.scene = sc.file.string();
-  rep.output_length_unit = q.output_length_unit.value_or(sc.length_unit);
+  rep.scene = ss.source;
+  rep.output_length_unit = q.output_length_unit.value_or(ss.length_unit);
   if (q.out_dir.empty()) {
-    sweep_stages(sc, q, nullptr, rep);
+    sweep_stages(ss, q, nullptr, rep);
     return rep;
   }
   // One transaction: the sweep's files appear together when all are written, or not at all.
   RunTransaction txn(q.out_dir);
-  txn.run([&] { sweep_stages(sc, q, &txn, rep); });  // messages name the final paths, not the staging folder
+  txn.run([&] { sweep_stages(ss, q, &txn, rep); });  // messages name the final paths, not the staging folder
   rep.warnings = txn.warnings();  // an interrupted commit finished, stale staging folders removed
   return rep;
 }

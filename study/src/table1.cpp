@@ -214,7 +214,7 @@ Table1Result run_table1(const Table1Options& o) {
       if (o.scene) {
         s = o.scene->setup;  // impactor, materials, speed, contact rule
       } else {
-        s.impactor = scene::body_of_mass("sphere", sphere, m2);
+        s.impactor = contact::body_of_mass("sphere", sphere, m2);
         s.rule = o.rule;  // "paper": Eq. 26 on the ellipsoid, the sphere's own radius r exactly
         s.effective_modulus_Pa = collision::effective_modulus_Pa(
             {kYoungs_Pa, 0.3}, {kYoungs_Pa, 0.3}, collision::ModulusConvention::paper);
@@ -227,7 +227,7 @@ Table1Result run_table1(const Table1Options& o) {
       s.restitution.constant = 1.0;
       const double m1 = o.mass_ratios[mi] * s.impactor.mass_kg;
       const std::string name = o.scene ? s.target.name : std::string("ellipsoid");
-      s.target = scene::body_of_mass(name, targets[gi], m1, s.target.material);
+      s.target = contact::body_of_mass(name, targets[gi], m1, s.target.material);
       SweepOptions so;
       so.threads = o.threads;
       if (o.progress) {

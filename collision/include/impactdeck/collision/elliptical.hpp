@@ -9,6 +9,8 @@
 //     k_H = (2 pi / 3) E* sqrt[(K - E)/(A e^2)] / K^(3/2),
 // i.e. the spherical law 4/3 E* sqrt(R_eq) with the equivalent radius
 //     R_eq = (pi^2 / 4) (K - E) / (A e^2 K^3),   R_eq = 1/(2A) when A = B.
+#include <cmath>
+
 #include <Eigen/Dense>
 
 namespace impactdeck::collision {
@@ -52,5 +54,11 @@ struct ContactEllipse {
 };
 ContactEllipse contact_ellipse(const RelativeCurvatures& c, const EllipticalContact& e,
                                double effective_modulus_Pa, double force_N);
+
+/// Hertz's peak pressure p0 = 3 P / (2 pi a b) of a contact ellipse with semi-axes a, b under the
+/// normal force P (a circle: a = b).
+inline double hertz_peak_pressure_Pa(double force_N, double a_m, double b_m) {
+  return 3.0 * force_N / (2.0 * M_PI * a_m * b_m);
+}
 
 }  // namespace impactdeck::collision

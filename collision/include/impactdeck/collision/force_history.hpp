@@ -13,11 +13,22 @@
 
 namespace impactdeck::collision {
 
+/// The contact time (1 + R) t_m: the compression phase and its restitution mirror stretched by R.
+inline double contact_time_s(double compression_time_s, double restitution) {
+  return (1.0 + restitution) * compression_time_s;
+}
+
+/// The compression-phase time whose force the restitution phase has at time t (t_m < t <= (1 + R)
+/// t_m, R > 0): the mirror t_m - (t - t_m) / R.
+inline double restitution_mirror_s(double t_s, double compression_time_s, double restitution) {
+  return compression_time_s - (t_s - compression_time_s) / restitution;
+}
+
 struct ForceHistory {
   CompressionPhase compression;
   double restitution = 0;  ///< Poisson's coefficient R in [0, 1]
 
-  double contact_time_s() const { return (1.0 + restitution) * compression.compression_time_s; }
+  double contact_time_s() const { return collision::contact_time_s(compression.compression_time_s, restitution); }
   double impulse_compression_Ns() const { return compression.impulse_Ns; }
   double impulse_restitution_Ns() const { return restitution * compression.impulse_Ns; }
   double impulse_total_Ns() const { return (1.0 + restitution) * compression.impulse_Ns; }

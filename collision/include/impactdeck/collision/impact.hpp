@@ -65,11 +65,19 @@ struct ImpactResult {
   std::vector<std::string> warnings;
 };
 
-/// Solves the impact through the physics kernel (solve_kernel), then builds the force history and
-/// runs the paper's self-checks on it. Throws input.context.error(place, reason) for invalid input
-/// and where the kernel flags the point (no impact, not a Hertz contact, restitution refused),
-/// naming the reason and the curvatures. Check failures do not throw: see `checks.passed`.
+/// Solves the impact through the physics kernel (solve_kernel), then completes it (complete_impact).
+/// Throws input.context.error(place, reason) for invalid input and where the kernel flags the point
+/// (no impact, not a Hertz contact, restitution refused), naming the reason and the curvatures.
+/// Check failures do not throw: see `checks.passed`.
 ImpactResult solve_impact(const ImpactInput& input);
+
+/// The impact once the kernel has solved its point, without solving it again (`run` solves it once,
+/// in contact::ContactModel): `kernel` = solve_kernel(`k`), where `k` is the kernel's input that
+/// `input` stands for (the same bodies, point, normal, curvatures, E* and restitution). Adds the
+/// force history, the velocity jumps and the paper's self-checks; the checks integrate the curve
+/// and take the jumps from `input`'s rigid bodies, independently of the kernel's closed form.
+/// Throws as solve_impact for invalid input and a flagged point.
+ImpactResult complete_impact(const ImpactInput& input, const KernelInput& k, const KernelResult& kernel);
 
 /// One line explaining a kernel flag at a point (the curvatures of both surfaces, the approach
 /// velocity or the restitution), for errors and reports; the names are used as given (e.g. "'cube'").

@@ -46,6 +46,12 @@ struct ContactCurvature {
 
   static ContactCurvature sphere(double radius_m);  ///< k1 = k2 = paper = 1/r
   static ContactCurvature flat();                   ///< a plane
+
+  /// The 1/R a rule gives this body: Eq. 26's for `paper`, else the mean curvature (k1 + k2)/2
+  /// (the `mean` rule's; the elliptical rule uses both tensors and reports the mean).
+  double rule_curvature_per_m(ContactRule rule) const {
+    return rule == ContactRule::paper ? paper_curvature_per_m : 0.5 * (k1_per_m + k2_per_m);
+  }
 };
 
 /// One body as the kernel sees it (world frame).

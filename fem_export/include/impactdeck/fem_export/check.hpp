@@ -108,6 +108,10 @@ struct CheckResult {
 /// tolerance is reported in `passed`/`failures`.
 CheckResult run_check(const std::filesystem::path& deck_dir, const CheckOptions& options = {});
 
+/// The same for the deck `written` has just written (write_decks / write_deck_files): its
+/// description and mesh are taken from memory, not read back from deck.json and mesh.inp.
+CheckResult run_check(const DeckResult& written, const CheckOptions& options = {});
+
 /// Runs ccx on `dir`/impact.inp (cwd = dir, output in impact.log, progress from impact.sta up to
 /// `end_time_s`) with options.timeout_s, or default_solver_timeout_s(nodes, solves); returns the
 /// wall time in s. Throws InputError when ccx is missing, fails or times out. The runner of

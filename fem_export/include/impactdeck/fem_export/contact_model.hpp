@@ -101,6 +101,7 @@ struct ContactDeck {
   double time_step_s = 0, end_time_s = 0;
   std::size_t increments = 0;
   double mesh_seconds = 0;
+  nlohmann::json description;  ///< contact.json's contents, as written
 };
 
 /// Meshes both bodies and writes `folder`/impact.inp (+ contact.json with what the reader needs),
@@ -140,6 +141,8 @@ struct ContactRunResult {
 /// Runs ccx on the deck folder (check.hpp's runner) and reads the contact force history and the
 /// final state. Throws InputError when ccx fails or its output is incomplete.
 ContactRunResult run_contact_model(const std::filesystem::path& folder, const CheckOptions& options = {});
+/// The same for the deck `written` has just written: contact.json's contents from memory.
+ContactRunResult run_contact_model(const ContactDeck& written, const CheckOptions& options = {});
 
 /// Exposed for tests: the C3D10 edge-middle node of the ccx ordering (5: 1-2, 6: 2-3, 7: 3-1,
 /// 8: 1-4, 9: 2-4, 10: 3-4), 0-based corner pairs.

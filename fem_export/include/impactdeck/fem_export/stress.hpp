@@ -80,6 +80,7 @@ struct StressResult {
   std::size_t frd_bytes = 0;
   LengthUnit length_unit = LengthUnit::mm;   ///< of the positions in the .vtu / .msh (the deck's)
   std::vector<std::filesystem::path> files;  ///< written by write_stress_files
+  std::string von_mises_svg;                 ///< the text of von_mises.svg (empty: none written)
 };
 
 /// Reads `frd` (ccx's results) for `mesh` (node i = ccx node i + 1). Throws InputError when the

@@ -16,6 +16,7 @@
 
 #include "impactdeck/fem_export/check.hpp"
 #include "impactdeck/fem_export/contact_model.hpp"
+#include "impactdeck/contact/impact.hpp"
 #include "impactdeck/fem_export/decks.hpp"
 #include "impactdeck/scene/scene.hpp"
 
@@ -80,8 +81,34 @@ struct CompareReport {
   const ContactLevel* finest() const { return ladder.empty() ? nullptr : &ladder.back(); }
 };
 
-/// Runs the comparison. Throws InputError (exit 3) on bad input: an unknown impact, a plane or a
-/// fixed body (the full-contact model meshes both bodies and needs their masses).
+struct ImpactReport;
+
+/// What the comparison takes of one impact, computed once by its caller: the impact itself (never
+/// solved again), both prepared bodies and both bodies' deck requests.
+struct CompareInput {
+  std::string source;       ///< the scene file (errors name it when CompareOptions::context is empty)
+  std::string impact_name;
+  const contact::Impact* impact = nullptr;  ///< must outlive the call, as the bodies
+  const contact::PreparedBody* target = nullptr;
+  const contact::PreparedBody* impactor = nullptr;
+  fem_export::DeckRequest target_deck;    ///< the target's hybrid deck request, its force table included
+  fem_export::DeckRequest impactor_deck;  ///< the impactor's body and material (its load is unused)
+  double impactor_mesh_size_m = 0;        ///< the impactor's far-field element size in the contact model
+  std::vector<std::string> warnings;      ///< the report's first warnings
+};
+
+/// The comparison's input for impact `ir` of `scene` (its force table sampled) between the run's
+/// prepared bodies. Throws ctx.error(...) for a plane or a fixed body (the full-contact model
+/// meshes both bodies and needs their masses) and the deck requests' InputErrors.
+CompareInput compare_input(const Scene& scene, const ImpactReport& ir, const contact::PreparedBody& target,
+                           const contact::PreparedBody& impactor, const InputContext& ctx);
+
+/// Runs the comparison of an impact already computed (`run`'s stage compare_contact).
+CompareReport compare_contact(const CompareInput& input, const CompareOptions& options);
+
+/// `compare-contact`: impact `options.impact` of `scene`, its bodies prepared and the impact solved
+/// as `run` does, then compared. Throws InputError (exit 3) on bad input: an unknown impact, a plane
+/// or a fixed body. A contact where Hertz does not apply gives the verdict non_hertzian.
 CompareReport compare_contact(const Scene& scene, const CompareOptions& options);
 
 /// Replaces every path of the report (deck folders, solver files, the plot) by `map(path)`: the

@@ -13,17 +13,16 @@
 #include "impactdeck/fem_export/decks.hpp"
 #include "impactdeck/geometry/shape.hpp"
 #include "impactdeck/scene/compare_contact.hpp"
-#include "impactdeck/scene/contact.hpp"
+#include "impactdeck/contact/impact.hpp"
 #include "impactdeck/scene/scene.hpp"
 
 namespace impactdeck::scene {
 
-struct ImpactReport {
+/// One impact of a run: the impact computed once (contact::Impact: the contact, the kernel's result
+/// completed with the force history and checks, the validity) and what the run made of it.
+struct ImpactReport : contact::Impact {
   /// A copy of the scene's impact: the report stays valid after the Scene it came from is gone.
   std::shared_ptr<const ImpactSpec> spec;
-  ContactEvaluation contact;         ///< where the bodies touch, both surfaces, the kernel's input
-  collision::ImpactResult result;
-  collision::ValidityReport validity;  ///< of the Hertz model at this impact
   std::optional<collision::ForceTable> table;
   std::optional<std::filesystem::path> table_path;  ///< where the CSV was written
   std::optional<std::filesystem::path> plot_path;   ///< where the F(t) SVG was written
@@ -66,7 +65,7 @@ std::shared_ptr<const geometry::Shape> make_shape(const BodySpec& body, const Sc
                                                   RunReport* report = nullptr);
 
 /// Mass, inertia, material and placement of a body from its spec.
-PreparedBody prepare_body(const BodySpec& body, const Scene& scene, RunReport* report = nullptr);
+contact::PreparedBody prepare_body(const BodySpec& body, const Scene& scene, RunReport* report = nullptr);
 
 /// Runs everything the scene asks for. Throws InputError on bad input; a failed self-check is
 /// reported (see all_checks_passed), not thrown. One transaction (common/run_transaction.hpp):
@@ -76,7 +75,18 @@ RunReport run_scene(const Scene& scene, const RunOptions& options = {});
 
 /// Where the bodies of impact `s` touch, as `run` finds it (point mode: the projected point, else
 /// the first contact); a point where Hertz does not apply comes back flagged. Throws InputError.
-ContactEvaluation locate_impact_contact(const Scene& scene, const ImpactSpec& s, const ContactModel& model);
+contact::ContactEvaluation locate_impact_contact(const Scene& scene, const ImpactSpec& s, const contact::ContactModel& model);
+
+/// `run`'s impact `s` at a located contact `contact` (flag none) of `model`: its numbers checked
+/// against double precision's range (naming the scene keys), the kernel's result completed
+/// (contact::complete_impact: the kernel is not solved again) and the validity assessed; its
+/// warnings appended to `warnings`. Throws InputError.
+ImpactReport solve_located_impact(const Scene& scene, const ImpactSpec& s, const contact::ContactModel& model,
+                                  contact::ContactEvaluation contact, std::vector<std::string>& warnings);
+
+/// The hybrid deck's far-field element size when the scene gives none: half the smallest semi-axis
+/// of an ellipsoid or sphere, a quarter of a part's size.
+double default_mesh_size_m(const BodySpec& body, const contact::PreparedBody& prepared);
 
 /// The scene's force-table options for impact `s`, their errors naming the [outputs] keys' lines
 /// and the impact (ForceTableOptions' contexts).
@@ -85,7 +95,7 @@ collision::ForceTableOptions force_table_options(const Scene& scene, const Impac
 /// The hybrid deck request `run` builds for an impact (scene.outputs.fem must be set; `ir.table`
 /// sampled): the body `body` alone in its own frame with the force on the target; its context
 /// names the scene's [outputs.fem] key and the impact. Throws InputError.
-fem_export::DeckRequest hybrid_deck_request(const Scene& scene, const ImpactReport& ir, const PreparedBody& body);
+fem_export::DeckRequest hybrid_deck_request(const Scene& scene, const ImpactReport& ir, const contact::PreparedBody& body);
 
 /// Every stage the tool knows, in pipeline order (for stages_run / stages_skipped).
 const std::vector<std::string>& all_stages();

@@ -22,17 +22,17 @@
 #include "impactdeck/collision/hertz.hpp"
 #include "impactdeck/collision/impact.hpp"
 #include "impactdeck/geometry/shape.hpp"
-#include "impactdeck/scene/contact.hpp"
+#include "impactdeck/contact/contact_model.hpp"
 
 namespace impactdeck::study {
 
-/// One sweep: both bodies (scene::PreparedBody: shape, placement, mass, inertia, material), the
+/// One sweep: both bodies (contact::PreparedBody: shape, placement, mass, inertia, material), the
 /// contact rule, E* and the restitution model. The sweep takes the target at rest and moves the
 /// impactor along the inward normal at `approach_speed_m_s` at every point (the paper's setting);
 /// the bodies' own velocities are not used.
 struct SweepSetup {
-  scene::PreparedBody target;
-  scene::PreparedBody impactor;
+  contact::PreparedBody target;
+  contact::PreparedBody impactor;
   collision::ContactRule rule = collision::ContactRule::elliptical;
   double effective_modulus_Pa = 0;   ///< E* (Eq. 28 or Hertz convention)
   double approach_speed_m_s = 1.0;   ///< impactor velocity = -speed * n at every point
@@ -55,7 +55,7 @@ struct SweepOptions {
 };
 
 /// Everything computed at one point (SI), from the physics kernel (collision::solve_kernel) through
-/// scene::ContactModel, as `impactdeck run` computes it.
+/// contact::ContactModel, as `impactdeck run` computes it.
 struct PointResult {
   /// Why the model does not apply here (collision::flag_word gives the CSV word): a sharp edge or
   /// corner, an impactor that does not fit a concave region, a saddle, no approach, ... Nothing
@@ -112,14 +112,14 @@ std::string flag_counts_text(const SweepResult& r);
 
 /// One point (the sweep's kernel): the target is hit at `at` (its own frame). Never throws: a point
 /// where the model does not apply comes back flagged.
-PointResult sweep_point(const scene::ContactModel& model, double approach_speed_m_s,
+PointResult sweep_point(const contact::ContactModel& model, double approach_speed_m_s,
                         const geometry::SurfacePoint& at);
 /// The same, written in place into `out` (every field; a sweep's preallocated slot).
-void sweep_point(const scene::ContactModel& model, double approach_speed_m_s, const geometry::SurfacePoint& at,
+void sweep_point(const contact::ContactModel& model, double approach_speed_m_s, const geometry::SurfacePoint& at,
                  PointResult& out);
 /// `count` points at once, out[k] written in place as sweep_point(model, speed, at[k], out[k]) bit
 /// for bit; the kernel's steps run over groups of points (ContactModel::at_surface_points).
-void sweep_points(const scene::ContactModel& model, double approach_speed_m_s, const geometry::SurfacePoint* at,
+void sweep_points(const contact::ContactModel& model, double approach_speed_m_s, const geometry::SurfacePoint* at,
                   std::size_t count, PointResult* out);
 
 /// The whole cloud. Throws InputError on bad input (bodies, speed), and when every point is flagged.

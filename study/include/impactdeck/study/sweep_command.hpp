@@ -15,7 +15,6 @@
 
 #include "impactdeck/common/stage.hpp"
 #include "impactdeck/common/units.hpp"
-#include "impactdeck/scene/scene.hpp"
 #include "impactdeck/study/cloud.hpp"
 #include "impactdeck/study/limits.hpp"
 #include "impactdeck/study/sweep.hpp"
@@ -27,6 +26,19 @@ namespace impactdeck::study {
 /// ellipsoid, area-uniform on anything else). Throws UsageError with a did-you-mean otherwise;
 /// `option` names the option in it.
 CloudKind parse_cloud_kind(const std::string& text, const geometry::Shape& target, const std::string& option = "--cloud");
+
+/// One impact made ready for a sweep (scene::sweep_case builds it from a scene): both bodies and
+/// the physics settings, and the names the reports and files give.
+struct SweepCase {
+  SweepSetup setup;
+  std::string source;                    ///< the scene file
+  std::string impact, target, impactor;  ///< names
+  LengthUnit length_unit = LengthUnit::m;  ///< the scene's: of --points rows and, by default, of the files
+  /// The impact's max_projection_distance (m): how far a --points row may lie from the target's
+  /// surface (empty: 1 % of the target's size, as `run` projects an impact point).
+  std::optional<double> max_projection_distance_m;
+  double prepare_seconds = 0;  ///< wall time spent building it (the stage "scene")
+};
 
 struct SweepRequest {
   std::string impact;         ///< empty: the scene's first impact
@@ -63,7 +75,7 @@ struct SweepReport {
 
 /// Runs the sweep. Throws InputError (exit 3) naming the scene (or --points file) and the place,
 /// UsageError for a bad --cloud; nothing is left in `out_dir` when it throws.
-SweepReport run_sweep_command(const scene::Scene& scene, const SweepRequest& request);
+SweepReport run_sweep_command(const SweepCase& sweep, const SweepRequest& request);
 
 /// `sweep --json` (docs/cli.md): scene, impact, cloud, output_length_unit, points, force_ratio,
 /// mass_only_ratio, min, max, approach_speed_m_s, restitution_clamped_points, sharp_points,

@@ -27,7 +27,7 @@ namespace impactdeck::study {
 /// Materials, approach speed and contact rule come from the scene (the restitution does not enter
 /// F_max and is not evaluated).
 struct Table1Scene {
-  SweepSetup setup;       ///< from sweep_from_scene
+  SweepSetup setup;       ///< from scene::sweep_case
   int stretch_axis = 0;   ///< 0 = x, 1 = y, 2 = z
   std::string source;     ///< scene file
   std::string impact, target, impactor;  ///< names, for the reports

@@ -1,5 +1,5 @@
 #pragma once
-// Scene text made ASCII before toml++ parses it (private to scene/src).
+// TOML text made ASCII before toml++ parses it: scene files, --set values and campaign files.
 //
 // Why: toml++ 3.3.0 (Debian 12) reaches __builtin_unreachable() — undefined behaviour — in
 // is_non_ascii_horizontal_whitespace for most non-ASCII code points (U+00A1–U+0499 among them:
@@ -18,11 +18,11 @@
 
 #include "impactdeck/common/error.hpp"
 
-namespace impactdeck::scene::detail {
+namespace impactdeck::scene {
 
 /// The ASCII form of `text` described above; throws where.error("line L, column C", reason).
 std::string toml_ascii(const std::string& text, const InputContext& where);
 /// The same, naming the file `name`.
 std::string toml_ascii(const std::string& text, const std::string& name);
 
-}  // namespace impactdeck::scene::detail
+}  // namespace impactdeck::scene

@@ -1,4 +1,4 @@
-#include "impactdeck/scene/contact.hpp"
+#include "impactdeck/contact/contact_model.hpp"
 
 #include <algorithm>
 #include <cassert>
@@ -9,43 +9,7 @@
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/geometry/mesh_shape.hpp"
 
-namespace impactdeck::scene {
-
-bool PreparedBody::fixed() const { return std::isinf(mass_kg); }
-
-Eigen::Matrix3d PreparedBody::inertia_world_kg_m2() const {
-  if (fixed()) return Eigen::Matrix3d::Identity();
-  const Eigen::Matrix3d& R = pose.rotation;
-  const Eigen::Matrix3d I = R * inertia_kg_m2 * R.transpose();
-  return 0.5 * (I + I.transpose());
-}
-
-collision::RigidBody PreparedBody::rigid_body() const {
-  collision::RigidBody r;
-  r.mass_kg = mass_kg;
-  r.inertia_kg_m2 = inertia_world_kg_m2();
-  r.center_of_mass_m = centroid_world_m();
-  r.velocity_m_s = velocity_m_s;
-  r.angular_velocity_rad_s = angular_velocity_rad_s;
-  return r;
-}
-
-PreparedBody body_of_mass(std::string name, std::shared_ptr<const geometry::Shape> shape, double mass_kg,
-                          const collision::ElasticMaterial& material) {
-  PreparedBody b;
-  b.name = std::move(name);
-  b.shape = std::move(shape);
-  b.volume = b.shape->volume_properties();
-  b.material = material;
-  b.mass_kg = mass_kg;
-  if (std::isinf(mass_kg)) {
-    b.inertia_kg_m2 = Eigen::Matrix3d::Identity() * mass_kg;
-    return b;
-  }
-  if (!(b.volume.volume_m3 > 0.0)) throw InputError("", "body '" + b.name + "'", "has no volume");
-  b.inertia_kg_m2 = b.volume.inertia_per_density_m5 * (mass_kg / b.volume.volume_m3);
-  return b;
-}
+namespace impactdeck::contact {
 
 ContactModel::ContactModel(const PreparedBody& target, const PreparedBody& impactor, collision::ContactRule rule,
                            double effective_modulus_Pa, const collision::RestitutionModel& restitution,
@@ -251,9 +215,9 @@ ContactEvaluation ContactModel::at_first_contact(const InputContext& ctx) const 
     throw ctx.error("", "point = \"first-contact\" needs the bodies to move relative to each other (the "
                         "impactor's velocity equals the target's)");
   }
-  geometry::PlacedShape t{target_.shape.get(), target_.pose};
-  geometry::PlacedShape m{impactor_.shape.get(), impactor_.pose};
-  const geometry::FirstContact fc = geometry::first_contact(t, m, u, ctx);
+  contact::PlacedShape t{target_.shape.get(), target_.pose};
+  contact::PlacedShape m{impactor_.shape.get(), impactor_.pose};
+  const contact::FirstContact fc = contact::first_contact(t, m, u, ctx);
   ContactEvaluation e;
   e.target_point = fc.target_point;
   e.impactor_point = fc.mover_point;
@@ -266,4 +230,4 @@ ContactEvaluation ContactModel::at_first_contact(const InputContext& ctx) const 
   return e;
 }
 
-}  // namespace impactdeck::scene
+}  // namespace impactdeck::contact

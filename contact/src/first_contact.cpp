@@ -1,6 +1,6 @@
 // First contact of two placed bodies under a translation (first_contact.hpp). No CGAL here: the
 // meshes' AABB trees are reached through MeshShape::sweep_faces and sweep_face_pairs.
-#include "impactdeck/geometry/first_contact.hpp"
+#include "impactdeck/contact/first_contact.hpp"
 
 #include <algorithm>
 #include <array>
@@ -17,7 +17,14 @@
 #include "impactdeck/geometry/mesh_shape.hpp"
 #include "impactdeck/geometry/plane.hpp"
 
-namespace impactdeck::geometry {
+namespace impactdeck::contact {
+
+using geometry::Ellipsoid;
+using geometry::MeshShape;
+using geometry::Plane;
+using geometry::Pose;
+using geometry::Shape;
+using geometry::SurfacePoint;
 
 namespace {
 
@@ -570,4 +577,4 @@ FirstContact first_contact(const PlacedShape& target_in, const PlacedShape& move
   return dress(target, mover, d, h);
 }
 
-}  // namespace impactdeck::geometry
+}  // namespace impactdeck::contact

@@ -1,5 +1,6 @@
-#include "impactdeck/study/scene_sweep.hpp"
+#include "impactdeck/scene/sweep_case.hpp"
 
+#include <chrono>
 #include <cmath>
 #include <optional>
 #include <sstream>
@@ -8,34 +9,42 @@
 #include "impactdeck/common/suggest.hpp"
 #include "impactdeck/scene/pipeline.hpp"
 
-namespace impactdeck::study {
+namespace impactdeck::scene {
 
-SceneSweep sweep_from_scene(const scene::Scene& sc, const std::string& name) {
-  SceneSweep out;
+study::SweepCase sweep_case(const Scene& sc, const std::string& name) {
+  const auto start = std::chrono::steady_clock::now();
+  study::SweepCase out;
+  const ImpactSpec* impact = nullptr;
   const std::string file = sc.file.string();
   for (const auto& i : sc.impacts)
     if (name.empty() || i.name == name) {
-      out.impact = &i;
+      impact = &i;
       break;
     }
-  if (!out.impact) {
+  if (!impact) {
     std::string list;
     for (const auto& i : sc.impacts) list += (list.empty() ? "" : ", ") + ("'" + i.name + "'");
     std::vector<std::string> names;
     for (const auto& i : sc.impacts) names.push_back(i.name);
     throw InputError(file, "--impact", "no impact named '" + name + "' (the scene has " + list + ")" + did_you_mean(name, names));
   }
-  const scene::ImpactSpec& s = *out.impact;
+  const ImpactSpec& s = *impact;
+  out.source = file;
+  out.impact = s.name;
+  out.target = s.target;
+  out.impactor = s.impactor;
+  out.length_unit = sc.length_unit;
+  out.max_projection_distance_m = s.max_projection_distance_m;
   // The sweep's setting: the target at rest, the impactor translating along the inward normal.
-  auto at_rest = [](scene::PreparedBody b) {
+  auto at_rest = [](contact::PreparedBody b) {
     b.velocity_m_s.setZero();
     b.angular_velocity_rad_s.setZero();
     return b;
   };
-  out.setup.target = at_rest(scene::prepare_body(sc.body(s.target), sc));
-  out.setup.impactor = at_rest(scene::prepare_body(sc.body(s.impactor), sc));
+  out.setup.target = at_rest(prepare_body(sc.body(s.target), sc));
+  out.setup.impactor = at_rest(prepare_body(sc.body(s.impactor), sc));
   if (!out.setup.target.shape->bounded()) {
-    throw InputError(file, scene::Place{s.place.line, s.place.key + ".target"}.describe(),
+    throw InputError(file, Place{s.place.line, s.place.key + ".target"}.describe(),
                      "impact '" + s.name + "': a sweep covers the target's surface; target '" + s.target +
                          "' is a plane (swap target and impactor)");
   }
@@ -49,8 +58,8 @@ SceneSweep sweep_from_scene(const scene::Scene& sc, const std::string& name) {
   if (s.approach_speed_m_s) {
     out.setup.approach_speed_m_s = *s.approach_speed_m_s;
   } else {
-    const scene::BodySpec& tb = sc.body(s.target);
-    const scene::BodySpec& ib = sc.body(s.impactor);
+    const BodySpec& tb = sc.body(s.target);
+    const BodySpec& ib = sc.body(s.impactor);
     out.setup.approach_speed_m_s = (ib.velocity_m_s - tb.velocity_m_s).norm();
     if (!(out.setup.approach_speed_m_s > 0.0)) {
       throw InputError(file, s.place.describe(),
@@ -58,19 +67,20 @@ SceneSweep sweep_from_scene(const scene::Scene& sc, const std::string& name) {
                        "or a velocity of '" + s.impactor + "' relative to '" + s.target + "'");
     }
   }
+  out.prepare_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
 }
 
-Table1Scene table1_scene_from(const scene::Scene& sc, const std::string& impact_name, int stretch_axis) {
-  const SceneSweep ss = sweep_from_scene(sc, impact_name);
-  Table1Scene t;
-  t.setup = ss.setup;
+study::Table1Scene table1_scene(const Scene& sc, const std::string& impact_name, int stretch_axis) {
+  const study::SweepCase c = sweep_case(sc, impact_name);
+  study::Table1Scene t;
+  t.setup = c.setup;
   t.stretch_axis = stretch_axis;
-  t.source = sc.file.string();
-  t.impact = ss.impact->name;
-  t.target = ss.impact->target;
-  t.impactor = ss.impact->impactor;
+  t.source = c.source;
+  t.impact = c.impact;
+  t.target = c.target;
+  t.impactor = c.impactor;
   return t;
 }
 
-}  // namespace impactdeck::study
+}  // namespace impactdeck::scene

@@ -1,5 +1,5 @@
 #pragma once
-// The geometric half of an impact: placed bodies, where they touch, and the physics kernel's
+// The geometric half of an impact: where two placed bodies touch, and the physics kernel's
 // input built from both surfaces there. `run`, `sweep` and `study` all go through ContactModel, so
 // that one contact point gives bit for bit the same numbers whatever command asks for it.
 #include <cstddef>
@@ -10,7 +10,8 @@
 #include "impactdeck/collision/hertz.hpp"
 #include "impactdeck/collision/kernel.hpp"
 #include "impactdeck/common/error.hpp"
-#include "impactdeck/geometry/first_contact.hpp"
+#include "impactdeck/contact/body.hpp"
+#include "impactdeck/contact/first_contact.hpp"
 #include "impactdeck/geometry/pose.hpp"
 #include "impactdeck/geometry/shape.hpp"
 
@@ -18,38 +19,7 @@ namespace impactdeck::geometry {
 class MeshShape;
 }
 
-namespace impactdeck::scene {
-
-struct BodySpec;
-
-/// A body made ready for impacts: its shape in its own frame, its placement and its rigid-body
-/// state (velocities in the world frame).
-struct PreparedBody {
-  std::string name;
-  const BodySpec* spec = nullptr;  ///< null for bodies made without a scene (study presets)
-  std::shared_ptr<const geometry::Shape> shape;
-  geometry::Pose pose;             ///< own frame -> world
-  geometry::VolumeProperties volume;  ///< own frame, unit density
-  double mass_kg = 0;              ///< +infinity when fixed
-  Eigen::Matrix3d inertia_kg_m2 = Eigen::Matrix3d::Zero();  ///< own frame, about the centroid
-  collision::ElasticMaterial material;
-  std::optional<double> yield_strength_Pa;
-  Eigen::Vector3d velocity_m_s = Eigen::Vector3d::Zero();            ///< world
-  Eigen::Vector3d angular_velocity_rad_s = Eigen::Vector3d::Zero();  ///< world
-
-  bool fixed() const;
-  Eigen::Vector3d centroid_world_m() const { return pose.to_world(volume.centroid_m); }
-  /// R I R^T (identity for a fixed body: never used, its inverse mass is 0).
-  Eigen::Matrix3d inertia_world_kg_m2() const;
-  /// The rigid-body state in the world frame (collision::RigidBody).
-  collision::RigidBody rigid_body() const;
-};
-
-/// A free body made without a scene: `shape` at rest at the origin of the world, with total mass
-/// `mass_kg` (+infinity: fixed) spread uniformly (inertia scaled from the shape's unit-density
-/// inertia). Throws InputError when the shape has no volume and the mass is finite.
-PreparedBody body_of_mass(std::string name, std::shared_ptr<const geometry::Shape> shape, double mass_kg,
-                          const collision::ElasticMaterial& material = {});
+namespace impactdeck::contact {
 
 /// Everything about one contact point: where it is on both bodies, both surfaces' curvature there,
 /// the kernel's input and its result.
@@ -107,7 +77,7 @@ class ContactModel {
                          ContactPointResult* out) const;
 
   /// First-contact mode: the impactor, as placed, translates along the relative velocity of the
-  /// bodies until they touch (geometry::first_contact). Throws ctx.error("", reason) when they
+  /// bodies until they touch (contact::first_contact). Throws ctx.error("", reason) when they
   /// never touch, already overlap, or do not move relative to each other.
   ContactEvaluation at_first_contact(const InputContext& ctx = {}) const;
 
@@ -150,4 +120,4 @@ class ContactModel {
   Eigen::Vector3d target_centroid_, impactor_centroid_;  ///< world, as placed
 };
 
-}  // namespace impactdeck::scene
+}  // namespace impactdeck::contact

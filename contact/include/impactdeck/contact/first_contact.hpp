@@ -10,12 +10,12 @@
 #include "impactdeck/geometry/pose.hpp"
 #include "impactdeck/geometry/shape.hpp"
 
-namespace impactdeck::geometry {
+namespace impactdeck::contact {
 
 /// A shape placed in the world (the shape is not owned: it must outlive the call).
 struct PlacedShape {
-  const Shape* shape = nullptr;
-  Pose pose;
+  const geometry::Shape* shape = nullptr;
+  geometry::Pose pose;
 };
 
 struct FirstContact {
@@ -28,9 +28,9 @@ struct FirstContact {
   /// the target mesh's smooth normal (MeshShape::closest_point) at the point.
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
   /// The contact point in the target's own frame, with the target's outward normal there.
-  SurfacePoint target_point;
+  geometry::SurfacePoint target_point;
   /// The contact point in the mover's own frame, with the mover's outward normal there.
-  SurfacePoint mover_point;
+  geometry::SurfacePoint mover_point;
   /// "<mover feature>-<target feature>", each "vertex", "edge" or "face" on a mesh and "smooth"
   /// on an analytic shape ("vertex-face": a vertex of the mover meets a face of the target;
   /// "edge-edge"; "smooth-face"; ...); "smooth" alone when both are analytic.
@@ -59,4 +59,4 @@ struct FirstContact {
 FirstContact first_contact(const PlacedShape& target, const PlacedShape& mover, const Eigen::Vector3d& direction_world,
                            const InputContext& ctx = {});
 
-}  // namespace impactdeck::geometry
+}  // namespace impactdeck::contact

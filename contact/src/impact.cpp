@@ -1,0 +1,33 @@
+#include "impactdeck/contact/impact.hpp"
+
+#include <utility>
+
+namespace impactdeck::contact {
+
+collision::ImpactInput impact_input(const ContactModel& model, const ContactEvaluation& e) {
+  collision::ImpactInput in;
+  in.target = model.target().rigid_body();
+  in.impactor = model.impactor().rigid_body();
+  in.impactor.center_of_mass_m += e.impactor_translation_m;
+  in.impactor.velocity_m_s = e.input.impactor.velocity_m_s;  // -speed n with approach_speed_m_s
+  in.contact.point_m = e.point_m;
+  in.contact.normal = e.normal;
+  in.target_curvature = e.input.target.curvature;
+  in.impactor_curvature = e.input.impactor.curvature;
+  in.rule = model.rule();
+  in.effective_modulus_Pa = e.input.effective_modulus_Pa;
+  in.restitution = *e.input.restitution;
+  return in;
+}
+
+Impact complete_impact(const ContactModel& model, ContactEvaluation contact, const collision::ImpactInput& input,
+                       const collision::ValidityLimits& limits) {
+  Impact i;
+  i.result = collision::complete_impact(input, contact.input, contact.result);
+  i.validity = collision::assess_validity(contact.input, i.result.kernel, model.target().yield_strength_Pa,
+                                          model.impactor().yield_strength_Pa, limits);
+  i.contact = std::move(contact);
+  return i;
+}
+
+}  // namespace impactdeck::contact
