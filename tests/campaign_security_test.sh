@@ -133,6 +133,11 @@ for forged in "1; touch ${mark}_10" "\$(touch ${mark}_11)" "4242 \`touch ${mark}
   expect_error "forged job id '$forged'" 3 "/slurm/jobs.txt: line 2: '.*' is not a Slurm job id \(digits only\)" "$bin" campaign status "$camp"
   check "forged job id '$forged': squeue not run, no marker" '[ ! -e slurmlog/squeue.args ] && no_markers'
 done
+# ... and before sbatch runs: nothing is submitted next to a forged job list.
+rm -f slurmlog/sbatch.args
+expect_error "a forged job list refuses submission" 3 "/slurm/jobs.txt: line 2: '-j1' is not a Slurm job id" \
+  "$bin" campaign run "$camp" --executor slurm
+check "sbatch not run next to a forged job list" '[ ! -e slurmlog/sbatch.args ]'
 printf '4242\n' >"$camp/slurm/jobs.txt"
 
 # sbatch refusing: exit 3 (an external tool's failure, docs/cli.md), naming the script.
@@ -185,7 +190,8 @@ printf 'scene = "base.toml"\n[points]\ncsv = "points.fifo"\n' >fifo.toml
 expect_error "a FIFO as points CSV" 3 "points\.fifo: file: is a FIFO" timeout 60 "$bin" campaign plan fifo.toml --out fifo_out
 check "no folder made" '[ ! -e fifo_out ]'
 cp -r links deep && rm -r deep/collect
-python3 -c "import sys; sys.stdout.write('[' * 200000 + ']' * 200000)" >deep/cases/0/result.json
+# (inside the collected impact: copying it overflowed collect's stack, SIGSEGV)
+python3 -c "import sys; sys.stdout.write('{\"impacts\": [{\"name\": \"impact1\", \"deep\": ' + '[' * 200000 + ']' * 200000 + '}]}')" >deep/cases/0/result.json
 expect_error "a result.json nested 200 000 deep" 3 "deep/cases/0/result\.json: nesting: nested deeper than 64 levels" "$bin" campaign collect deep
 cp -r links damaged && rm -r damaged/collect
 printf '{"impacts": [{"name": "impact1", "max_force_N": 1' >damaged/cases/0/result.json

@@ -218,6 +218,7 @@ std::string sbatch_command(const fs::path& dir_in, const fs::path& script, const
 std::string submit_sbatch(const fs::path& dir_in, const fs::path& script, const SlurmOptions& o) {
   check_sbatch_options(o.sbatch_options);
   const fs::path dir = fs::absolute(dir_in).lexically_normal();
+  job_ids(dir);  // the job list the id is added to must be sound before anything is submitted
   const detail::ProgramRun run = detail::run_program(sbatch_argv(dir, script, o), /*merge_stderr=*/true);
   if (run.spawn_error != 0) {
     throw InputError("sbatch", "submit", std::string("cannot run 'sbatch': ") + std::strerror(run.spawn_error) +
@@ -234,7 +235,7 @@ std::string submit_sbatch(const fs::path& dir_in, const fs::path& script, const 
                          ": " + msg);
   }
   detail::FileLock lock(dir / ".campaign.lock", /*wait=*/true);
-  job_ids(dir);  // what is there must be job ids before it is kept
+  job_ids(dir);  // still sound under the lock
   const fs::path jobs = dir / "slurm" / "jobs.txt";
   std::string text;
   if (detail::check_inside(dir, fs::path("slurm") / "jobs.txt", detail::Kind::file)) {
