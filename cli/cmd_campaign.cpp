@@ -44,6 +44,7 @@ void register_campaign(CLI::App& app, Context& ctx) {
     VerboseTimer timer(ctx, "campaign plan", "plan " + a->file);
     const campaign::Campaign c = campaign::read_campaign(a->file);
     const campaign::PlanResult r = campaign::plan_campaign(c, a->out);
+    for (const auto& w : r.warnings) ctx.warn(w);
     std::cout << (r.already_planned ? "already planned: " : "planned: ") << r.cases << " cases in " << a->out
               << " (input hash " << r.input_hash << ")\n";
   });
@@ -56,7 +57,8 @@ void register_campaign(CLI::App& app, Context& ctx) {
   run->add_option("--executor", a->executor, "local (default) or slurm")->check(CLI::IsMember({"local", "slurm"}));
   run->add_option("--cpus-per-task", a->cpus_per_task, "slurm: CPUs per array task, the ccx threads (default: --threads)")
       ->check(CLI::Range(1, 1024));
-  run->add_option("--sbatch-option", a->sbatch, "slurm: an extra #SBATCH option, e.g. --partition=short (repeatable)")
+  run->add_option("--sbatch-option", a->sbatch,
+                  "slurm: an extra sbatch option, e.g. --partition=short (repeatable; one argument of sbatch's command line)")
       ->allow_extra_args(false);
   run->add_flag("--dry-run", a->dry_run, "slurm: write campaign.sbatch, do not submit");
   run->callback([a, run, &ctx] {
@@ -65,14 +67,15 @@ void register_campaign(CLI::App& app, Context& ctx) {
       campaign::SlurmOptions o;
       o.max_parallel = run->count("--jobs") > 0 ? a->jobs : 0;  // no --jobs: no %K limit
       o.cpus_per_task = a->cpus_per_task > 0 ? a->cpus_per_task : a->threads;
-      o.sbatch_lines = a->sbatch;
+      o.sbatch_options = a->sbatch;
       o.executable = self_executable();
       const fs::path script = campaign::write_sbatch(a->dir, o);
       if (a->dry_run) {
-        std::cout << "wrote " << script.string() << " (not submitted)\n";
+        std::cout << "wrote " << script.string() << " (not submitted); submit it with:\n"
+                  << campaign::sbatch_command(a->dir, script, o) << "\n";
         return;
       }
-      const std::string job = campaign::submit_sbatch(a->dir, script);
+      const std::string job = campaign::submit_sbatch(a->dir, script, o);
       std::cout << "submitted job " << job << " (" << script.string() << "); follow it with 'impactdeck campaign status "
                 << a->dir << "'\n";
       return;
@@ -91,7 +94,18 @@ void register_campaign(CLI::App& app, Context& ctx) {
     if (s.checks_failed) std::cout << ", " << s.checks_failed << " with a failed self-check";
     if (s.other) std::cout << ", " << s.other << " not run (locked by another process)";
     std::cout << "\n";
-    if (s.failed) std::cerr << "impactdeck: error: " << s.failed << " case(s) failed (see 'impactdeck campaign status')\n";
+    if (s.failed) {  // the cases by their folders; each folder's failure.json says why
+      const fs::path dir = fs::absolute(a->dir).lexically_normal();
+      std::string list;
+      for (std::size_t i = 0; i < s.failed_ids.size() && i < 10; ++i) list += (i ? ", " : "") + std::to_string(s.failed_ids[i]);
+      if (s.failed_ids.size() > 10) list += ", ...";
+      std::cerr << "impactdeck: error: "
+                << InputError::compose((dir / "cases" / std::to_string(s.failed_ids.front())).string(), "failure.json",
+                                       std::to_string(s.failed) + " of " + std::to_string(s.total) +
+                                           " case(s) failed (cases " + list + "; the reasons: 'impactdeck campaign status " +
+                                           dir.string() + "')")
+                << "\n";
+    }
     ctx.exit_code = s.exit_code();
   });
 

@@ -89,14 +89,16 @@ rm failing/cases/0/scene.toml
 rc=$?
 check "a failed case makes run exit 3" '[ $rc = 3 ]'
 "$bin" campaign collect failing >/dev/null
-check "the table gives the failure's reason" 'grep -q "^0,failed,.*scene.toml: file: cannot be opened" failing/collect/cases.csv'
+check "the table gives the failure's reason" 'grep -q "^0,failed,.*scene.toml: file: does not exist" failing/collect/cases.csv'
 
 # Slurm script, not submitted.
 out=$("$bin" campaign run clean --executor slurm --dry-run --jobs 3 --cpus-per-task 2 --sbatch-option=--partition=short)
-check "--dry-run writes the script only" '[[ "$out" == "wrote "*"campaign.sbatch (not submitted)" ]]'
+check "--dry-run writes the script only and prints how to submit it" '[[ "$out" == "wrote "*"campaign.sbatch (not submitted); submit it with:"* ]]'
 check "the array covers every case with %K" 'grep -qx "#SBATCH --array=0-11%3" clean/campaign.sbatch'
 check "--cpus-per-task sets the ccx threads" 'grep -qx "#SBATCH --cpus-per-task=2" clean/campaign.sbatch && grep -q "SLURM_ARRAY_TASK_ID\" --threads 2$" clean/campaign.sbatch'
-check "extra #SBATCH options" 'grep -qx "#SBATCH --partition=short" clean/campaign.sbatch'
+want="'--chdir=$tmp/clean' '--partition=short' '$tmp/clean/campaign.sbatch'"
+check "extra sbatch options: arguments of the printed sbatch command, not #SBATCH lines" \
+  'grep -qF -- "$want" <<<"$out" && ! grep -q partition clean/campaign.sbatch'
 check "each task runs run-case with absolute paths" "grep -qx \"exec '$bin' campaign run-case '$tmp/clean' \\\"\\\$SLURM_ARRAY_TASK_ID\\\" --threads 2\" clean/campaign.sbatch"
 # What the array does, run by hand: each task line with its id is a no-op on a done campaign.
 SLURM_ARRAY_TASK_ID=5 sh clean/campaign.sbatch >task.txt 2>&1

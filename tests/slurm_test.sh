@@ -124,4 +124,25 @@ echo "$status" | grep -q '4 cases, 4 done' || { cat slurm/slurm/*.out >&2 2>/dev
 "$exe" campaign collect slurm >/dev/null || fail "campaign collect (slurm)"
 diff local/collect/cases.csv slurm/collect/cases.csv >&2 || fail "the Slurm table differs from the local one"
 [ "$(wc -l <slurm/collect/cases.csv)" = 5 ] || fail "the table should hold a header and 4 rows"
-echo "ok: Slurm job $job ran 4 cases; the table equals the local executor's"
+[ -f "slurm/slurm/${job}_0.out" ] || fail "no task output in the campaign folder's slurm/ (--output is relative to --chdir)"
+
+# A campaign folder whose name holds spaces, quotes, \$(...), a backtick and a newline: the real
+# sbatch gets it as its --chdir argument, the script quotes it for sh; every case runs there and
+# no injected command runs (tests/campaign_security_test.sh does the same under a fake sbatch).
+mark="$tmp/PWNED_slurm"
+hostile="$tmp/sp ace 'q' \"d\" \$(touch $mark.1) \`touch $mark.2\`"$'\n'"touch $mark.3"
+mkdir -p "$hostile"
+"$exe" campaign plan campaign.toml --out "$hostile/c" >/dev/null || fail "campaign plan (hostile folder name)"
+out=$("$exe" campaign run "$hostile/c" --executor slurm --sbatch-option='--comment=$(touch '"$mark"'.4)') ||
+  fail "campaign run --executor slurm (hostile folder name): $out"
+job2=$(echo "$out" | sed -n 's/^submitted job \([0-9]*\).*/\1/p')
+[ -n "$job2" ] || fail "no job id in: $out"
+for _ in $(seq 200); do
+  [ -z "$(squeue -h -j "$job2" 2>/dev/null)" ] && break
+  sleep 0.2
+done
+status=$("$exe" campaign status "$hostile/c") || fail "campaign status (hostile folder name)"
+echo "$status" | grep -q '4 cases, 4 done' || fail "not every case done in the hostile folder: $status"
+[ -f "$hostile/c/slurm/${job2}_0.out" ] || fail "the tasks' output is not in the hostile folder's slurm/"
+! compgen -G "$mark.*" >/dev/null || fail "an injected command ran: $(compgen -G "$mark.*")"
+echo "ok: Slurm job $job ran 4 cases; the table equals the local executor's; job $job2 ran 4 cases in a hostile folder, nothing injected"

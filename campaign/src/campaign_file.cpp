@@ -12,6 +12,7 @@
 #include "impactdeck/campaign/orientations.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/common/input_file.hpp"
+#include "impactdeck/common/suggest.hpp"
 #include "impactdeck/common/units.hpp"
 #include "impactdeck/scene/pipeline.hpp"
 #include "impactdeck/scene/scene.hpp"
@@ -24,7 +25,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr std::size_t kMaxCases = 1000000;
+// A points CSV of 10^6 points (the case limit) at 3 x 25 characters a line.
+constexpr std::uintmax_t kMaxPointsCsvBytes = std::uintmax_t{128} << 20;
 
 // One choice of one generator: the overrides it sets and what the map needs.
 struct Option {
@@ -119,7 +121,7 @@ std::size_t body_index(const scene::Scene& sc, const std::string& name) {
 
 }  // namespace
 
-Campaign read_campaign(const fs::path& file) {
+Campaign read_campaign(const fs::path& file, std::size_t max_cases) {
   FileReader fr(file);
   std::error_code ec;
   const std::string text = read_input_file(file, "campaign file", kMaxSceneBytes);  // regular files only
@@ -153,6 +155,7 @@ Campaign read_campaign(const fs::path& file) {
   const scene::ImpactSpec& spec = base.impacts[impact];
 
   std::vector<Axis> axes;
+  std::vector<std::string> axis_places;  // where each axis comes from: its line and key
   if (const toml::node* n = root.get("cases")) {
     const toml::array* a = n->as_array();
     if (!a || !a->is_array_of_tables() || a->empty()) fr.fail(n, "cases", "must be a list of tables ([[cases]])");
@@ -167,6 +170,7 @@ Campaign read_campaign(const fs::path& file) {
       axis.push_back(std::move(o));
     }
     axes.push_back(std::move(axis));
+    axis_places.push_back(place(n, "cases"));
     c.generators.push_back("cases");
   }
   if (const toml::node* n = root.get("product")) {
@@ -179,6 +183,7 @@ Campaign read_campaign(const fs::path& file) {
       Axis axis;
       for (const toml::node& e : *a) axis.push_back(Option{{{key, value_text(e)}}, {}, {}});
       axes.push_back(std::move(axis));
+      axis_places.push_back(place(v, "product.\"" + key + "\""));
     }
     c.generators.push_back("product");
   }
@@ -197,10 +202,12 @@ Campaign read_campaign(const fs::path& file) {
       if (t->contains("count")) fr.fail(csv, "points.csv", "give either count or csv, not both");
       if (!csv->is_string()) fr.fail(csv, "points.csv", "must be a file name (string)");
       // The same projection limit as `run` (1 % of the target's size).
-      cloud = study::csv_point_cloud(*shape, base_dir / csv->as_string()->get(), unit, 0.01 * shape->size_m(),
-                                     kMaxCases);
+      // A regular file of bounded size (a FIFO would block, a device never end): checked first.
+      const fs::path csv_file = base_dir / csv->as_string()->get();
+      check_input_file(csv_file, "points file", kMaxPointsCsvBytes);
+      cloud = study::csv_point_cloud(*shape, csv_file, unit, 0.01 * shape->size_m(), max_cases);
     } else {
-      const std::size_t count = fr.count(*t, "points", "count", kMaxCases);
+      const std::size_t count = fr.count(*t, "points", "count", max_cases);
       std::uint64_t seed = 1;
       if (const toml::node* s = t->get("seed")) {
         if (!s->is_integer() || s->as_integer()->get() < 0) fr.fail(s, "points.seed", "must be a whole number >= 0");
@@ -212,6 +219,7 @@ Campaign read_campaign(const fs::path& file) {
     const std::string key = "impacts[" + std::to_string(impact) + "].point";
     for (const auto& p : cloud) axis.push_back(Option{{{key, vec_text(p.point_m / unit)}}, p.point_m, {}});
     axes.push_back(std::move(axis));
+    axis_places.push_back(place(n, "points"));
     c.generators.push_back("points");
   }
   if (const toml::node* n = root.get("orientations")) {
@@ -245,6 +253,7 @@ Campaign read_campaign(const fs::path& file) {
                             q});
     }
     axes.push_back(std::move(axis));
+    axis_places.push_back(place(n, "orientations"));
     c.generators.push_back("orientations");
   }
   if (axes.empty()) {
@@ -252,9 +261,14 @@ Campaign read_campaign(const fs::path& file) {
   }
 
   std::size_t total = 1;
-  for (const Axis& a : axes) {
-    if (total > kMaxCases / a.size()) throw InputError(fr.name(), "", "more than " + std::to_string(kMaxCases) + " cases");
-    total *= a.size();
+  for (std::size_t i = 0; i < axes.size(); ++i) {
+    const std::size_t n = axes[i].size();
+    if (total > max_cases / n) {
+      throw InputError(fr.name(), axis_places[i],
+                       "its " + std::to_string(n) + " choices times the " + std::to_string(total) +
+                           " cases before it make more than " + std::to_string(max_cases) + " cases (the limit)");
+    }
+    total *= n;
   }
   // Row-major: the last axis varies fastest.
   for (std::size_t id = 0; id < total; ++id) {
@@ -273,7 +287,18 @@ Campaign read_campaign(const fs::path& file) {
       if (std::find(c.keys.begin(), c.keys.end(), o.key) == c.keys.end()) c.keys.push_back(o.key);
     // Validated exactly like `run --set`; the message names the campaign file and case, then the
     // scene and the key.
-    scene::load_scene(c.scene, k.overrides, InputContext{fr.name(), "case " + std::to_string(id)});
+    const std::string case_place = "case " + std::to_string(id);
+    const scene::Scene sc = scene::load_scene(c.scene, k.overrides, InputContext{fr.name(), case_place});
+    // The collected impact must exist in every case: overrides that rename it would leave the
+    // table empty.
+    if (impact_index(sc, c.impact) == sc.impacts.size()) {
+      std::vector<std::string> names;
+      for (const auto& i : sc.impacts) names.push_back(i.name);
+      throw InputError(fr.name(), case_place,
+                       "the case's overrides leave no impact named '" + c.impact +
+                           "', the impact the campaign collects (set 'impact' to one the cases keep)" +
+                           did_you_mean(c.impact, names));
+    }
     c.cases.push_back(std::move(k));
   }
   return c;

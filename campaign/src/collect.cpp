@@ -12,9 +12,10 @@
 
 #include "impactdeck/campaign/campaign.hpp"
 #include "impactdeck/campaign/runner.hpp"
-#include "impactdeck/common/atomic_file.hpp"
 #include "impactdeck/common/csv_sidecar.hpp"
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/common/run_transaction.hpp"
+#include "impactdeck/common/suggest.hpp"
 #include "impactdeck/plot/drawing.hpp"
 #include "impactdeck/plot/html.hpp"
 #include "impactdeck/common/units.hpp"
@@ -84,11 +85,6 @@ struct Row {
   CaseState state = CaseState::planned;
   json inputs, impact, result, failure;
 };
-
-Eigen::Vector3d vec(const json& j) {
-  if (!j.is_array() || j.size() != 3) return Eigen::Vector3d::Zero();
-  return {j[0].get<double>(), j[1].get<double>(), j[2].get<double>()};
-}
 
 // Where a drop campaign's case sits on the orientation sphere: the direction the part moves
 // towards the impactor, in the part's own frame (world -z for a drop on a floor below).
@@ -280,32 +276,60 @@ std::string report_page(const fs::path& dir, const std::string& impact, const st
   return page.str();
 }
 
+// The collected impact of a done case's result.json: refused when the case has none of that name
+// (its overrides renamed it; the table would be empty).
+json collected_impact(const json& result, const std::string& impact, const fs::path& file) {
+  std::vector<std::string> names;
+  for (const json& i : result["impacts"]) {
+    if (i["name"] == impact) return i;
+    names.push_back(i["name"].get<std::string>());
+  }
+  std::string list;
+  for (const auto& n : names) list += (list.empty() ? "'" : ", '") + n + "'";
+  throw InputError(file.string(), "key 'impacts'",
+                   "has no impact named '" + impact + "', the impact the campaign collects (the case's impacts: " +
+                       (list.empty() ? "none" : list) + "; did its overrides rename it?)" + did_you_mean(impact, names));
+}
+
+// The worst case's folder is copied as it is: only real folders and regular files, no link.
+void check_tree(const fs::path& root) {
+  std::error_code ec;
+  for (fs::recursive_directory_iterator it(root, ec), end; !ec && it != end; it.increment(ec)) {
+    const fs::file_status st = it->symlink_status(ec);
+    if (fs::is_symlink(st)) detail::refuse_link(it->path());
+    if (!fs::is_directory(st) && !fs::is_regular_file(st)) {
+      throw InputError(it->path().string(), "file", "is not a regular file or folder: the worst case is not copied");
+    }
+  }
+  if (ec) throw InputError(root.string(), "folder", "cannot be read: " + ec.message());
+}
+
 }  // namespace
 
 CollectResult collect(const fs::path& dir_in) {
-  const fs::path dir = fs::absolute(dir_in).lexically_normal();
-  const json plan = detail::read_json(campaign_json(dir));
-  const std::string impact = plan.value("impact", "");
-  std::vector<std::string> keys = plan.value("keys", std::vector<std::string>{});
-  const auto generators = plan.value("generators", std::vector<std::string>{});
+  const detail::Plan plan = detail::read_plan(dir_in);
+  const fs::path& dir = plan.dir;
+  const std::string& impact = plan.impact;
+  const std::vector<std::string>& keys = plan.keys;
+  const auto& generators = plan.generators;
   const bool points = std::find(generators.begin(), generators.end(), "points") != generators.end();
   const bool drops = std::find(generators.begin(), generators.end(), "orientations") != generators.end();
 
   CollectResult out;
   std::vector<Row> rows;
-  for (const auto& c : plan.at("cases")) {
+  for (const detail::PlanCase& c : plan.cases) {
     Row r;
-    r.id = c.at("id").get<std::size_t>();
-    r.inputs = c.value("overrides", json::object());
+    r.id = c.id;
+    r.inputs = c.overrides;
     r.state = case_state(dir, r.id);
     const fs::path folder = case_folder(dir, r.id);
     if (r.state == CaseState::done) {
-      r.result = detail::read_json(folder / "result.json");
-      for (const auto& i : r.result.value("impacts", json::array()))
-        if (i.value("name", "") == impact) r.impact = i;
+      r.result = detail::read_result(dir, r.id);
+      r.impact = collected_impact(r.result, impact, folder / "result.json");
+      detail::check_inside(dir, fs::path("cases") / std::to_string(r.id) / "scene.toml", detail::Kind::file);
       ++out.done;
     } else if (r.state == CaseState::failed) {
-      r.failure = detail::read_json(folder / "failure.json");
+      r.failure = detail::read_failure(dir, r.id);
       ++out.failed;
     } else {
       ++out.pending;
@@ -355,9 +379,11 @@ CollectResult collect(const fs::path& dir_in) {
     }
   }
 
+  // Everything is checked before anything is written: `collect` a real folder (created by the
+  // transaction when missing), the worst case's folder free of links.
   const fs::path cdir = dir / "collect";
-  std::error_code ec;
-  fs::create_directories(cdir, ec);
+  detail::check_inside(dir, "collect", detail::Kind::folder);
+  if (out.worst_id) check_tree(case_folder(dir, *out.worst_id));
   const json doc = {{"campaign", dir.string()},
                     {"impact", impact},
                     {"keys", keys},
@@ -367,63 +393,61 @@ CollectResult collect(const fs::path& dir_in) {
                     {"worst_case_id", out.worst_id ? json(*out.worst_id) : json(nullptr)},
                     {"worst_case_by", all_stress ? "peak_von_mises_Pa" : "max_force_N"},
                     {"cases", cases}};
-  AtomicFileSet files;
-  out.csv = cdir / "cases.csv";
-  out.json = cdir / "cases.json";
-  files.add(out.csv, csv.str());
-  {  // the table's JSON sidecar: the unit of every column (common/csv_sidecar.hpp)
+  // One transaction (common/run_transaction.hpp): every file and the worst case's copy appear
+  // together, or nothing changes.
+  RunTransaction txn(cdir, "collect");
+  txn.run([&] {
+    const std::string where = plan.file.string();
+    auto add = [&](const std::string& name, const std::string& text) {
+      detail::write_new_file(txn.file(name, where, "collect"), text);
+      return cdir / name;
+    };
     const std::string text = csv.str();
-    files.add(csv_sidecar_path(out.csv),
-              csv_sidecar_text(out.csv, csv_columns(std::string_view(text).substr(0, text.find('\n'))),
-                               {{"title", "impactdeck campaign collect: one row per case (cases.json: the same, "
-                                          "with every case's inputs and results)"}}));
-  }
-  files.add(out.json, doc.dump(2) + "\n");
+    out.csv = add("cases.csv", text);
+    // the table's JSON sidecar: the unit of every column (common/csv_sidecar.hpp)
+    add(csv_sidecar_path(out.csv).filename().string(),
+        csv_sidecar_text(out.csv, csv_columns(std::string_view(text).substr(0, text.find('\n'))),
+                         {{"title", "impactdeck campaign collect: one row per case (cases.json: the same, "
+                                    "with every case's inputs and results)"}}));
+    out.json = add("cases.json", doc.dump(2) + "\n");
 
-  // The map over the part's surface (points) or the orientation sphere (drops).
-  std::string map_text;
-  if (points || drops) {
-    std::vector<Eigen::Vector3d> pts;
-    std::vector<double> force;
-    std::vector<std::size_t> ids;
-    std::optional<LengthUnit> unit;  // a point campaign's: its scene's length unit
-    const auto& pc = plan.at("cases");
-    for (const Row& r : rows) {
-      const json f = at(r.impact, "/max_force_N");
-      if (r.state != CaseState::done || !f.is_number()) continue;
-      if (!drops && !unit) unit = scene::load_scene(case_folder(dir, r.id) / "scene.toml").length_unit;
-      if (drops) {
-        pts.push_back(drop_direction(case_folder(dir, r.id) / "scene.toml", impact));
-      } else {
-        pts.push_back(vec(pc[r.id].value("point_m", json(nullptr))));
+    // The map over the part's surface (points) or the orientation sphere (drops).
+    std::string map_text;
+    if (points || drops) {
+      std::vector<Eigen::Vector3d> pts;
+      std::vector<double> force;
+      std::vector<std::size_t> ids;
+      std::optional<LengthUnit> unit;  // a point campaign's: its scene's length unit
+      for (const Row& r : rows) {
+        const json f = at(r.impact, "/max_force_N");
+        if (r.state != CaseState::done || !f.is_number()) continue;
+        if (!drops && !unit) unit = scene::load_scene(case_folder(dir, r.id) / "scene.toml").length_unit;
+        if (drops) {
+          pts.push_back(drop_direction(case_folder(dir, r.id) / "scene.toml", impact));
+        } else {
+          pts.push_back(plan.cases[r.id].point_m.value_or(Eigen::Vector3d::Zero()));
+        }
+        force.push_back(f.get<double>());
+        ids.push_back(r.id);
       }
-      force.push_back(f.get<double>());
-      ids.push_back(r.id);
+      if (!pts.empty()) {
+        const std::string title = drops ? "Max force over the drop orientations" : "Max force over the impact points";
+        map_text = map_svg(pts, force, drops, title);
+        out.map_svg = add("map.svg", map_text);
+        out.map_vtp = add("map.vtp", vtp(pts, force, ids, unit));
+      }
     }
-    if (!pts.empty()) {
-      out.map_svg = cdir / "map.svg";
-      out.map_vtp = cdir / "map.vtp";
-      const std::string title = drops ? "Max force over the drop orientations" : "Max force over the impact points";
-      map_text = map_svg(pts, force, drops, title);
-      files.add(*out.map_svg, map_text);
-      files.add(*out.map_vtp, vtp(pts, force, ids, unit));
+    out.report_html = add("report.html", report_page(dir, impact, keys, rows, out, all_stress, map_text));
+    if (out.worst_id) {  // a copy of the worst case's folder (scene, decks, result), checked above
+      const fs::path stage = txn.folder("worst_case", where, "collect");
+      std::error_code ec;
+      fs::copy(case_folder(dir, *out.worst_id), stage, fs::copy_options::recursive | fs::copy_options::copy_symlinks, ec);
+      if (ec) throw InputError((cdir / "worst_case").string(), "copy", "cannot copy the worst case: " + ec.message());
+      fs::remove(stage / ".lock", ec);
+      out.worst_case = cdir / "worst_case";
     }
-  }
-  out.report_html = cdir / "report.html";
-  files.add(out.report_html, report_page(dir, impact, keys, rows, out, all_stress, map_text));
-  files.commit();
-
-  if (out.worst_id) {  // a copy of the worst case's folder (scene, decks, result)
-    const fs::path stage = cdir / ".worst_case.partial";
-    fs::remove_all(stage, ec);
-    fs::copy(case_folder(dir, *out.worst_id), stage, fs::copy_options::recursive, ec);
-    if (ec) throw InputError(stage.string(), "copy", "cannot copy the worst case: " + ec.message());
-    fs::remove(stage / ".lock", ec);
-    out.worst_case = cdir / "worst_case";
-    fs::remove_all(*out.worst_case, ec);
-    fs::rename(stage, *out.worst_case, ec);
-    if (ec) throw InputError(out.worst_case->string(), "rename", ec.message());
-  }
+    txn.commit();
+  });
   refresh_states(dir);
   return out;
 }

@@ -1,4 +1,6 @@
 // `campaign plan`: case folders with their resolved scenes, and campaign.json.
+#include <sys/stat.h>
+
 #include <iomanip>
 #include <set>
 #include <sstream>
@@ -7,8 +9,8 @@
 
 #include "impactdeck/campaign/campaign.hpp"
 #include "impactdeck/campaign/runner.hpp"
-#include "impactdeck/common/atomic_file.hpp"
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/common/run_transaction.hpp"
 #include "impactdeck/scene/scene.hpp"
 #include "detail.hpp"
 
@@ -26,12 +28,10 @@ std::string fnv1a64_hex(const std::string& bytes, std::uint64_t h) {
 }
 
 fs::path campaign_json(const fs::path& dir) {
-  const fs::path p = dir / "campaign.json";
-  std::error_code ec;
-  if (!fs::is_regular_file(p, ec)) {
+  if (!detail::check_inside(dir, "campaign.json", detail::Kind::file)) {
     throw InputError(dir.string(), "campaign.json", "missing: not a planned campaign folder (run 'impactdeck campaign plan')");
   }
-  return p;
+  return dir / "campaign.json";
 }
 
 PlanResult plan_campaign(const Campaign& c, const fs::path& dir_in) {
@@ -55,55 +55,66 @@ PlanResult plan_campaign(const Campaign& c, const fs::path& dir_in) {
   r.cases = c.cases.size();
   r.input_hash = fnv1a64_hex(all);
 
-  std::error_code ec;
-  if (fs::exists(dir / "campaign.json", ec)) {
-    nlohmann::json old;
-    try {
-      old = nlohmann::json::parse(detail::read_text(dir / "campaign.json"));
-    } catch (const nlohmann::json::exception&) {
-      throw InputError((dir / "campaign.json").string(), "file", "is not valid JSON");
+  // An existing folder: the same campaign is left as it is, another refused; a `cases` entry
+  // without campaign.json (not a plan of ours: never replaced, never written through) refused.
+  struct stat st {};
+  if (::stat(dir.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) {
+    if (detail::check_inside(dir, "campaign.json", detail::Kind::file)) {
+      const nlohmann::json old = detail::read_json_inside(dir, "campaign.json", "campaign.json", detail::kMaxPlanBytes);
+      if (!old.is_object() || old.find("input_hash") == old.end() || old["input_hash"] != r.input_hash) {
+        throw InputError(dir.string(), "campaign.json",
+                         "the folder holds another campaign (its input hash differs): plan into a new folder");
+      }
+      r.already_planned = true;
+      return r;
     }
-    if (old.value("input_hash", "") != r.input_hash) {
-      throw InputError(dir.string(), "campaign.json",
-                       "the folder holds another campaign (its input hash differs): plan into a new folder");
+    if (detail::check_inside(dir, "cases", detail::Kind::folder)) {
+      throw InputError((dir / "cases").string(), "file",
+                       "exists but the folder holds no campaign.json (not a campaign plan): plan into a new folder");
     }
-    r.already_planned = true;
-    return r;
   }
-  fs::create_directories(dir / "cases", ec);
-  if (!fs::is_directory(dir / "cases")) throw InputError(dir.string(), "--out", "cannot create the campaign folder");
 
-  nlohmann::json cases = nlohmann::json::array();
-  for (std::size_t i = 0; i < c.cases.size(); ++i) {
-    const Case& k = c.cases[i];
-    const fs::path folder = case_folder(dir, k.id);
-    fs::create_directories(folder, ec);
-    write_file_atomically(folder / "scene.toml", texts[i]);
-    nlohmann::json inputs = nlohmann::json::object();
-    for (const auto& o : k.overrides) inputs[o.key] = o.value;
-    nlohmann::json j = {{"id", k.id},
-                        {"folder", fs::path("cases") / std::to_string(k.id)},
-                        {"overrides", inputs},
-                        {"scene_hash", case_hashes[i]},
-                        {"state", "planned"}};
-    if (k.point_m) j["point_m"] = {k.point_m->x(), k.point_m->y(), k.point_m->z()};
-    if (k.orientation) {
-      j["orientation_quaternion_wxyz"] = {k.orientation->w(), k.orientation->x(), k.orientation->y(),
-                                          k.orientation->z()};
+  // One transaction: the case folders and campaign.json are staged in a hidden folder inside the
+  // campaign folder and renamed into place together; a plan cut short leaves nothing.
+  RunTransaction txn(dir, "--out");
+  return txn.run([&] {
+    const std::string where = c.file.string();
+    const fs::path cases_dir = txn.folder("cases", where, "cases");
+    detail::make_folder(cases_dir);
+    nlohmann::json cases = nlohmann::json::array();
+    for (std::size_t i = 0; i < c.cases.size(); ++i) {
+      const Case& k = c.cases[i];
+      const fs::path folder = cases_dir / std::to_string(k.id);
+      detail::make_folder(folder);
+      detail::write_new_file(folder / "scene.toml", texts[i]);
+      nlohmann::json inputs = nlohmann::json::object();
+      for (const auto& o : k.overrides) inputs[o.key] = o.value;
+      nlohmann::json j = {{"id", k.id},
+                          {"folder", fs::path("cases") / std::to_string(k.id)},
+                          {"overrides", inputs},
+                          {"scene_hash", case_hashes[i]},
+                          {"state", "planned"}};
+      if (k.point_m) j["point_m"] = {k.point_m->x(), k.point_m->y(), k.point_m->z()};
+      if (k.orientation) {
+        j["orientation_quaternion_wxyz"] = {k.orientation->w(), k.orientation->x(), k.orientation->y(),
+                                            k.orientation->z()};
+      }
+      cases.push_back(std::move(j));
     }
-    cases.push_back(std::move(j));
-  }
-  const nlohmann::json doc = {{"format", "impactdeck-campaign 1"},
-                              {"campaign_file", fs::absolute(c.file).lexically_normal().string()},
-                              {"scene", c.scene.string()},
-                              {"impact", c.impact},
-                              {"generators", c.generators},
-                              {"keys", c.keys},
-                              {"input_hash", r.input_hash},
-                              {"case_count", c.cases.size()},
-                              {"cases", cases}};
-  write_file_atomically(dir / "campaign.json", doc.dump(2) + "\n");  // last: its presence means planned
-  return r;
+    const nlohmann::json doc = {{"format", "impactdeck-campaign 1"},
+                                {"campaign_file", fs::absolute(c.file).lexically_normal().string()},
+                                {"scene", c.scene.string()},
+                                {"impact", c.impact},
+                                {"generators", c.generators},
+                                {"keys", c.keys},
+                                {"input_hash", r.input_hash},
+                                {"case_count", c.cases.size()},
+                                {"cases", cases}};
+    detail::write_new_file(txn.file("campaign.json", where, "campaign.json"), doc.dump(2) + "\n");
+    txn.commit();
+    r.warnings = txn.warnings();
+    return r;
+  });
 }
 
 }  // namespace impactdeck::campaign

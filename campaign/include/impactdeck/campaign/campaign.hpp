@@ -29,20 +29,27 @@ struct Campaign {
   std::vector<Case> cases;              ///< ids 0 ... N-1, row-major, last generator fastest
 };
 
+/// At most this many cases (docs/campaign-format.md).
+inline constexpr std::size_t kMaxCases = 1000000;
+
 /// Reads a campaign file, expands its generators and validates every case's scene exactly like
-/// `run --set` would. Throws InputError naming the campaign file, the case and the key.
-Campaign read_campaign(const std::filesystem::path& file);
+/// `run --set` would (and that each case keeps the collected impact). Throws InputError naming the
+/// campaign file, the case and the key. `max_cases`: the case limit (lower in the fuzz target).
+Campaign read_campaign(const std::filesystem::path& file, std::size_t max_cases = kMaxCases);
 
 /// What `campaign plan` did.
 struct PlanResult {
   std::size_t cases = 0;
   bool already_planned = false;  ///< the folder held this very campaign: nothing rewritten
   std::string input_hash;
+  std::vector<std::string> warnings;  ///< the folder's housekeeping (a killed plan's staging folder removed)
 };
 
-/// Writes `dir`/cases/<id>/scene.toml (the resolved scene) for every case and then, atomically,
-/// `dir`/campaign.json. A folder that already holds a campaign with another input hash is refused
-/// (InputError); one holding the same campaign is left as it is.
+/// Writes `dir`/cases/<id>/scene.toml (the resolved scene) for every case and `dir`/campaign.json
+/// as one transaction (common/run_transaction.hpp: staged in a hidden folder inside `dir`, renamed
+/// into place at the end; a plan cut short leaves nothing). A folder that already holds a campaign
+/// with another input hash is refused (InputError); one holding the same campaign is left as it is;
+/// a `cases` entry without campaign.json, or a symbolic link at either name, is refused.
 PlanResult plan_campaign(const Campaign& campaign, const std::filesystem::path& dir);
 
 /// The campaign.json file of a plan folder (InputError when missing or unreadable).

@@ -43,6 +43,7 @@ struct LocalOptions {
 
 struct RunSummary {
   std::size_t total = 0, done = 0, failed = 0, skipped = 0, checks_failed = 0, other = 0;
+  std::vector<std::size_t> failed_ids;  ///< the cases that failed, in id order
   int exit_code() const;  ///< 3 if a case failed or was refused (locked elsewhere), 4 if a check failed, else 0
 };
 
@@ -54,20 +55,32 @@ RunSummary run_local(const std::filesystem::path& dir, const LocalOptions& optio
 struct SlurmOptions {
   std::size_t max_parallel = 0;  ///< `%K` of --array (0: no limit)
   int cpus_per_task = 1;         ///< --cpus-per-task, and the ccx threads of each case
-  std::vector<std::string> sbatch_lines;  ///< extra `#SBATCH` options, e.g. "--partition=short"
+  /// extra sbatch options, e.g. "--partition=short": each one argument of sbatch's command line
+  /// (never a line of the script); one with a control character, or not starting with '-', is refused
+  std::vector<std::string> sbatch_options;
   std::filesystem::path executable;
 };
 
 /// Writes `dir`/campaign.sbatch: a job array over the case ids, each task running
-/// `EXECUTABLE campaign run-case DIR $SLURM_ARRAY_TASK_ID --threads C` (absolute paths).
+/// `EXECUTABLE campaign run-case DIR $SLURM_ARRAY_TASK_ID --threads C` (absolute paths, quoted for
+/// sh). Its #SBATCH lines hold constants only; the folder and the user's options go on sbatch's
+/// command line (sbatch_command).
 std::filesystem::path write_sbatch(const std::filesystem::path& dir, const SlurmOptions& options);
 
-/// Submits the script with `sbatch --parsable`, records the job id in `dir`/slurm/jobs.txt and
-/// returns it. Throws Error when sbatch is missing or refuses.
-std::string submit_sbatch(const std::filesystem::path& dir, const std::filesystem::path& script);
+/// The command that submits the script, each argument quoted for sh (what `--dry-run` prints):
+/// `sbatch --parsable --chdir=DIR [OPTIONS...] SCRIPT`.
+std::string sbatch_command(const std::filesystem::path& dir, const std::filesystem::path& script,
+                           const SlurmOptions& options);
+
+/// Submits the script with that command (an argument vector, no shell), records the job id in
+/// `dir`/slurm/jobs.txt and returns it. Throws InputError (exit 3, an external tool's failure)
+/// when sbatch is missing or refuses.
+std::string submit_sbatch(const std::filesystem::path& dir, const std::filesystem::path& script,
+                          const SlurmOptions& options);
 
 /// `campaign status`: the count per state, the cases not done, and squeue's lines for the
-/// campaign's jobs when squeue is on the PATH. Refreshes the states in campaign.json.
+/// campaign's jobs when squeue is on the PATH (run from an argument vector; slurm/jobs.txt must
+/// hold job ids, digits only, else InputError naming its line). Refreshes the states in campaign.json.
 std::string status_report(const std::filesystem::path& dir);
 
 /// Rewrites the `state` of every case in campaign.json from the case folders (under a lock).

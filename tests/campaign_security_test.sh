@@ -1,0 +1,231 @@
+#!/usr/bin/env bash
+# Campaigns against hostile names, planted links and damaged files (issue 29; docs/reliability.md,
+# "Campaigns: names are never code"):
+# 1. Slurm: campaign folders named with a newline + `touch /tmp/PWNED_...`, `$(...)`, backticks,
+#    `;`, spaces and quotes, and hostile --sbatch-option values, submitted to a fake sbatch (a
+#    script on PATH) that runs every array task with bash in the --chdir folder as Slurm would, and
+#    `campaign status` with a fake squeue: no injected command runs (no marker file), each case
+#    runs in the right folder, sbatch and squeue get exactly the intended arguments; forged
+#    slurm/jobs.txt lines are refused (exit 3 naming the file) before squeue runs.
+# 2. Links: a symlinked case folder, a dangling .lock link, a link in the worst case's folder, a
+#    `cases` link at plan time, a `collect` link, a result.json link: each refused with exit 3
+#    naming the path, nothing outside touched.
+# 3. Bounded work and damaged files: a FIFO as points CSV, a result.json nested 200 000 deep,
+#    damaged campaign.json / result.json, a case result without the collected impact.
+# 4. Messages and transactions: failed cases named by their folder, sbatch's refusal exit 3, a
+#    plan cut short (file size limit) leaves nothing.
+# usage: campaign_security_test.sh IMPACTDECK SOURCE_DIR
+set -u
+bin=$(readlink -f "$1"); src=$(readlink -f "$2")
+tmp=$(mktemp -d); [ -n "${KEEP_TMP:-}" ] || trap 'rm -rf "$tmp"; rm -f /tmp/PWNED_$$_*' EXIT
+mark=/tmp/PWNED_$$
+fails=0
+check() { if eval "$2"; then :; else echo "FAILED: $1"; fails=$((fails+1)); fi; }
+no_markers() { ! compgen -G "${mark}_*" >/dev/null; }
+results() { local r=("$1"/cases/*/result.json); [ -e "${r[0]}" ] && echo "${#r[@]}" || echo 0; }  # names may hold newlines
+# expect_error NAME CODE PATTERN COMMAND...: exit CODE, one stderr line matching PATTERN.
+expect_error() {
+  local name=$1 code=$2 pattern=$3; shift 3
+  "$@" >"$tmp/out.txt" 2>"$tmp/err.txt"
+  local rc=$?
+  if [ "$rc" != "$code" ] || [ "$(wc -l <"$tmp/err.txt")" != 1 ] || ! grep -Eq -- "$pattern" "$tmp/err.txt"; then
+    echo "FAILED: $name: exit $rc (expected $code), stderr: $(head -c 400 "$tmp/err.txt")"
+    fails=$((fails+1))
+  fi
+}
+cd "$tmp" || exit 1
+
+cp "$src/samples/two_spheres.toml" base.toml
+cat >c.toml <<'TOML'
+scene = "base.toml"
+[product]
+"impacts[0].restitution" = [0.9, 0.5]
+TOML
+
+# ---- 1. Slurm: fake sbatch and squeue on the PATH -------------------------------------------
+mkdir fakebin slurmlog
+cat >fakebin/sbatch <<'SH'
+#!/bin/bash
+# A fake sbatch: records its arguments (NUL-separated), then runs the job array the way Slurm
+# does: in the --chdir folder, output to the #SBATCH --output pattern (relative to that folder),
+# each task the script run by bash with SLURM_ARRAY_TASK_ID set. FAKE_SBATCH_FAIL: refuse.
+set -u
+log=$FAKE_SLURM_LOG
+printf '%s\0' "$@" >"$log/sbatch.args"
+if [ -n "${FAKE_SBATCH_FAIL:-}" ]; then echo "sbatch: error: Batch job submission failed: Invalid partition name specified" >&2; exit 1; fi
+script=${!#}
+chdir=$PWD
+for a in "${@:1:$#-1}"; do case $a in --chdir=*) chdir=${a#--chdir=} ;; esac; done
+range=$(sed -n 's/^#SBATCH --array=\([0-9]*-[0-9]*\).*/\1/p' "$script")
+output=$(sed -n 's/^#SBATCH --output=//p' "$script")
+job=4242
+cd "$chdir" || { echo "sbatch: error: cannot chdir" >&2; exit 1; }
+printf '%s' "$PWD" >"$log/sbatch.pwd"
+for i in $(seq "${range%-*}" "${range#*-}"); do
+  out=${output//%A/$job}; out=${out//%a/$i}
+  SLURM_ARRAY_JOB_ID=$job SLURM_ARRAY_TASK_ID=$i bash "$script" >"$out" 2>&1
+done
+echo "$job"
+SH
+cat >fakebin/squeue <<'SH'
+#!/bin/bash
+printf '%s\0' "$@" >"$FAKE_SLURM_LOG/squeue.args"
+echo "4242 RUNNING node1"
+SH
+chmod +x fakebin/sbatch fakebin/squeue
+export PATH="$tmp/fakebin:$PATH" FAKE_SLURM_LOG="$tmp/slurmlog"
+
+# Folder names that were shell commands in the old #SBATCH --chdir line, and ones with spaces and
+# quotes (the old script ran the case in the wrong folder, or not at all).
+names=(
+  "$tmp/nl"$'\n'"touch ${mark}_1"$'\n'"x"
+  "$tmp/sub \$(touch ${mark}_2) \`touch ${mark}_3\`; touch ${mark}_4"
+  "$tmp/sp ace 'single' \"double\" #hash \\back"
+)
+k=0
+for dir in "${names[@]}"; do
+  k=$((k+1))
+  mkdir -p "$dir"
+  "$bin" campaign plan c.toml --out "$dir/camp" >/dev/null 2>"$tmp/err.txt" || { echo "FAILED: plan into hostile folder $k: $(cat "$tmp/err.txt")"; fails=$((fails+1)); continue; }
+  camp="$dir/camp"
+  rm -f slurmlog/*
+  "$bin" campaign run "$camp" --executor slurm --jobs 2 \
+    --sbatch-option='--comment=$(touch '"${mark}"'_5)' \
+    --sbatch-option='--comment=`touch '"${mark}"'_6`' \
+    --sbatch-option="--comment=a; touch ${mark}_7" \
+    --sbatch-option="--comment=a b 'c' \"d\" #e" >out.txt 2>err.txt
+  rc=$?
+  check "folder $k: submitted (exit $rc: $(head -c 300 err.txt))" '[ $rc = 0 ] && grep -q "^submitted job 4242" out.txt'
+  check "folder $k: no injected command ran" 'no_markers'
+  check "folder $k: sbatch ran the tasks in the campaign folder" '[ "$(cat slurmlog/sbatch.pwd)" = "$camp" ]'
+  check "folder $k: each task's output in the campaign folder's slurm/" '[ -f "$camp/slurm/4242_0.out" ] && [ -f "$camp/slurm/4242_1.out" ]'
+  status=$("$bin" campaign status "$camp" 2>&1)
+  check "folder $k: both cases ran in the right folder ($status)" '[[ "$status" == *"2 cases, 2 done"* ]]'
+  # sbatch's arguments, exactly: the folder and each option one argument of their own.
+  expected=$(printf '%s\0' --parsable "--chdir=$camp" '--comment=$(touch '"${mark}"'_5)' '--comment=`touch '"${mark}"'_6`' \
+    "--comment=a; touch ${mark}_7" "--comment=a b 'c' \"d\" #e" "$camp/campaign.sbatch" | od -c)
+  check "folder $k: sbatch's argument vector" '[ "$(od -c <slurmlog/sbatch.args)" = "$expected" ]'
+  check "folder $k: the script holds none of the folder's or options' text in #SBATCH lines" \
+    '! grep "^#SBATCH" "$camp/campaign.sbatch" | grep -q -e "$tmp" -e comment'
+  check "folder $k: squeue got the job id as its own argument" \
+    '[ "$(od -c <slurmlog/squeue.args)" = "$(printf "%s\0" -h -o "%i %T %R" -j 4242 | od -c)" ]'
+done
+
+# A newline (or any control character) in an option cannot be made safe in a #SBATCH line nor is
+# it an option: refused before anything is written or run.
+camp="${names[0]}/camp"
+rm -f slurmlog/* "$camp/campaign.sbatch"
+expect_error "an option with a newline is refused" 3 "--sbatch-option: value 1 '--comment=x\\\\x0Atouch ${mark}_8': holds a control character" \
+  "$bin" campaign run "$camp" --executor slurm --sbatch-option="--comment=x"$'\n'"touch ${mark}_8"
+check "nothing submitted, no script written, no marker" '[ ! -e slurmlog/sbatch.args ] && [ ! -e "$camp/campaign.sbatch" ] && no_markers'
+# --dry-run prints the submitting command, each argument quoted for sh: running it is safe.
+"$bin" campaign run "$camp" --executor slurm --dry-run --sbatch-option='--comment=$(touch '"${mark}"'_9)' >out.txt
+rm -f "$camp"/cases/*/result.json
+out=$(cat out.txt)
+bash -c "${out#*submit it with:$'\n'}" >/dev/null 2>dry.err || cat dry.err
+check "--dry-run's printed command submits with the right arguments, nothing injected" \
+  '[ "$(cat slurmlog/sbatch.pwd)" = "$camp" ] && no_markers && [ "$(results "$camp")" = 2 ]'
+
+# Forged job ids in slurm/jobs.txt: refused before squeue runs.
+for forged in "1; touch ${mark}_10" "\$(touch ${mark}_11)" "4242 \`touch ${mark}_12\`" "-j1"; do
+  rm -f slurmlog/squeue.args
+  printf '4242\n%s\n' "$forged" >"$camp/slurm/jobs.txt"
+  expect_error "forged job id '$forged'" 3 "/slurm/jobs.txt: line 2: '.*' is not a Slurm job id \(digits only\)" "$bin" campaign status "$camp"
+  check "forged job id '$forged': squeue not run, no marker" '[ ! -e slurmlog/squeue.args ] && no_markers'
+done
+# ... and before sbatch runs: nothing is submitted next to a forged job list.
+rm -f slurmlog/sbatch.args
+expect_error "a forged job list refuses submission" 3 "/slurm/jobs.txt: line 2: '-j1' is not a Slurm job id" \
+  "$bin" campaign run "$camp" --executor slurm
+check "sbatch not run next to a forged job list" '[ ! -e slurmlog/sbatch.args ]'
+printf '4242\n' >"$camp/slurm/jobs.txt"
+
+# sbatch refusing: exit 3 (an external tool's failure, docs/cli.md), naming the script.
+expect_error "sbatch refused" 3 "campaign\.sbatch: sbatch: sbatch refused it \(exit 1\): sbatch: error: Batch job submission failed" \
+  env FAKE_SBATCH_FAIL=1 "$bin" campaign run "$camp" --executor slurm
+expect_error "sbatch missing" 3 "^impactdeck: error: sbatch: submit: cannot run 'sbatch'" \
+  env PATH=/nonexistent "$bin" campaign run "$camp" --executor slurm
+
+# ---- 2. Links are never followed ------------------------------------------------------------
+"$bin" campaign plan c.toml --out links >/dev/null
+# A symlinked case folder: run-case used to delete out/ in the link's target first.
+mv links/cases/0 outside0 && mkdir -p outside0/out/keep && ln -s "$tmp/outside0" links/cases/0
+expect_error "run-case on a symlinked case folder" 3 "links/cases/0: symbolic link: is a symbolic link to '$tmp/outside0': refused" \
+  "$bin" campaign run-case links 0
+check "the link's target is untouched" '[ -d outside0/out/keep ] && [ ! -e outside0/result.json ] && [ ! -e outside0/failure.json ]'
+expect_error "campaign run with a symlinked case folder" 3 "links/cases/0: symbolic link" "$bin" campaign run links --quiet
+check "campaign run started nothing" '[ ! -e links/cases/1/result.json ] && [ ! -e links/cases/1/run.log ]'
+rm links/cases/0 && mv outside0 links/cases/0 && rm -r links/cases/0/out
+# A dangling .lock link: run-case created the file it pointed at.
+ln -s "$tmp/created_outside" links/cases/1/.lock
+expect_error "a dangling .lock link" 3 "links/cases/1/\.lock: symbolic link" "$bin" campaign run-case links 1
+check "no file created outside" '[ ! -e created_outside ]'
+rm links/cases/1/.lock
+"$bin" campaign run links --quiet >/dev/null || echo "FAILED: run links"
+# A link inside the worst case's folder: collect copied what it pointed at.
+mkdir secret && echo "private" >secret/key.txt
+for i in 0 1; do ln -s "$tmp/secret" "links/cases/$i/out/leak"; done
+expect_error "collect with a link in the worst case" 3 "links/cases/[01]/out/leak: symbolic link" "$bin" campaign collect links
+check "collect wrote nothing" '[ ! -e links/collect ]'
+rm links/cases/*/out/leak
+# A `collect` link and a result.json link.
+mkdir elsewhere && ln -s "$tmp/elsewhere" links/collect
+expect_error "a collect link" 3 "links/collect: symbolic link" "$bin" campaign collect links
+check "nothing written through the collect link" '[ -z "$(ls -A elsewhere)" ]'
+rm links/collect
+mv links/cases/1/result.json result1.json && ln -s "$tmp/result1.json" links/cases/1/result.json
+expect_error "a result.json link" 3 "links/cases/1/result\.json: symbolic link" "$bin" campaign collect links
+expect_error "status with a result.json link" 3 "links/cases/1/result\.json: symbolic link" "$bin" campaign status links
+rm links/cases/1/result.json && mv result1.json links/cases/1/result.json
+"$bin" campaign collect links >/dev/null || echo "FAILED: collect links after the links were removed"
+check "collect copies the worst case without its lock" '[ -f links/collect/worst_case/result.json ] && [ ! -e links/collect/worst_case/.lock ]'
+# plan through a `cases` link.
+mkdir planned target_of_link && ln -s "$tmp/target_of_link" planned/cases
+expect_error "plan through a cases link" 3 "planned/cases: symbolic link" "$bin" campaign plan c.toml --out planned
+check "nothing written through it" '[ -z "$(ls -A target_of_link)" ] && [ ! -e planned/campaign.json ]'
+
+# ---- 3. Bounded work, damaged files ---------------------------------------------------------
+mkfifo points.fifo
+printf 'scene = "base.toml"\n[points]\ncsv = "points.fifo"\n' >fifo.toml
+expect_error "a FIFO as points CSV" 3 "points\.fifo: file: is a FIFO" timeout 60 "$bin" campaign plan fifo.toml --out fifo_out
+check "no folder made" '[ ! -e fifo_out ]'
+cp -r links deep && rm -r deep/collect
+# (inside the collected impact: copying it overflowed collect's stack, SIGSEGV)
+python3 -c "import sys; sys.stdout.write('{\"impacts\": [{\"name\": \"impact1\", \"deep\": ' + '[' * 200000 + ']' * 200000 + '}]}')" >deep/cases/0/result.json
+expect_error "a result.json nested 200 000 deep" 3 "deep/cases/0/result\.json: nesting: nested deeper than 64 levels" "$bin" campaign collect deep
+cp -r links damaged && rm -r damaged/collect
+printf '{"impacts": [{"name": "impact1", "max_force_N": 1' >damaged/cases/0/result.json
+expect_error "a cut-short result.json" 3 "damaged/cases/0/result\.json: line 1, column [0-9]+: is not valid JSON: syntax error" "$bin" campaign collect damaged
+printf '{"impacts": 3}' >damaged/cases/0/result.json
+expect_error "a result.json of the wrong shape" 3 "damaged/cases/0/result\.json: key 'impacts': must be a list of impacts" "$bin" campaign collect damaged
+sed 's/"name": "impact1"/"name": "impact2"/' links/cases/0/result.json >damaged/cases/0/result.json
+expect_error "a result.json without the collected impact" 3 "damaged/cases/0/result\.json: key 'impacts': has no impact named 'impact1'.*; did you mean 'impact2'\?$" "$bin" campaign collect damaged
+cp links/cases/0/result.json damaged/cases/0/result.json
+head -c 100 links/campaign.json >damaged/campaign.json
+expect_error "a cut-short campaign.json (status)" 3 "damaged/campaign\.json: line [0-9]+, column [0-9]+: is not valid JSON" "$bin" campaign status damaged
+expect_error "a cut-short campaign.json (collect)" 3 "damaged/campaign\.json: line [0-9]+, column [0-9]+: is not valid JSON" "$bin" campaign collect damaged
+python3 -c "import json,sys; j=json.load(open('links/campaign.json')); j['cases'][1]['id']='one'; json.dump(j, open('damaged/campaign.json','w'))"
+expect_error "a campaign.json with a bad id (status)" 3 "damaged/campaign\.json: key 'cases\[1\]\.id': must be 1" "$bin" campaign status damaged
+expect_error "a campaign.json with a bad id (collect)" 3 "damaged/campaign\.json: key 'cases\[1\]\.id': must be 1" "$bin" campaign collect damaged
+check "no collect folder in the damaged campaigns" '[ ! -e deep/collect ] && [ ! -e damaged/collect ]'
+
+# ---- 4. Messages and transactions -----------------------------------------------------------
+"$bin" campaign plan c.toml --out failing >/dev/null
+rm failing/cases/1/scene.toml
+expect_error "failed cases are named by their folder" 3 "failing/cases/1: failure\.json: 1 of 2 case\(s\) failed \(cases 1; " \
+  "$bin" campaign run failing --quiet
+# A plan cut short by a write that fails (a file size limit of 1 KiB: EFBIG, as a full disk's
+# ENOSPC; each case's scene.toml fits, campaign.json does not: the plan fails after staging every
+# case) leaves nothing: no case folder, no campaign.json, no staging folder, not even the folder.
+cat >many.toml <<'TOML'
+scene = "base.toml"
+[product]
+"impacts[0].restitution" = [0.9, 0.8, 0.7, 0.6, 0.5, 0.4, 0.3, 0.2]
+TOML
+expect_error "a plan cut short" 3 "write failed: File too large" bash -c "trap '' XFSZ; ulimit -f 1; exec \"$bin\" campaign plan many.toml --out cut"
+check "the plan cut short left nothing" '[ ! -e cut ]'
+mkdir cut2 && touch cut2/unrelated
+expect_error "a plan cut short in an existing folder" 3 "write failed: File too large" bash -c "trap '' XFSZ; ulimit -f 1; exec \"$bin\" campaign plan many.toml --out cut2"
+check "the existing folder holds what it held" '[ "$(ls -A cut2)" = unrelated ]'
+
+[ "$fails" = 0 ] && echo "campaign_security_test: ok" || { echo "campaign_security_test: $fails failed"; exit 1; }
