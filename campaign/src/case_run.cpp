@@ -15,6 +15,7 @@
 #include "impactdeck/campaign/runner.hpp"
 #include "impactdeck/common/atomic_file.hpp"
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/common/input_file.hpp"
 #include "impactdeck/scene/pipeline.hpp"
 #include "impactdeck/scene/report.hpp"
 #include "impactdeck/scene/scene.hpp"
@@ -58,11 +59,9 @@ bool FileLock::probe_locked(const fs::path& path) {
 }
 
 std::string read_text(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  if (!in) throw InputError(p.string(), "file", "cannot be opened (missing or unreadable)");
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
+  // A regular file only (a FIFO in a case folder would block `campaign collect`), within a
+  // quarter of the free memory.
+  return read_input_file(p, "campaign file", available_memory_bytes() / 4, "a quarter of the free memory");
 }
 
 nlohmann::json read_json(const fs::path& p) {

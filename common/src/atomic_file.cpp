@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/common/input_file.hpp"
 
 namespace impactdeck {
 namespace fs = std::filesystem;
@@ -136,7 +137,10 @@ std::vector<fs::path> AtomicFileSet::commit() {
 
 std::vector<std::string> AtomicFileSet::interrupted_commit(const fs::path& folder) {
   std::vector<std::string> targets;
-  std::ifstream in(folder / kMarker);
+  // A regular file only (a FIFO planted under the marker's name must not block).
+  std::error_code ec;
+  if (!fs::is_regular_file(fs::symlink_status(folder / kMarker, ec))) return targets;
+  std::istringstream in(read_input_file(folder / kMarker, "commit marker", kMaxSceneBytes));
   for (std::string line; std::getline(in, line);)
     if (!line.empty()) targets.push_back(line);
   return targets;

@@ -1,5 +1,9 @@
 #include "stl_binary.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -26,8 +30,20 @@ struct FileCloser {
 std::optional<LoadedMesh> read_binary_stl(const std::filesystem::path& file, const std::string& where,
                                           LengthUnit unit, std::uintmax_t bytes) {
   if (bytes < kHeaderBytes + kTriangleBytes) return std::nullopt;
-  std::unique_ptr<std::FILE, FileCloser> f(std::fopen(file.c_str(), "rb"));
-  if (!f) return std::nullopt;  // the general route reports why
+  // Opened without blocking and checked on the descriptor: a FIFO swapped in after the caller's
+  // check_input_file cannot hang the run (the general route reports why it is refused).
+  const int fd = ::open(file.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) return std::nullopt;
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    ::close(fd);
+    return std::nullopt;
+  }
+  std::unique_ptr<std::FILE, FileCloser> f(::fdopen(fd, "rb"));
+  if (!f) {
+    ::close(fd);
+    return std::nullopt;
+  }
   unsigned char head[kHeaderBytes];
   if (std::fread(head, 1, kHeaderBytes, f.get()) != kHeaderBytes) return std::nullopt;
   std::uint32_t count = 0;
