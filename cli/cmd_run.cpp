@@ -43,6 +43,7 @@ void register_run(CLI::App& app, Context& ctx) {
       ->check(CLI::NonNegativeNumber);
   add_output_length_unit_option(cmd, args->output_length_unit);
   cmd->callback([args, &ctx] {
+    check_stdout_writable();  // its output follows the commit: refused now, not after it
     if (!std::isfinite(args->solver_timeout_s)) throw UsageError("--solver-timeout-s must be a finite number of seconds");
     check_threads(static_cast<unsigned>(std::min(args->threads, 1 << 30)));
     const scene::Scene sc = scene::load_scene(args->scene, overrides_from(args->set));
