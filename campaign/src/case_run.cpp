@@ -61,6 +61,8 @@ bool FileLock::probe_locked(const fs::path& path) {
 std::string read_text(const fs::path& p) {
   // A regular file only (a FIFO in a case folder would block `campaign collect`), within a
   // quarter of the free memory.
+  std::error_code ec;
+  if (!fs::exists(p, ec)) throw InputError(p.string(), "file", "cannot be opened (missing or unreadable)");
   return read_input_file(p, "campaign file", available_memory_bytes() / 4, "a quarter of the free memory");
 }
 
