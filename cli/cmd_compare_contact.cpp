@@ -53,6 +53,7 @@ void register_compare_contact(CLI::App& app, Context& ctx) {
   cmd->add_flag("--no-hybrid", [args](std::int64_t) { args->options.run_hybrid = false; },
                 "Run the full-contact model only");
   cmd->callback([args, &ctx] {
+    check_stdout_writable();  // its output follows the commit: refused now, not after it
     const scene::Scene sc = scene::load_scene(args->scene, overrides_from(args->set));
     // One transaction (docs/reliability.md): the decks and ccx's results are staged inside --out
     // and published together when the comparison completed, whatever its verdict; a failure or a

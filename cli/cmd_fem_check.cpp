@@ -44,6 +44,7 @@ void register_fem_check(CLI::App& app, Context& ctx) {
                   "Wall-time limit of the ccx run (default: derived from the deck's size, stated in --json)")
       ->check(positive_number());
   cmd->callback([args, &ctx] {
+    check_stdout_writable();  // its output follows the commit: refused now, not after it
     check_threads(static_cast<unsigned>(std::min(args->options.threads, 1 << 30)));
     if (!std::isfinite(args->options.timeout_s)) throw UsageError("--solver-timeout-s must be a finite number of seconds");
     fem_export::CheckOptions o = args->options;

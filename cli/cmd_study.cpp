@@ -99,6 +99,7 @@ void register_study(CLI::App& app, Context& ctx) {
       ->check(positive_number());
   add_set_option(cmd, a->set);
   cmd->callback([a, &ctx] {
+    check_stdout_writable();  // its output follows the commit: refused now, not after it
     check_threads(a->threads);
     study::Table1Options o = study::table1_preset(a->preset);
     if (!a->g.empty()) o.geometric_ratios = parse_list(a->g, "--geometric-ratios");

@@ -21,6 +21,12 @@ struct Context {
   void note(const std::string& command, const std::string& text) const;
 };
 
+/// Checks, before a command that publishes files starts, that stdout can be written: a zero-byte
+/// write fails on a closed or read-only stdout (EBADF) and on a device that is always full
+/// (/dev/full: ENOSPC). Its output is printed after the files are published, so a stdout found
+/// unusable only then would leave them behind with exit 3 (issue 29). Throws InputError("stdout").
+void check_stdout_writable();
+
 void register_run(CLI::App& app, Context& ctx);
 void register_sweep(CLI::App& app, Context& ctx);
 void register_study(CLI::App& app, Context& ctx);

@@ -1,5 +1,10 @@
 #include "conventions.hpp"
 
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+
 #include <functional>
 #include <iomanip>
 #include <memory>
@@ -32,6 +37,14 @@ VerboseTimer::~VerboseTimer() {
   std::ostringstream t;
   t << stage_ << ": " << std::setprecision(3) << s << " s";
   ctx_.note(command_, t.str());
+}
+
+void check_stdout_writable() {
+  std::cout.flush();
+  if (::write(STDOUT_FILENO, "", 0) < 0) {
+    throw InputError("stdout", "", std::string("write failed: ") + std::strerror(errno) +
+                                       " (checked before the run: nothing was computed or written)");
+  }
 }
 
 namespace {

@@ -89,6 +89,21 @@ py::array_t<double> array(const Eigen::Matrix3d& m) {
   return a;
 }
 
+// A surface query point: three finite numbers within kMaxQueryCoordinate_m of the origin. Farther
+// away the squared distances of the closest-point search leave double precision (1e160 m gave an
+// infinite distance_m); the bound is the part files' own coordinate limit (docs/reliability.md).
+constexpr double kMaxQueryCoordinate_m = 1e20;
+Eigen::Vector3d query_point(const py::handle& h) {
+  const Eigen::Vector3d x = vec3(h, "point");
+  if (x.cwiseAbs().maxCoeff() > kMaxQueryCoordinate_m) {
+    std::ostringstream m;
+    m << "point (" << x.x() << ", " << x.y() << ", " << x.z() << ") m lies farther than 1e20 m from the origin, "
+      << "beyond the coordinates a part may have: no distance can be computed there";
+    throw InputError("", "point_m", m.str());
+  }
+  return x;
+}
+
 py::dict surface_point(const geometry::SurfacePoint& s) {
   py::dict d;
   d["point_m"] = array(s.point_m);
@@ -175,6 +190,13 @@ PYBIND11_MODULE(impactdeck, m) {
   static py::exception<CheckFailed> check(m, "CheckFailed", base.ptr());
   static py::exception<Error> internal(m, "InternalError", base.ptr());
   base.attr("exit_code") = static_cast<int>(ExitCode::internal_error);
+  // numpy's C API is looked up once, here, under the import: pybind11 does it on the first array
+  // made, inside a C++ static initialiser that imports numpy; two threads making their first
+  // array at once deadlocked there (one holding the initialiser's guard and waiting for the GIL,
+  // the other holding the GIL and waiting for the guard).
+  py::module_::import("numpy");
+  (void)py::array_t<double>(0);
+  (void)py::array_t<bool>(0);
   usage.attr("exit_code") = static_cast<int>(ExitCode::usage);
   input.attr("exit_code") = static_cast<int>(ExitCode::invalid_input);
   check.attr("exit_code") = static_cast<int>(ExitCode::check_failed);
@@ -343,7 +365,7 @@ PYBIND11_MODULE(impactdeck, m) {
       .def_property_readonly("inertia_per_density_m5", [](const PyPart& p) { return array(p.volume.inertia_per_density_m5); })
       .def_property_readonly("size_m", [](const PyPart& p) { return p.shape->size_m(); })
       .def("closest_point", [](const PyPart& p, py::object q) {
-        const Eigen::Vector3d x = vec3(q, "point");
+        const Eigen::Vector3d x = query_point(q);
         geometry::SurfacePoint s;
         {
           py::gil_scoped_release release;
@@ -352,7 +374,7 @@ PYBIND11_MODULE(impactdeck, m) {
         return surface_point(s);
       }, py::arg("point_m"))
       .def("curvature", [](const PyPart& p, py::object q) {
-        const Eigen::Vector3d x = vec3(q, "point");
+        const Eigen::Vector3d x = query_point(q);
         geometry::Curvature c;
         double radius = std::numeric_limits<double>::quiet_NaN();
         geometry::SurfacePoint s;

@@ -1,6 +1,10 @@
 // The shared conventions in common/: "did you mean" (edit distance), the CSV sidecar, the JSON
 // number helper. The CLI's use of them is tested end to end in cli_conventions_test.sh.
+#include <unistd.h>
+
+#include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <limits>
 #include <optional>
 #include <vector>
@@ -9,8 +13,10 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "impactdeck/common/atomic_file.hpp"
 #include "impactdeck/common/csv_sidecar.hpp"
 #include "impactdeck/common/json_number.hpp"
+#include "impactdeck/common/run_transaction.hpp"
 #include "impactdeck/common/suggest.hpp"
 #include "impactdeck/common/units.hpp"
 #include "scratch_files.hpp"
@@ -114,6 +120,48 @@ TEST(CsvSidecar, TextIsJsonWithEveryColumn) {
   EXPECT_TRUE(j.contains("impactdeck_version"));
   EXPECT_NO_THROW(nlohmann::json::parse(csv_sidecar_text("t.csv", {}, {})));
   EXPECT_EQ(csv_sidecar_path("out/t.csv"), std::filesystem::path("out/t.csv.json"));
+}
+
+TEST(CsvSidecar, NamesUpTo255BytesHaveASidecarWithinNameMax) {
+  // Output names may have 255 bytes (docs/reliability.md); FILE.csv.json of a 251..255-byte name
+  // would not (issue 29): those sidecars get a shortened name with the whole name's hash.
+  namespace fs = std::filesystem;
+  const std::string base250 = std::string(246, 'a') + ".csv";
+  EXPECT_EQ(csv_sidecar_path("out/" + base250), fs::path("out/" + base250 + ".json"));  // 255: as before
+  std::vector<std::string> sidecars;
+  for (std::size_t n = 251; n <= 255; ++n) {
+    for (const char fill : {'a', 'b'}) {
+      const std::string csv = std::string(n - 4, fill) + ".csv";
+      const fs::path side = csv_sidecar_path(fs::path("out") / csv);
+      EXPECT_EQ(side.parent_path(), fs::path("out"));
+      EXPECT_LE(side.filename().string().size(), kMaxFileNameBytes) << n;
+      EXPECT_EQ(side.extension(), ".json");
+      sidecars.push_back(side.filename().string());
+    }
+  }
+  std::sort(sidecars.begin(), sidecars.end());
+  EXPECT_EQ(std::unique(sidecars.begin(), sidecars.end()), sidecars.end()) << "two CSV names share a sidecar";
+  // Never cut inside a UTF-8 character: 'é' is two bytes.
+  std::string accented;
+  while (accented.size() < 251) accented += "\xC3\xA9";
+  const std::string cut = csv_sidecar_path(accented + ".csv").string();
+  EXPECT_EQ(cut.substr(0, cut.find('~')).size() % 2, 0u) << cut;
+  // And the pair is written and published on a real file system, through one transaction.
+  const fs::path d = fs::temp_directory_path() / ("impactdeck_sidecar_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  const std::string csv = std::string(251, 'z') + ".csv";
+  {
+    RunTransaction txn(d);
+    const fs::path staged = txn.file(csv, "scene", "key");
+    const fs::path staged_side = txn.file(csv_sidecar_path(csv).string(), "scene", "key (its sidecar)");
+    EXPECT_EQ(staged_side, csv_sidecar_path(staged));
+    write_file_atomically(staged, "time_s\n0\n");
+    write_csv_sidecar(staged, {"time_s"}, {});
+    txn.commit();
+  }
+  EXPECT_TRUE(fs::is_regular_file(d / csv));
+  EXPECT_EQ(nlohmann::json::parse(test::slurp(csv_sidecar_path(d / csv))).at("file"), csv);
+  fs::remove_all(d);
 }
 
 TEST(JsonNumber, NonFiniteIsNullAndNoNegativeZero) {

@@ -2,6 +2,7 @@
 #include <string>
 
 #include <gtest/gtest.h>
+#include <tinyxml2.h>
 
 #include "impactdeck/plot/drawing.hpp"
 #include "impactdeck/plot/html.hpp"
@@ -53,4 +54,40 @@ TEST(Html, PageIsSelfContainedAndEscapesItsText) {
   EXPECT_NE(s.find("default-src 'none'"), std::string::npos);
   EXPECT_EQ(s.find("<script"), std::string::npos);
   EXPECT_EQ(s.find("://"), std::string::npos);  // no external resource
+}
+
+namespace {
+
+// The bytes XML 1.0 forbids (its Char production): C0 controls but tab, newline and carriage
+// return. tinyxml2 does not check this itself, so the test does; "" when there is none.
+std::string forbidden_xml_bytes(const std::string& s) {
+  std::string bad;
+  for (char c : s) {
+    const unsigned char u = static_cast<unsigned char>(c);
+    if (u < 0x20 && c != '\t' && c != '\n' && c != '\r') bad += "\\x" + std::to_string(u) + " ";
+  }
+  return bad;
+}
+
+}  // namespace
+
+TEST(Html, ControlCharactersInNamesGiveWellFormedSvgAndHtml) {
+  // An impact or body name with every C0 control character (issue 29): written as its visible
+  // symbol U+2401..U+241F, so the SVG and the page stay well-formed XML / valid HTML.
+  std::string name = "hit";
+  for (char c = 1; c < 0x20; ++c) name += c;
+  name += '\x7f';
+  Drawing d(100, 50);
+  d.text({10, 20}, name, 12);
+  const std::string svg = to_svg(d);
+  EXPECT_EQ(forbidden_xml_bytes(svg), "");
+  tinyxml2::XMLDocument doc;
+  ASSERT_EQ(doc.Parse(svg.c_str(), svg.size()), tinyxml2::XML_SUCCESS) << doc.ErrorStr();
+  EXPECT_NE(svg.find("hit\xE2\x90\x81\xE2\x90\x82"), std::string::npos);  // U+2401 U+2402
+  EXPECT_NE(svg.find("\xE2\x90\x9F\xE2\x90\xA1"), std::string::npos);  // U+241F, DEL as U+2421
+  HtmlPage p(name);
+  p.heading(name);
+  p.table({name}, {{name}});
+  EXPECT_EQ(forbidden_xml_bytes(p.str()), "");
+  EXPECT_EQ(html_escape("a\tb\nc"), "a\tb\nc");  // white space kept
 }

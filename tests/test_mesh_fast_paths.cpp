@@ -231,6 +231,118 @@ TEST(SelfIntersections, TriangleArrayCountEqualsCgalSurfaceMeshRoute) {
   }
 }
 
+namespace {
+
+// A prism whose two caps are k-corner polygons triangulated as fans from their corner 0 (as the
+// readers triangulate a convex polygon face), the sides as quads of two triangles; outward.
+TriangleMesh fan_prism(int k, double height = 0.5) {
+  TriangleMesh m;
+  for (int z = 0; z < 2; ++z)
+    for (int i = 0; i < k; ++i) {
+      const double a = 2 * M_PI * i / k;
+      m.vertices_m.emplace_back(std::cos(a), std::sin(a), z * height);
+    }
+  for (int i = 1; i + 1 < k; ++i) {
+    m.triangles.push_back({0, i + 1, i});              // bottom, facing -z
+    m.triangles.push_back({k, k + i, k + i + 1});      // top, facing +z
+  }
+  for (int i = 0; i < k; ++i) {
+    const int j = (i + 1) % k;
+    m.triangles.push_back({i, j, k + j});
+    m.triangles.push_back({i, k + j, k + i});
+  }
+  return m;
+}
+
+// A cone: apex over a k-corner base (its own fan), so the apex's star is not planar.
+TriangleMesh fan_cone(int k) {
+  TriangleMesh m;
+  for (int i = 0; i < k; ++i) {
+    const double a = 2 * M_PI * i / k;
+    m.vertices_m.emplace_back(std::cos(a), std::sin(a), 0.0);
+  }
+  m.vertices_m.emplace_back(0.1, -0.05, 1.0);
+  for (int i = 1; i + 1 < k; ++i) m.triangles.push_back({0, i + 1, i});
+  for (int i = 0; i < k; ++i) m.triangles.push_back({i, (i + 1) % k, k});
+  return m;
+}
+
+}  // namespace
+
+TEST(SelfIntersections, HighDegreeStarsCountedByAngleAsTheCgalRoute) {
+  // The faces around a vertex in 64 or more triangles are paired by angle, not by boxes (issue 29):
+  // the same pairs as CGAL's Surface_mesh route, on fans that do and do not intersect.
+  const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, -2, 0.5).normalized()).toRotationMatrix();
+  std::vector<std::pair<std::string, TriangleMesh>> cases;
+  cases.push_back({"prism of 300-gons", fan_prism(300)});
+  {
+    TriangleMesh m = fan_prism(300);
+    transform_mesh(m, turn, Eigen::Vector3d(3, -1, 2));  // no cap in a coordinate plane
+    cases.push_back({"turned prism", m});
+  }
+  {
+    TriangleMesh m = fan_prism(300);  // a top corner pulled across its cap: the fan folds over
+    m.vertices_m[300 + 150] = Eigen::Vector3d(0.9, 0.05, 0.5);
+    cases.push_back({"folded top fan", m});
+  }
+  {
+    TriangleMesh m = fan_prism(300);  // a bottom corner pushed up through the top cap
+    m.vertices_m[77] = Eigen::Vector3d(0.2, 0.3, 0.8);
+    transform_mesh(m, turn, Eigen::Vector3d::Zero());
+    cases.push_back({"corner through the top fan", m});
+  }
+  {
+    TriangleMesh m = fan_prism(300);  // the top fan's corner 0 pushed below the bottom cap: two stars cross
+    m.vertices_m[300] = Eigen::Vector3d(0.1, 0.0, -0.3);
+    cases.push_back({"fan corner through the other fan", m});
+  }
+  cases.push_back({"cone", fan_cone(200)});
+  {
+    TriangleMesh m = fan_cone(200);  // a base corner pulled up through the cone's far side
+    m.vertices_m[100] = Eigen::Vector3d(0.5, 0.0, 0.9);
+    cases.push_back({"base corner through the cone", m});
+  }
+  for (const auto& [name, m] : cases) {
+    SCOPED_TRACE(name);
+    const std::size_t reference = self_intersections(m, true);
+    EXPECT_EQ(self_intersections(m, false, 1), reference);
+    EXPECT_EQ(self_intersections(m, false, 2), reference);
+    const bool intersecting = name != "prism of 300-gons" && name != "turned prism" && name != "cone";
+    EXPECT_EQ(reference > 0, intersecting) << reference;
+    RecordProperty("pairs: " + name, static_cast<int>(reference));
+  }
+}
+
+TEST(SelfIntersections, A200000CornerFaceIsChecked) {
+  // An OFF prism whose two faces have 200 000 corners each (fans on read): the box test alone
+  // reported every pair of one fan's triangles and did not finish (timings: docs/reliability.md,
+  // "Limits", polygons).
+  TempDir dir;
+  const int k = 200000;
+  const TriangleMesh ref = fan_prism(k);
+  {
+    std::ofstream off(dir.path / "big.off");
+    off.precision(17);
+    off << "OFF\n" << 2 * k << " " << k + 2 << " 0\n";
+    for (const auto& v : ref.vertices_m) off << v.x() << " " << v.y() << " " << v.z() << "\n";
+    off << k;
+    for (int i = k - 1; i >= 0; --i) off << " " << i;  // bottom, facing -z
+    off << "\n" << k;
+    for (int i = 0; i < k; ++i) off << " " << k + i;
+    off << "\n";
+    for (int i = 0; i < k; ++i) off << "4 " << i << " " << (i + 1) % k << " " << k + (i + 1) % k << " " << k + i << "\n";
+  }
+  const LoadedMesh loaded = load_mesh(dir.path / "big.off", LengthUnit::m);
+  ASSERT_EQ(loaded.mesh.triangles.size(), 4u * k - 4u);
+  const ValidationReport r = validate_mesh(loaded.mesh, {});
+  EXPECT_TRUE(r.self_intersections_checked);
+  EXPECT_EQ(r.self_intersecting_pairs, 0u);
+  // One corner pushed through the other face: found, and only those pairs.
+  TriangleMesh pierced = loaded.mesh;
+  pierced.vertices_m[5] = Eigen::Vector3d(0.2, 0.3, 0.8);
+  EXPECT_GT(validate_mesh(pierced, {}).self_intersecting_pairs, 0u);
+}
+
 TEST(SelfIntersections, NonManifoldMeshesKeepTheCgalRoute) {
   // Two cubes sharing an edge: CGAL splits the non-manifold places before counting, so these stay
   // on its route; the option makes no difference.

@@ -174,6 +174,50 @@ class Parts(unittest.TestCase):
             self.assertEqual(rc, 0)
             self.assertAlmostEqual(json.loads(stdout)["force_ratio"], r["force_ratio"], delta=1e-15)
 
+    def test_closest_point_far_away_is_finite_or_refused(self):
+        cube = impactdeck.load_part(os.path.join(SRC, "tests", "data", "cube.off"), "m")
+        # 1e15 m away: the exact distance (to rounding), not Inf.
+        s = cube.closest_point([1e15, 0.0, 0.0])
+        self.assertTrue(math.isfinite(s["distance_m"]))
+        self.assertAlmostEqual(s["distance_m"] / (1e15 - 1.0), 1.0, delta=1e-12)
+        # Beyond the coordinates a part may have (1e20 m): a clear error naming the point, not Inf.
+        for q in ([1e160, 0.0, 0.0], [0.0, -1e300, 0.0]):
+            with self.assertRaises(impactdeck.InputError) as e:
+                cube.closest_point(q)
+            self.assertIn("farther than 1e20 m", str(e.exception))
+
+
+class Threads(unittest.TestCase):
+    # Two threads making their first numpy-returning call at the same time deadlocked the
+    # interpreter (issue 29: 6 of 6 tries). Each try is a fresh interpreter (the first call is what
+    # matters), bounded by a timeout so that a regression fails instead of hanging the suite.
+    SCRIPT = r"""
+import sys, threading
+import impactdeck
+part = impactdeck.load_part(sys.argv[1], "m")
+start = threading.Barrier(4)
+results = []
+def work():
+    start.wait()
+    results.append(part.closest_point([0.3, 0.1, 2.0])["point_m"].shape)
+    results.append(part.center_of_mass_m.shape)
+threads = [threading.Thread(target=work) for _ in range(4)]
+for t in threads: t.start()
+for t in threads: t.join()
+print(len(results), results[0])
+"""
+
+    def test_first_numpy_calls_from_threads_at_once(self):
+        cube = os.path.join(SRC, "tests", "data", "cube.off")
+        for attempt in range(6):
+            try:
+                p = subprocess.run([sys.executable, "-c", self.SCRIPT, cube], capture_output=True, text=True,
+                                   timeout=60, env=os.environ)
+            except subprocess.TimeoutExpired:
+                self.fail(f"try {attempt + 1}: the threads' first numpy calls deadlocked (no exit within 60 s)")
+            self.assertEqual(p.returncode, 0, p.stderr)
+            self.assertEqual(p.stdout.strip(), "8 (3,)")
+
 
 if __name__ == "__main__":
     unittest.main(verbosity=2)

@@ -247,13 +247,118 @@ TEST(RunTransaction, StaleStagingFoldersAndOldLeftoversAreRemoved) {
   EXPECT_NE(listing(d).find(".impactdeck-stage-"), std::string::npos);
 }
 
-TEST(RunTransaction, ACorruptOrForeignJournalIsDroppedWithAWarning) {
+TEST(RunTransaction, ACorruptOrForeignJournalIsRefusedAndKept) {
   const fs::path d = fresh_dir("corrupt");
   put(d / ".impactdeck-commit", "impactdeck-commit 1\n../../etc\nF x\n");
-  RunTransaction next(d);
-  ASSERT_EQ(next.warnings().size(), 1u);
-  EXPECT_NE(next.warnings()[0].find("names no staging folder"), std::string::npos) << next.warnings()[0];
-  EXPECT_FALSE(fs::exists(d / ".impactdeck-commit"));
+  try {
+    RunTransaction next(d);
+    ADD_FAILURE() << "a journal naming no staging folder was acted on";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.code(), ExitCode::invalid_input);
+    EXPECT_EQ(e.where(), (d / ".impactdeck-commit").string());
+    EXPECT_NE(e.reason().find("names no staging folder"), std::string::npos) << e.reason();
+  }
+  EXPECT_EQ(listing(d), ".impactdeck-commit ");
+}
+
+namespace {
+
+// The InputError a RunTransaction on `d` throws, or a failure when it opens.
+InputError refusal_of(const fs::path& d) {
+  try {
+    RunTransaction next(d);
+  } catch (const InputError& e) {
+    return e;
+  }
+  ADD_FAILURE() << "the forged journal in " << d << " was acted on";
+  return InputError("", "", "");
+}
+
+// Every file below `d` with its content, links as "-> target": the state a refused journal must
+// leave untouched.
+std::string tree(const fs::path& d) {
+  std::vector<std::string> lines;
+  for (auto it = fs::recursive_directory_iterator(d); it != fs::recursive_directory_iterator(); ++it) {
+    const fs::path rel = fs::relative(it->path(), d);
+    if (it->is_symlink()) {
+      lines.push_back(rel.string() + " -> " + fs::read_symlink(it->path()).string());
+    } else if (it->is_regular_file()) {
+      lines.push_back(rel.string() + " = " + slurp(it->path()));
+    } else {
+      lines.push_back(rel.string() + "/");
+    }
+  }
+  std::sort(lines.begin(), lines.end());
+  std::string s;
+  for (const auto& l : lines) s += l + "\n";
+  return s;
+}
+
+}  // namespace
+
+TEST(RunTransaction, AForgedJournalThroughALinkIsRefusedAndTouchesNothing) {
+  // A folder outside --out that a planted journal tries to have moved aside and removed: the
+  // journal names 'link/precious', and 'link' is a symbolic link to the outside folder.
+  const fs::path outside = fresh_dir("forged_outside");
+  fs::create_directories(outside / "precious");
+  put(outside / "precious" / "data.txt", "keep me");
+  const fs::path d = fresh_dir("forged");
+  fs::create_directory_symlink(outside, d / "link");
+  const fs::path stage = d / ".impactdeck-stage-999999999-0";
+  fs::create_directories(stage / "new" / "link" / "precious");
+  fs::create_directories(stage / "old");
+  put(d / ".impactdeck-commit", "impactdeck-commit 1\n.impactdeck-stage-999999999-0\nD link/precious\n");
+  const std::string inside_before = tree(d), outside_before = tree(outside);
+  const InputError e = refusal_of(d);
+  EXPECT_EQ(e.code(), ExitCode::invalid_input);
+  EXPECT_EQ(e.where(), (d / ".impactdeck-commit").string());
+  EXPECT_NE(e.reason().find("'link' is a symbolic link"), std::string::npos) << e.reason();
+  EXPECT_EQ(slurp(outside / "precious" / "data.txt"), "keep me");
+  EXPECT_EQ(tree(outside), outside_before);
+  EXPECT_EQ(tree(d), inside_before);
+}
+
+TEST(RunTransaction, AForgedJournalWhoseStagingFoldersAreLinksIsRefused) {
+  const fs::path outside = fresh_dir("forged2_outside");
+  fs::create_directories(outside / "new");
+  fs::create_directories(outside / "fem_x");
+  put(outside / "new" / "a.csv", "outside file");
+  put(outside / "fem_x" / "f", "outside folder");
+  // 1. The staging folder itself a link: its 'new/a.csv' would be moved in from outside.
+  {
+    const fs::path d = fresh_dir("forged2");
+    fs::create_directory_symlink(outside, d / ".impactdeck-stage-999999999-0");
+    put(d / ".impactdeck-commit", "impactdeck-commit 1\n.impactdeck-stage-999999999-0\nF a.csv\n");
+    const std::string before = tree(d);
+    EXPECT_NE(refusal_of(d).reason().find("is not a real folder"), std::string::npos);
+    EXPECT_EQ(tree(d), before);
+  }
+  // 2. Its 'old' a link to outside: the replaced folder 'fem_x' would be moved out of --out.
+  {
+    const fs::path d = fresh_dir("forged3");
+    const fs::path stage = d / ".impactdeck-stage-999999999-0";
+    fs::create_directories(stage / "new" / "fem_x");
+    fs::create_directory_symlink(outside, stage / "old");
+    fs::create_directories(d / "fem_x");
+    put(d / "fem_x" / "deck.json", "old deck");
+    put(d / ".impactdeck-commit", "impactdeck-commit 1\n.impactdeck-stage-999999999-0\nD fem_x\n");
+    const std::string before = tree(d);
+    EXPECT_NE(refusal_of(d).reason().find("'old' is a symbolic link"), std::string::npos);
+    EXPECT_EQ(tree(d), before);
+  }
+  // 3. A staged output that is a link (to a file outside): it would be published into --out.
+  {
+    const fs::path d = fresh_dir("forged4");
+    const fs::path stage = d / ".impactdeck-stage-999999999-0";
+    fs::create_directories(stage / "new");
+    fs::create_symlink(outside / "new" / "a.csv", stage / "new" / "a.csv");
+    put(d / ".impactdeck-commit", "impactdeck-commit 1\n.impactdeck-stage-999999999-0\nF a.csv\n");
+    const std::string before = tree(d);
+    EXPECT_NE(refusal_of(d).reason().find("is a symbolic link, not a file"), std::string::npos);
+    EXPECT_EQ(tree(d), before);
+  }
+  EXPECT_EQ(slurp(outside / "new" / "a.csv"), "outside file");
+  EXPECT_EQ(slurp(outside / "fem_x" / "f"), "outside folder");
 }
 
 TEST(RunTransaction, TheOutputFolderMustBeAFolder) {

@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/common/input_file.hpp"
 
 namespace impactdeck {
 namespace fs = std::filesystem;
@@ -59,21 +60,32 @@ fs::path write_temporary(const fs::path& path, const std::function<void(std::ost
       throw InputError(path.string(), "output",
                        "cannot write in folder '" + dir.string() + "': " + std::strerror(errno));
     }
+    // A failed write: the file and errno's reason (a full file system when errno was lost).
+    auto write_failed = [&](int e) {
+      struct statvfs fs_st {};
+      if (e == 0 && ::statvfs(dir.c_str(), &fs_st) == 0 && fs_st.f_bavail == 0) e = ENOSPC;
+      return InputError(path.string(), "output", std::string("write failed: ") + (e ? std::strerror(e) : "I/O error"));
+    };
     try {
       errno = 0;
-      fill(out);
+      try {
+        fill(out);
+      } catch (const InputError&) {
+        throw;
+      } catch (...) {
+        // A writer that stops at its stream's first failed write throws its own error (study's
+        // row writer: "write failed", exit 1): the failed write is what happened, said here with
+        // the file's name (exit 3; a sweep onto a full disk named no file, issue 29).
+        if (out.good()) throw;
+        throw write_failed(errno);
+      }
       int e = errno;  // the first failed write's reason (a bad stream writes nothing more)
       if (out) {
         errno = 0;
         out.flush();
         e = errno;
       }
-      if (!out) {
-        struct statvfs fs_st {};
-        if (e == 0 && ::statvfs(dir.c_str(), &fs_st) == 0 && fs_st.f_bavail == 0) e = ENOSPC;
-        throw InputError(path.string(), "output",
-                         std::string("write failed: ") + (e ? std::strerror(e) : "I/O error"));
-      }
+      if (!out) throw write_failed(e);
     } catch (...) {
       out.close();
       fs::remove(tmp, ec);
@@ -136,7 +148,10 @@ std::vector<fs::path> AtomicFileSet::commit() {
 
 std::vector<std::string> AtomicFileSet::interrupted_commit(const fs::path& folder) {
   std::vector<std::string> targets;
-  std::ifstream in(folder / kMarker);
+  // A regular file only (a FIFO planted under the marker's name must not block).
+  std::error_code ec;
+  if (!fs::is_regular_file(fs::symlink_status(folder / kMarker, ec))) return targets;
+  std::istringstream in(read_input_file(folder / kMarker, "commit marker", kMaxSceneBytes));
   for (std::string line; std::getline(in, line);)
     if (!line.empty()) targets.push_back(line);
   return targets;

@@ -1,6 +1,8 @@
 #include "impactdeck/common/csv_sidecar.hpp"
 
+#include <cstdint>
 #include <cstdio>
+#include <cstring>
 
 #include "impactdeck/common/atomic_file.hpp"
 #include "impactdeck/common/version.hpp"
@@ -34,9 +36,24 @@ std::string json_string(std::string_view s) {
 }  // namespace
 
 std::filesystem::path csv_sidecar_path(const std::filesystem::path& csv) {
-  std::filesystem::path p = csv;
-  p += ".json";
-  return p;
+  const std::string name = csv.filename().string();
+  if (name.size() + 5 <= kMaxFileNameBytes) {
+    std::filesystem::path p = csv;
+    p += ".json";
+    return p;
+  }
+  // Too long for NAME_MAX with ".json": the name's first bytes (cut at a UTF-8 character
+  // boundary), '~', the FNV-1a 64-bit hash of the whole name in 16 hex digits, ".json".
+  std::uint64_t h = 0xcbf29ce484222325ULL;
+  for (const char c : name) {
+    h ^= static_cast<unsigned char>(c);
+    h *= 0x100000001b3ULL;
+  }
+  char tail[32];
+  std::snprintf(tail, sizeof tail, "~%016llx.json", static_cast<unsigned long long>(h));
+  std::size_t keep = kMaxFileNameBytes - std::strlen(tail);
+  while (keep > 0 && (static_cast<unsigned char>(name[keep]) & 0xC0) == 0x80) --keep;
+  return csv.parent_path() / (name.substr(0, keep) + tail);
 }
 
 std::string csv_column_unit(std::string_view c) {

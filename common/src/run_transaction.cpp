@@ -81,6 +81,15 @@ struct LockedFolder {
   bool held_by_someone_else() const { return fd == -2; }
 };
 
+// A commit journal that impactdeck did not write, or whose paths are no longer safe to act on:
+// the run is refused (exit 3) and nothing is touched.
+struct JournalRefused : InputError {
+  JournalRefused(const fs::path& marker, const std::string& reason)
+      : InputError(marker.string(), "journal",
+                   reason + ": not a journal impactdeck wrote, refused; nothing was moved or removed (if no "
+                            "impactdeck run was killed while publishing into this folder, remove the journal)") {}
+};
+
 bool pid_alive(long pid) { return pid > 0 && (::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH); }
 
 // `.fem_NAME.old-PID` / `.fem_NAME.partial-PID`: folders of impactdeck versions before the run
@@ -192,6 +201,8 @@ RunTransaction::RunTransaction(const fs::path& out_dir, std::string flag) : out_
       lock_out();
       try {
         recover_locked();
+      } catch (const JournalRefused&) {
+        throw;
       } catch (const InputError& e) {
         warnings_.push_back("could not clean up after a killed run in '" + where + "': " + e.reason());
       }
@@ -335,28 +346,112 @@ fs::path RunTransaction::scratch(const std::string& name) {
 
 namespace {
 
-// Publishes one staged output of `stage` into `out`; false when it was published already (a
-// commit finished by recovery). A folder that exists at the target is moved into stage/old first.
-bool publish(const fs::path& out, const fs::path& stage, const std::string& name, bool is_folder) {
-  const fs::path src = stage / "new" / name, dst = out / name;
-  struct stat st {};
-  if (::lstat(src.c_str(), &st) != 0) return false;
-  if (is_folder && ::lstat(dst.c_str(), &st) == 0) {
-    fs::path aside;
-    for (int k = 0;; ++k) {
-      aside = stage / "old" / std::to_string(k);
-      if (::lstat(aside.c_str(), &st) != 0) break;
+// An open folder; closed on destruction.
+struct Fd {
+  int fd = -1;
+  Fd() = default;
+  explicit Fd(int f) : fd(f) {}
+  Fd(const Fd&) = delete;
+  Fd& operator=(const Fd&) = delete;
+  Fd(Fd&& o) noexcept : fd(o.fd) { o.fd = -1; }
+  Fd& operator=(Fd&& o) noexcept {
+    std::swap(fd, o.fd);
+    return *this;
+  }
+  ~Fd() {
+    if (fd >= 0) ::close(fd);
+  }
+};
+
+// `name` split at its last '/': the folder part ("" for none) and the last component.
+std::pair<std::string, std::string> split_name(const std::string& name) {
+  const auto at = name.rfind('/');
+  if (at == std::string::npos) return {"", name};
+  return {name.substr(0, at), name.substr(at + 1)};
+}
+
+// Opens the folder `rel` (components separated by '/', "" for `base` itself) below the open folder
+// `base` one component at a time, never following a symbolic link: every component must be a real
+// folder. On failure returns an Fd of -1 and says why in `why` (naming the component, relative).
+Fd open_below(int base, const std::string& rel, std::string& why) {
+  Fd cur(::dup(base));
+  if (cur.fd < 0) {
+    why = "cannot open a folder: " + errno_text(errno);
+    return Fd();
+  }
+  std::string done;
+  std::size_t start = 0;
+  while (start < rel.size()) {
+    const std::size_t end = std::min(rel.find('/', start), rel.size());
+    const std::string comp = rel.substr(start, end - start);
+    start = end + 1;
+    if (comp.empty() || comp == ".") continue;
+    done += (done.empty() ? "" : "/") + comp;
+    struct stat st {};
+    if (comp == ".." || ::fstatat(cur.fd, comp.c_str(), &st, AT_SYMLINK_NOFOLLOW) != 0) {
+      why = "'" + done + "' " + (comp == ".." ? std::string("leaves the folder") : "cannot be used: " + errno_text(errno));
+      return Fd();
     }
-    ::mkdir((stage / "old").c_str(), 0700);
-    if (::rename(dst.c_str(), aside.c_str()) != 0) {
+    if (!S_ISDIR(st.st_mode)) {
+      why = "'" + done + "' is " + kind_of(st) + ", not a real folder";
+      return Fd();
+    }
+    Fd next(::openat(cur.fd, comp.c_str(), O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC));
+    if (next.fd < 0) {
+      why = "'" + done + "' cannot be opened without following a link: " + errno_text(errno);
+      return Fd();
+    }
+    cur = std::move(next);
+  }
+  return cur;
+}
+
+// Publishes one staged output of the staging folder `stage_fd` (at `stage`, for messages) into the
+// output folder `out_fd` (at `out`); false when it was published already (a commit finished by
+// recovery). A folder that exists at the target is moved into stage/old first. Every folder on
+// the way is opened below `out_fd` or `stage_fd` without following a symbolic link, and the
+// renames are made relative to those open folders, so nothing outside either is ever moved.
+bool publish(int out_fd, const fs::path& out, int stage_fd, const fs::path& stage, const std::string& name,
+             bool is_folder) {
+  const auto [dir, leaf] = split_name(name);
+  const fs::path src = stage / "new" / name, dst = out / name;
+  std::string why;
+  const Fd from = open_below(stage_fd, "new/" + dir, why);
+  if (from.fd < 0) throw InputError(src.string(), "output", "staged output unusable: " + why);
+  struct stat st {};
+  if (::fstatat(from.fd, leaf.c_str(), &st, AT_SYMLINK_NOFOLLOW) != 0) return false;
+  const Fd to = open_below(out_fd, dir, why);
+  if (to.fd < 0) throw InputError(dst.string(), "output", "cannot publish below '" + out.string() + "': " + why);
+  if (is_folder && ::fstatat(to.fd, leaf.c_str(), &st, AT_SYMLINK_NOFOLLOW) == 0) {
+    ::mkdirat(stage_fd, "old", 0700);
+    const Fd old = open_below(stage_fd, "old", why);
+    if (old.fd < 0) throw InputError((stage / "old").string(), "output", why);
+    std::string aside;
+    for (int k = 0;; ++k) {
+      aside = std::to_string(k);
+      if (::fstatat(old.fd, aside.c_str(), &st, AT_SYMLINK_NOFOLLOW) != 0) break;
+    }
+    if (::renameat(to.fd, leaf.c_str(), old.fd, aside.c_str()) != 0) {
       throw InputError(dst.string(), "output", "cannot move the previous folder aside to replace it: " + errno_text(errno));
     }
   }
-  if (::rename(src.c_str(), dst.c_str()) != 0) {
+  if (::renameat(from.fd, leaf.c_str(), to.fd, leaf.c_str()) != 0) {
     throw InputError(dst.string(), "output", std::string("cannot rename the staged ") + (is_folder ? "folder" : "file") +
                                                  " into place: " + errno_text(errno));
   }
   return true;
+}
+
+// ".impactdeck-stage-PID-N", the only staging names a transaction makes.
+bool is_stage_name(const std::string& n) {
+  const std::string prefix = RunTransaction::kStagePrefix;
+  if (!starts_with(n, prefix)) return false;
+  const std::string rest = n.substr(prefix.size());
+  const auto dash = rest.find('-');
+  auto digits = [](const std::string& d, std::size_t max) {
+    return !d.empty() && d.size() <= max && d.find_first_not_of("0123456789") == std::string::npos;
+  };
+  return dash != std::string::npos && digits(rest.substr(0, dash), 10) && digits(rest.substr(dash + 1), 5);
 }
 
 struct Journal {
@@ -376,7 +471,7 @@ Journal read_journal(const fs::path& marker, bool& legacy, std::size_t& legacy_c
   Journal j;
   legacy = false;
   const int fd = ::open(marker.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC | O_NONBLOCK);
-  if (fd < 0) throw InputError(marker.string(), "journal", "cannot be read: " + errno_text(errno));
+  if (fd < 0) throw JournalRefused(marker, "cannot be read: " + errno_text(errno));
   std::string text(kMaxJournalBytes + 1, '\0');
   std::size_t got = 0;
   for (;;) {
@@ -386,7 +481,7 @@ Journal read_journal(const fs::path& marker, bool& legacy, std::size_t& legacy_c
     if (got == text.size()) break;
   }
   ::close(fd);
-  if (got > kMaxJournalBytes) throw InputError(marker.string(), "journal", "larger than 1 MiB: not a journal");
+  if (got > kMaxJournalBytes) throw JournalRefused(marker, "larger than 1 MiB");
   text.resize(got);
   std::istringstream in(text);
   std::string line;
@@ -398,16 +493,54 @@ Journal read_journal(const fs::path& marker, bool& legacy, std::size_t& legacy_c
     return j;
   }
   std::getline(in, j.stage);
-  if (!starts_with(j.stage, RunTransaction::kStagePrefix) || j.stage.find('/') != std::string::npos) {
-    throw InputError(marker.string(), "journal", "names no staging folder");
-  }
+  if (!is_stage_name(j.stage)) throw JournalRefused(marker, "names no staging folder ('" + printable(j.stage) + "')");
   while (std::getline(in, line)) {
     if (line.size() < 3 || (line[0] != 'F' && line[0] != 'D') || line[1] != ' ') {
-      throw InputError(marker.string(), "journal", "corrupt entry '" + printable(line) + "'");
+      throw JournalRefused(marker, "corrupt entry '" + printable(line) + "'");
     }
-    j.outputs.emplace_back(RunTransaction::check_name(line.substr(2), marker.string(), "journal"), line[0] == 'D');
+    std::string name;
+    try {
+      name = RunTransaction::check_name(line.substr(2), marker.string(), "journal");
+    } catch (const InputError& e) {
+      throw JournalRefused(marker, e.reason());
+    }
+    j.outputs.emplace_back(name, line[0] == 'D');
   }
   return j;
+}
+
+// Checks, before anything is moved, that every path the journal `j` names is safe to act on: the
+// staging folder is a real folder in `out` (the caller opened it without following a link), each
+// output a distinct name whose folders, in the output folder and in stage/new alike, are real
+// folders (no symbolic link in any component), and each staged output still there is a file or a
+// folder as the journal says. Throws JournalRefused.
+void check_journal(const fs::path& marker, const Journal& j, int out_fd, int stage_fd) {
+  std::string why;
+  if (open_below(stage_fd, "new", why).fd < 0) throw JournalRefused(marker, "staging folder '" + j.stage + "': " + why);
+  struct stat st {};
+  if (::fstatat(stage_fd, "old", &st, AT_SYMLINK_NOFOLLOW) == 0 && !S_ISDIR(st.st_mode)) {
+    throw JournalRefused(marker, "staging folder '" + j.stage + "': 'old' is " + kind_of(st) + ", not a real folder");
+  }
+  for (std::size_t i = 0; i < j.outputs.size(); ++i) {
+    const auto& [name, is_folder] = j.outputs[i];
+    for (std::size_t k = 0; k < i; ++k) {
+      const std::string& other = j.outputs[k].first;
+      if (other == name || starts_with(name, other + "/") || starts_with(other, name + "/")) {
+        throw JournalRefused(marker, "names the output '" + printable(name) + "' twice or inside '" + printable(other) + "'");
+      }
+    }
+    const auto [dir, leaf] = split_name(name);
+    const Fd from = open_below(stage_fd, "new/" + dir, why);
+    if (from.fd < 0) throw JournalRefused(marker, "output '" + printable(name) + "' in the staging folder: " + why);
+    if (::fstatat(from.fd, leaf.c_str(), &st, AT_SYMLINK_NOFOLLOW) == 0 &&
+        (is_folder ? !S_ISDIR(st.st_mode) : !S_ISREG(st.st_mode))) {
+      throw JournalRefused(marker, "staged output '" + printable(name) + "' is " + kind_of(st) + ", not " +
+                                       (is_folder ? "a real folder" : "a file"));
+    }
+    if (open_below(out_fd, dir, why).fd < 0) {
+      throw JournalRefused(marker, "output '" + printable(name) + "': " + why + " in the output folder");
+    }
+  }
 }
 
 }  // namespace
@@ -425,28 +558,30 @@ void RunTransaction::recover_locked() {
     } else {
       bool legacy = false;
       std::size_t legacy_count = 0;
-      Journal j;
-      try {
-        j = read_journal(marker, legacy, legacy_count);
-      } catch (const InputError& e) {
-        // Not written by impactdeck (or cut short on a full disk before any rename): drop it.
-        warnings_.push_back("removed '" + marker.string() + "': " + e.reason());
-        ::unlink(marker.c_str());
-        j.stage.clear();
-      }
-      if (j.stage.empty() && !legacy) {
-        // nothing to finish
-      } else if (legacy) {
+      // A journal that fails a check below is refused (JournalRefused, exit 3) before anything
+      // is touched: a planted journal must not move or remove anything, inside --out or out.
+      const Journal j = read_journal(marker, legacy, legacy_count);
+      if (legacy) {
         warnings_.push_back("a previous run was killed while replacing its " + std::to_string(legacy_count) +
                             " output files in '" + where + "' (marker of an older impactdeck): they may mix two runs "
                             "until they are written again; marker removed");
         ::unlink(marker.c_str());
       } else {
         const fs::path stage = out_ / j.stage;
-        LockedFolder lock(stage);
-        if (!lock.held_by_someone_else()) {
+        Fd stage_fd(::openat(out_fd_, j.stage.c_str(), O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC));
+        if (stage_fd.fd < 0 && errno == ENOENT) {
+          // Nothing is left to finish: every rename needs the staging folder.
+          warnings_.push_back("removed '" + marker.string() + "': its staging folder '" + j.stage + "' no longer exists");
+          ::unlink(marker.c_str());
+        } else if (stage_fd.fd < 0) {
+          throw JournalRefused(marker, "its staging folder '" + j.stage + "' is not a real folder in '" + where +
+                                           "' (" + errno_text(errno) + ")");
+        } else if (::flock(stage_fd.fd, LOCK_EX | LOCK_NB) == 0) {  // else: a live run's; left alone
+          check_journal(marker, j, out_fd_, stage_fd.fd);
           std::size_t finished = 0;
-          for (const auto& [name, folder] : j.outputs) finished += publish(out_, stage, name, folder) ? 1 : 0;
+          for (const auto& [name, folder] : j.outputs) {
+            finished += publish(out_fd_, out_, stage_fd.fd, stage, name, folder) ? 1 : 0;
+          }
           std::error_code ec;
           fs::remove_all(stage, ec);
           ::unlink(marker.c_str());
@@ -546,7 +681,7 @@ std::vector<fs::path> RunTransaction::commit() {
   done_ = true;
   try {
     for (const Output& o : outputs_) {
-      publish(out_, stage_, o.name, o.is_folder);
+      publish(out_fd_, out_, stage_fd_, stage_, o.name, o.is_folder);
       published.push_back(out_ / o.name);
       if (const int ms = commit_delay_ms(); ms > 0) std::this_thread::sleep_for(std::chrono::milliseconds(ms));
     }

@@ -284,6 +284,8 @@ int solver_threads(const CheckOptions& o) {
 // First "*ERROR" line and last non-empty line of a ccx log; "No space left on device" anywhere
 // in it is reported in first_error's place when there is no *ERROR line.
 void scan_log(const fs::path& log, std::string& first_error, std::string& last_line) {
+  std::error_code ec;
+  if (!fs::is_regular_file(log, ec)) return;  // a FIFO would block
   std::ifstream in(log);
   std::string no_space;
   for (std::string l; std::getline(in, l);) {
@@ -308,6 +310,8 @@ struct StaLine {
   std::string text;
 };
 std::optional<StaLine> last_sta_line(const fs::path& sta) {
+  std::error_code ec;
+  if (!fs::is_regular_file(sta, ec)) return std::nullopt;  // a FIFO would block
   std::ifstream in(sta);
   std::string l, tail;
   while (std::getline(in, l))

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <limits>
 #include <functional>
 #include <map>
 #include <iomanip>
@@ -13,6 +14,7 @@
 #include "impactdeck/common/atomic_file.hpp"
 #include "impactdeck/common/csv_sidecar.hpp"
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/common/input_file.hpp"
 #include "impactdeck/fem_export/decks.hpp"
 #include "impactdeck/plot/stress_plot.hpp"
 #include "impactdeck/common/json_number.hpp"
@@ -115,6 +117,7 @@ const char* to_string(VerdictKind k) {
 
 StressResult read_stresses(const fs::path& frd, const TetMesh& mesh, const StressInputs& in) {
   const std::string where = frd.string();
+  check_input_file(frd, "CalculiX results (.frd)", std::numeric_limits<std::uintmax_t>::max());  // not a FIFO
   std::ifstream f(frd, std::ios::binary);
   if (!f) throw InputError(where, "file", "CalculiX results (.frd) cannot be opened (missing or unreadable)");
   const std::size_t n = mesh.nodes_m.size();
@@ -237,6 +240,7 @@ StressResult read_stresses(const fs::path& frd, const TetMesh& mesh, const Stres
 
 std::vector<double> read_node_stresses(const fs::path& frd, std::vector<ProbeStress>& probes, double end_time_s) {
   const std::string where = frd.string();
+  check_input_file(frd, "CalculiX results (.frd)", std::numeric_limits<std::uintmax_t>::max());  // not a FIFO
   std::ifstream f(frd, std::ios::binary);
   if (!f) throw InputError(where, "file", "CalculiX results (.frd) cannot be opened (missing or unreadable)");
   std::map<long, std::size_t> wanted;  // ccx node id -> probe

@@ -6,6 +6,7 @@
 #include <set>
 #include <sstream>
 
+#include "impactdeck/common/input_file.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/geometry/cad_shape.hpp"
 
@@ -30,11 +31,8 @@ CadFileUnit make_unit(const std::string& name, double metres) {
 }
 
 std::string read_all(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(file.string(), "file", "cannot be opened (missing or unreadable)");
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
+  // A regular file only (a FIFO would block), read within a quarter of the free memory.
+  return read_input_file(file, "CAD file", available_memory_bytes() / 4, "a quarter of the free memory");
 }
 
 // STEP: every entity holding LENGTH_UNIT, as SI_UNIT(prefix, .METRE.) or CONVERSION_BASED_UNIT.

@@ -1,5 +1,9 @@
 #include "impactdeck/geometry/mesh_io.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -49,7 +53,14 @@ LoadedMesh load_mesh(const fs::path& file, LengthUnit unit) {
     // binary STL is read directly (float32 records, no assimp, no per-triangle allocation); an
     // ASCII one by the own reader. A read that comes up short goes to the general route below,
     // which says why.
-    std::unique_ptr<std::FILE, FileCloser> f(std::fopen(file.c_str(), "rb"));
+    // Opened without blocking and checked on the descriptor: a FIFO swapped in after
+    // check_part_file cannot hang the run (the general route below says why it is refused).
+    std::unique_ptr<std::FILE, FileCloser> f;
+    if (const int fd = ::open(file.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC); fd >= 0) {
+      struct stat st {};
+      if (::fstat(fd, &st) == 0 && S_ISREG(st.st_mode)) f.reset(::fdopen(fd, "rb"));
+      if (!f) ::close(fd);
+    }
     std::string head(static_cast<std::size_t>(std::min<std::uintmax_t>(84, bytes)), '\0');
     if (f && std::fread(head.data(), 1, head.size(), f.get()) == head.size()) {
       if (!detail::is_ascii_stl(head, bytes)) {

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <exception>
 #include <limits>
+#include <map>
 #include <numeric>
 #include <sstream>
 #include <thread>
@@ -109,6 +110,292 @@ bool triangles_intersect(const TriangleMesh& m, int a, int b) {
   return CGAL::do_intersect(K::Triangle_3(pa[0], pa[1], pa[2]), K::Triangle_3(pb[0], pb[1], pb[2]));
 }
 
+// ---------------------------------------------------------------------------------------------
+// Stars of high-degree vertices (issue 29). The triangles around a vertex of high degree — a
+// polygon face of k corners read as a fan has one vertex in k - 2 triangles — all contain that
+// vertex, so their boxes all overlap, and long thin fan triangles' boxes nest: the box test alone
+// reported Theta(k^2) pairs (20 000 corners: over 100 s). Those triangles are taken out of the box
+// pass and their pairs found by angle instead, around the vertex v, in the coordinate plane that
+// drops the axis of the star's largest normal component (dropping a coordinate is exact).
+// A star triangle whose projection is a proper triangle (a "wedge": apex c = proj(v), corners P, Q)
+// is injective under the projection, so a point x != v it shares with any triangle t projects to a
+// point != c whose direction from c lies in the wedge's closed angular interval and in the closed
+// angular extent of proj(t) (or proj(t) contains c, and then t is tested against every wedge).
+// Directions are compared by exact orientation predicates and ranked, so the intervals are integer
+// intervals on a circle; overlapping ones are found by a sweep in O(n log n + pairs). Every pair
+// found is still decided by triangles_intersect, so the count is the box pass's, pair for pair.
+constexpr std::size_t kStarDegree = 64;  // stars this large are handled by angle
+
+using Point2 = K::Point_2;
+
+struct StarInterval {
+  int lo = 0, hi = 0;  // closed, in direction ranks
+  int face = 0;
+  bool wedge = false;  // a star triangle (else another triangle tested against the wedges)
+};
+
+struct Box3 {
+  double lo[3], hi[3];
+};
+
+Box3 face_box(const TriangleMesh& m, int f) {
+  Box3 b;
+  const auto& t = m.triangles[f];
+  for (int d = 0; d < 3; ++d) {
+    const double x = m.vertices_m[t[0]][d], y = m.vertices_m[t[1]][d], z = m.vertices_m[t[2]][d];
+    b.lo[d] = std::min({x, y, z});
+    b.hi[d] = std::max({x, y, z});
+  }
+  return b;
+}
+
+bool boxes_meet(const Box3& a, const Box3& b) {
+  for (int d = 0; d < 3; ++d)
+    if (a.hi[d] < b.lo[d] || b.hi[d] < a.lo[d]) return false;
+  return true;
+}
+
+// The wedge intervals of a star sorted by start, as a balanced tree whose nodes hold the largest
+// end and the box of their triangles: query(a, b, box) reports each wedge whose interval meets
+// [a, b] and whose box meets `box`, descending only into nodes that can hold one.
+class WedgeTree {
+ public:
+  WedgeTree(const TriangleMesh& m, const std::vector<StarInterval>& spans) : m_(m), s_(spans) {
+    if (s_.empty()) return;
+    max_hi_.resize(4 * s_.size());
+    box_.resize(4 * s_.size());
+    build(1, 0, s_.size());
+  }
+  template <class F>
+  void query(int a, int b, const Box3& q, F&& report) const {
+    if (!s_.empty()) query(1, 0, s_.size(), a, b, q, report);
+  }
+
+ private:
+  void build(std::size_t node, std::size_t l, std::size_t r) {
+    if (r - l == 1) {
+      max_hi_[node] = s_[l].hi;
+      box_[node] = face_box(m_, s_[l].face);
+      return;
+    }
+    const std::size_t mid = (l + r) / 2;
+    build(2 * node, l, mid);
+    build(2 * node + 1, mid, r);
+    max_hi_[node] = std::max(max_hi_[2 * node], max_hi_[2 * node + 1]);
+    for (int d = 0; d < 3; ++d) {
+      box_[node].lo[d] = std::min(box_[2 * node].lo[d], box_[2 * node + 1].lo[d]);
+      box_[node].hi[d] = std::max(box_[2 * node].hi[d], box_[2 * node + 1].hi[d]);
+    }
+  }
+  template <class F>
+  void query(std::size_t node, std::size_t l, std::size_t r, int a, int b, const Box3& q, F& report) const {
+    if (s_[l].lo > b || max_hi_[node] < a || !boxes_meet(box_[node], q)) return;  // s_[l]: the node's first start
+    if (r - l == 1) {
+      report(s_[l].face);
+      return;
+    }
+    const std::size_t mid = (l + r) / 2;
+    query(2 * node, l, mid, a, b, q, report);
+    query(2 * node + 1, mid, r, a, b, q, report);
+  }
+  const TriangleMesh& m_;
+  const std::vector<StarInterval>& s_;
+  std::vector<int> max_hi_;
+  std::vector<Box3> box_;
+};
+
+// Candidate pairs (a, b), a < b, of the star of `v` (its regular triangles `wedges`) with each
+// other and with the triangles `others` (never two of `others`). `axis` is the dropped coordinate.
+void star_candidates(const TriangleMesh& m, int v, int axis, const std::vector<int>& wedges,
+                     const std::vector<int>& others, std::vector<std::pair<int, int>>& pairs) {
+  const int ax = (axis + 1) % 3, ay = (axis + 2) % 3;
+  auto proj = [&](int vertex) {
+    const Eigen::Vector3d& p = m.vertices_m[vertex];
+    return Point2(p[ax], p[ay]);
+  };
+  const Point2 c = proj(v);
+  // Upper half (angle in [0, pi)) first, then counter-clockwise within a half.
+  auto half = [&](const Point2& p) { return (p.y() > c.y() || (p.y() == c.y() && p.x() > c.x())) ? 0 : 1; };
+  auto before = [&](const Point2& p, const Point2& q) {
+    const int hp = half(p), hq = half(q);
+    if (hp != hq) return hp < hq;
+    return CGAL::orientation(c, p, q) == CGAL::LEFT_TURN;
+  };
+  std::vector<Point2> dirs;
+  std::vector<StarInterval> items;
+  std::vector<int> full;  // others whose projection contains c: tested against every wedge
+  // Endpoints as indices into dirs (ranked below); an interval runs counter-clockwise lo -> hi.
+  std::vector<std::pair<int, int>> ends;
+  for (const int f : wedges) {
+    const auto& t = m.triangles[f];
+    int k = 0;
+    while (t[k] != v) ++k;
+    Point2 p = proj(t[(k + 1) % 3]), q = proj(t[(k + 2) % 3]);
+    if (CGAL::orientation(c, p, q) == CGAL::RIGHT_TURN) std::swap(p, q);
+    ends.emplace_back(int(dirs.size()), int(dirs.size()) + 1);
+    dirs.push_back(p);
+    dirs.push_back(q);
+    items.push_back({0, 0, f, true});
+  }
+  for (const int f : others) {
+    const auto& t = m.triangles[f];
+    const Point2 a[3] = {proj(t[0]), proj(t[1]), proj(t[2])};
+    bool contains = a[0] == c || a[1] == c || a[2] == c;
+    const CGAL::Orientation o = CGAL::orientation(a[0], a[1], a[2]);
+    if (!contains && o != CGAL::COLLINEAR) {
+      const CGAL::Orientation e0 = CGAL::orientation(a[0], a[1], c), e1 = CGAL::orientation(a[1], a[2], c),
+                              e2 = CGAL::orientation(a[2], a[0], c);
+      contains = e0 != CGAL::opposite(o) && e1 != CGAL::opposite(o) && e2 != CGAL::opposite(o);  // inside or on the boundary
+    }
+    for (int i = 0; i < 3 && !contains; ++i)
+      for (int j = i + 1; j < 3 && !contains; ++j)
+        contains = a[i] != a[j] && CGAL::collinear(a[i], c, a[j]) && CGAL::collinear_are_ordered_along_line(a[i], c, a[j]);
+    int lo = -1, hi = -1;
+    if (!contains) {
+      // c outside the projection: its extent runs from the corner every other is counter-clockwise
+      // of (or on the same ray) to the one every other is clockwise of.
+      for (int i = 0; i < 3; ++i) {
+        bool first = true, last = true;
+        for (int j = 0; j < 3; ++j) {
+          const CGAL::Orientation oj = CGAL::orientation(c, a[i], a[j]);
+          first = first && oj != CGAL::RIGHT_TURN;
+          last = last && oj != CGAL::LEFT_TURN;
+        }
+        if (first && lo < 0) lo = i;
+        if (last && hi < 0) hi = i;
+      }
+    }
+    if (lo < 0 || hi < 0) {
+      full.push_back(f);
+      continue;
+    }
+    ends.emplace_back(int(dirs.size()), int(dirs.size()) + 1);
+    dirs.push_back(a[lo]);
+    dirs.push_back(a[hi]);
+    items.push_back({0, 0, f, false});
+  }
+  // Ranks: equal directions (same half, collinear with c) share one.
+  std::vector<int> order(dirs.size()), rank(dirs.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](int x, int y) { return before(dirs[x], dirs[y]); });
+  int r = -1;
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    if (i == 0 || before(dirs[order[i - 1]], dirs[order[i]])) ++r;
+    rank[order[i]] = r;
+  }
+  const int circle = r + 1;
+  // Intervals passing the reference direction are split in two.
+  std::vector<StarInterval> spans;
+  spans.reserve(items.size() + 16);
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    StarInterval it = items[i];
+    const int lo = rank[ends[i].first], hi = rank[ends[i].second];
+    if (lo <= hi) {
+      it.lo = lo;
+      it.hi = hi;
+      spans.push_back(it);
+    } else {
+      it.lo = lo;
+      it.hi = circle - 1;
+      spans.push_back(it);
+      it.lo = 0;
+      it.hi = hi;
+      spans.push_back(it);
+    }
+  }
+  std::sort(spans.begin(), spans.end(), [](const StarInterval& x, const StarInterval& y) { return x.lo < y.lo; });
+  auto add = [&](int a, int b) { pairs.emplace_back(std::min(a, b), std::max(a, b)); };
+  std::vector<StarInterval> wedge_spans;
+  for (const StarInterval& it : spans)
+    if (it.wedge) wedge_spans.push_back(it);
+  // Wedges with each other: a sweep by start; a wedge meets every active one (end >= its start).
+  std::multimap<int, int> active;  // end -> face
+  for (const StarInterval& it : wedge_spans) {
+    while (!active.empty() && active.begin()->first < it.lo) active.erase(active.begin());
+    for (const auto& [end, face] : active)
+      if (face != it.face) add(it.face, face);
+    active.emplace(it.hi, it.face);
+  }
+  // Others with the wedges: through a tree whose nodes also hold their triangles' box, so that
+  // triangles overlapping in projection only (two parallel fans) are not paired.
+  const WedgeTree tree(m, wedge_spans);
+  for (const StarInterval& it : spans)
+    if (!it.wedge) tree.query(it.lo, it.hi, face_box(m, it.face), [&](int w) { add(it.face, w); });
+  for (const int f : full) tree.query(0, circle - 1, face_box(m, f), [&](int w) { add(f, w); });
+}
+
+// Splits the faces into the stars of vertices of degree >= kStarDegree (each face to its vertex
+// of highest degree; only faces with a proper projection) and the rest (`boxed`, the box pass's),
+// and returns the candidate pairs the stars give: each pair involving a star face exactly once.
+std::vector<std::pair<int, int>> star_pairs(const TriangleMesh& m, std::vector<int>& boxed) {
+  const std::size_t nf = m.triangles.size();
+  std::vector<std::uint32_t> degree(m.vertices_m.size(), 0);
+  for (const auto& t : m.triangles)
+    for (int k = 0; k < 3; ++k) ++degree[t[k]];
+  std::vector<int> star_of(nf, -1);  // the vertex whose star holds the face
+  std::map<int, std::vector<int>> stars;
+  for (std::size_t f = 0; f < nf; ++f) {
+    const auto& t = m.triangles[f];
+    int best = -1;
+    for (int k = 0; k < 3; ++k)
+      if (degree[t[k]] >= kStarDegree && (best < 0 || degree[t[k]] > degree[best] || (degree[t[k]] == degree[best] && t[k] < best)))
+        best = t[k];
+    if (best >= 0) stars[best].push_back(int(f));
+  }
+  std::vector<std::pair<int, int>> pairs;
+  std::vector<int> order;  // stars in vertex order; a star pairs with the faces of later stars
+  std::map<int, int> axis_of;
+  for (auto& [v, faces] : stars) {
+    // The dropped axis: the largest component of the summed (area-weighted) normals.
+    Eigen::Vector3d n = Eigen::Vector3d::Zero();
+    for (const int f : faces) {
+      const auto& t = m.triangles[f];
+      n += (m.vertices_m[t[1]] - m.vertices_m[t[0]]).cross(m.vertices_m[t[2]] - m.vertices_m[t[0]]);
+    }
+    int axis = 0;
+    n.cwiseAbs().maxCoeff(&axis);
+    const int ax = (axis + 1) % 3, ay = (axis + 2) % 3;
+    std::vector<int> regular;
+    for (const int f : faces) {
+      const auto& t = m.triangles[f];
+      auto p = [&](int k) { return Point2(m.vertices_m[t[k]][ax], m.vertices_m[t[k]][ay]); };
+      if (CGAL::orientation(p(0), p(1), p(2)) != CGAL::COLLINEAR) {
+        regular.push_back(f);
+        star_of[f] = v;
+      }
+    }
+    faces = std::move(regular);
+    axis_of[v] = axis;
+  }
+  for (std::size_t f = 0; f < nf; ++f)
+    if (star_of[f] < 0) boxed.push_back(int(f));
+  for (const auto& [v, faces] : stars) {
+    if (faces.empty()) continue;
+    // Others: boxed faces and faces of later stars whose box meets this star's box.
+    Eigen::Vector3d lo = m.vertices_m[v], hi = m.vertices_m[v];
+    for (const int f : faces)
+      for (int k = 0; k < 3; ++k) {
+        lo = lo.cwiseMin(m.vertices_m[m.triangles[f][k]]);
+        hi = hi.cwiseMax(m.vertices_m[m.triangles[f][k]]);
+      }
+    std::vector<int> others;
+    for (std::size_t f = 0; f < nf; ++f) {
+      if (star_of[f] >= 0 && star_of[f] <= v) continue;  // this star's, or an earlier star's (paired there)
+      const auto& t = m.triangles[f];
+      bool meets = true;
+      for (int d = 0; d < 3 && meets; ++d) {
+        const double a = m.vertices_m[t[0]][d], b = m.vertices_m[t[1]][d], e = m.vertices_m[t[2]][d];
+        meets = std::max({a, b, e}) >= lo[d] && std::min({a, b, e}) <= hi[d];
+      }
+      if (meets) others.push_back(int(f));
+    }
+    star_candidates(m, v, axis_of[v], faces, others, pairs);
+  }
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  return pairs;
+}
+
 // Box bounds: a float box is rounded outward so that it contains the double triangle.
 template <class NT>
 NT round_down(double x);
@@ -138,21 +425,26 @@ float round_up<float>(double x) {
 template <class NT>
 std::size_t count_self_intersections_direct(const TriangleMesh& m, unsigned threads) {
   using Box = CGAL::Box_intersection_d::Box_d<NT, 3, CGAL::Box_intersection_d::ID_FROM_BOX_ADDRESS>;
-  const std::size_t nf = m.triangles.size();
+  // The stars of high-degree vertices first (by angle); the other faces go through the boxes.
+  std::vector<int> face_of;
+  std::size_t star_count = 0;
+  for (const auto& [a, b] : star_pairs(m, face_of)) star_count += triangles_intersect(m, a, b) ? 1 : 0;
+  const std::size_t nf = face_of.size();
   std::vector<Box> boxes(nf);
-  for (std::size_t f = 0; f < nf; ++f) {
+  for (std::size_t i = 0; i < nf; ++i) {
     NT lo[3], hi[3];
-    const auto& t = m.triangles[f];
+    const auto& t = m.triangles[face_of[i]];
     for (int d = 0; d < 3; ++d) {
       const double a = m.vertices_m[t[0]][d], b = m.vertices_m[t[1]][d], c = m.vertices_m[t[2]][d];
       lo[d] = round_down<NT>(std::min({a, b, c}));
       hi[d] = round_up<NT>(std::max({a, b, c}));
     }
-    boxes[f] = Box(lo, hi);
+    boxes[i] = Box(lo, hi);
   }
   std::vector<const Box*> ptr(nf);
   for (std::size_t f = 0; f < nf; ++f) ptr[f] = &boxes[f];
   const Box* base = boxes.data();
+  auto face = [&](const Box* b) { return face_of[std::size_t(b - base)]; };
   constexpr std::ptrdiff_t kCutoff = 2000;  // as PMP::self_intersections
 
   const std::size_t slabs = std::max<std::size_t>(1, std::min<std::size_t>(threads, nf / 20000));
@@ -177,7 +469,7 @@ std::size_t count_self_intersections_direct(const TriangleMesh& m, unsigned thre
       std::size_t count = 0;
       CGAL::box_self_intersection_d(ptr.begin() + cut[s], ptr.begin() + cut[s + 1],
                                     [&](const Box* x, const Box* y) {
-                                      if (triangles_intersect(m, int(x - base), int(y - base))) ++count;
+                                      if (triangles_intersect(m, face(x), face(y))) ++count;
                                     },
                                     kCutoff);
       counts[s] = count;
@@ -193,7 +485,7 @@ std::size_t count_self_intersections_direct(const TriangleMesh& m, unsigned thre
   }
   for (auto& e : errors)
     if (e) std::rethrow_exception(e);
-  std::size_t total = 0;
+  std::size_t total = star_count;
   for (std::size_t c : counts) total += c;
   // Pairs across slabs i < j: only boxes of slab i reaching past slab j's lowest x, and boxes of
   // slab j reaching below slab i's highest x, can meet.
@@ -208,7 +500,7 @@ std::size_t count_self_intersections_direct(const TriangleMesh& m, unsigned thre
       for (std::size_t k = cut[j]; k < cut[j + 1]; ++k)
         if (ptr[k]->min_coord(0) <= i_hi) right.push_back(ptr[k]);
       CGAL::box_intersection_d(left.begin(), left.end(), right.begin(), right.end(),
-                               [&](const Box* x, const Box* y) { total += triangles_intersect(m, int(x - base), int(y - base)); },
+                               [&](const Box* x, const Box* y) { total += triangles_intersect(m, face(x), face(y)); },
                                kCutoff);
     }
   return total;

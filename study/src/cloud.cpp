@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/common/input_file.hpp"
 #include "impactdeck/geometry/mesh_shape.hpp"
 
 namespace impactdeck::study {
@@ -108,8 +109,8 @@ namespace impactdeck::study {
 std::vector<geometry::SurfacePoint> csv_point_cloud(const geometry::Shape& target, const std::filesystem::path& csv,
                                                     double metres_per_unit, double max_distance_m,
                                                     std::size_t max_points) {
-  std::ifstream in(csv);
-  if (!in) throw InputError(csv.string(), "file", "cannot be opened (missing or unreadable)");
+  // A regular file of bounded size (a FIFO would block the sweep forever).
+  std::istringstream in(read_input_file(csv, "points file", kMaxPointsFileBytes));
   std::vector<geometry::SurfacePoint> out;
   std::string line;
   std::size_t n = 0;

@@ -32,7 +32,8 @@ void write_rows(std::ostream& o, std::size_t rows, const RowsText& text, const R
   };
   auto put = [&](const std::string& s) {
     o.write(s.data(), static_cast<std::streamsize>(s.size()));
-    if (!o) throw Error(ExitCode::internal_error, "write failed");  // the file writer names the file
+    // write_file_atomically turns this into the file's own "write failed: REASON" (exit 3).
+    if (!o) throw Error(ExitCode::internal_error, "write failed");
   };
 
   if (workers <= 1) {

@@ -5,6 +5,7 @@
 //   {"file": "force.csv", "impactdeck_version": "...", "columns": [{"name": "time_s", "unit": "s"}, ...],
 //    "metadata": {"scene": "...", ...}}
 // (docs/cli.md, "CSV files").
+#include <cstddef>
 #include <filesystem>
 #include <string>
 #include <string_view>
@@ -13,7 +14,14 @@
 
 namespace impactdeck {
 
-/// `csv` with ".json" appended: force.csv -> force.csv.json.
+/// A file name's limit (NAME_MAX of Linux file systems).
+inline constexpr std::size_t kMaxFileNameBytes = 255;
+
+/// `csv` with ".json" appended: force.csv -> force.csv.json. When that last component would pass
+/// kMaxFileNameBytes (a CSV name of 251 to 255 bytes), the sidecar is the name's first bytes (cut
+/// at a UTF-8 character boundary), '~', the FNV-1a 64-bit hash of the whole CSV name in 16 hex
+/// digits and ".json": 255 bytes at most, one per CSV name. Reserve and write the sidecar under
+/// this name only (its JSON's "file" names the CSV).
 std::filesystem::path csv_sidecar_path(const std::filesystem::path& csv);
 
 /// The unit a column name declares by its suffix (the naming rule of docs/STYLE.md): x_m -> "m",

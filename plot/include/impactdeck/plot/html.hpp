@@ -8,7 +8,9 @@
 
 namespace impactdeck::plot {
 
-/// Text as HTML character data or attribute value: & < > " ' escaped.
+/// Text as HTML character data or attribute value (also XML, for SVG): & < > " ' escaped, NUL as
+/// U+FFFD, other control characters but tab, newline and carriage return as their visible symbols
+/// (U+2401..U+241F, DEL as U+2421), which XML 1.0 and HTML allow.
 std::string html_escape(std::string_view text);
 
 /// RFC 4648 base64 of `bytes` (for data: URIs).

@@ -45,7 +45,10 @@ std::vector<geometry::SurfacePoint> projected_grid_cloud(const geometry::Shape& 
                                                          const InputContext& context = {});
 const char* to_string(CloudKind k);
 
-/// Points read from a CSV file (three numbers x, y, z per line in `metres_per_unit` metres, the
+/// Size limit of a points file: 1 000 000 points (the default --max-points) take about 50 MB.
+inline constexpr std::uintmax_t kMaxPointsFileBytes = std::uintmax_t{256} << 20;
+
+/// Points read from a CSV file (a regular file of at most kMaxPointsFileBytes; three numbers x, y, z per line in `metres_per_unit` metres, the
 /// target's own frame; lines starting with '#' and a first line that is not numeric are skipped),
 /// each moved to the closest point of the target exactly as `impactdeck run` projects an impact
 /// point. Throws InputError naming the file and line for an unreadable file, a malformed line, more

@@ -1,0 +1,70 @@
+#!/usr/bin/env bash
+# Failures found after the work is done must not leave a half-published run (issue 29):
+#  - a stdout that cannot be written (/dev/full, closed) is refused before the run, exit 3 naming
+#    stdout, and the output folder stays as it was;
+#  - `sweep` onto a full file system (a tmpfs of 256 KiB, mounted in a private mount namespace
+#    when the test may mount) exits 3 naming the file that could not be written, and leaves the
+#    folder as it was.
+# usage: output_failure_test.sh IMPACTDECK SOURCE_DIR
+set -u
+bin=$1; src=$2
+. "$src/tests/check_lib.sh"
+scene=$src/samples/two_spheres.toml
+sweep_scene=$src/samples/fig4_sweep.toml
+
+# A folder with an earlier run's file in it: it must come back byte for byte.
+out=$tmp/out
+mkdir -p "$out"
+echo "earlier run" >"$out/force_two_spheres.csv"
+before=$(cd "$out" && ls -A && cat force_two_spheres.csv)
+unchanged() { [ "$(cd "$out" && ls -A && cat force_two_spheres.csv)" = "$before" ]; }
+
+"$bin" run "$scene" --out "$out" --json >/dev/full 2>"$tmp/err"; rc=$?
+check "run --json > /dev/full: exit 3" [ "$rc" = 3 ]
+check "run --json > /dev/full: one line naming stdout" \
+  grep -qx "impactdeck: error: stdout: write failed: No space left on device (checked before the run: nothing was computed or written)" "$tmp/err"
+check "run --json > /dev/full: the output folder as before" unchanged
+
+"$bin" run "$scene" --out "$out" >&- 2>"$tmp/err"; rc=$?
+check "run with stdout closed: exit 3" [ "$rc" = 3 ]
+check "run with stdout closed: names stdout" grep -q "^impactdeck: error: stdout: write failed: Bad file descriptor" "$tmp/err"
+check "run with stdout closed: the output folder as before" unchanged
+
+"$bin" run "$scene" --out "$out" 1</dev/null 2>"$tmp/err"; rc=$?
+check "run with a read-only stdout: exit 3" [ "$rc" = 3 ]
+check "run with a read-only stdout: the output folder as before" unchanged
+
+"$bin" sweep "$sweep_scene" --out "$out" --json --quiet >/dev/full 2>"$tmp/err"; rc=$?
+check "sweep > /dev/full: exit 3" [ "$rc" = 3 ]
+check "sweep > /dev/full: the output folder as before" unchanged
+
+# The same commands with a usable stdout publish (the checks above are not refusing everything).
+"$bin" run "$scene" --out "$out" --json >"$tmp/doc.json" 2>"$tmp/err"; rc=$?
+check "run: exit 0" [ "$rc" = 0 ]
+check "run: the file replaced" [ "$(head -c 4 "$out/force_two_spheres.csv")" = "time" ]
+
+# sweep onto a full disk.
+full=$tmp/full
+mkdir -p "$full"
+if unshare -m true 2>/dev/null; then
+  unshare -m bash -c '
+    mount -t tmpfs -o size=256k tmpfs "$1" || exit 77
+    head -c 200000 /dev/zero >"$1/filler"
+    "$2" sweep "$3" --out "$1" --quiet --grid-steps 40 --formats csv,vtp,pos >"$4/sweep.out" 2>"$4/sweep.err"
+    echo $? >"$4/sweep.rc"
+    ls -A "$1" >"$4/sweep.ls"
+  ' _ "$full" "$bin" "$sweep_scene" "$tmp"
+  if [ "$?" = 77 ]; then
+    echo "output_failure_test: cannot mount a tmpfs here: the full-disk sweep case was not run"
+  else
+    check "sweep on a full disk: exit 3" [ "$(cat "$tmp/sweep.rc")" = 3 ]
+    check "sweep on a full disk: one line" [ "$(wc -l <"$tmp/sweep.err")" = 1 ]
+    check "sweep on a full disk: names the file and the reason" \
+      grep -Eq "^impactdeck: error: $full/[^:]+: .*No space left on device" "$tmp/sweep.err"
+    check "sweep on a full disk: nothing left but the filler" [ "$(cat "$tmp/sweep.ls")" = filler ]
+    cat "$tmp/sweep.err"
+  fi
+else
+  echo "output_failure_test: no mount namespace here: the full-disk sweep case was not run"
+fi
+finish output_failure_test
