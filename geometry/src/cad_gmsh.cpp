@@ -201,6 +201,7 @@ struct TriangulationResult {
   std::vector<std::size_t> node_tags;
   std::vector<double> xyz;
   std::map<int, std::vector<std::size_t>> face_nodes;
+  double deviation_bound = 0;  ///< from the B-rep, model units (0: unknown, Gmsh's)
 };
 
 // In the child process: Gmsh's 2D mesh of the current model (edges up to size_max, refined by
@@ -298,6 +299,9 @@ TriangulationResult occ_fallback(const fs::path& file, CadFormat format, double 
     }
   }
   TriangulationResult t;
+  // BRepMesh keeps its facets within the chordal deflection of the faces (twice that, for its
+  // approximate enforcement): the search's candidate margin.
+  t.deviation_bound = 2 * kOccDeflectionRelative * size;
   for (std::size_t n = 0; n < o.nodes.size(); ++n) {
     t.node_tags.push_back(n + 1);
     for (int k = 0; k < 3; ++k) t.xyz.push_back(o.nodes[n][k]);
@@ -402,6 +406,7 @@ CadLoaded load_model(const fs::path& file, CadFormat format, double unit_m, doub
 
   // Triangulation: Gmsh's 2D mesh of the faces, in a child process (triangulate_in_child).
   const TriangulationResult tri = triangulate(file, format, size, mesh_size_relative * size, deadline_s, out.warnings);
+  out.triangulation_deviation_m = tri.deviation_bound * unit_m;
   gmsh_step(file, "triangulation", [&] {
     std::map<std::size_t, int> index;
     for (std::size_t i = 0; i < tri.node_tags.size(); ++i) {

@@ -31,6 +31,9 @@ struct CadLoaded {
   std::vector<Eigen::Vector3d> nodes_m;
   std::vector<std::array<int, 3>> triangles;
   std::vector<int> triangle_face;  ///< face tag of each triangle
+  /// A bound on the triangles' distance from the B-rep when known (OpenCASCADE's triangulation:
+  /// twice its chordal deflection); 0 for Gmsh's (the search then pads by half the longest edge).
+  double triangulation_deviation_m = 0;
   struct Edge {
     int tag = 0;
     std::vector<int> faces;          ///< adjacent faces

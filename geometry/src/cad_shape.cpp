@@ -255,7 +255,9 @@ std::shared_ptr<const CadShape> CadShape::load(const fs::path& file, LengthUnit 
   mo.sharp_angle_deg = o.sharp_angle_deg;
   impl->tess = std::make_unique<MeshShape>(std::move(mesh), mass, mo);
   impl->size = impl->tess->size_m();
-  impl->margin = 0.5 * longest + 1e-9 * impl->size;
+  // The search's candidate margin: the triangulation's known deviation from the B-rep
+  // (OpenCASCADE's fallback, whose flat faces have long triangles), else half its longest edge.
+  impl->margin = (L.triangulation_deviation_m > 0 ? L.triangulation_deviation_m : 0.5 * longest) + 1e-9 * impl->size;
 
   int max_tag = 0;
   for (int f : L.faces) max_tag = std::max(max_tag, f);
