@@ -101,8 +101,17 @@ class CoutCapture {
     std::istringstream in(text_.str());
     std::string line, all;
     while (std::getline(in, line)) {
-      if (line.empty()) continue;
-      all += (all.empty() ? "" : "; ") + line;
+      // Colour escapes (ESC [ ... m) dropped; the IGES reader's entity count is not a complaint.
+      std::string plain;
+      for (std::size_t i = 0; i < line.size(); ++i) {
+        if (line[i] == '\x1b' && i + 1 < line.size() && line[i + 1] == '[') {
+          while (i < line.size() && line[i] != 'm') ++i;
+          continue;
+        }
+        plain += line[i];
+      }
+      if (plain.empty() || plain.rfind("Total number of loaded entities", 0) == 0) continue;
+      all += (all.empty() ? "" : "; ") + plain;
     }
     return all;
   }
