@@ -68,6 +68,23 @@ if(NOT TARGET impactdeck_gmsh)
   target_link_libraries(impactdeck_gmsh INTERFACE ${IMPACTDECK_GMSH_LIBRARY})
 endif()
 
+# OpenCASCADE (Debian libocct-data-exchange-dev, libocct-modeling-algorithms-dev): the CAD plugin
+# uses its readers and its adaptive mass properties directly (geometry/src/cad_occ.cpp); the same
+# shared libraries Gmsh is built on.
+find_path(IMPACTDECK_OCCT_INCLUDE BRepGProp.hxx PATH_SUFFIXES opencascade)
+impactdeck_require(IMPACTDECK_OCCT_INCLUDE "the OpenCASCADE headers" libocct-modeling-algorithms-dev)
+set(IMPACTDECK_OCCT_LIBRARIES)
+foreach(lib TKSTEP TKIGES TKXSBase TKTopAlgo TKGeomBase TKBRep TKG3d TKMath TKernel)
+  find_library(IMPACTDECK_OCCT_${lib} ${lib})
+  impactdeck_require(IMPACTDECK_OCCT_${lib} "the OpenCASCADE library ${lib}" libocct-data-exchange-dev)
+  list(APPEND IMPACTDECK_OCCT_LIBRARIES ${IMPACTDECK_OCCT_${lib}})
+endforeach()
+if(NOT TARGET impactdeck_occt)
+  add_library(impactdeck_occt INTERFACE)
+  target_include_directories(impactdeck_occt SYSTEM INTERFACE ${IMPACTDECK_OCCT_INCLUDE})
+  target_link_libraries(impactdeck_occt INTERFACE ${IMPACTDECK_OCCT_LIBRARIES})
+endif()
+
 # MED (libmedc, Debian libmedc-dev): the mesh format Code_Aster reads. Debian's med.h defines
 # MED_HAVE_MPI and includes hdf5.h, so it needs the OpenMPI and parallel-HDF5 include folders.
 find_path(IMPACTDECK_MED_INCLUDE med.h)

@@ -3,13 +3,16 @@
 #include <gmsh.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <iomanip>
 #include <map>
 #include <mutex>
 #include <sstream>
 
 #include "impactdeck/common/atomic_file.hpp"
+#include "impactdeck/common/child_process.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/common/guarded_step.hpp"
 #include "impactdeck/common/version.hpp"
@@ -272,9 +275,13 @@ void check_mesh(const MeshResult& r, const InputContext& where) {
 // Gmsh works in mm; the .msh files are written in the output unit.
 double msh_scaling_factor(const MeshOptions& o) { return 1.0 / (kMmPerM * metres_per(o.output_unit)); }
 
-void write_msh(const fs::path& folder, const std::string& name, const MeshOptions& o, MeshResult& r) {
+void set_msh_paths(const fs::path& folder, const std::string& name, MeshResult& r) {
   r.msh41 = folder / (name + ".msh");
   r.msh22 = folder / (name + "_v22.msh");
+}
+
+void write_msh(const fs::path& folder, const std::string& name, const MeshOptions& o, MeshResult& r) {
+  set_msh_paths(folder, name, r);
   gmsh::option::setNumber("Mesh.SaveAll", 0);  // physical groups only: BODY, LOAD, PROBEk
   gmsh::option::setNumber("Mesh.ScalingFactor", msh_scaling_factor(o));
   gmsh::option::setNumber("Mesh.MshFileVersion", 4.1);
@@ -286,6 +293,16 @@ void write_msh(const fs::path& folder, const std::string& name, const MeshOption
 // After meshing a body whose load point and probes are geometry points (ellipsoid and CAD routes):
 // extract the tetrahedra, name LOAD and PROBEk, check and record the quality and the attempt,
 // write the .msh files.
+// The quality of a point mesh (ellipsoid and CAD routes), checked, and the try recorded.
+void record_point_mesh(const InputContext& where, const MeshOptions& o, double h0_mm, int algorithm_2d,
+                       const char* route, MeshResult& r) {
+  fill_quality(r.mesh, r.quality);
+  check_mesh(r, where);
+  r.quality.mesh_size_m = o.mesh_size_m;
+  r.quality.load_mesh_size_m = h0_mm / kMmPerM;
+  r.quality.attempts.push_back({route, algorithm_2d, o.algorithm_3d, o.mesh_size_m, h0_mm / kMmPerM, "ok"});
+}
+
 void finish_point_mesh(const InputContext& where, const MeshOptions& o, const fs::path& folder,
                        const std::string& name, int load_tag, const std::vector<int>& probe_tags,
                        const Eigen::Vector3d& p_mm, double h0_mm, int algorithm_2d, const char* route,
@@ -295,13 +312,66 @@ void finish_point_mesh(const InputContext& where, const MeshOptions& o, const fs
     index = extract(r.mesh, where);
     add_node_groups(r, node_of_point_entity(load_tag, index, where, "LOAD"), p_mm, probe_tags, index, o, where);
   });
-  fill_quality(r.mesh, r.quality);
-  check_mesh(r, where);
-  r.quality.mesh_size_m = o.mesh_size_m;
-  r.quality.load_mesh_size_m = h0_mm / kMmPerM;
-  r.quality.attempts.push_back({route, algorithm_2d, o.algorithm_3d, o.mesh_size_m, h0_mm / kMmPerM, "ok"});
+  record_point_mesh(where, o, h0_mm, algorithm_2d, route, r);
   gmsh_step(where, "write", [&] { write_msh(folder, name, o, r); });
 }
+
+// A point mesh passed back from the child process that made it (CAD route): the tetrahedra, the
+// node groups and their distances; the parent records the quality again from them.
+std::string serialise_point_mesh(const MeshResult& r) {
+  ByteWriter w;
+  w.put<std::uint64_t>(r.mesh.nodes_m.size());
+  for (const auto& n : r.mesh.nodes_m) {
+    for (int k = 0; k < 3; ++k) w.put<double>(n[k]);
+  }
+  w.put<std::uint64_t>(r.mesh.tets.size());
+  for (const auto& t : r.mesh.tets) {
+    for (int k = 0; k < 4; ++k) w.put<std::int32_t>(t[k]);
+  }
+  w.put<std::uint64_t>(r.mesh.node_groups.size());
+  for (const auto& [g, n] : r.mesh.node_groups) {
+    w.put_string(g);
+    w.put<std::int32_t>(n);
+  }
+  w.put<double>(r.quality.load_node_distance_m);
+  w.put<std::uint64_t>(r.quality.probe_node_distance_m.size());
+  for (double d : r.quality.probe_node_distance_m) w.put<double>(d);
+  return w.take();
+}
+
+void read_point_mesh(const std::string& bytes, const InputContext& where, MeshResult& r) {
+  ByteReader in(bytes, where, "gmsh mesh");
+  const std::size_t nodes = in.count(3 * sizeof(double));
+  for (std::size_t i = 0; i < nodes; ++i) {
+    Eigen::Vector3d x;
+    for (int k = 0; k < 3; ++k) x[k] = in.get<double>();
+    r.mesh.nodes_m.push_back(x);
+  }
+  const std::size_t tets = in.count(4 * sizeof(std::int32_t));
+  for (std::size_t i = 0; i < tets; ++i) {
+    std::array<int, 4> t{};
+    for (int k = 0; k < 4; ++k) {
+      t[k] = in.get<std::int32_t>();
+      if (t[k] < 0 || static_cast<std::size_t>(t[k]) >= nodes) throw where.error("gmsh mesh", "a tetrahedron names an unknown node");
+    }
+    r.mesh.tets.push_back(t);
+  }
+  const std::size_t groups = in.count(8 + 4);
+  for (std::size_t i = 0; i < groups; ++i) {
+    std::string g = in.get_string();
+    const int n = in.get<std::int32_t>();
+    if (n < 0 || static_cast<std::size_t>(n) >= nodes) throw where.error("gmsh mesh", "a node group names an unknown node");
+    r.mesh.node_groups.emplace_back(std::move(g), n);
+  }
+  r.quality.load_node_distance_m = in.get<double>();
+  const std::size_t probes = in.count(sizeof(double));
+  for (std::size_t i = 0; i < probes; ++i) r.quality.probe_node_distance_m.push_back(in.get<double>());
+}
+
+// The B-rep's 2D and 3D mesh may abort the process (Gmsh 4.8 throws inside its OpenMP face
+// meshing, where no catch reaches), crash, or run for minutes: each CAD try meshes in a child
+// process; all tries together are stopped after this many seconds.
+constexpr double kCadMeshDeadlineS = 600;
 
 
 std::string geo_header(const std::string& what, const MeshOptions& o) {
@@ -838,7 +908,8 @@ MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& l
 
 // One try of the CAD route with Gmsh's 2D algorithm alg2, in a session of its own.
 MeshResult mesh_cad_once(const fs::path& cad, double cad_unit_m, const Eigen::Vector3d& load_point_m,
-                         const MeshOptions& o, const fs::path& folder, const std::string& name, int alg2) {
+                         const MeshOptions& o, const fs::path& folder, const std::string& name, int alg2,
+                         double deadline_s) {
   const InputContext where = o.context.in_file(cad.string());
   // STEP and IGES come in mm (OpenCASCADE converts from the file's own unit); a BREP has no unit:
   // its coordinates are in cad_unit_m metres and are scaled to mm.
@@ -907,8 +978,19 @@ MeshResult mesh_cad_once(const fs::path& cad, double cad_unit_m, const Eigen::Ve
     gmsh::model::setPhysicalName(0, gmsh::model::addPhysicalGroup(0, {load_tag}), "LOAD");
     add_probe_groups(probe_tags);
   });
-  generate_tets(where, o, alg2, p_mm, h0, h);
-  finish_point_mesh(where, o, folder, name, load_tag, probe_tags, p_mm, h0, alg2, "cad", r);
+  // In a child process (stopped after deadline_s): the mesh, its tetrahedra and node groups, the .msh files.
+  const std::string made = run_in_child(
+      where, "gmsh mesh", "Gmsh's mesher (2D algorithm " + std::to_string(alg2) + ")", deadline_s,
+      [&] {
+        MeshResult c = r;
+        generate_tets(where, o, alg2, p_mm, h0, h);
+        finish_point_mesh(where, o, folder, name, load_tag, probe_tags, p_mm, h0, alg2, "cad", c);
+        return serialise_point_mesh(c);
+      },
+      &GmshSession::last_error);
+  read_point_mesh(made, where, r);
+  record_point_mesh(where, o, h0, alg2, "cad", r);
+  set_msh_paths(folder, name, r);
   fs::copy_file(cad, copy, fs::copy_options::overwrite_existing);
 
   std::ostringstream g;
@@ -945,9 +1027,16 @@ MeshResult mesh_cad_with_gmsh(const fs::path& cad, double cad_unit_m, const Eige
   if (!(cad_unit_m > 0)) throw file.error("unit", "must be > 0");
   const std::vector<int> algorithms = o.algorithm_2d ? std::vector<int>{o.algorithm_2d} : std::vector<int>{6, 1, 5};
   std::vector<MeshAttempt> failed;
+  const auto t0 = std::chrono::steady_clock::now();
   for (std::size_t k = 0;; ++k) {
     try {
-      MeshResult r = mesh_cad_once(cad, cad_unit_m, load_point_m, o, folder, name, algorithms[k]);
+      const double left = kCadMeshDeadlineS - std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      if (left <= 0) {
+        std::ostringstream s;
+        s << "no try left within " << kCadMeshDeadlineS << " s";
+        throw file.error("gmsh mesh", s.str());
+      }
+      MeshResult r = mesh_cad_once(cad, cad_unit_m, load_point_m, o, folder, name, algorithms[k], left);
       r.quality.attempts.insert(r.quality.attempts.begin(), failed.begin(), failed.end());
       return r;
     } catch (const InputError& e) {

@@ -9,13 +9,17 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <exception>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <sstream>
 #include <string>
 
+#include "cad_occ.hpp"
 #include "cad_plugin.hpp"
+#include "impactdeck/common/child_process.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/common/guarded_step.hpp"
 #include "impactdeck/common/version.hpp"
@@ -97,8 +101,17 @@ class CoutCapture {
     std::istringstream in(text_.str());
     std::string line, all;
     while (std::getline(in, line)) {
-      if (line.empty()) continue;
-      all += (all.empty() ? "" : "; ") + line;
+      // Colour escapes (ESC [ ... m) dropped; the IGES reader's entity count is not a complaint.
+      std::string plain;
+      for (std::size_t i = 0; i < line.size(); ++i) {
+        if (line[i] == '\x1b' && i + 1 < line.size() && line[i + 1] == '[') {
+          while (i < line.size() && line[i] != 'm') ++i;
+          continue;
+        }
+        plain += line[i];
+      }
+      if (plain.empty() || plain.rfind("Total number of loaded entities", 0) == 0) continue;
+      all += (all.empty() ? "" : "; ") + plain;
     }
     return all;
   }
@@ -110,6 +123,7 @@ class CoutCapture {
 
 // Reads the file into a new model; returns what OpenCASCADE wrote to std::cout meanwhile.
 std::string import_into(const ModelState& st) {
+  detail::occ_init_translators();  // else Gmsh cannot set the IGES target unit (cad_occ.hpp)
   gmsh::model::add(st.name);
   gmsh::option::setString("Geometry.OCCTargetUnit", "MM");
   gmsh::logger::start();
@@ -179,22 +193,180 @@ Eigen::Vector3d normal_at(int face, double u, double v) {
   return v3(n).normalized();
 }
 
+// OpenCASCADE's adaptive integration of the mass properties stops when the volume changes by less
+// than this from one refinement to the next (cad_occ.hpp). The moments converge more slowly than
+// the volume: asked for 1e-9, a cylinder's inertia stayed 5.6e-8 off; at 1e-12 it is within 3e-10
+// (rounding). The fixed Gauss rule of Gmsh's occ::getMass is not exact on B-spline faces (9.9e-6
+// off on CAP_50SGV_8_10.stp; issue 29 saw 2.2e-4 on another part).
+constexpr double kMassRelativeAccuracy = 1e-12;
+// OpenCASCADE's triangulation (the fallback): chordal deflection as a fraction of the part's size,
+// angular deflection; a face is matched to Gmsh's within the deflection plus 1e-6 of the size.
+constexpr double kOccDeflectionRelative = 1e-3;
+constexpr double kOccAngleRad = 0.3;
+double pad_limit(double size) { return kOccDeflectionRelative * size + 1e-6 * size; }
+
+// The surface mesh the child process passes back: nodes, and each face's triangles as node tags.
+struct TriangulationResult {
+  std::vector<std::size_t> node_tags;
+  std::vector<double> xyz;
+  std::map<int, std::vector<std::size_t>> face_nodes;
+  double deviation_bound = 0;  ///< from the B-rep, model units (0: unknown, Gmsh's)
+};
+
+// In the child process: Gmsh's 2D mesh of the current model (edges up to size_max, refined by
+// curvature), serialised. Options need no restoring: the parent's Gmsh never sees them.
+std::string mesh_faces(double size_max, int algorithm) {
+  const std::vector<std::pair<std::string, double>> opts = {
+      {"Mesh.MeshSizeMax", size_max},         {"Mesh.MeshSizeMin", 0.0},
+      {"Mesh.MeshSizeFromCurvature", 12},     {"Mesh.MeshSizeFromPoints", 0},
+      {"Mesh.MeshSizeExtendFromBoundary", 1}, {"Mesh.Algorithm", static_cast<double>(algorithm)}};
+  for (const auto& [k, v] : opts) gmsh::option::setNumber(k, v);
+  gmsh::model::mesh::generate(2);
+  std::vector<std::size_t> tags;
+  std::vector<double> xyz, par;
+  gmsh::model::mesh::getNodes(tags, xyz, par, -1, -1, true, false);
+  ByteWriter w;
+  w.put<std::uint64_t>(tags.size());
+  for (std::size_t i = 0; i < tags.size(); ++i) {
+    w.put<std::uint64_t>(tags[i]);
+    for (int k = 0; k < 3; ++k) w.put<double>(xyz[3 * i + k]);
+  }
+  gmsh::vectorpair faces;
+  gmsh::model::getEntities(faces, 2);
+  w.put<std::uint64_t>(faces.size());
+  for (const auto& [d, f] : faces) {
+    std::vector<std::size_t> etags, enodes;
+    gmsh::model::mesh::getElementsByType(2, etags, enodes, f);
+    w.put<std::int64_t>(f);
+    w.put<std::uint64_t>(enodes.size());
+    for (std::size_t n : enodes) w.put<std::uint64_t>(n);
+  }
+  return w.take();
+}
+
+TriangulationResult parse_triangulation(const std::string& bytes, const InputContext& where) {
+  ByteReader r(bytes, where, "triangulation");
+  TriangulationResult t;
+  const std::size_t n = r.count(4 * 8);
+  for (std::size_t i = 0; i < n; ++i) {
+    t.node_tags.push_back(r.get<std::uint64_t>());
+    for (int k = 0; k < 3; ++k) t.xyz.push_back(r.get<double>());
+  }
+  const std::size_t faces = r.count(2 * 8);
+  for (std::size_t i = 0; i < faces; ++i) {
+    const auto f = static_cast<int>(r.get<std::int64_t>());
+    auto& nodes = t.face_nodes[f];
+    const std::size_t m = r.count(8);
+    for (std::size_t k = 0; k < m; ++k) nodes.push_back(r.get<std::uint64_t>());
+  }
+  return t;
+}
+
+// OpenCASCADE's triangulation (cad_occ.hpp) with each of its faces matched to the Gmsh face
+// that holds the centroid of its largest triangle (nearest, by projection).
+TriangulationResult occ_fallback(const fs::path& file, CadFormat format, double size) {
+  const detail::OccTriangulation o = [&] {
+    CoutCapture quiet;
+    return detail::occ_triangulate(file, format, kOccDeflectionRelative * size, kOccAngleRad);
+  }();
+  gmsh::vectorpair faces;
+  gmsh::model::getEntities(faces, 2);
+  std::vector<std::array<double, 6>> boxes;
+  for (const auto& [d, f] : faces) {
+    std::array<double, 6> b{};
+    gmsh::model::getBoundingBox(2, f, b[0], b[1], b[2], b[3], b[4], b[5]);
+    boxes.push_back(b);
+  }
+  const double pad = pad_limit(size);
+  std::vector<int> tag_of(o.face_probe.size(), -1);
+  std::vector<bool> has_triangles(o.face_probe.size(), false);
+  for (int f : o.triangle_face) has_triangles[static_cast<std::size_t>(f)] = true;
+  for (std::size_t i = 0; i < o.face_probe.size(); ++i) {
+    if (!has_triangles[i]) continue;  // every triangle collapsed (a degenerate face)
+    const Eigen::Vector3d& q = o.face_probe[i];
+    // The nearest face holding the probe (isInside); else the nearest projection at all (a probe
+    // close to a trimming curve).
+    double best = std::numeric_limits<double>::infinity(), best_any = best;
+    int any = -1;
+    for (std::size_t k = 0; k < faces.size(); ++k) {
+      const auto& b = boxes[k];
+      if (q.x() < b[0] - pad || q.y() < b[1] - pad || q.z() < b[2] - pad || q.x() > b[3] + pad ||
+          q.y() > b[4] + pad || q.z() > b[5] + pad) {
+        continue;
+      }
+      Eigen::Vector3d p;
+      double u = 0, v = 0;
+      if (!project(faces[k].second, q, p, u, v, 1e-7 * size)) continue;
+      const double dist = (p - q).norm();
+      if (dist < best_any) best_any = dist, any = faces[k].second;
+      if (dist < best && gmsh::model::isInside(2, faces[k].second, {u, v})) best = dist, tag_of[i] = faces[k].second;
+    }
+    if (tag_of[i] < 0 && best_any <= pad) tag_of[i] = any;
+    if (tag_of[i] < 0) {
+      throw InputError(file.string(), "triangulation",
+                       "OpenCASCADE's face " + std::to_string(i + 1) + " matches no face of Gmsh's model");
+    }
+  }
+  TriangulationResult t;
+  // BRepMesh keeps its facets within the chordal deflection of the faces (twice that, for its
+  // approximate enforcement): the search's candidate margin.
+  t.deviation_bound = 2 * kOccDeflectionRelative * size;
+  for (std::size_t n = 0; n < o.nodes.size(); ++n) {
+    t.node_tags.push_back(n + 1);
+    for (int k = 0; k < 3; ++k) t.xyz.push_back(o.nodes[n][k]);
+  }
+  for (std::size_t e = 0; e < o.triangles.size(); ++e) {
+    auto& nodes = t.face_nodes[tag_of[static_cast<std::size_t>(o.triangle_face[e])]];
+    for (int k = 0; k < 3; ++k) nodes.push_back(static_cast<std::size_t>(o.triangles[e][k]) + 1);
+  }
+  return t;
+}
+
+// The search triangulation: Gmsh's 2D mesh (algorithm 6, Frontal-Delaunay) in a child process
+// (run_in_child), stopped after deadline_s: Gmsh 4.8 throws from inside its OpenMP face meshing
+// ("Impossible to mesh periodic surface", "Unable to recover the edge"), where no catch reaches,
+// crashes, or runs for minutes (a thin torus). When it fails, OpenCASCADE's own triangulation
+// (occ_fallback), with a warning saying why. (Gmsh's other 2D algorithms are no better on such
+// parts: on netgen's frame.step 1 crashes and 5 hangs.)
+TriangulationResult triangulate(const fs::path& file, CadFormat format, double size, double size_max,
+                                double deadline_s, std::vector<std::string>& warnings) {
+  const InputContext where{file.string(), ""};
+  std::string failures;
+  try {
+    const std::string bytes = run_in_child(where, "triangulation", "Gmsh's surface mesher", deadline_s,
+                                           [&] { return mesh_faces(size_max, 6); }, &last_gmsh_error);
+    return parse_triangulation(bytes, where);
+  } catch (const InputError& e) {
+    failures = e.reason() + "; ";
+  }
+  try {
+    TriangulationResult t = occ_fallback(file, format, size);
+    warnings.push_back(file.string() + ": triangulation: " + failures +
+                       "OpenCASCADE's triangulation (BRepMesh) used instead, as the search guide only");
+    return t;
+  } catch (const InputError& e) {
+    throw where.error("triangulation", failures + "OpenCASCADE's triangulation: " + e.reason());
+  }
+}
+
 void release(int model);
-CadLoaded load_model(const fs::path& file, double unit_m, double mesh_size_relative, int model);
+CadLoaded load_model(const fs::path& file, CadFormat format, double unit_m, double mesh_size_relative,
+                     double deadline_s, int model);
 
 // Reads a part into a new model; a failure drops the model again.
-CadLoaded load(const fs::path& file, double unit_m, double mesh_size_relative) {
+CadLoaded load(const fs::path& file, CadFormat format, double unit_m, double mesh_size_relative, double deadline_s) {
   static int next = 0;
   const int model = ++next;
   try {
-    return load_model(file, unit_m, mesh_size_relative, model);
+    return load_model(file, format, unit_m, mesh_size_relative, deadline_s, model);
   } catch (...) {
     release(model);
     throw;
   }
 }
 
-CadLoaded load_model(const fs::path& file, double unit_m, double mesh_size_relative, int model) {
+CadLoaded load_model(const fs::path& file, CadFormat format, double unit_m, double mesh_size_relative,
+                     double deadline_s, int model) {
   ModelState st{file, unit_m, "impactdeck_cad_" + std::to_string(model)};
   CadLoaded out;
   out.model = model;
@@ -218,79 +390,37 @@ CadLoaded load_model(const fs::path& file, double unit_m, double mesh_size_relat
                        " faces, none closing a volume): mass properties need a closed solid" + occt_note);
     }
     size = model_size(x0, y0, z0);
-    // Mass properties about the part's centre of mass (summed over the solids: first moments,
-    // then each solid's inertia moved to the common centre by the parallel axis theorem).
-    const double L = unit_m;
-    double volume = 0;
-    Eigen::Vector3d first = Eigen::Vector3d::Zero();
-    std::vector<std::tuple<double, Eigen::Vector3d, Eigen::Matrix3d>> parts;
-    for (const auto& [d, t] : vols) {
-      double m = 0, cx = 0, cy = 0, cz = 0;
-      std::vector<double> I;
-      gmsh::model::occ::getMass(3, t, m);
-      gmsh::model::occ::getCenterOfMass(3, t, cx, cy, cz);
-      gmsh::model::occ::getMatrixOfInertia(3, t, I);
-      if (!(m > 0) || I.size() != 9) {
-        throw InputError(where, "solid " + std::to_string(t), "has no positive volume (is it closed?)");
-      }
-      Eigen::Matrix3d J;
-      for (int i = 0; i < 9; ++i) J(i / 3, i % 3) = I[i];
-      parts.emplace_back(m, Eigen::Vector3d(cx, cy, cz), J);
-      volume += m;
-      first += m * Eigen::Vector3d(cx, cy, cz);
-    }
-    const Eigen::Vector3d c = first / volume;
-    Eigen::Matrix3d J = Eigen::Matrix3d::Zero();
-    for (const auto& [m, ci, Ji] : parts) {
-      const Eigen::Vector3d r = ci - c;
-      J += Ji + m * (r.squaredNorm() * Eigen::Matrix3d::Identity() - r * r.transpose());
-    }
-    out.volume.volume_m3 = volume * L * L * L;
-    out.volume.centroid_m = c * L;
-    out.volume.inertia_per_density_m5 = 0.5 * (J + J.transpose()) * std::pow(L, 5);
-    double area = 0;
-    for (const auto& [d, t] : faces) {
-      double a = 0;
-      gmsh::model::occ::getMass(2, t, a);
-      area += a;
-    }
-    out.volume.area_m2 = area * L * L;
   });
+  // Mass properties: OpenCASCADE's adaptive integration (cad_occ.hpp) of the file read by its own
+  // reader, to kMassRelativeAccuracy; its error estimate is reported.
+  {
+    CoutCapture quiet;  // the readers' own chatter
+    const detail::OccMass m = detail::occ_mass_properties(file, format, kMassRelativeAccuracy);
+    if (m.solids != out.solids) {
+      throw InputError(where, "mass properties", "Gmsh finds " + std::to_string(out.solids) + " solids, OpenCASCADE " +
+                       std::to_string(m.solids));
+    }
+    const double L = unit_m;
+    out.volume.volume_m3 = m.volume * L * L * L;
+    out.volume.centroid_m = m.centre * L;
+    out.volume.inertia_per_density_m5 = m.inertia * std::pow(L, 5);
+    out.volume.area_m2 = m.area * L * L;
+    out.mass_relative_error_estimate = m.relative_error;
+  }
   if (!occt_said.empty()) out.warnings.push_back(where + ": OpenCASCADE while reading: " + occt_said);
   if (out.solids > 1) {
     out.warnings.push_back(where + ": " + std::to_string(out.solids) +
                            " solids taken as one body (mass properties summed; overlaps would count twice)");
   }
 
-  // Triangulation: Gmsh's 2D mesh of the faces, options restored afterwards (the mesher plugin
-  // shares Gmsh's option table).
+  // Triangulation: Gmsh's 2D mesh of the faces, in a child process (triangulate_in_child).
+  const TriangulationResult tri = triangulate(file, format, size, mesh_size_relative * size, deadline_s, out.warnings);
+  out.triangulation_deviation_m = tri.deviation_bound * unit_m;
   gmsh_step(file, "triangulation", [&] {
-    const std::vector<std::pair<std::string, double>> opts = {
-        {"Mesh.MeshSizeMax", mesh_size_relative * size}, {"Mesh.MeshSizeMin", 0.0},
-        {"Mesh.MeshSizeFromCurvature", 12},        {"Mesh.MeshSizeFromPoints", 0},
-        {"Mesh.MeshSizeExtendFromBoundary", 1},     {"Mesh.Algorithm", 6}};
-    std::vector<double> saved;
-    for (const auto& [k, v] : opts) {
-      double old = 0;
-      gmsh::option::getNumber(k, old);
-      saved.push_back(old);
-      gmsh::option::setNumber(k, v);
-    }
-    try {
-      gmsh::model::mesh::generate(2);
-    } catch (...) {
-      for (std::size_t i = 0; i < opts.size(); ++i) gmsh::option::setNumber(opts[i].first, saved[i]);
-      throw;
-    }
-    for (std::size_t i = 0; i < opts.size(); ++i) gmsh::option::setNumber(opts[i].first, saved[i]);
-
-    std::vector<std::size_t> tags;
-    std::vector<double> xyz, par;
-    gmsh::model::mesh::getNodes(tags, xyz, par, -1, -1, true, false);
     std::map<std::size_t, int> index;
-    for (std::size_t i = 0; i < tags.size(); ++i) {
-      index[tags[i]] = static_cast<int>(out.nodes_m.size());
-      out.nodes_m.push_back(v3(xyz, 3 * i) * unit_m);
+    for (std::size_t i = 0; i < tri.node_tags.size(); ++i) {
+      index[tri.node_tags[i]] = static_cast<int>(out.nodes_m.size());
+      out.nodes_m.push_back(v3(tri.xyz, 3 * i) * unit_m);
     }
     const double tol = 1e-7 * size;
     for (const auto& [d, f] : faces) {
@@ -298,13 +428,19 @@ CadLoaded load_model(const fs::path& file, double unit_m, double mesh_size_relat
       std::vector<double> lo, hi;
       gmsh::model::getParametrizationBounds(2, f, lo, hi);
       out.face_bounds.push_back({lo[0], hi[0], lo[1], hi[1]});
-      std::vector<std::size_t> etags, enodes;
-      gmsh::model::mesh::getElementsByType(2, etags, enodes, f);
+      const auto found = tri.face_nodes.find(f);
+      static const std::vector<std::size_t> none;
+      const std::vector<std::size_t>& enodes = found == tri.face_nodes.end() ? none : found->second;
       const std::size_t first = out.triangles.size();
       double best_area = -1;
       std::size_t best = first;
-      for (std::size_t e = 0; e < etags.size(); ++e) {
-        std::array<int, 3> t{index.at(enodes[3 * e]), index.at(enodes[3 * e + 1]), index.at(enodes[3 * e + 2])};
+      for (std::size_t e = 0; e + 2 < enodes.size(); e += 3) {
+        const auto node = [&](std::size_t k) {
+          const auto it = index.find(enodes[e + k]);
+          if (it == index.end()) throw InputError(where, "triangulation", "a triangle names an unknown node");
+          return it->second;
+        };
+        std::array<int, 3> t{node(0), node(1), node(2)};
         out.triangles.push_back(t);
         out.triangle_face.push_back(f);
         const double a = (out.nodes_m[t[1]] - out.nodes_m[t[0]]).cross(out.nodes_m[t[2]] - out.nodes_m[t[0]]).norm();
@@ -325,7 +461,6 @@ CadLoaded load_model(const fs::path& file, double unit_m, double mesh_size_relat
         for (std::size_t k = first; k < out.triangles.size(); ++k) std::swap(out.triangles[k][1], out.triangles[k][2]);
       }
     }
-    gmsh::model::mesh::clear();
   });
   if (out.triangles.empty()) throw InputError(where, "triangulation", "Gmsh produced no surface triangles");
 

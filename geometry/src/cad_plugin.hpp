@@ -14,6 +14,7 @@
 
 #include <Eigen/Dense>
 
+#include "impactdeck/geometry/cad_shape.hpp"
 #include "impactdeck/geometry/shape.hpp"
 
 namespace impactdeck::geometry::detail {
@@ -24,11 +25,15 @@ struct CadLoaded {
   int solids = 0;
   std::vector<int> faces;         ///< face tags
   std::vector<std::array<double, 4>> face_bounds;  ///< umin, umax, vmin, vmax per face
-  VolumeProperties volume;        ///< exact (OpenCASCADE), summed over the solids
+  VolumeProperties volume;        ///< OpenCASCADE's adaptive integration, summed over the solids
+  double mass_relative_error_estimate = 0;  ///< OpenCASCADE's estimate of its relative error (volume)
   // Surface triangulation (Gmsh 2D mesh of the B-rep), each triangle oriented outward.
   std::vector<Eigen::Vector3d> nodes_m;
   std::vector<std::array<int, 3>> triangles;
   std::vector<int> triangle_face;  ///< face tag of each triangle
+  /// A bound on the triangles' distance from the B-rep when known (OpenCASCADE's triangulation:
+  /// twice its chordal deflection); 0 for Gmsh's (the search then pads by half the longest edge).
+  double triangulation_deviation_m = 0;
   struct Edge {
     int tag = 0;
     std::vector<int> faces;          ///< adjacent faces
@@ -61,8 +66,10 @@ struct GmshCadV1 {
   const char* version;  ///< kVersion of the plugin's build
   std::size_t sizeof_loaded, sizeof_frame;
   /// Reads `file` (model coordinates times `model_unit_m` are metres), mass properties,
-  /// triangulation with edges up to `mesh_size_relative` x the part size, B-rep edges. Throws InputError.
-  CadLoaded (*load)(const std::filesystem::path& file, double model_unit_m, double mesh_size_relative);
+  /// triangulation with edges up to `mesh_size_relative` x the part size (Gmsh in a child process
+  /// stopped after `deadline_s`), B-rep edges. Throws InputError.
+  CadLoaded (*load)(const std::filesystem::path& file, CadFormat format, double model_unit_m,
+                    double mesh_size_relative, double deadline_s);
   bool (*project_on_face)(int model, int face, const Eigen::Vector3d& q_m, CadFacePoint& out);
   bool (*face_frame)(int model, int face, double u, double v, CadFaceFrame& out);
   bool (*project_on_edge)(int model, int edge, const Eigen::Vector3d& q_m, CadEdgePoint& out);

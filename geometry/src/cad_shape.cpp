@@ -217,6 +217,7 @@ std::shared_ptr<const CadShape> CadShape::load(const fs::path& file, LengthUnit 
   if (!(o.triangulation_size_relative > 0 && o.triangulation_size_relative <= 1)) {
     throw InputError(where, "triangulation_size_relative", "must lie in (0, 1]");
   }
+  if (!(o.triangulation_deadline_s > 0)) throw InputError(where, "triangulation_deadline_s", "must be > 0");
 
   auto impl = std::make_unique<Impl>();
   impl->file = file;
@@ -237,7 +238,7 @@ std::shared_ptr<const CadShape> CadShape::load(const fs::path& file, LengthUnit 
   const auto& p = plugin();
   {
     std::lock_guard<std::recursive_mutex> lock(gmsh_mutex());
-    impl->loaded = p.load(file, model_unit_m, o.triangulation_size_relative);
+    impl->loaded = p.load(file, *format, model_unit_m, o.triangulation_size_relative, o.triangulation_deadline_s);
   }
   CadLoaded& L = impl->loaded;
 
@@ -254,7 +255,9 @@ std::shared_ptr<const CadShape> CadShape::load(const fs::path& file, LengthUnit 
   mo.sharp_angle_deg = o.sharp_angle_deg;
   impl->tess = std::make_unique<MeshShape>(std::move(mesh), mass, mo);
   impl->size = impl->tess->size_m();
-  impl->margin = 0.5 * longest + 1e-9 * impl->size;
+  // The search's candidate margin: the triangulation's known deviation from the B-rep
+  // (OpenCASCADE's fallback, whose flat faces have long triangles), else half its longest edge.
+  impl->margin = (L.triangulation_deviation_m > 0 ? L.triangulation_deviation_m : 0.5 * longest) + 1e-9 * impl->size;
 
   int max_tag = 0;
   for (int f : L.faces) max_tag = std::max(max_tag, f);
@@ -413,6 +416,7 @@ std::size_t CadShape::face_count() const { return impl_->loaded.faces.size(); }
 std::size_t CadShape::edge_count() const { return impl_->loaded.edges.size(); }
 std::size_t CadShape::sharp_edge_count() const { return impl_->sharp.size(); }
 const MeshShape& CadShape::triangulation() const { return *impl_->tess; }
+double CadShape::mass_relative_error_estimate() const { return impl_->loaded.mass_relative_error_estimate; }
 double CadShape::triangulation_volume_relative_difference() const { return impl_->tess_volume_rel; }
 const std::vector<std::string>& CadShape::warnings() const { return impl_->loaded.warnings; }
 double CadShape::load_seconds() const { return impl_->load_seconds; }

@@ -2,6 +2,8 @@
 // that a unit contradiction is refused before the CAD plugin is even loaded.
 #include <algorithm>
 #include <cctype>
+#include <cmath>
+#include <map>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -35,48 +37,173 @@ std::string read_all(const fs::path& file) {
   return read_input_file(file, "CAD file", available_memory_bytes() / 4, "a quarter of the free memory");
 }
 
-// STEP: every entity holding LENGTH_UNIT, as SI_UNIT(prefix, .METRE.) or CONVERSION_BASED_UNIT.
+// STEP: the DATA section's entities "#id = body;" (strings and comments skipped when splitting).
+std::map<long, std::string> step_entities(const std::string& text) {
+  std::map<long, std::string> out;
+  const std::size_t n = text.size();
+  std::size_t i = 0;
+  while (i < n) {
+    // Next "#digits" at the start of an instance (after ';' or the section header).
+    const std::size_t hash = text.find('#', i);
+    if (hash == std::string::npos) break;
+    std::size_t k = hash + 1;
+    while (k < n && std::isdigit(static_cast<unsigned char>(text[k]))) ++k;
+    std::size_t eq = k;
+    while (eq < n && std::isspace(static_cast<unsigned char>(text[eq]))) ++eq;
+    if (k == hash + 1 || eq >= n || text[eq] != '=' || k - hash > 18) {
+      i = hash + 1;
+      continue;
+    }
+    const long id = std::stol(text.substr(hash + 1, k - hash - 1));
+    std::string body;
+    std::size_t j = eq + 1;
+    for (; j < n && text[j] != ';'; ++j) {
+      if (text[j] == '\'') {  // a string: '' is a quote inside it
+        body += text[j++];
+        while (j < n) {
+          if (text[j] == '\'' && j + 1 < n && text[j + 1] == '\'') {
+            body += "''";
+            j += 2;
+          } else if (text[j] == '\'') {
+            break;
+          } else {
+            body += text[j++];
+          }
+        }
+        if (j < n) body += '\'';
+      } else if (text[j] == '/' && j + 1 < n && text[j + 1] == '*') {
+        const std::size_t close = text.find("*/", j + 2);
+        j = close == std::string::npos ? n : close + 1;
+      } else if (!std::isspace(static_cast<unsigned char>(text[j]))) {
+        body += static_cast<char>(std::toupper(static_cast<unsigned char>(text[j])));
+      }
+    }
+    out[id] = body;
+    i = j + 1;
+  }
+  return out;
+}
+
+// The arguments of the first "NAME(" in body (up to its matching parenthesis); nullopt if absent.
+std::optional<std::string> step_args(const std::string& body, const std::string& name) {
+  std::size_t at = 0;
+  while ((at = body.find(name + "(", at)) != std::string::npos) {
+    if (at > 0 && (std::isalnum(static_cast<unsigned char>(body[at - 1])) || body[at - 1] == '_')) {
+      at += name.size();
+      continue;
+    }
+    int depth = 0;
+    bool in_string = false;
+    for (std::size_t k = at + name.size(); k < body.size(); ++k) {
+      const char c = body[k];
+      if (c == '\'') in_string = !in_string;
+      if (in_string) continue;
+      if (c == '(') ++depth;
+      if (c == ')' && --depth == 0) return body.substr(at + name.size() + 1, k - at - name.size() - 1);
+    }
+    return std::nullopt;
+  }
+  return std::nullopt;
+}
+
+// "#12" -> 12; -1 when not a reference.
+long step_ref(const std::string& token) {
+  if (token.size() < 2 || token[0] != '#') return -1;
+  for (std::size_t k = 1; k < token.size(); ++k) {
+    if (!std::isdigit(static_cast<unsigned char>(token[k]))) return -1;
+  }
+  return token.size() > 18 ? -1 : std::stol(token.substr(1));
+}
+
+// Splits a STEP argument list at its top-level commas.
+std::vector<std::string> step_split(const std::string& args) {
+  std::vector<std::string> out(1);
+  int depth = 0;
+  bool in_string = false;
+  for (const char c : args) {
+    if (c == '\'') in_string = !in_string;
+    if (!in_string && c == '(') ++depth;
+    if (!in_string && c == ')') --depth;
+    if (!in_string && depth == 0 && c == ',') {
+      out.emplace_back();
+    } else {
+      out.back() += c;
+    }
+  }
+  return out;
+}
+
+CadFileUnit step_unit(const std::map<long, std::string>& e, long id, const std::string& where, int depth);
+
+// A LENGTH_MEASURE_WITH_UNIT(LENGTH_MEASURE(v), #unit): v times the unit, in metres.
+double step_measure_m(const std::map<long, std::string>& e, long id, const std::string& where, int depth) {
+  const auto it = e.find(id);
+  const auto args = it == e.end() ? std::nullopt : step_args(it->second, "LENGTH_MEASURE_WITH_UNIT");
+  const auto parts = args ? step_split(*args) : std::vector<std::string>{};
+  const auto value = parts.size() == 2 ? step_args(parts[0], "LENGTH_MEASURE") : std::nullopt;
+  double v = 0;
+  try {
+    if (value) v = std::stod(*value);
+  } catch (const std::exception&) {
+    v = 0;
+  }
+  if (!(v > 0) || !std::isfinite(v)) {
+    throw InputError(where, "length unit", "#" + std::to_string(id) + " is not a LENGTH_MEASURE_WITH_UNIT with a positive value");
+  }
+  return v * step_unit(e, step_ref(parts[1]), where, depth + 1).metres;
+}
+
+// The length unit entity #id: SI_UNIT(prefix, .METRE.) or CONVERSION_BASED_UNIT('NAME', #measure).
+CadFileUnit step_unit(const std::map<long, std::string>& e, long id, const std::string& where, int depth) {
+  const auto it = e.find(id);
+  if (it == e.end() || depth > 8) {
+    throw InputError(where, "length unit", "the unit #" + std::to_string(id) + " is missing or refers to itself");
+  }
+  const std::string& body = it->second;
+  if (const auto si = step_args(body, "SI_UNIT")) {
+    const auto a = step_split(*si);
+    if (a.size() != 2 || a[1] != ".METRE.") {
+      throw InputError(where, "length unit", "unknown SI length unit " + (a.size() == 2 ? a[1] : *si));
+    }
+    static const std::vector<std::pair<std::string, std::pair<std::string, double>>> prefixes = {
+        {"$", {"metre", 1.0}},           {".MILLI.", {"millimetre", 1e-3}}, {".CENTI.", {"centimetre", 1e-2}},
+        {".DECI.", {"decimetre", 0.1}},  {".KILO.", {"kilometre", 1e3}},    {".MICRO.", {"micrometre", 1e-6}},
+        {".NANO.", {"nanometre", 1e-9}}, {".DECA.", {"decametre", 10.0}},   {".HECTO.", {"hectometre", 100.0}}};
+    for (const auto& [p, u] : prefixes) {
+      if (p == a[0]) return make_unit(u.first, u.second);
+    }
+    throw InputError(where, "length unit", "unknown SI prefix " + a[0]);
+  }
+  if (const auto cb = step_args(body, "CONVERSION_BASED_UNIT")) {
+    const auto a = step_split(*cb);
+    if (a.size() != 2 || a[0].size() < 2 || a[0].front() != '\'' || a[0].back() != '\'') {
+      throw InputError(where, "length unit", "#" + std::to_string(id) + ": CONVERSION_BASED_UNIT without a name and a measure");
+    }
+    const double m = step_measure_m(e, step_ref(a[1]), where, depth);
+    std::string name = a[0].substr(1, a[0].size() - 2);
+    for (char& c : name) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (name.empty()) name = "unnamed conversion-based unit";
+    return make_unit(name, m);
+  }
+  throw InputError(where, "length unit", "#" + std::to_string(id) + " is neither an SI_UNIT nor a CONVERSION_BASED_UNIT");
+}
+
+// STEP: the length unit of each GLOBAL_UNIT_ASSIGNED_CONTEXT (the unit the coordinates are in),
+// followed through CONVERSION_BASED_UNIT -> LENGTH_MEASURE_WITH_UNIT -> its own unit.
 std::vector<CadFileUnit> step_units(const std::string& text, const std::string& where) {
+  const auto e = step_entities(text);
   std::vector<CadFileUnit> units;
-  std::size_t pos = 0;
-  while ((pos = text.find("LENGTH_UNIT", pos)) != std::string::npos) {
-    const std::size_t begin = text.rfind('#', pos);
-    const std::size_t end = text.find(';', pos);
-    const std::string e = upper(text.substr(begin == std::string::npos ? 0 : begin,
-                                            (end == std::string::npos ? text.size() : end) - begin));
-    pos += 11;
-    if (e.find("LENGTH_UNIT(") == std::string::npos && e.find("LENGTH_UNIT (") == std::string::npos) continue;
-    if (const std::size_t si = e.find("SI_UNIT("); si != std::string::npos) {
-      const std::size_t close = e.find(')', si);
-      std::string args = e.substr(si + 8, close - si - 8);
-      args.erase(std::remove_if(args.begin(), args.end(), [](char c) { return std::isspace(static_cast<unsigned char>(c)); }),
-                 args.end());
-      const std::size_t comma = args.find(',');
-      const std::string prefix = args.substr(0, comma), name = args.substr(comma + 1);
-      if (name != ".METRE.") throw InputError(where, "length unit", "unknown SI length unit " + name);
-      static const std::vector<std::pair<std::string, std::pair<std::string, double>>> prefixes = {
-          {"$", {"metre", 1.0}},        {".MILLI.", {"millimetre", 1e-3}}, {".CENTI.", {"centimetre", 1e-2}},
-          {".DECI.", {"decimetre", 0.1}}, {".KILO.", {"kilometre", 1e3}},   {".MICRO.", {"micrometre", 1e-6}},
-          {".NANO.", {"nanometre", 1e-9}}};
-      bool known = false;
-      for (const auto& [p, u] : prefixes) {
-        if (p == prefix) units.push_back(make_unit(u.first, u.second)), known = true;
+  for (const auto& [id, body] : e) {
+    const auto ctx = step_args(body, "GLOBAL_UNIT_ASSIGNED_CONTEXT");
+    if (!ctx) continue;
+    std::string list = *ctx;  // "(#1,#2,#3)"
+    if (list.size() >= 2 && list.front() == '(' && list.back() == ')') list = list.substr(1, list.size() - 2);
+    for (const auto& token : step_split(list)) {
+      const long ref = step_ref(token);
+      const auto u = e.find(ref);
+      if (u != e.end() && u->second.find("LENGTH_UNIT(") != std::string::npos) {
+        units.push_back(step_unit(e, ref, where, 0));
       }
-      if (!known) throw InputError(where, "length unit", "unknown SI prefix " + prefix);
-    } else if (const std::size_t cb = e.find("CONVERSION_BASED_UNIT("); cb != std::string::npos) {
-      const std::size_t q0 = e.find('\'', cb), q1 = e.find('\'', q0 + 1);
-      const std::string name = q0 == std::string::npos || q1 == std::string::npos ? "" : e.substr(q0 + 1, q1 - q0 - 1);
-      static const std::vector<std::pair<std::string, double>> known = {
-          {"INCH", 0.0254}, {"FOOT", 0.3048}, {"MILLIMETRE", 1e-3}, {"MILLIMETER", 1e-3}, {"METRE", 1.0},
-          {"METER", 1.0},   {"CENTIMETRE", 1e-2}, {"CENTIMETER", 1e-2}, {"YARD", 0.9144}, {"MILE", 1609.344},
-          {"MIL", 2.54e-5}};
-      double m = 0;
-      for (const auto& [n, v] : known) {
-        if (n == name) m = v;
-      }
-      std::string lower = name;
-      for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-      units.push_back(make_unit(lower.empty() ? "unnamed conversion-based unit" : lower, m));
     }
   }
   return units;
@@ -177,8 +304,8 @@ std::optional<CadFileUnit> cad_file_length_unit(const fs::path& file) {
   const std::string text = read_all(file);
   std::vector<CadFileUnit> units = *format == CadFormat::step ? step_units(text, where) : iges_units(text, where);
   if (units.empty()) {
-    throw InputError(where, "length unit", "the STEP file states no length unit (no LENGTH_UNIT entity): "
-                                           "corrupt or not a STEP file");
+    throw InputError(where, "length unit", "the STEP file states no length unit (no GLOBAL_UNIT_ASSIGNED_CONTEXT "
+                                           "with a LENGTH_UNIT): corrupt or not a STEP file");
   }
   std::set<std::string> names;
   for (const auto& u : units) names.insert(u.name);

@@ -274,6 +274,7 @@ InspectReport inspect_cad(const InspectOptions& a, const std::vector<Eigen::Vect
   j["mass_properties_approximate"] = false;
   j["approximation_reason"] = nullptr;
   j["mass_properties_source"] = "exact (OpenCASCADE, B-rep solid)";
+  j["mass_properties_relative_error_estimate"] = json_number(shape->mass_relative_error_estimate());
   j["triangulation"] = {{"triangles", shape->triangulation().mesh().triangle_count()},
                         {"vertices", shape->triangulation().mesh().vertex_count()},
                         {"volume_relative_difference", json_number(shape->triangulation_volume_relative_difference())}};
@@ -296,7 +297,8 @@ InspectReport inspect_cad(const InspectOptions& a, const std::vector<Eigen::Vect
     << to_string(a.length_unit) << (shape->file_unit() ? ", as the file states" : ", declared: a BREP states none") << ")\n";
   o << "  solids " << shape->solid_count() << ", faces " << shape->face_count() << ", edges " << shape->edge_count()
     << " (" << shape->sharp_edge_count() << " sharp)\n";
-  o << "  volume " << vp.volume_m3 << " m^3, area " << vp.area_m2 << " m^2 (exact, from the B-rep)\n";
+  o << "  volume " << vp.volume_m3 << " m^3, area " << vp.area_m2 << " m^2 (from the B-rep, relative error estimate "
+    << std::setprecision(2) << shape->mass_relative_error_estimate() << std::setprecision(7) << ")\n";
   if (density) o << "  mass " << *density * vp.volume_m3 << " kg (density " << *density << " kg/m^3)\n";
   o << "  centre of mass " << text(vp.centroid_m) << " m\n";
   const Eigen::Matrix3d shown = vp.inertia_per_density_m5 * density.value_or(1.0);

@@ -48,6 +48,9 @@ struct CadShapeOptions {
   double triangulation_size_relative = 0.05;
   /// A point within this fraction of the part's size from a sharp edge is on the edge.
   double sharp_band_relative = 1e-6;
+  /// Gmsh meshes the triangulation in a child process (its failures abort, and it can hang),
+  /// stopped after this many seconds; then OpenCASCADE's triangulation is used (with a warning).
+  double triangulation_deadline_s = 60.0;
 };
 
 /// Where a surface point lies on the B-rep.
@@ -107,6 +110,9 @@ class CadShape final : public Shape {
   /// The search triangulation (a closed, outward MeshShape) and its volume's relative difference
   /// from the exact one (an accuracy figure of the guide, not of the results).
   const MeshShape& triangulation() const;
+  /// OpenCASCADE's estimate of the relative error of its adaptive integration of the volume (the
+  /// moments use the same refinement); below 1e-9 unless it could not get there.
+  double mass_relative_error_estimate() const;
   double triangulation_volume_relative_difference() const;
   const std::vector<std::string>& warnings() const;
   /// Wall time of reading the file, mass properties, triangulation and edges (s).
