@@ -82,7 +82,7 @@ TEST(Table1, PaperPresetReproducesThePaper) {
 }
 
 TEST(Table1, EmbeddedPaperValuesEqualTheDataFile) {
-  // tests/data/paper_table1.csv is the shared transcription (rows mu, columns g); the study embeds
+  // tests/data/paper_table1.csv is a transcription of the paper's table (rows mu, columns g); the study embeds
   // the same numbers transposed (rows g, columns mu).
   std::ifstream f(std::string(IMPACTDECK_SOURCE_DIR) + "/tests/data/paper_table1.csv");
   ASSERT_TRUE(f) << "tests/data/paper_table1.csv";
