@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -115,7 +116,9 @@ int main(int argc, char** argv) {
     for (const Sample& s : paper_map) vmax = std::max(vmax, std::abs(s.paper));
     write_svg(argv[1], paper_map, nlon, nlat, vmax,
               "F_max(Eq. 26) / F_max(elliptical) − 1, ellipsoid 2000 × 500 × 500 mm, ball r = 50 mm");
-    std::printf("\nMap for g = 4 (the paper's 2000 × 500 × 500 mm ellipsoid): `%s`.\n", argv[1]);
+    // The file name only: the page must not carry the generating machine's paths.
+    std::printf("\nMap for g = 4 (the paper's 2000 × 500 × 500 mm ellipsoid): `%s`.\n",
+                std::filesystem::path(argv[1]).filename().c_str());
   }
   return 0;
 }

@@ -1,4 +1,4 @@
-// CalculiX on a hybrid deck (issue 15, goals row 6): the 1-D wave case of MODEL.md — a free steel
+// CalculiX on a hybrid deck (issue 15, goals row 6): the 1-D wave case of docs/validation.md — a free steel
 // bar 1000 x 20 x 20 mm hit on its end face by a steel ball r = 10 mm at 1 m/s (F_max 1723 N,
 // t_m 34.7 us), C3D4 at 5 mm (~5,100 nodes), a probe at mid-length, 100 increments across the
 // contact and ~150 after it (~250 in all, through 0.4 ms).
@@ -299,7 +299,7 @@ int main(int argc, char** argv) {
   }
 
   const double area = 20e-3 * 20e-3;
-  std::printf("\n1-D wave reference (MODEL.md): F_max / A = %.4f MPa at t_m + L/(2c) = %.1f us (c = sqrt(E/rho)).\n",
+  std::printf("\n1-D wave reference: F_max / A = %.4f MPa at t_m + L/(2c) = %.1f us (c = sqrt(E/rho)).\n",
               1e-6 * rep.impacts[0].result.history.compression.max_force_N / area,
               1e6 * (rep.impacts[0].result.history.compression.compression_time_s + 0.5 / std::sqrt(2.05e11 / 7850)));
   fs::remove_all(dir);

@@ -87,14 +87,14 @@ std::string bar_scene(double h_mm, double end_time_s, const std::string& probes)
 
 // ---- 1. The 1-D wave ----------------------------------------------------------------------------
 void wave(const fs::path& work, const fs::path& figs) {
-  const double L = 1000, w = 20;  // mm, MODEL.md's bar
+  const double L = 1000, w = 20;  // mm, docs/validation.md's bar
   const fs::path dir = work / "wave";
   fs::create_directories(work);
   write_box_stl(work / "bar.stl", 0, L, w, w);
   std::printf("## 1. The 1-D wave in a long bar\n\n");
   std::printf("A free steel bar %g x %g x %g mm (E = %g Pa, rho = %g kg/m3), hit at the centre of its end face "
               "by a steel ball r = 10 mm at 1 m/s (R = 1), point load, probes on the axis at x = 250, 500 and "
-              "750 mm. Away from the end, sigma(x, t) = F(t - x/c) / A with c = sqrt(E/rho) (MODEL.md). End time "
+              "750 mm. Away from the end, sigma(x, t) = F(t - x/c) / A with c = sqrt(E/rho) (1-D wave theory). End time "
               "200 us (the reflection from the far end reaches x = 750 mm at 245 us), step 1 us after the contact.\n\n",
               L, w, w, kE, kRho);
   std::printf("| mesh size (mm) | nodes | probe x (mm) | FE peak (MPa) | F_max/A (MPa) | error | FE time of peak (us) "

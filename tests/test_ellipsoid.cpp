@@ -94,7 +94,7 @@ TEST(Ellipsoid, PaperRadiusEq26) {
   EXPECT_NEAR(e.paper_radius_m(e.closest_point({0, 1, 0})), 0.5 * (0.5 + 4.0 / 0.5), 1e-14);
   // Sphere: its radius wherever it is hit. (The axis-normal sections through (1, 1, 1)/sqrt(3)
   // are circles of radius r sqrt(2/3): not normal sections, so Eq. 26 taken literally would give
-  // less than r; MODEL.md.)
+  // less than r; docs/table1.md, "The sphere row".)
   const Ellipsoid s = Ellipsoid::sphere(0.05);
   EXPECT_EQ(s.paper_radius_m(s.closest_point({0, 1, 0})), 0.05);
   EXPECT_EQ(s.paper_radius_m(s.closest_point({1, 1, 1})), 0.05);

@@ -29,7 +29,7 @@ Scene grid_scene(double mass_ratio, double aspect, double modulus, double veloci
   BodySpec target;
   target.name = "target";
   target.shape = ShapeKind::ellipsoid;
-  // Smaller semi-axis 20 x the impactor radius (MODEL.md's Table 1 setting), a = aspect * b.
+  // Smaller semi-axis 20 x the impactor radius (docs/table1.md's preset), a = aspect * b.
   const double b = 20 * radius;
   target.semi_axes_m = {aspect * b, b, b};
   target.material = "mat";

@@ -160,7 +160,7 @@ TEST(FemMed, ReadsBackWithMdumpWithCountsAndGroups) {
 #endif
 }
 
-// ---- Code_Aster keyword table (DECKS.md) ---------------------------------------------------
+// ---- Code_Aster keyword table (its command catalogues, code_aster/Cata/Commands, 15.2) -----
 
 namespace {
 
@@ -247,7 +247,7 @@ TEST(FemCodeAster, CommMatchesTheKeywordTableOfDecksMd) {
   EXPECT_NE(comm.find("Scene: test_fem.cpp"), std::string::npos);
   EXPECT_NE(comm.find("impactdeck "), std::string::npos);
 
-  // command -> allowed top-level keywords, allowed keywords inside _F (DECKS.md table).
+  // command -> allowed top-level keywords, allowed keywords inside _F (Code_Aster's catalogues).
   const std::map<std::string, std::pair<std::set<std::string>, std::set<std::string>>> table = {
       {"DEBUT", {{}, {}}},
       {"LIRE_MAILLAGE", {{"FORMAT", "UNITE"}, {}}},
@@ -275,7 +275,7 @@ TEST(FemCodeAster, CommMatchesTheKeywordTableOfDecksMd) {
   std::map<std::string, const Call*> first;
   for (const Call& c : calls) {
     auto t = table.find(c.command);
-    ASSERT_NE(t, table.end()) << "command not in the DECKS.md table: " << c.command;
+    ASSERT_NE(t, table.end()) << "command not in the keyword table: " << c.command;
     for (const auto& [k, v] : c.keys) EXPECT_TRUE(t->second.first.count(k)) << c.command << " " << k;
     for (const auto& k : c.nested) {
       EXPECT_TRUE(t->second.first.count(k) || t->second.second.count(k)) << c.command << " _F " << k;

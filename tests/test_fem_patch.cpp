@@ -216,7 +216,7 @@ TEST(FemPatch, BadPatchesAreRefusedWithReasons) {
 
 namespace {
 
-// One result block in ccx's fixed-width .frd layout (DECKS.md "Stresses from ccx").
+// One result block in ccx's fixed-width .frd layout (ccx 2.20 User's Manual, result format).
 void frd_block(std::ostream& o, double t, const char* name, const std::vector<std::vector<double>>& rows) {
   char line[256];
   std::snprintf(line, sizeof line, "  100CL  101%12.5E%12d                     1    1           1\n", t,

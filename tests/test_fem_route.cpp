@@ -149,7 +149,7 @@ INSTANTIATE_TEST_SUITE_P(
     [](const ::testing::TestParamInfo<PartCase>& i) { return std::string(i.param.name); });
 
 // The analytic 1-D wave: a long free bar hit on its end face carries sigma(x, t) = F(t - x/c)/A
-// away from the end, c = sqrt(E/rho) (MODEL.md). A 400 x 20 x 20 mm steel bar, written here as an
+// away from the end, c = sqrt(E/rho) (docs/validation.md). A 400 x 20 x 20 mm steel bar, written here as an
 // STL of 12 triangles, hit at the centre of its end face by a 10 mm ball at 1 m/s; probe at
 // mid-length. Then the verdict both ways on the same run.
 TEST(FemWave, MidLengthProbeSeesForceOverAreaAfterTheWaveTransit) {

@@ -68,7 +68,7 @@ const Table1Result& paper_result() {
 TEST(Table1, PaperPresetReproducesThePaper) {
   const Table1Result& r = paper_result();
   ASSERT_TRUE(r.compared);
-  EXPECT_EQ(r.points_per_cell, 390u);  // MODEL.md: 390 points, tips and rim included
+  EXPECT_EQ(r.points_per_cell, 390u);  // docs/table1.md: 390 points, tips and rim
   EXPECT_EQ(r.cells_compared, 71u);    // 72 cells with g != 1, one left out
   EXPECT_LE(r.mean_abs_delta, kTable1MeanAbs);
   EXPECT_LE(r.max_abs_delta, kTable1MaxAbs);
@@ -82,7 +82,7 @@ TEST(Table1, PaperPresetReproducesThePaper) {
 }
 
 TEST(Table1, EmbeddedPaperValuesEqualTheDataFile) {
-  // tests/data/paper_table1.csv is the shared transcription (rows mu, columns g); the study embeds
+  // tests/data/paper_table1.csv is a transcription of the paper's table (rows mu, columns g); the study embeds
   // the same numbers transposed (rows g, columns mu).
   std::ifstream f(std::string(IMPACTDECK_SOURCE_DIR) + "/tests/data/paper_table1.csv");
   ASSERT_TRUE(f) << "tests/data/paper_table1.csv";
@@ -106,7 +106,7 @@ TEST(Table1, EmbeddedPaperValuesEqualTheDataFile) {
 }
 
 TEST(Table1, SizeRatioIsSharp) {
-  // MODEL.md: the fit is sharp in the size ratio; 19 and 21 are clearly worse than 20.
+  // docs/table1.md: the fit is sharp in the size ratio; 19 and 21 are clearly worse than 20.
   for (double s : {19.0, 21.0}) {
     Table1Options o = table1_preset("paper");
     o.size_ratio = s;
@@ -116,7 +116,7 @@ TEST(Table1, SizeRatioIsSharp) {
 }
 
 TEST(Table1, SphereRowIsExactlyOne) {
-  // A sphere's radius is its radius under the paper's rule too (MODEL.md: Eq. 26's axis-normal
+  // A sphere's radius is its radius under the paper's rule too (docs/table1.md: Eq. 26's axis-normal
   // sections are not normal sections), and r x n = 0 on a sphere: the row is 1, as printed.
   const Table1Result& r = paper_result();
   const std::size_t g1 = 4;

@@ -121,7 +121,7 @@ const ShapePolynomials& shape_polynomials() {
 
 double compression_time_factor() {
   // C_n = sqrt(pi) Gamma(1 + 1/p) / Gamma(1/2 + 1/p) for n = 3/2, i.e. sqrt(pi) Gamma(1.4)/Gamma(0.9)
-  // = 1.47163759216235232869... (50-digit evaluation; MODEL.md). Evaluated in double through GSL's
+  // = 1.47163759216235232869... (evaluated to 50 digits). Evaluated in double through GSL's
   // gamma it is 8 ulp off, which would leak into every time; the test checks the two agree.
   return 1.4716375921623523;
 }

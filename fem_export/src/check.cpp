@@ -568,7 +568,7 @@ CheckResult check_deck(const fs::path& dir, const Deck& deck, const CheckOptions
   Eigen::Vector3d P = Eigen::Vector3d::Zero();
   for (std::size_t i = 0; i < v.size(); ++i) P += node_mass[i] * v[i];
   // ccx 2.20 integrates the C3D4 mass matrix at one point: M_e = m_e / 16 (1 1^T) (x) I_3, so
-  // L_e = m_e ybar_e x vbar_e exactly (DECKS.md facts; measured here: matches (p - c) x Pi to 1e-5,
+  // L_e = m_e ybar_e x vbar_e exactly (docs/fem.md, "The check"; measured: matches (p - c) x Pi to 1e-5,
   // where the fully integrated matrix misses by several %). Its rigid-rotation inertia is the
   // one-point one, sum m_e (|ybar|^2 1 - ybar ybar^T).
   Eigen::Vector3d L = Eigen::Vector3d::Zero();

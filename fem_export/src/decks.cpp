@@ -1,4 +1,4 @@
-// Code_Aster and CalculiX decks (DECKS.md), written into a staging folder renamed at the end.
+// Code_Aster and CalculiX decks (docs/fem.md), written into a staging folder renamed at the end.
 #include "impactdeck/fem_export/decks.hpp"
 
 #include <unistd.h>

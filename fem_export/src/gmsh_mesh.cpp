@@ -445,7 +445,7 @@ MeshResult mesh_ellipsoid_with_gmsh(const Eigen::Vector3d& semi_axes_m, const Ei
     gmsh::model::setPhysicalName(0, gmsh::model::addPhysicalGroup(0, {load_tag}), "LOAD");
     add_probe_groups(probe_tags);
   });
-  const int alg2 = o.algorithm_2d ? o.algorithm_2d : 1;  // MeshAdapt: the dilated OCC sphere (DECKS.md)
+  const int alg2 = o.algorithm_2d ? o.algorithm_2d : 1;  // MeshAdapt: Gmsh 4.8.4's default fails on the dilated OCC sphere
   generate_tets(where, o, alg2, p_mm, h0, h);
   finish_point_mesh(where, o, folder, name, load_tag, probe_tags, p_mm, h0, alg2, "analytic", r);
 

@@ -230,7 +230,7 @@ Curvature Ellipsoid::curvature(const SurfacePoint& at) const {
 
 double Ellipsoid::paper_radius_m(const SurfacePoint& at) const {
   // A sphere's radius is its radius wherever it is hit: Eq. 26's axis-normal sections are not
-  // normal sections (Meusnier), so off the axes they would give less than r (MODEL.md).
+  // normal sections (Meusnier), so off the axes they would give less than r (docs/table1.md).
   if (is_sphere()) return e_.x();
   // Section i (the plane x_i = p_i) is the ellipse with semi-axes alpha = e_j s, beta = e_k s,
   // s^2 = 1 - (p_i / e_i)^2, and p at the parametric angle gamma (p_j = alpha cos g, p_k = beta sin g).

@@ -78,7 +78,7 @@ LoadedMesh load_mesh(const fs::path& file, LengthUnit unit) {
     }
   }
   // OFF, OBJ, PLY and ASCII STL: own readers in double precision (text_mesh_readers.hpp); assimp
-  // (float32) reads binary STL only, which is float32 anyway.
+  // (float32) sees only a binary STL the direct reader below declines (size and count disagree).
   if (auto own = detail::read_own_format(file, ext, unit, bytes)) return std::move(*own);
 
   LoadedMesh out;

@@ -21,7 +21,7 @@ namespace {
 
 const std::vector<double> kDecades = {1e-4, 1e-3, 1e-2, 1e-1, 1.0, 1e1, 1e2, 1e3, 1e4};
 
-// Quantities that cancel from the ratio (MODEL.md); fixed, plausible values. Steel sphere of
+// Quantities that cancel from the ratio (docs/table1.md); fixed, plausible values. Steel sphere of
 // r = 50 mm at 1 m/s, the paper's Eq. 28 modulus.
 constexpr double kSphereRadius_m = 0.05;
 constexpr double kDensity_kg_m3 = 7850.0;

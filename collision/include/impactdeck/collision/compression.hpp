@@ -1,5 +1,5 @@
 #pragma once
-// Compression phase of a Hertz impact, in closed form (paper Eq. 2-12, MODEL.md).
+// Compression phase of a Hertz impact, in closed form (paper Eq. 2-12; docs/architecture.md).
 //
 //   m_w x'' + k_H x^n = 0,  x(0) = 0, x'(0) = v,  n = 3/2, p = n + 1
 //   x_max = [p m_w v^2 / (2 k_H)]^(1/p),  F_max = k_H x_max^n            (Eq. 8)

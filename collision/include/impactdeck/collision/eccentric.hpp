@@ -1,5 +1,5 @@
 #pragma once
-// Eccentric collision bookkeeping (paper Eq. 16-23, 32; MODEL.md "Eccentric collision").
+// Eccentric collision bookkeeping (paper Eq. 16-23, 32; docs/architecture.md).
 //
 //   1/m_w = sum_i [ 1/m_i + (r_i x n)^T I_i^-1 (r_i x n) ]          (tensor form; Eq. 21 is its
 //                                                                     principal-axes special case)

@@ -1,6 +1,7 @@
 #pragma once
 // Force history of one impact: the closed-form compression phase followed by the restitution
-// phase, and its sampling into a piecewise-linear table for FEM (MODEL.md "Restitution").
+// phase, and its sampling into a piecewise-linear table for FEM (paper Eq. 13, Sect. 2.3;
+// docs/architecture.md, "Numerical choices").
 //
 //   compression   F(t) = F_max Z(t/t_m)^n                              0 <= t <= t_m
 //   restitution   F(t) = F_comp(t_m - (t - t_m)/R)                     t_m <= t <= (1+R) t_m

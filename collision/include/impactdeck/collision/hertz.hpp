@@ -1,5 +1,5 @@
 #pragma once
-// Hertz contact stiffness (paper Eq. 1, 27, 28, 29; MODEL.md "Hertz contact").
+// Hertz contact stiffness (paper Eq. 1, 27, 28, 29; Johnson, Contact Mechanics, 1985, ch. 4).
 //   P = k_H x^n, n = 3/2,   k_H = 4/3 E* sqrt(R*)                       (Eq. 27)
 //   1/R* = 1/R1 + 1/R2 (a plane has curvature 0)                          (Eq. 29, Eq. 15)
 //   1/E* = (1-nu1^2)/E1 + (1-nu2^2)/E2   ("hertz" convention, default)

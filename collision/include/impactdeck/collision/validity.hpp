@@ -1,5 +1,5 @@
 #pragma once
-// Validity of the Hertz contact model at one impact (MODEL.md "Validity of the Hertz model"):
+// Validity of the Hertz contact model at one impact (Johnson, Contact Mechanics, 1985, ch. 4, 6):
 // Hertz assumes small strains and a contact patch small against both bodies, and an elastic
 // material. Reported for every impact; a quantity out of its range is warned about by name.
 //

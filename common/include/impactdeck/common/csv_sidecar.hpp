@@ -24,7 +24,7 @@ inline constexpr std::size_t kMaxFileNameBytes = 255;
 /// this name only (its JSON's "file" names the CSV).
 std::filesystem::path csv_sidecar_path(const std::filesystem::path& csv);
 
-/// The unit a column name declares by its suffix (the naming rule of docs/STYLE.md): x_m -> "m",
+/// The unit a column name declares by its suffix (docs/cli.md, "CSV files"): x_m -> "m",
 /// force_N -> "N", impulse_Ns -> "N s", dvx_m_s -> "m/s", dwx_rad_s -> "rad/s", ..._Pa -> "Pa",
 /// ..._kg -> "kg", ..._s -> "s", hertz_constant_N_per_m1_5 -> "N/m^1.5"; "1" (dimensionless) for
 /// any other name, "" for the row index, labels and flags (`index`, `point`, `id`, `state`, `flag`, ...).

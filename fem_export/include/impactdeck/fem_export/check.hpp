@@ -8,9 +8,9 @@
 //            L_FE = sum_e m_e ybar_e x vbar_e, y = x - c; the fully integrated matrix's formula
 //            misses by several %, measured)
 //            omega_FE = I_FE^-1 L_FE   vs   omega_ref = I_FE^-1 ((p - c) x Pi d)
-// M_FE, c, I_FE are the FE mesh's own mass, centroid and inertia (DECKS.md: a coarse mesh is
-// lighter than the analytic body). Probe nodes' time-averaged velocities are reported with their
-// scatter, not checked (DECKS.md: their elastic vibration exceeds the rigid-body velocity).
+// M_FE, c, I_FE are the FE mesh's own mass, centroid and inertia (a coarse mesh is lighter
+// than the analytic body: docs/validation.md). Probe nodes' time-averaged velocities are reported with their
+// scatter, not checked (docs/validation.md: their elastic vibration exceeds the rigid-body velocity).
 //
 // Beside this solver self-check, the FE result is compared with the rigid model (deck.json
 // "model": the part's exact mass properties and the impact's velocity jumps of the target):
@@ -53,8 +53,8 @@ struct CheckOptions {
 };
 
 /// The default ccx time limit of a deck: 10 times an estimate of its run time (2e-4 s per node and
-/// increment, times sqrt(nodes / 1000) above 1000 nodes; DECKS.md's measured runs take 0.4 to 0.9
-/// of the estimate), and at least 300 s.
+/// increment, times sqrt(nodes / 1000) above 1000 nodes; measured ccx 2.20 runs take 0.4 to 0.9
+/// of the estimate, docs/reliability.md), and at least 300 s.
 double default_solver_timeout_s(std::size_t nodes, std::size_t increments);
 
 struct ProbeResult {

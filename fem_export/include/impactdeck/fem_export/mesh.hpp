@@ -3,7 +3,7 @@
 // (gmsh.h stays inside fem_export/src). Two routes:
 //   - an analytic ellipsoid: OCC unit sphere rotated so that a pole lands on the load point's
 //     direction, then dilated by the semi-axes; the pole is a model vertex, so a mesh node lies
-//     exactly on the load point (DECKS.md);
+//     exactly on the load point (docs/fem.md, "Geometry and mesh");
 //   - a mesh part: the part's triangulated surface, handed over from memory (whatever file format
 //     it came from, after validation and repair) -> one discrete surface -> classifySurfaces ->
 //     createGeometry -> volume; the load point is a geometry point embedded in the surface that
@@ -98,10 +98,10 @@ struct MeshOptions {
   /// inside the body.
   std::vector<Eigen::Vector3d> probes_m;
   /// Gmsh Mesh.Algorithm (2D) of the first try; 0 = the route's default (ellipsoid: 1 MeshAdapt,
-  /// DECKS.md; mesh part: 6 Frontal-Delaunay).
+  /// the only one that meshed the dilated OCC sphere in Gmsh 4.8.4; mesh part: 6 Frontal-Delaunay).
   int algorithm_2d = 0;
-  /// Gmsh Mesh.Algorithm3D: 1 Delaunay (default: the same mesh on every run), 10 HXT (DECKS.md
-  /// suggests it against slivers, but Gmsh 4.8.4's HXT gives a different mesh on each run, which
+  /// Gmsh Mesh.Algorithm3D: 1 Delaunay (default: the same mesh on every run), 10 HXT (avoided a
+  /// Delaunay sliver on one test mesh, but Gmsh 4.8.4's HXT gives a different mesh on each run, which
   /// breaks "the .geo reproduces the mesh"). Slivers are caught by the quality floor.
   int algorithm_3d = 1;
   /// Mesh part only: feature angle for classifySurfaces, degrees.

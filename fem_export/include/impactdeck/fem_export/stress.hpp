@@ -1,5 +1,5 @@
 #pragma once
-// Stresses of a CalculiX run, read back from its .frd (DECKS.md "Stresses from ccx"): the nodal
+// Stresses of a CalculiX run, read back from its .frd (ccx 2.20 User's Manual, *EL FILE): the nodal
 // stresses S (extrapolated from the elements and averaged at the nodes by ccx, MPa in the deck's
 // units) and displacements U of every output increment. Von Mises
 //     sigma_v = sqrt(1/2 [(sx - sy)^2 + (sy - sz)^2 + (sz - sx)^2] + 3 (txy^2 + tyz^2 + tzx^2))

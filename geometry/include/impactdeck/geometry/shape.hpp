@@ -50,7 +50,7 @@ class Shape {
   virtual bool on_sharp_feature(const SurfacePoint& /*at*/) const { return false; }
   /// The paper's local radius (Eq. 26): mean radius of the sections by the three axis-normal
   /// planes through the point, degenerate (tangent) sections left out; a sphere's radius on a
-  /// sphere (MODEL.md: axis-normal sections are not normal sections), infinity on a plane.
+  /// sphere (axis-normal sections are not normal sections: docs/table1.md), infinity on a plane.
   virtual double paper_radius_m(const SurfacePoint& at) const = 0;
   /// Where the ray from `origin_m` (inside the solid) along `direction` leaves the surface.
   virtual std::optional<SurfacePoint> ray_exit(const Eigen::Vector3d& origin_m,

@@ -12,7 +12,7 @@
 
 namespace impactdeck::study {
 
-/// The grid that reproduces the paper's Table 1 (MODEL.md "Table 1"): (y/b, z/c) on the square
+/// The grid that reproduces the paper's Table 1 (docs/table1.md, "The setting"): (y/b, z/c) on the square
 /// [-1, 1]^2 with step 1/`steps`, kept where (y/b)^2 + (z/c)^2 <= 1, lifted to both sides
 /// x = +-a sqrt(1 - (y/b)^2 - (z/c)^2); points on the rim (x = 0) appear once.
 /// For steps = 8: 390 points, both tips and the rim included. Throws InputError for steps < 1.

@@ -5,8 +5,8 @@
 // mu = m1/m2 (ellipsoid / sphere).
 //
 // F_max ~ k_H^(2/5) (m_w v^2)^(3/5): modulus, Poisson ratio, speed, density and m2 cancel from the
-// ratio (MODEL.md). What remains is g, mu, the cloud, the target's size relative to the sphere and
-// the local-radius rule; the `paper` preset is the setting of MODEL.md that reproduces the table.
+// ratio (docs/table1.md). What remains is g, mu, the cloud, the target's size relative to the sphere and
+// the local-radius rule; the `paper` preset is the setting that reproduces the table (docs/table1.md).
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -58,7 +58,7 @@ std::shared_ptr<const geometry::Shape> stretched_target(const geometry::Shape& t
                                                         const InputContext& ctx = {});
 
 /// Named presets. "paper": the 9 x 9 grid {1e-4 ... 1e4}^2, size ratio 20, Eq. 26 radius, the
-/// 390-point grid (MODEL.md "Table 1"). Throws InputError for an unknown name.
+/// 390-point grid (docs/table1.md). Throws InputError for an unknown name.
 Table1Options table1_preset(const std::string& name);
 
 /// The paper's Table 1 as printed: the 9 g values, the 9 mu values and ratio[g][mu].
