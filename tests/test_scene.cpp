@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "impactdeck/collision/elliptical.hpp"
+#include "impactdeck/common/csv_sidecar.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/scene/pipeline.hpp"
 #include "impactdeck/scene/report.hpp"
@@ -280,4 +281,20 @@ TEST(SceneFem, BadOutputsFemKeysNameTheKey) {
   expect_error(fem + "calculix = false\ncode_aster = false\n", R"(no deck to write)");
   expect_error(replace(fem, "shape = \"ellipsoid\"", "shape = \"ellipsoid\"\nfixed = true"),
                R"(target 'target' is fixed)");
+}
+
+// Issue 29: a force table named with 251 to 255 bytes (allowed for output names) is written with
+// its JSON sidecar, whose name common/csv_sidecar.hpp keeps within 255 bytes.
+TEST(Scene, ForceTableNamesUpTo255BytesGetTheirSidecar) {
+  const std::string name = std::string(251, 'f') + ".csv";  // 255 bytes
+  const Scene s = parse_scene(kBase + "[outputs]\nforce_table_csv = \"" + name + "\"\n", "long.toml");
+  const fs::path out = fs::temp_directory_path() / "impactdeck_test_long_sidecar";
+  fs::remove_all(out);
+  fs::create_directories(out);
+  const RunReport r = run_scene(s, RunOptions{out});
+  EXPECT_TRUE(r.all_checks_passed());
+  EXPECT_TRUE(fs::is_regular_file(out / name));
+  EXPECT_TRUE(fs::is_regular_file(out / csv_sidecar_path(name)));
+  EXPECT_LE(csv_sidecar_path(name).string().size(), 255u);
+  EXPECT_NE(csv_sidecar_path(name), fs::path(name + ".json"));
 }

@@ -11,6 +11,7 @@
 #include "impactdeck/collision/elliptical.hpp"
 #include "impactdeck/collision/hertz.hpp"
 #include "impactdeck/common/atomic_file.hpp"
+#include "impactdeck/common/csv_sidecar.hpp"
 #include "impactdeck/common/run_transaction.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/common/stage.hpp"
@@ -426,7 +427,7 @@ StagedOutputs reserve_outputs(const Scene& scene, RunTransaction& txn) {
     if (scene.outputs.force_table_csv) {
       const std::string csv = per_impact(*scene.outputs.force_table_csv, s, "force_table_csv");
       st.table.push_back(reserve(csv, place_of("force_table_csv"), false));
-      reserve(csv + ".json", place_of("force_table_csv") + " (its JSON sidecar)", false);
+      reserve(csv_sidecar_path(csv).string(), place_of("force_table_csv") + " (its JSON sidecar)", false);
     }
     if (scene.outputs.force_plot_svg) {
       st.plot.push_back(reserve(per_impact(*scene.outputs.force_plot_svg, s, "force_plot_svg"), place_of("force_plot_svg"), false));

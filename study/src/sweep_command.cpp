@@ -89,7 +89,7 @@ void sweep_stages(const SweepCase& ss, const SweepRequest& q, RunTransaction* tx
       staged_base = staged.parent_path() / fs::path(prefix).filename();
       if (std::string_view(suffix).substr(std::string_view(suffix).size() - 4) == ".csv") {
         // its JSON sidecar (common/csv_sidecar.hpp)
-        rep.files_written.push_back(txn->public_path(txn->file(prefix + suffix + ".json", txn->out_dir().string(), prefix_place)));
+        rep.files_written.push_back(txn->public_path(txn->file(csv_sidecar_path(prefix + suffix).string(), txn->out_dir().string(), prefix_place)));
       }
     }
   }
