@@ -3,6 +3,7 @@
 #include <iomanip>
 #include <sstream>
 
+#include "impactdeck/common/csv_sidecar.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/common/json_number.hpp"
 #include "impactdeck/common/run_transaction.hpp"
