@@ -890,7 +890,6 @@ DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
                  {"mesh", quality},
                  {"files", names}};
     write_file_atomically(stage / "deck.json", deck.dump(2) + "\n");
-    out.calculix = r.options.calculix;
     out.description = std::move(deck);
 
     out.mesh = std::move(m);  // the check takes it from here (run_check(DeckResult))

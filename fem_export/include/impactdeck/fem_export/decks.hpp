@@ -250,7 +250,6 @@ struct DeckResult {
   PatchSummary patch;
   double contact_zone_radius_m = 0;
   BodyComparison body_check;
-  bool calculix = false;      ///< the folder holds a CalculiX deck
   nlohmann::json description;  ///< deck.json's contents, as written
   TetMesh mesh;               ///< the mesh of mesh.inp and mesh.med, in metres, as meshed
 };
