@@ -42,17 +42,12 @@ class FileLock {
 enum class Kind { file, folder };
 bool check_inside(const std::filesystem::path& dir, const std::filesystem::path& rel, Kind want);
 
-/// The largest JSON nesting depth read (run --json documents are about 8 deep).
-inline constexpr int kMaxJsonDepth = 64;
 /// campaign.json of 10^6 cases is about 300 MB.
 inline constexpr std::uintmax_t kMaxPlanBytes = std::uintmax_t{512} << 20;
 /// A case's result.json or failure.json.
 inline constexpr std::uintmax_t kMaxResultBytes = std::uintmax_t{64} << 20;
 
-/// JSON text parsed with its nesting bounded by kMaxJsonDepth; InputError naming `file` with the
-/// line and column of a syntax error, or the depth.
-nlohmann::json parse_json(const std::string& text, const std::string& file);
-/// The regular file `dir`/`rel` (check_inside, at most `max_bytes`) parsed by parse_json.
+/// The regular file `dir`/`rel` (check_inside, at most `max_bytes`) parsed by parse_json_bounded.
 nlohmann::json read_json_inside(const std::filesystem::path& dir, const std::filesystem::path& rel,
                                 const std::string& noun, std::uintmax_t max_bytes);
 

@@ -18,6 +18,7 @@
 #include "impactdeck/campaign/runner.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/common/input_file.hpp"
+#include "impactdeck/common/json_read.hpp"
 
 extern char** environ;
 
@@ -109,39 +110,11 @@ bool check_inside(const fs::path& dir, const fs::path& rel, Kind want) {
   return true;
 }
 
-nlohmann::json parse_json(const std::string& text, const std::string& file) {
-  struct TooDeep {};
-  try {
-    return json::parse(text, [](int depth, json::parse_event_t event, json&) {
-      if ((event == json::parse_event_t::object_start || event == json::parse_event_t::array_start) &&
-          depth >= kMaxJsonDepth) {
-        throw TooDeep{};
-      }
-      return true;
-    });
-  } catch (const TooDeep&) {
-    throw InputError(file, "nesting", "nested deeper than " + std::to_string(kMaxJsonDepth) +
-                                          " levels: not a file impactdeck wrote (its documents are about 8 deep)");
-  } catch (const json::parse_error& e) {
-    // "[json.exception.parse_error.101] parse error at line 1, column 5: REASON"
-    std::string what = e.what(), place = "byte " + std::to_string(e.byte);
-    const std::string at = "parse error at ";
-    if (const auto a = what.find(at); a != std::string::npos) {
-      what.erase(0, a + at.size());
-      if (const auto colon = what.find(": "); colon != std::string::npos) {
-        place = what.substr(0, colon);
-        what.erase(0, colon + 2);
-      }
-    }
-    throw InputError(file, place, "is not valid JSON: " + what);
-  }
-}
-
 nlohmann::json read_json_inside(const fs::path& dir, const fs::path& rel, const std::string& noun,
                                 std::uintmax_t max_bytes) {
   const fs::path p = dir / rel;
   if (!check_inside(dir, rel, Kind::file)) throw InputError(p.string(), "file", "missing");
-  return parse_json(read_input_file(p, noun, max_bytes), p.string());
+  return parse_json_bounded(read_input_file(p, noun, max_bytes), p.string());
 }
 
 Plan read_plan(const fs::path& dir_in) {

@@ -12,6 +12,7 @@
 
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/common/input_file.hpp"
+#include "impactdeck/common/json_read.hpp"
 #include "impactdeck/common/numeric.hpp"
 #include "impactdeck/fem_export/decks.hpp"
 #include "impactdeck/fem_export/mesh.hpp"
@@ -167,13 +168,7 @@ void check_load_node(const Deck& d, const std::string& where) {
 Deck read_deck(const fs::path& dir) {
   const fs::path jp = dir / "deck.json";
   const std::string where = jp.string();
-  json j;
-  try {
-    j = json::parse(read_text(jp, "deck description"));
-  } catch (const json::exception& e) {
-    throw InputError(where, "json", std::string("not a deck description: ") + e.what());
-  }
-  Deck d = deck_from(j, where);
+  Deck d = deck_from(parse_json_bounded(read_text(jp, "deck description"), where), where);
   // mesh.inp: *NODE, *ELEMENT and *NSET blocks as calculix_mesh_inp writes them.
   const fs::path mp = dir / "mesh.inp";
   std::istringstream in(read_text(mp, "mesh"));
