@@ -19,6 +19,7 @@
 #include "impactdeck/common/version.hpp"
 #include "impactdeck/fem_export/force_table.hpp"
 #include "impactdeck/common/json_number.hpp"
+#include "impactdeck/common/numeric.hpp"
 
 namespace impactdeck::fem_export {
 namespace fs = std::filesystem;
@@ -622,7 +623,7 @@ namespace {
 void check_element_count(const DeckRequest& r, const InputContext& where) {
   const double volume = r.body.volume_m3 > 0                  ? r.body.volume_m3
                         : r.model.volume_m3 > 0              ? r.model.volume_m3
-                        : r.body.kind == BodyKind::ellipsoid ? 4.0 / 3.0 * M_PI * r.body.semi_axes_m.prod()
+                        : r.body.kind == BodyKind::ellipsoid ? ellipsoid_volume(r.body.semi_axes_m.x(), r.body.semi_axes_m.y(), r.body.semi_axes_m.z())
                                                              : 0.0;  // unknown: only the real count is checked
   const double est = estimate_tet_count(volume, r.options.mesh.mesh_size_m, r.options.mesh.load_mesh_size_m);
   if (est > static_cast<double>(r.options.max_elements)) {

@@ -7,10 +7,13 @@
 #include <cmath>
 #include <cstdint>
 #include <iomanip>
+#include <array>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <sstream>
 
+#include "impactdeck/common/numeric.hpp"
 #include "impactdeck/common/atomic_file.hpp"
 #include "impactdeck/common/child_process.hpp"
 #include "impactdeck/common/error.hpp"
@@ -414,7 +417,7 @@ MeshResult mesh_ellipsoid_with_gmsh(const Eigen::Vector3d& semi_axes_m, const Ei
   axis.normalize();
 
   MeshResult r;
-  r.quality.part_volume_m3 = 4.0 / 3.0 * kPi * semi_axes_m.prod();
+  r.quality.part_volume_m3 = ellipsoid_volume(semi_axes_m.x(), semi_axes_m.y(), semi_axes_m.z());
   GmshSession session(name);
   int load_tag = -1, vol = -1;
   std::vector<int> probe_tags;
@@ -650,17 +653,39 @@ bool faces_all_planar() {
   return true;
 }
 
-// A fresh model `name` holding the part's STL copy (its triangles, not yet classified).
-void merge_part(const fs::path& stl, const std::string& name) {
+// A fresh model `name` holding the part's triangles (in mm, not yet classified) as one discrete
+// surface, built from memory as Gmsh's STL reader builds it from the STL copy the .geo merges:
+// corners with equal coordinates are one node, numbered 3 j + k + 1 after the first corner (k of
+// triangle j) that names it, and triangle j is element j + 1. So meshing from memory and the
+// .geo's merge of the copy start from the same model, and the run never reads back a file it
+// wrote.
+void add_part(const PartSurface& s, const std::string& name) {
   gmsh::clear();
   gmsh::model::add(name);
-  gmsh::merge(stl.string());
+  const int surface = gmsh::model::addDiscreteEntity(2);
+  std::map<std::array<double, 3>, std::size_t> node_at;
+  std::vector<std::size_t> node_tags, element_tags, element_nodes;
+  std::vector<double> xyz;
+  for (std::size_t j = 0; j < s.triangles.size(); ++j) {
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d p = s.vertices_m[s.triangles[j][k]] * kMmPerM;
+      const auto [at, fresh] = node_at.try_emplace({p.x(), p.y(), p.z()}, 3 * j + k + 1);
+      if (fresh) {
+        node_tags.push_back(at->second);
+        xyz.insert(xyz.end(), {p.x(), p.y(), p.z()});
+      }
+      element_nodes.push_back(at->second);
+    }
+    element_tags.push_back(j + 1);
+  }
+  gmsh::model::mesh::addNodes(2, surface, node_tags, xyz);
+  gmsh::model::mesh::addElementsByType(surface, 2, element_tags, element_nodes);
 }
 
-// Gmsh's feature classification of the merged part, then its geometry: the faces as classified
+// Gmsh's feature classification of the part (add_part), then its geometry: the faces as classified
 // when all are planar (above), else Gmsh's split into parametrizable patches. Returns whether the
 // split was used (the .geo repeats the choice).
-bool classify_part_surfaces(double feature_angle_rad, const fs::path& stl, const std::string& name) {
+bool classify_part_surfaces(double feature_angle_rad, const PartSurface& surf, const std::string& name) {
   gmsh::model::mesh::classifySurfaces(feature_angle_rad, true, false, kPi);
   if (faces_all_planar()) {
     try {
@@ -670,7 +695,7 @@ bool classify_part_surfaces(double feature_angle_rad, const fs::path& stl, const
       // Gmsh could not parametrize a face after all: the split below, as for any other part.
     }
   }
-  merge_part(stl, name);
+  add_part(surf, name);
   gmsh::model::mesh::classifySurfaces(feature_angle_rad, true, true, kPi);
   gmsh::model::mesh::createGeometry();
   return true;
@@ -728,27 +753,24 @@ MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& l
   int load_surface = -1;       // remeshed: the surface the load point is embedded in
   std::size_t load_tag = 0;    // part triangles: the Gmsh node at the load point
   std::vector<int> probe_tags;
-  std::string stl_written;     // which surface the STL copy holds now ("remeshed" / "part triangles")
   bool split_patches = false;  // remeshed: Gmsh split the surface into parametrizable patches
 
-  // Writes the STL copy the try merges (the .geo merges the same file).
-  auto write_stl = [&](bool own) {
-    const std::string kind = own ? "part triangles" : "remeshed";
-    if (stl_written == kind) return;
-    if (own) {
+  // The surface a try meshes: the part's, or (own triangles) the part's with a vertex at the load
+  // point, made once.
+  std::optional<PartSurface> split;
+  auto surface_of = [&](bool own) -> const PartSurface& {
+    if (!own) return surf;
+    if (!split) {
       int at = -1;
-      const PartSurface split = with_vertex_at(surf, load_point_m, size_m, at);
-      if ((split.vertices_m[at] - load_point_m).norm() > 1e-6 * size_m) {
+      split = with_vertex_at(surf, load_point_m, size_m, at);
+      if ((split->vertices_m[at] - load_point_m).norm() > 1e-6 * size_m) {
         throw where.error("load point", "is not on the part's surface");
       }
-      write_file_atomically(stl_copy, part_stl(split));
-    } else {
-      write_file_atomically(stl_copy, part_stl(surf));
     }
-    stl_written = kind;
+    return *split;
   };
 
-  // Builds the geometry from the STL copy and meshes it with one try's settings.
+  // Builds the geometry from the try's surface and meshes it with the try's settings.
   auto mesh_try = [&](const Try& t, MeshResult& r) {
     const double h = h_first * t.size_factor, h0 = std::min(h0_first, h);
     r = MeshResult{};
@@ -757,12 +779,12 @@ MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& l
     r.quality.load_mesh_size_m = h0 / kMmPerM;
     probe_tags.clear();
     split_patches = false;
-    write_stl(t.own_triangles);
-    gmsh_step(where, "read part", [&] { merge_part(stl_copy, name); });
+    const PartSurface& tried = surface_of(t.own_triangles);
+    gmsh_step(where, "read part", [&] { add_part(tried, name); });
     gmsh_step(where, t.own_triangles ? "volume" : "classify surfaces", [&] {
       std::vector<int> st;
       if (!t.own_triangles) {
-        split_patches = classify_part_surfaces(o.feature_angle_deg * kPi / 180.0, stl_copy, name);
+        split_patches = classify_part_surfaces(o.feature_angle_deg * kPi / 180.0, tried, name);
       }
       gmsh::vectorpair surfs;
       gmsh::model::getEntities(surfs, 2);
@@ -876,6 +898,8 @@ MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& l
 
   const Try& t = tries[kept];
   const double h = h_first * t.size_factor, h0 = std::min(h0_first, h);
+  // The kept try's surface, for the .geo to merge (the run itself meshed it from memory).
+  write_file_atomically(stl_copy, part_stl(surface_of(t.own_triangles)));
   std::ostringstream g;
   g << geo_header("mesh part (" + part + ") from memory, written as " + stl_copy.filename().string() +
                   " (mm)", o);

@@ -12,6 +12,7 @@
 #include <gsl/gsl_sf_ellint.h>
 
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/common/numeric.hpp"
 #include "impactdeck/common/symmetric2.hpp"
 
 namespace impactdeck::geometry {
@@ -52,7 +53,7 @@ double Ellipsoid::area_m2() const {
 VolumeProperties Ellipsoid::volume_properties() const {
   VolumeProperties v;
   const double a = e_.x(), b = e_.y(), c = e_.z();
-  v.volume_m3 = 4.0 / 3.0 * M_PI * a * b * c;
+  v.volume_m3 = ellipsoid_volume(a, b, c);
   v.area_m2 = area_m2();
   v.centroid_m.setZero();
   // I = m/5 diag(b^2+c^2, a^2+c^2, a^2+b^2) with m = rho V.

@@ -26,6 +26,10 @@ inline bool within_magnitude_range(double x) {
 /// which stays for the extreme inputs (compression_phase, the energy flux, fast_hypot).
 inline bool is_moderate_positive(double y) { return y > 1e-300 && y < 1e300; }
 
+/// Volume of the ellipsoid of semi-axes a, b, c: 4/3 pi a b c (the one formula: the ellipsoid's
+/// mass properties, the deck's element estimate and the analytic mesh's reference volume).
+inline double ellipsoid_volume(double a, double b, double c) { return 4.0 / 3.0 * M_PI * a * b * c; }
+
 inline bool is_finite_all() { return true; }
 template <class... T>
 bool is_finite_all(double x, T... rest) {
