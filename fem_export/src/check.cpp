@@ -36,7 +36,7 @@ struct Deck {
   std::size_t load_node = 0;  // 1-based
   std::vector<std::string> probes;
   std::vector<int> probe_nodes;  // 1-based
-  TetMesh mesh;       // node i has ccx id i + 1
+  TetMesh mesh;       // node i is the solver's node i + 1
   // Written by this version (older decks: the defaults).
   RigidReference model;
   bool has_model = false;
