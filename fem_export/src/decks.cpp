@@ -29,7 +29,6 @@ using detail::output_every;
 
 namespace {
 
-
 void validate(const DeckRequest& r, const InputContext& where) {
   const DeckOptions& o = r.options;
   if (!(o.time_step_s > 0) || !std::isfinite(o.time_step_s)) throw where.error("time_step_s", "must be > 0");
@@ -76,7 +75,10 @@ void validate(const DeckRequest& r, const InputContext& where) {
   if (!(t.min_gamma >= 0 && t.min_gamma < 1)) throw where.error("min_gamma", "must lie in [0, 1)");
   if (r.yield_strength_Pa && !(*r.yield_strength_Pa > 0)) throw where.error("yield_strength_Pa", "must be > 0");
   for (const std::string& name : o.solvers) {
-    if (!find_solver(name)) throw where.error("solvers", "unknown solver '" + name + "'");
+    if (find_solver(name)) continue;
+    std::string known;
+    for (const Solver* s : solvers()) known += (known.empty() ? "" : ", ") + s->name();
+    throw where.error("solvers", "unknown solver '" + name + "' (registered: " + known + ")");
   }
 }
 
