@@ -1,11 +1,13 @@
 #pragma once
 // Helpers shared by the FEM test files: a fresh output folder under the build tree, a file's text,
-// a box as a CAD export writes it.
+// a box as a CAD export writes it, a small ellipsoid deck request.
 #include <array>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+
+#include "impactdeck/fem_export/decks.hpp"
 
 namespace impactdeck::test {
 
@@ -47,6 +49,28 @@ inline void write_box_stl(const std::filesystem::path& p, const std::array<doubl
     }
   }
   stl << "endsolid box\n";
+}
+
+/// A 2 x 0.5 x 0.5 m steel ellipsoid hit at (0, 0.5, 0), one probe, a coarse mesh; a triangular
+/// pulse: its piecewise-linear table is exact, impulse F t_end / 2.
+inline fem_export::DeckRequest ellipsoid_request() {
+  fem_export::DeckRequest r;
+  r.source = "test_fem.cpp";
+  r.impact = "test";
+  r.body.kind = fem_export::BodyKind::ellipsoid;
+  r.body.semi_axes_m = Eigen::Vector3d(2.0, 0.5, 0.5);
+  r.material = {2.05e11, 0.3, 7850};
+  r.force.time_s = {0, 5e-5, 1e-4};
+  r.force.force_N = {0, 2e5, 0};
+  r.impulse_Ns = 10.0;
+  r.direction = Eigen::Vector3d(0, -1, 0);
+  r.load_point_m = Eigen::Vector3d(0, 0.5, 0);
+  r.options.end_time_s = 3e-4;
+  r.options.time_step_s = 1e-5;
+  r.options.mesh.mesh_size_m = 0.4;
+  r.options.mesh.load_mesh_size_m = 0.15;
+  r.options.mesh.probes_m = {Eigen::Vector3d(0, 0.4, 0.25)};
+  return r;
 }
 
 }  // namespace impactdeck::test

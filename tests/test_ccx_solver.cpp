@@ -8,9 +8,11 @@
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/fem_export/decks.hpp"
 #include "impactdeck/scene/scene.hpp"
+#include "calculix/calculix.hpp"  // fem_export/src: the deck text
 
 using namespace impactdeck;
 using namespace impactdeck::fem_export;
+using calculix::calculix_inp;
 
 namespace {
 

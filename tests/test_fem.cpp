@@ -39,26 +39,7 @@ std::string run(const std::string& cmd) {
   return out;
 }
 
-// A triangular pulse: its piecewise-linear table is exact, impulse F t_end / 2.
-DeckRequest ellipsoid_request() {
-  DeckRequest r;
-  r.source = "test_fem.cpp";
-  r.impact = "test";
-  r.body.kind = BodyKind::ellipsoid;
-  r.body.semi_axes_m = Eigen::Vector3d(2.0, 0.5, 0.5);
-  r.material = {2.05e11, 0.3, 7850};
-  r.force.time_s = {0, 5e-5, 1e-4};
-  r.force.force_N = {0, 2e5, 0};
-  r.impulse_Ns = 10.0;
-  r.direction = Eigen::Vector3d(0, -1, 0);
-  r.load_point_m = Eigen::Vector3d(0, 0.5, 0);
-  r.options.end_time_s = 3e-4;
-  r.options.time_step_s = 1e-5;
-  r.options.mesh.mesh_size_m = 0.4;
-  r.options.mesh.load_mesh_size_m = 0.15;
-  r.options.mesh.probes_m = {Eigen::Vector3d(0, 0.4, 0.25)};
-  return r;
-}
+using test::ellipsoid_request;
 
 // Tetrahedra (type 4) in the $Elements section of an MSH 2.2 file.
 std::size_t msh22_tet_count(const std::string& msh) {
@@ -239,7 +220,7 @@ std::string strip(std::string v) {
 TEST(FemCodeAster, CommMatchesTheKeywordTableOfDecksMd) {
   const fs::path d = fresh_dir("comm");
   DeckRequest r = ellipsoid_request();
-  r.options.calculix = false;
+  r.options.solvers = {"code_aster"};
   const DeckResult res = write_decks(r, d / "deck");
   const std::string comm = slurp(d / "deck" / "impact.comm");
   // Header: units, source scene, version.

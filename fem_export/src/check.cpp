@@ -1,4 +1,4 @@
-// The CalculiX momentum check (see check.hpp).
+// The momentum check of a deck run by its solver (see check.hpp).
 #include "impactdeck/fem_export/check.hpp"
 
 #include <algorithm>
@@ -17,7 +17,8 @@
 #include "impactdeck/fem_export/decks.hpp"
 #include "impactdeck/fem_export/mesh.hpp"
 #include "impactdeck/common/json_number.hpp"
-#include "solver_process.hpp"
+#include "impactdeck/fem_export/solver.hpp"
+#include "deck_text.hpp"
 
 namespace impactdeck::fem_export {
 namespace fs = std::filesystem;
@@ -26,13 +27,6 @@ using nlohmann::json;
 namespace {
 
 
-// Deck and result files: regular files only, bounded by the memory left (a .dat of a big deck
-// is large, but never larger than what the check can hold).
-std::string read_text(const fs::path& p, const std::string& what) {
-  std::error_code ec;
-  if (!fs::exists(p, ec)) throw InputError(p.string(), "file", what + " does not exist");
-  return read_input_file(p, what, available_memory_bytes() / 4, "a quarter of the free memory");
-}
 
 struct Deck {
   double impulse_Ns = 0, density_kg_m3 = 0, contact_end_s = 0, end_time_s = 0, time_step_s = 0;
@@ -43,7 +37,7 @@ struct Deck {
   std::size_t load_node = 0;  // 1-based
   std::vector<std::string> probes;
   std::vector<int> probe_nodes;  // 1-based
-  TetMesh mesh;       // node i has ccx id i + 1
+  TetMesh mesh;       // node i is the solver's node i + 1
   // Written by this version (older decks: the defaults).
   RigidReference model;
   bool has_model = false;
@@ -53,6 +47,7 @@ struct Deck {
   std::optional<double> yield_strength_Pa;
   std::string impact;
   DeckUnits units;  // deck.json length_unit (older decks: mm)
+  const Solver* solver = nullptr;  // the solver that runs it (deck_from)
 };
 
 Eigen::Vector3d vec3(const json& j) { return Eigen::Vector3d(j.at(0), j.at(1), j.at(2)); }
@@ -148,8 +143,20 @@ Deck deck_from(const json& j, const std::string& where) {
     if (j.contains("yield_strength_Pa") && j.at("yield_strength_Pa").is_number()) {
       d.yield_strength_Pa = j.at("yield_strength_Pa").get<double>();
     }
-    if (!j.at("calculix").get<bool>()) {
-      throw InputError(where, "calculix", "the deck has no CalculiX input (calculix = false)");
+    // The first solver that runs here and whose files the deck has (the first one's key is required).
+    const Solver* first = nullptr;
+    for (const Solver* s : solvers()) {
+      if (!s->can_run()) continue;
+      if (!first) first = s;
+      if ((s == first ? j.at(s->name()) : j.value(s->name(), json(false))).get<bool>()) {
+        d.solver = s;
+        break;
+      }
+    }
+    if (!d.solver) {
+      const std::string name = first ? first->name() : "solver";
+      throw InputError(where, name, "the deck has no " + (first ? first->title() : std::string("runnable")) +
+                                        " input (" + name + " = false)");
     }
   } catch (const json::exception& e) {
     throw InputError(where, "json", std::string("not a deck description: ") + e.what());
@@ -159,56 +166,17 @@ Deck deck_from(const json& j, const std::string& where) {
 
 void check_load_node(const Deck& d, const std::string& where) {
   if (d.load_node < 1 || d.load_node > d.mesh.nodes_m.size()) {
-    throw InputError(where, "load_node", "node " + std::to_string(d.load_node) + " is not in mesh.inp (" +
+    throw InputError(where, "load_node", "node " + std::to_string(d.load_node) + " is not in " + d.solver->mesh_file() + " (" +
                                              std::to_string(d.mesh.nodes_m.size()) + " nodes)");
   }
 }
 
-// A deck folder on disk (`fem-check DIR`): deck.json and mesh.inp read and checked.
+// A deck folder on disk (`fem-check DIR`): deck.json and the solver's mesh (mesh.inp) read and checked.
 Deck read_deck(const fs::path& dir) {
   const fs::path jp = dir / "deck.json";
   const std::string where = jp.string();
-  Deck d = deck_from(parse_json_bounded(read_text(jp, "deck description"), where), where);
-  // mesh.inp: *NODE, *ELEMENT and *NSET blocks as calculix_mesh_inp writes them.
-  const fs::path mp = dir / "mesh.inp";
-  std::istringstream in(read_text(mp, "mesh"));
-  std::string line, block;
-  int lineno = 0;
-  while (std::getline(in, line)) {
-    ++lineno;
-    if (line.rfind("**", 0) == 0 || line.empty()) continue;
-    if (line[0] == '*') {
-      block = line.substr(0, line.find(','));
-      continue;
-    }
-    std::replace(line.begin(), line.end(), ',', ' ');
-    std::istringstream ls(line);
-    if (block == "*NODE") {
-      long id;
-      Eigen::Vector3d x;
-      if (!(ls >> id >> x.x() >> x.y() >> x.z()) || id != static_cast<long>(d.mesh.nodes_m.size()) + 1) {
-        throw InputError(mp.string(), "line " + std::to_string(lineno), "bad node line");
-      }
-      d.mesh.nodes_m.push_back(x / d.units.per_m());
-    } else if (block == "*ELEMENT") {
-      long id;
-      std::array<int, 4> t{};
-      if (!(ls >> id >> t[0] >> t[1] >> t[2] >> t[3])) {
-        throw InputError(mp.string(), "line " + std::to_string(lineno), "bad element line");
-      }
-      for (int& k : t) {
-        if (k < 1 || k > static_cast<int>(d.mesh.nodes_m.size())) {
-          throw InputError(mp.string(), "line " + std::to_string(lineno), "unknown node");
-        }
-        --k;
-      }
-      d.mesh.tets.push_back(t);
-    }
-  }
-  if (d.mesh.tets.empty()) throw InputError(mp.string(), "*ELEMENT", "no tetrahedra");
-  for (const auto& x : d.mesh.nodes_m) {
-    if (!x.allFinite()) throw InputError(mp.string(), "*NODE", "a coordinate is not a finite number");
-  }
+  Deck d = deck_from(parse_json_bounded(detail::read_text(jp, "deck description"), where), where);
+  d.mesh = d.solver->read_mesh(dir, d.units);
   check_load_node(d, where);
   return d;
 }
@@ -221,208 +189,6 @@ Deck deck_of(const DeckResult& written) {
   check_load_node(d, where);
   return d;
 }
-
-// Velocity prints of the .dat: set -> list of (time, node -> velocity in m/s).
-struct DatFile {
-  std::map<std::string, std::vector<std::pair<double, std::map<int, Eigen::Vector3d>>>> velocities;
-  double total_mass_kg = -1;
-};
-
-DatFile read_dat(const fs::path& p, const DeckUnits& units) {
-  DatFile d;
-  std::istringstream in(read_text(p, "CalculiX results"));
-  std::string line;
-  enum { none, vel, mass } state = none;
-  std::map<int, Eigen::Vector3d>* current = nullptr;
-  while (std::getline(in, line)) {
-    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
-    const auto set_pos = line.find(" for set ");
-    if (set_pos != std::string::npos) {
-      const auto and_pos = line.find(" and time ", set_pos);
-      char* end = nullptr;
-      const double t = and_pos == std::string::npos ? NAN : std::strtod(line.c_str() + and_pos + 10, &end);
-      if (!std::isfinite(t)) {
-        throw InputError(p.string(), "line '" + line.substr(0, 80) + "'", "a print header without a time");
-      }
-      const std::string set = line.substr(set_pos + 9, and_pos - set_pos - 9);
-      if (line.find("velocities (vx,vy,vz)") != std::string::npos) {
-        auto& v = d.velocities[set];
-        v.emplace_back(t, std::map<int, Eigen::Vector3d>{});
-        current = &v.back().second;
-        state = vel;
-      } else if (line.find("total mass for set") != std::string::npos) {
-        state = mass;
-      } else {
-        state = none;
-      }
-      continue;
-    }
-    std::istringstream ls(line);
-    if (state == vel) {
-      int node;
-      Eigen::Vector3d v;
-      if (ls >> node >> v.x() >> v.y() >> v.z()) (*current)[node] = v / units.per_m();
-    } else if (state == mass) {
-      double m;
-      if (ls >> m) d.total_mass_kg = m / units.per_kg();  // deck mass unit -> kg
-      state = none;
-    }
-  }
-  return d;
-}
-
-int solver_threads(const CheckOptions& o) {
-  if (o.threads > 0) return o.threads;
-  return static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-}
-
-// First "*ERROR" line and last non-empty line of a ccx log; "No space left on device" anywhere
-// in it is reported in first_error's place when there is no *ERROR line.
-void scan_log(const fs::path& log, std::string& first_error, std::string& last_line) {
-  std::error_code ec;
-  if (!fs::is_regular_file(log, ec)) return;  // a FIFO would block
-  std::ifstream in(log);
-  std::string no_space;
-  for (std::string l; std::getline(in, l);) {
-    if (!l.empty() && l.back() == '\r') l.pop_back();
-    if (first_error.empty() && l.find("*ERROR") != std::string::npos) first_error = l;
-    if (no_space.empty() && l.find("No space left") != std::string::npos) no_space = l;
-    if (l.find_first_not_of(" \t") != std::string::npos) last_line = l;
-  }
-  if (first_error.empty()) first_error = no_space;
-  auto trim = [](std::string& t) {
-    t.erase(0, t.find_first_not_of(" \t"));
-    if (t.size() > 200) t = t.substr(0, 200) + "...";
-  };
-  trim(first_error);
-  trim(last_line);
-}
-
-// The last line of ccx's .sta file: step, increment and total time (nullopt when there is none).
-struct StaLine {
-  int step = 0, increment = 0;
-  double time_s = 0;
-  std::string text;
-};
-std::optional<StaLine> last_sta_line(const fs::path& sta) {
-  std::error_code ec;
-  if (!fs::is_regular_file(sta, ec)) return std::nullopt;  // a FIFO would block
-  std::ifstream in(sta);
-  std::string l, tail;
-  while (std::getline(in, l))
-    if (!l.empty()) tail = l;
-  std::istringstream ls(tail);
-  StaLine s;
-  int attempts, iterations;
-  if (!(ls >> s.step >> s.increment >> attempts >> iterations >> s.time_s)) return std::nullopt;
-  s.text = tail;
-  return s;
-}
-
-// How far ccx got ("" when unknown).
-std::string sta_progress(const fs::path& sta, double end_time_s) {
-  const auto s = last_sta_line(sta);
-  if (!s || !(s->time_s >= 0 && s->time_s <= 1.01 * end_time_s)) return "";  // none, or a line cut short
-  std::ostringstream m;
-  m << "ccx reached t = " << s->time_s << " s of " << end_time_s << " s (step " << s->step << ", increment "
-    << s->increment << ")";
-  return m.str();
-}
-
-// "the disk is full (...)" when the work folder's file system has (almost) no room left or the log
-// says so: the usual reason for cut-short results.
-std::string disk_full_note(const fs::path& work, const std::string& log_text) {
-  const long long free = detail::free_bytes(work);
-  const bool said = log_text.find("No space left") != std::string::npos;
-  const bool full_now = free >= 0 && free < (1 << 20);
-  if (!said && !full_now) return "";
-  std::string note = "the disk is full";
-  if (full_now) note += " (" + std::to_string(free) + " bytes free on the file system of '" + work.string() + "')";
-  else note += " (ccx's log says so; " + std::to_string(free) + " bytes are free now)";
-  return note;
-}
-
-// Runs ccx in `work` (output to impact.log; progress from impact.sta). Returns the wall time.
-double run_ccx(const fs::path& work, const CheckOptions& o, double end_time_s, double timeout_s,
-               const std::string& timeout_source) {
-  const std::string job = kJobName;
-  for (const char* ext : {".dat", ".sta", ".frd", ".cvg", ".12d", ".log"}) {
-    std::error_code ec;
-    fs::remove(work / (job + ext), ec);
-  }
-  const auto t0 = std::chrono::steady_clock::now();
-  std::string last;
-  auto last_print = t0;
-  bool final_line = false;  // after the run: the last state once more, however short the run was
-  auto poll = [&] {
-    if (!o.progress || (!final_line && std::chrono::steady_clock::now() - last_print < std::chrono::seconds(2))) return;
-    last_print = std::chrono::steady_clock::now();
-    const auto s = last_sta_line(work / (job + ".sta"));
-    if (s && s->text != last) {
-      const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      *o.progress << "ccx: step " << s->step << ", increment " << s->increment << ", time " << s->time_s << " s of "
-                  << end_time_s << " s (" << static_cast<int>(100.0 * std::min(1.0, s->time_s / end_time_s)) << " %), "
-                  << static_cast<int>(el) << " s elapsed\n";
-      o.progress->flush();
-      last = s->text;
-    }
-  };
-  const std::string threads = std::to_string(solver_threads(o));
-  const fs::path log = work / (job + ".log");
-  detail::SolverRun run;
-  try {
-    run = detail::run_solver({o.ccx, "-i", job}, work, log,
-                             {"OMP_NUM_THREADS=" + threads, "CCX_NPROC_EQUATION_SOLVER=" + threads}, timeout_s, poll);
-  } catch (const InputError& e) {
-    if (e.reason().rfind("cannot run", 0) != 0) throw;
-    throw e.context().error(e.place(), e.reason() + " (install the Debian package calculix-ccx, or name the "
-                                                    "solver with --ccx)");
-  }
-  // A run shorter than the 2 s between progress lines still shows where ccx ended.
-  final_line = true;
-  poll();
-  const std::string where = log.string();
-  std::string first_error, last_line;
-  scan_log(log, first_error, last_line);
-  const std::string progress = sta_progress(work / (job + ".sta"), end_time_s);
-  const std::string disk = disk_full_note(work, first_error + "\n" + last_line);
-  auto detail_text = [&] {
-    std::string d;
-    if (!disk.empty()) d += "; " + disk;
-    if (!first_error.empty()) d += ": " + first_error;
-    else if (!last_line.empty()) d += "; last line of the log: '" + last_line + "'";
-    else d += "; the log is empty";
-    return d;
-  };
-  if (run.timed_out) {
-    std::ostringstream m;
-    m << "ccx ran longer than the solver timeout of " << timeout_s << " s (" << timeout_source
-      << ") and was stopped (its process group killed)" << (progress.empty() ? "" : "; " + progress)
-      << "; raise --solver-timeout-s, or coarsen the deck";
-    throw InputError(where, "ccx run", m.str());
-  }
-  if (run.signal != 0) {
-    throw InputError(where, "ccx run", "ccx was killed by " + detail::describe_signal(run.signal) +
-                                           (progress.empty() ? "" : " when " + progress) + detail_text());
-  }
-  if (run.exit_code != 0 || !first_error.empty()) {
-    throw InputError(where, "ccx run", "ccx failed (exit code " + std::to_string(run.exit_code) + ")" +
-                                           (first_error.empty() ? detail_text() : (disk.empty() ? "" : " (" + disk + ")") +
-                                                                                    ": " + first_error));
-  }
-  return run.wall_s;
-}
-
-}  // namespace
-
-double run_ccx_job(const fs::path& dir, const CheckOptions& o, double end_time_s, std::size_t nodes,
-                   std::size_t solves) {
-  if (o.timeout_s > 0) return run_ccx(dir, o, end_time_s, o.timeout_s, "--solver-timeout-s");
-  return run_ccx(dir, o, end_time_s, default_solver_timeout_s(nodes, solves),
-                 "default for " + std::to_string(nodes) + " nodes and " + std::to_string(solves) + " solves");
-}
-
-namespace {
 
 CheckResult check_deck(const fs::path& dir, const Deck& deck, const CheckOptions& o);
 
@@ -468,41 +234,13 @@ CheckResult check_deck(const fs::path& dir, const Deck& deck, const CheckOptions
                               std::to_string(increments) + " increments";
   }
   const fs::path work = o.run_solver && !o.work_dir.empty() ? o.work_dir : dir;
-  if (o.run_solver) {
-    if (work != dir) {
-      for (const std::string f : {std::string(kJobName) + ".inp", std::string("mesh.inp")}) {
-        std::error_code ec;
-        fs::copy_file(dir / f, work / f, fs::copy_options::overwrite_existing, ec);
-        if (ec) throw InputError((dir / f).string(), "copy for the ccx run", ec.message());
-      }
-    }
-    r.solver_wall_time_s = run_ccx(work, o, deck.end_time_s, r.solver_timeout_s, r.solver_timeout_source);
-    r.solver_threads = solver_threads(o);
-    for (const char* ext : {".dat", ".frd", ".sta", ".cvg", ".12d", ".log"}) {
-      const fs::path f = work / (std::string(kJobName) + ext);
-      std::error_code ec;
-      if (fs::is_regular_file(f, ec)) r.solver_files.push_back(f);
-    }
-  }
-  const fs::path dat_path = work / (std::string(kJobName) + ".dat");
-  if (std::error_code ec; !fs::exists(dat_path, ec)) {
-    std::string first_error, last_line;
-    scan_log(work / (std::string(kJobName) + ".log"), first_error, last_line);
-    if (!o.run_solver) throw InputError(dat_path.string(), "ccx results", "missing: run without --no-run to make them");
-    throw InputError(dat_path.string(), "ccx results",
-                     "ccx ended without writing impact.dat" +
-                         (last_line.empty() ? std::string("; its log is empty") : "; last line of impact.log: '" + last_line + "'"));
-  }
-  DatFile dat;
-  try {
-    dat = read_dat(dat_path, deck.units);
-  } catch (const InputError& e) {
-    std::string first_error, last_line;
-    if (o.run_solver) scan_log(work / (std::string(kJobName) + ".log"), first_error, last_line);
-    const std::string disk = o.run_solver ? disk_full_note(work, first_error + "\n" + last_line) : "";
-    if (disk.empty()) throw;
-    throw e.context().error(e.place(), e.reason() + "; " + disk);
-  }
+  const SolverJob job{dir, work, deck.mesh, deck.units, deck.end_time_s, deck.probes, r.solver_timeout_s,
+                      r.solver_timeout_source, o};
+  const SolverOutput run = deck.solver->run(job);
+  r.solver_wall_time_s = run.wall_time_s;
+  r.solver_threads = run.threads;
+  r.solver_files = run.files;
+  const fs::path& dat_path = run.results_file;
 
   // FE mass, centroid and inertia of the mesh (exact for linear tetrahedra).
   const TetMesh& m = deck.mesh;
@@ -517,45 +255,11 @@ CheckResult check_deck(const fs::path& dir, const Deck& deck, const CheckOptions
     first += me * s / 4.0;
   }
   const Eigen::Vector3d c = first / r.fe_mass_kg;
-  r.solver_mass_kg = dat.total_mass_kg;
+  r.solver_mass_kg = run.total_mass_kg;
 
-  // Momentum from the all-node print of step 2.
-  auto all = dat.velocities.find("BODYN");
-  const bool have_velocities = all != dat.velocities.end() && !all->second.empty() &&
-                               all->second.back().second.size() == m.nodes_m.size();
-  if (!have_velocities || !(dat.total_mass_kg > 0)) {
-    std::string why;
-    if (all == dat.velocities.end() || all->second.empty()) {
-      why = "the all-node velocity print of step 2 (*NODE PRINT, NSET=BODYN) is missing";
-    } else if (!have_velocities) {
-      why = "the all-node velocity print of step 2 has " + std::to_string(all->second.back().second.size()) +
-            " of the mesh's " + std::to_string(m.nodes_m.size()) + " nodes (cut short)";
-    } else {
-      why = "the total mass print of step 2 (*EL PRINT, EMAS) is missing";
-    }
-    if (o.run_solver) {
-      std::string first_error, last_line;
-      scan_log(work / (std::string(kJobName) + ".log"), first_error, last_line);
-      const std::string disk = disk_full_note(work, first_error + "\n" + last_line);
-      const std::string progress = sta_progress(work / (std::string(kJobName) + ".sta"), deck.end_time_s);
-      if (!disk.empty()) why += "; " + disk;
-      if (!progress.empty()) why += "; " + progress;
-      if (disk.empty() && !last_line.empty()) why += "; last line of impact.log: '" + last_line + "'";
-    } else {
-      why += " (run without --no-run to make it)";
-    }
-    throw InputError(dat_path.string(), "step 2", why);
-  }
-  const auto& [t_all, v_all] = all->second.back();
-  r.momentum_time_s = t_all;
-  std::vector<Eigen::Vector3d> v(m.nodes_m.size());
-  for (const auto& [node, vel] : v_all) {
-    if (node < 1 || static_cast<std::size_t>(node) > v.size() || !vel.allFinite()) {
-      throw InputError(dat_path.string(), "step 2", "velocity of node " + std::to_string(node) +
-                                                        ": not a node of the mesh, or not a finite number");
-    }
-    v[static_cast<std::size_t>(node - 1)] = vel;
-  }
+  // Momentum from the solver's velocities of every node after the pulse.
+  r.momentum_time_s = run.momentum_time_s;
+  const std::vector<Eigen::Vector3d>& v = run.node_velocity_m_s;
   Eigen::Vector3d P = Eigen::Vector3d::Zero();
   for (std::size_t i = 0; i < v.size(); ++i) P += node_mass[i] * v[i];
   // ccx 2.20 integrates the C3D4 mass matrix at one point: M_e = m_e / 16 (1 1^T) (x) I_3, so
@@ -593,16 +297,10 @@ CheckResult check_deck(const fs::path& dir, const Deck& deck, const CheckOptions
   for (const auto& name : deck.probes) {
     ProbeResult pr;
     pr.name = name;
-    auto it = dat.velocities.find(name);
-    if (it == dat.velocities.end()) {
-      throw InputError(dat_path.string(), name, "no velocity print for this probe");
-    }
+    const auto& [node, history] = run.probe_velocity.at(name);
     std::vector<double> vals;
-    int node = 0;
-    for (const auto& [t, nv] : it->second) {
-      if (nv.empty()) continue;
-      node = nv.begin()->first;
-      if (t > deck.contact_end_s && t <= deck.end_time_s * (1 + 1e-9)) vals.push_back(nv.begin()->second.dot(d));
+    for (const auto& [t, velocity] : history) {
+      if (t > deck.contact_end_s && t <= deck.end_time_s * (1 + 1e-9)) vals.push_back(velocity.dot(d));
     }
     if (vals.empty()) throw InputError(dat_path.string(), name, "no velocity after the pulse");
     if (node < 1 || static_cast<std::size_t>(node) > m.nodes_m.size()) {
@@ -648,8 +346,7 @@ CheckResult check_deck(const fs::path& dir, const Deck& deck, const CheckOptions
   }
 
   // Stresses, when this run wrote them.
-  const fs::path frd = work / (std::string(kJobName) + ".frd");
-  if (o.stresses && fs::exists(frd)) {
+  if (o.stresses) {
     StressInputs si;
     si.load_node = deck.load_node - 1;
     for (std::size_t i = 0; i < deck.probes.size(); ++i) si.probes.emplace_back(deck.probes[i], deck.probe_nodes[i] - 1);
@@ -658,7 +355,9 @@ CheckResult check_deck(const fs::path& dir, const Deck& deck, const CheckOptions
     si.yield_strength_Pa = deck.yield_strength_Pa;
     si.end_time_s = deck.end_time_s;
     si.length_unit = deck.units.length;
-    r.stress = read_stresses(frd, m, si);
+    r.stress = deck.solver->stresses(job, si);
+  }
+  if (r.stress) {
     write_stress_files(work, m, *r.stress,
                        "Von Mises stress, impact '" + deck.impact + "' (" + (deck.patch_load ? "Hertz-patch" : "point") + " load)");
     // Published with the solver's own results (fem-check moves solver_files into the deck folder).
@@ -684,7 +383,7 @@ CheckResult check_deck(const fs::path& dir, const Deck& deck, const CheckOptions
   if (!is_finite_all(r.fe_mass_kg, r.expected_velocity_m_s, r.fe_velocity_m_s, r.linear_momentum_relative_error,
                      r.angular_momentum_relative_error.value_or(0.0)) ||
       !(r.fe_mass_kg > 0) || !r.angular_velocity_fe_rad_s.allFinite() || !r.angular_velocity_expected_rad_s.allFinite()) {
-    throw InputError((dir / "mesh.inp").string(), "momentum check",
+    throw InputError((dir / deck.solver->mesh_file()).string(), "momentum check",
                      "the mesh's mass or inertia is zero or not finite (degenerate tetrahedra): no momentum to check");
   }
   return r;

@@ -18,27 +18,17 @@
 #include "impactdeck/common/run_transaction.hpp"
 #include "impactdeck/common/version.hpp"
 #include "impactdeck/fem_export/force_table.hpp"
+#include "impactdeck/fem_export/solver.hpp"
+#include "deck_text.hpp"
 #include "impactdeck/common/json_number.hpp"
 #include "impactdeck/common/numeric.hpp"
 
 namespace impactdeck::fem_export {
 namespace fs = std::filesystem;
+using detail::increments;
+using detail::output_every;
 
 namespace {
-
-constexpr const char* kMedMesh = "BODYMESH";
-
-std::string num(double v) {
-  std::ostringstream s;
-  s << std::setprecision(12) << v + 0.0;  // + 0.0: no "-0"
-  std::string t = s.str();
-  if (t.find_first_of(".eE") == std::string::npos && t != "inf" && t != "nan") t += ".0";
-  return t;
-}
-
-std::size_t increments(const DeckOptions& o) {
-  return static_cast<std::size_t>(std::ceil(o.end_time_s / o.time_step_s - 1e-9));
-}
 
 void validate(const DeckRequest& r, const InputContext& where) {
   const DeckOptions& o = r.options;
@@ -85,40 +75,12 @@ void validate(const DeckRequest& r, const InputContext& where) {
   }
   if (!(t.min_gamma >= 0 && t.min_gamma < 1)) throw where.error("min_gamma", "must lie in [0, 1)");
   if (r.yield_strength_Pa && !(*r.yield_strength_Pa > 0)) throw where.error("yield_strength_Pa", "must be > 0");
-}
-
-// The frd output interval of the free-vibration step: every increment unless nodes x increments
-// exceeds the budget (DeckOptions::stress_output_budget).
-std::size_t output_every(const DeckOptions& o, const TimeSchedule& ts, std::size_t nodes) {
-  const double work = static_cast<double>(nodes) * static_cast<double>(ts.main_increments);
-  if (!(o.stress_output_budget > 0) || work <= o.stress_output_budget) return 1;
-  return static_cast<std::size_t>(std::ceil(work / o.stress_output_budget));
-}
-
-// Pairs (t, f) four to a line, as ccx's *AMPLITUDE reads them.
-void amplitude_rows(std::ostream& s, const std::vector<double>& t, const std::vector<double>& f) {
-  for (std::size_t i = 0; i < t.size(); ++i) {
-    s << num(t[i]) << ", " << num(f[i]) << ((i % 4 == 3 || i + 1 == t.size()) ? "\n" : ", ");
+  for (const std::string& name : o.solvers) {
+    if (find_solver(name)) continue;
+    std::string known;
+    for (const Solver* s : solvers()) known += (known.empty() ? "" : ", ") + s->name();
+    throw where.error("solvers", "unknown solver '" + name + "' (registered: " + known + ")");
   }
-}
-
-std::string header_lines(const std::string& c, const DeckRequest& r, const std::string& what) {
-  std::ostringstream h;
-  h << c << " impactdeck " << kVersion << ": " << what << "\n"
-    << c << " Hybrid approach: the impactor is replaced by its Hertz force history at node group LOAD.\n"
-    << c << " Units: " << r.options.units.description() << ".\n"
-    << c << " Scene: " << (r.source.empty() ? "(none)" : r.source) << "; impact: " << r.impact << "\n"
-    << c << " Impulse " << num(r.impulse_Ns) << " N s along (" << num(r.direction.x()) << ", "
-    << num(r.direction.y()) << ", " << num(r.direction.z()) << "); contact ends at "
-    << num(r.force.time_s.back()) << " s.\n";
-  return h.str();
-}
-
-std::vector<std::string> probe_groups(const TetMesh& m) {
-  std::vector<std::string> p;
-  for (const auto& [g, n] : m.node_groups)
-    if (g.rfind("PROBE", 0) == 0) p.push_back(g);
-  return p;
 }
 
 }  // namespace
@@ -154,6 +116,10 @@ std::string DeckUnits::description() const {
   }
   return l + ", N, s, " + mass + " (E in " + stress_unit() + ", density in " + mass + "/" + l + "3, velocity in " +
          l + "/s)";
+}
+
+bool DeckOptions::writes(const std::string& name) const {
+  return std::find(solvers.begin(), solvers.end(), name) != solvers.end();
 }
 
 const char* to_string(LoadKind k) { return k == LoadKind::hertz_patch ? "hertz-patch" : "point"; }
@@ -272,20 +238,6 @@ std::string format_body(const BodyComparison& c) {
   return s.str();
 }
 
-const char* to_string(CcxSolver s) {
-  switch (s) {
-    case CcxSolver::automatic: return "auto";
-    case CcxSolver::spooles: return "spooles";
-    case CcxSolver::iterative: return "iterative";
-  }
-  return "?";
-}
-
-CcxSolver ccx_solver_for(CcxSolver requested, std::size_t nodes) {
-  if (requested != CcxSolver::automatic) return requested;
-  return nodes >= kIterativeSolverMinNodes ? CcxSolver::iterative : CcxSolver::spooles;
-}
-
 namespace {
 // The main phase after the refined one: the user's step, adjusted down to divide the rest.
 void finish_schedule(TimeSchedule& t, const DeckOptions& o) {
@@ -388,233 +340,6 @@ ForceSampling force_sampling(const collision::ForceTable& f, const TimeSchedule&
   s.impulse_relative_error = f.impulse_Ns > 0 ? std::abs(impulse - f.impulse_Ns) / f.impulse_Ns : 0.0;
   s.peak_force_relative_error = table_peak > 0 ? std::max(0.0, 1.0 - peak / table_peak) : 0.0;
   return s;
-}
-
-std::string calculix_mesh_inp(const TetMesh& m, const DeckUnits& u) {
-  std::ostringstream s;
-  s << "** impactdeck " << kVersion << ": mesh of the target body (" << to_string(u.length)
-    << "), included by impact.inp\n";
-  s << "*NODE, NSET=BODYN\n" << std::setprecision(15);
-  for (std::size_t i = 0; i < m.nodes_m.size(); ++i) {
-    const Eigen::Vector3d x = m.nodes_m[i] * u.per_m();
-    s << i + 1 << ", " << num(x.x()) << ", " << num(x.y()) << ", " << num(x.z()) << "\n";
-  }
-  s << "*ELEMENT, TYPE=C3D4, ELSET=BODY\n";
-  for (std::size_t e = 0; e < m.tets.size(); ++e) {
-    const auto& t = m.tets[e];
-    s << e + 1 << ", " << t[0] + 1 << ", " << t[1] + 1 << ", " << t[2] + 1 << ", " << t[3] + 1 << "\n";
-  }
-  for (const auto& [g, n] : m.node_groups) s << "*NSET, NSET=" << g << "\n" << n + 1 << "\n";
-  return s.str();
-}
-
-std::string calculix_inp(const DeckRequest& r, const TetMesh& m, const PatchLoad* patch) {
-  const DeckOptions& o = r.options;
-  const TimeSchedule ts = deck_schedule(r);
-  const std::size_t every = output_every(o, ts, m.nodes_m.size());
-  std::ostringstream s;
-  s << header_lines("**", r, "CalculiX deck (ccx 2.20), run: ccx -i impact");
-  s << "** Step 1: implicit direct dynamics (fixed steps; refined while the force acts) through\n"
-       "** end_time_s, probe velocities, nodal stresses S and displacements U (impact.frd) every\n"
-       "** increment" << (every > 1 ? " (every " + std::to_string(every) + "th after the contact)" : std::string()) << ".\n"
-       "** Step 2: one increment printing every node's velocity and the total mass (the momentum check).\n"
-       "** The amplitudes use TOTAL TIME and stay at their closing zero.\n";
-  {
-    const ForceSampling fs = force_sampling(r.force, ts);
-    s << "** Increments: " << ts.pulse_increments << " across the contact ("
-      << (o.pulse_increments == kAutoPulseIncrements ? "at the force table's samples" : "as asked") << "), then "
-      << ts.main_increments << "; at them the force's impulse and peak\n** differ from the table's by "
-      << std::setprecision(3) << fs.impulse_relative_error << " and " << fs.peak_force_relative_error << ".\n";
-  }
-  if (patch) {
-    s << "** Load: the Hertz pressure of each instant's contact ellipse as nodal forces on "
-      << patch->nodes.size() << " surface nodes,\n** one amplitude per node (N), sum F(t), zero moment about the contact point.\n";
-  }
-  s << "*HEADING\nimpactdeck hybrid impact " << r.impact << "\n";
-  s << "*INCLUDE, INPUT=mesh.inp\n";
-  s << "*MATERIAL, NAME=BODYMAT\n*ELASTIC\n" << num(r.material.youngs_modulus_Pa * o.units.per_Pa()) << ", "
-    << num(r.material.poisson_ratio) << "\n*DENSITY\n" << num(r.material.density_kg_m3 * o.units.per_kg_m3()) << "\n";
-  s << "*SOLID SECTION, ELSET=BODY, MATERIAL=BODYMAT\n" << std::setprecision(15);
-  if (patch) {
-    for (std::size_t k = 0; k < patch->nodes.size(); ++k) {
-      s << "*AMPLITUDE, NAME=P" << k + 1 << ", TIME=TOTAL TIME\n";
-      amplitude_rows(s, patch->time_s, patch->force_N[k]);
-    }
-  } else {
-    s << "*AMPLITUDE, NAME=HERTZ, TIME=TOTAL TIME\n";
-    for (std::size_t i = 0; i < r.force.time_s.size(); ++i) {
-      s << num(r.force.time_s[i]) << ", " << num(r.force.force_N[i]) << "\n";
-    }
-  }
-  // The equation solver by deck size (CcxSolver; bench/bench_ccx.cpp measured the choice).
-  const char* dynamic = ccx_solver_for(o.solver, m.nodes_m.size()) == CcxSolver::iterative
-                            ? "*DYNAMIC, DIRECT, SOLVER=ITERATIVE SCALING\n"
-                            : "*DYNAMIC, DIRECT\n";
-  auto step = [&](std::size_t incs, double dt, double period, const std::string& what) {
-    s << "** " << what << "\n*STEP, INC=" << incs + 10 << "\n" << dynamic << num(dt) << ", " << num(period) << "\n";
-  };
-  auto loads_and_output = [&](std::size_t frequency) {
-    if (patch) {
-      for (std::size_t k = 0; k < patch->nodes.size(); ++k) {
-        s << "*CLOAD, AMPLITUDE=P" << k + 1 << "\n";
-        for (int c = 0; c < 3; ++c) s << patch->nodes[k] + 1 << ", " << c + 1 << ", " << num(r.direction[c]) << "\n";
-      }
-    } else {
-      s << "*CLOAD, AMPLITUDE=HERTZ\n";
-      for (int k = 0; k < 3; ++k) s << "LOAD, " << k + 1 << ", " << num(r.direction[k]) << "\n";
-    }
-    for (const auto& p : probe_groups(m)) s << "*NODE PRINT, NSET=" << p << ", FREQUENCY=" << frequency << "\nV\n";
-    s << "*NODE FILE, FREQUENCY=" << frequency << "\nU\n*EL FILE, FREQUENCY=" << frequency << "\nS\n";
-    s << "*END STEP\n";
-  };
-  if (!ts.pulse_segments.empty()) {
-    double begin = 0;
-    for (std::size_t i = 0; i < ts.pulse_segments.size(); ++i) {
-      const TimeSegment& g = ts.pulse_segments[i];
-      const bool last = i + 1 == ts.pulse_segments.size();
-      step(g.increments, g.step_s, g.end_s - begin,
-           std::string("Step 1a") + (ts.pulse_segments.size() > 1 ? "." + std::to_string(i + 1) : std::string()) +
-               (last ? ": through the end of the contact, refined" : ": refined, while the force acts"));
-      loads_and_output(1);
-      begin = g.end_s;
-    }
-    step(ts.main_increments, ts.main_step_s, o.end_time_s - ts.pulse_end_s, "Step 1b: free vibration through end_time_s");
-  } else {
-    step(ts.main_increments, ts.main_step_s, o.end_time_s, "Step 1: through end_time_s");
-  }
-  loads_and_output(every);
-  s << "** Step 2: one increment printing all velocities and the mass (momentum check)\n";
-  s << "*STEP, INC=10\n" << dynamic << num(ts.main_step_s) << ", " << num(ts.main_step_s) << "\n";
-  s << "*NODE PRINT, NSET=BODYN, FREQUENCY=1\nV\n";
-  s << "*EL PRINT, ELSET=BODY, TOTALS=ONLY, FREQUENCY=1\nEMAS\n";
-  s << "*END STEP\n";
-  return s.str();
-}
-
-std::string code_aster_comm(const DeckRequest& r, const TetMesh& m, const PatchLoad* patch) {
-  const DeckOptions& o = r.options;
-  std::ostringstream s;
-  s << header_lines("#", r, "Code_Aster command file (DYNA_VIBRA, versions 15.x and later)");
-  s << "# Files (units): mesh.med (20), probe velocity tables (38), von Mises at the probes and LOAD (39),\n"
-       "# results MED (80); see impact.export.\n";
-  s << "DEBUT()\n\n";
-  s << "MAIL = LIRE_MAILLAGE(FORMAT='MED', UNITE=20)\n\n";
-  s << "MODELE = AFFE_MODELE(MAILLAGE=MAIL,\n"
-       "                     AFFE=_F(GROUP_MA=('BODY',), PHENOMENE='MECANIQUE', MODELISATION='3D'))\n\n";
-  s << "MATER = DEFI_MATERIAU(ELAS=_F(E=" << num(r.material.youngs_modulus_Pa * r.options.units.per_Pa())
-    << ", NU=" << num(r.material.poisson_ratio) << ", RHO=" << num(r.material.density_kg_m3 * r.options.units.per_kg_m3())
-    << "))\n\n";
-  s << "CHMAT = AFFE_MATERIAU(MAILLAGE=MAIL, AFFE=_F(GROUP_MA=('BODY',), MATER=MATER))\n\n";
-  auto function = [&](const std::string& name, const std::vector<double>& t, const std::vector<double>& f) {
-    s << name << " = DEFI_FONCTION(NOM_PARA='INST',\n                      VALE=(\n";
-    for (std::size_t i = 0; i < t.size(); ++i) s << "                          " << num(t[i]) << ", " << num(f[i]) << ",\n";
-    s << "                      ),\n"
-         "                      INTERPOL=('LIN', 'LIN'),\n"
-         "                      PROL_GAUCHE='CONSTANT',\n"
-         "                      PROL_DROITE='CONSTANT')\n";
-  };
-  auto force_on = [&](const std::string& name, const std::string& group) {
-    s << name << " = AFFE_CHAR_MECA(MODELE=MODELE,\n                        FORCE_NODALE=_F(GROUP_NO=('" << group
-      << "',), FX=" << num(r.direction.x()) << ", FY=" << num(r.direction.y()) << ", FZ=" << num(r.direction.z())
-      << "))\n";
-  };
-  std::string excit;
-  if (patch) {
-    s << "# Hertz-patch load: one force history (N) per surface node LPk, along the unit direction of the\n"
-         "# force; at every time the forces sum to F(t) and have no moment about the contact point.\n";
-    for (std::size_t k = 0; k < patch->nodes.size(); ++k) {
-      const std::string id = std::to_string(k + 1);
-      function("FP" + id, patch->time_s, patch->force_N[k]);
-      force_on("CP" + id, "LP" + id);
-      excit += std::string(excit.empty() ? "" : ",\n                         ") + "_F(CHARGE=CP" + id + ", FONC_MULT=FP" + id + ")";
-    }
-    s << "\n";
-  } else {
-    s << "# Hertz force history F(t) in N; constant extrapolation on both sides, closing zero.\n";
-    function("FHERTZ", r.force.time_s, r.force.force_N);
-    s << "\n# Unit direction of the force on the target (times FHERTZ).\n";
-    force_on("CHARGE", "LOAD");
-    s << "\n";
-    excit = "_F(CHARGE=CHARGE, FONC_MULT=FHERTZ)";
-  }
-  const TimeSchedule ts = deck_schedule(r);
-  s << "# Time steps: refined through the end of the contact, then the main step.\n";
-  s << "LINST = DEFI_LIST_REEL(DEBUT=0.0,\n                       INTERVALLE=(";
-  for (const TimeSegment& g : ts.pulse_segments) {
-    s << "_F(JUSQU_A=" << num(g.end_s) << ", PAS=" << num(g.step_s) << "),\n                                   ";
-  }
-  s << "_F(JUSQU_A=" << num(o.end_time_s) << ", PAS=" << num(ts.main_step_s) << ")))\n\n";
-  s << "ASSEMBLAGE(MODELE=MODELE,\n"
-       "           CHAM_MATER=CHMAT,\n"
-       "           NUME_DDL=CO('NUMEDDL'),\n"
-       "           MATR_ASSE=(_F(MATRICE=CO('RIGI'), OPTION='RIGI_MECA'),\n"
-       "                      _F(MATRICE=CO('MASS'), OPTION='MASS_MECA')))\n\n";
-  s << "# Free body: K + a0 M is positive definite. SCHEMA written explicitly (15.x defaults to DIFF_CENTRE).\n";
-  s << "RESU = DYNA_VIBRA(TYPE_CALCUL='TRAN',\n"
-       "                  BASE_CALCUL='PHYS',\n"
-       "                  MODELE=MODELE,\n"
-       "                  CHAM_MATER=CHMAT,\n"
-       "                  MATR_MASS=MASS,\n"
-       "                  MATR_RIGI=RIGI,\n"
-       "                  SCHEMA_TEMPS=_F(SCHEMA='NEWMARK', BETA=0.25, GAMMA=0.5),\n"
-       "                  INCREMENT=_F(LIST_INST=LINST),\n"
-       "                  EXCIT=(" << excit << "))\n\n";
-  s << "# Von Mises stress (component VMIS)" << (patch ? "" : "; singular at the load node itself (point force)") << ".\n";
-  s << "RESU = CALC_CHAMP(reuse=RESU,\n"
-       "                  RESULTAT=RESU,\n"
-       "                  CONTRAINTE=('SIGM_ELNO',),\n"
-       "                  CRITERES=('SIEQ_ELNO', 'SIEQ_NOEU'))\n\n";
-  const auto probes = probe_groups(m);
-  if (!probes.empty()) s << "# Velocity of each probe node, " << to_string(r.options.units.length) << "/s, one table per component (unit 38).\n";
-  const char* comps[3] = {"DX", "DY", "DZ"};
-  for (std::size_t i = 0; i < probes.size(); ++i) {
-    for (int k = 0; k < 3; ++k) {
-      const std::string f = "V" + std::to_string(i + 1) + std::string(1, "XYZ"[k]);
-      s << f << " = RECU_FONCTION(RESULTAT=RESU, NOM_CHAM='VITE', NOM_CMP='" << comps[k]
-        << "', GROUP_NO=('" << probes[i] << "',))\n";
-    }
-    s << "IMPR_FONCTION(FORMAT='TABLEAU', UNITE=38,\n              COURBE=(";
-    for (int k = 0; k < 3; ++k) {
-      s << (k ? ", " : "") << "_F(FONCTION=V" << i + 1 << "XYZ"[k] << ")";
-    }
-    s << "))\n\n";
-  }
-  s << "# Von Mises (MPa) against time at each probe and at LOAD (unit 39).\n";
-  std::vector<std::string> at = probes;
-  at.push_back("LOAD");
-  for (std::size_t i = 0; i < at.size(); ++i) {
-    const std::string f = i + 1 == at.size() ? "VMLOAD" : "VM" + std::to_string(i + 1);
-    s << f << " = RECU_FONCTION(RESULTAT=RESU, NOM_CHAM='SIEQ_NOEU', NOM_CMP='VMIS', GROUP_NO=('" << at[i] << "',))\n";
-  }
-  s << "IMPR_FONCTION(FORMAT='TABLEAU', UNITE=39,\n              COURBE=(";
-  for (std::size_t i = 0; i < at.size(); ++i) {
-    s << (i ? ", " : "") << "_F(FONCTION=" << (i + 1 == at.size() ? std::string("VMLOAD") : "VM" + std::to_string(i + 1)) << ")";
-  }
-  s << "))\n\n";
-  s << "IMPR_RESU(FORMAT='MED', UNITE=80,\n"
-       "          RESU=_F(RESULTAT=RESU, NOM_CHAM=('DEPL', 'VITE', 'SIEQ_NOEU')))\n\n";
-  s << "FIN()\n";
-  return s.str();
-}
-
-std::string code_aster_export(const DeckRequest& r, const TetMesh& m) {
-  std::ostringstream s;
-  (void)m;
-  s << "P actions make_etude\n"
-    << "P version stable\n"
-    << "P time_limit " << std::max<long>(600, static_cast<long>(increments(r.options) / 10)) << "\n"
-    << "P memory_limit 2048\n"
-    << "P ncpus " << r.options.aster_cpus << "\n"
-    << "P mpi_nbcpu " << r.options.aster_mpi_processes << "\n"
-    << "P mpi_nbnoeud 1\n"
-    << "F comm " << kJobName << ".comm D 1\n"
-    << "F mmed mesh.med D 20\n"
-    << "F mess " << kJobName << ".mess R 6\n"
-    << "F resu " << kJobName << ".resu R 8\n"
-    << "F libr " << kJobName << "_probes.txt R 38\n"
-    << "F libr " << kJobName << "_von_mises.txt R 39\n"
-    << "F rmed " << kJobName << "_results.rmed R 80\n";
-  return s.str();
 }
 
 namespace {
@@ -768,16 +493,14 @@ DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
     std::vector<std::string> names = {"mesh.geo", "mesh.msh", "mesh_v22.msh"};
     if (r.body.kind == BodyKind::part) names.push_back("mesh_part.stl");
     if (r.body.kind == BodyKind::cad) names.push_back("mesh_part" + r.body.cad.extension().string());
-    if (r.options.calculix) {
-      write_file_atomically(stage / "mesh.inp", calculix_mesh_inp(m, r.options.units));
-      write_file_atomically(stage / (std::string(kJobName) + ".inp"), calculix_inp(r, m, pl));
-      names.insert(names.end(), {"mesh.inp", std::string(kJobName) + ".inp"});
-    }
-    if (r.options.code_aster) {
-      write_med(m, stage / "mesh.med", kMedMesh, r.options.units.length);
-      write_file_atomically(stage / (std::string(kJobName) + ".comm"), code_aster_comm(r, m, pl));
-      write_file_atomically(stage / (std::string(kJobName) + ".export"), code_aster_export(r, m));
-      names.insert(names.end(), {"mesh.med", std::string(kJobName) + ".comm", std::string(kJobName) + ".export"});
+    // Each chosen solver's files, in the registry's order (solver.hpp).
+    const TimeSchedule ts = deck_schedule(r);
+    const DeckInput input{r, m, pl, ts};
+    const std::vector<const Solver*> registered = solvers();
+    for (const Solver* s : registered) {
+      if (!r.options.writes(s->name())) continue;
+      const std::vector<std::string> written = s->write_deck(input, stage);
+      names.insert(names.end(), written.begin(), written.end());
     }
     ForceTableHeader fh;
     fh.source = r.source;
@@ -829,7 +552,6 @@ DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
       patch_json["max_sum_relative_error"] = pl->max_sum_relative_error;
       patch_json["max_moment_relative"] = pl->max_moment_relative;
     }
-    const TimeSchedule ts = deck_schedule(r);
     const ForceSampling sampling = force_sampling(r.force, ts);
     json segments = json::array();
     for (const TimeSegment& g : ts.pulse_segments) {
@@ -871,9 +593,6 @@ DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
                  {"density_kg_m3", r.material.density_kg_m3},
                  {"yield_strength_Pa", r.yield_strength_Pa ? json(*r.yield_strength_Pa) : json(nullptr)},
                  {"probes", probes},
-                 {"calculix", r.options.calculix},
-                 {"ccx_solver", to_string(ccx_solver_for(r.options.solver, m.nodes_m.size()))},
-                 {"code_aster", r.options.code_aster},
                  {"model", {{"mass_kg", r.model.mass_kg},
                             {"volume_m3", r.model.volume_m3},
                             {"centroid_m", v3(r.model.centroid_m)},
@@ -890,6 +609,7 @@ DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
                                  {"min_gamma", t.min_gamma}}},
                  {"mesh", quality},
                  {"files", names}};
+    for (const Solver* s : registered) s->describe(input, r.options.writes(s->name()), deck);  // "calculix": true, ...
     write_file_atomically(stage / "deck.json", deck.dump(2) + "\n");
     out.description = std::move(deck);
 

@@ -238,7 +238,7 @@ CompareReport compare_contact(const CompareInput& in, const CompareOptions& o) {
   if (o.run_hybrid) {
     fem_export::DeckRequest req = target_req;
     req.context = deck_context("hybrid deck");
-    req.options.code_aster = false;
+    req.options.solvers = {"calculix"};
     req.options.end_time_s = end_time;
     req.options.time_step_s = dt;
     req.options.pulse_increments = static_cast<int>(std::ceil(table.time_s.back() / dt - 1e-9));

@@ -279,8 +279,9 @@ fem_export::DeckRequest fem_request(const Scene& scene, const ImpactReport& ir, 
   r.options.end_time_s = f.end_time_s;
   r.options.time_step_s = f.time_step_s;
   r.options.pulse_increments = f.pulse_increments.value_or(fem_export::kAutoPulseIncrements);
-  r.options.code_aster = f.code_aster;
-  r.options.calculix = f.calculix;
+  r.options.solvers.clear();  // fem_export's registry names
+  if (f.calculix) r.options.solvers.push_back("calculix");
+  if (f.code_aster) r.options.solvers.push_back("code_aster");
   r.options.solver = f.solver == FemOutputs::Solver::spooles     ? fem_export::CcxSolver::spooles
                      : f.solver == FemOutputs::Solver::iterative ? fem_export::CcxSolver::iterative
                                                                  : fem_export::CcxSolver::automatic;

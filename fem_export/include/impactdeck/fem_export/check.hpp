@@ -1,5 +1,6 @@
 #pragma once
-// The momentum check of a deck, run for real with CalculiX: after the pulse a free body must carry
+// The momentum check of a deck, run for real by its solver (solver.hpp; CalculiX is the one that
+// runs here, ccx 2.20 below): after the pulse a free body must carry
 // the impulse as linear momentum, and its moment about the centre of mass as angular momentum.
 //
 //   linear   P_FE = sum_n m_n v_n   (lumped row sums of the consistent mass matrix: exact for P)
@@ -18,7 +19,8 @@
 //   model_angular_velocity_relative_error = |I_FE^-1 L_FE - dw| / |dw|   (null unless the lever arm
 //                                           exceeds a tenth of the radius of gyration: decks.hpp)
 // and the FE body with the part (volume, mass, inertia, Gmsh gamma floor; decks.hpp
-// compare_body). Then the stresses are read back from impact.frd (stress.hpp).
+// compare_body). Then the stresses are read back from the solver's results (CalculiX: impact.frd,
+// stress.hpp). The solver runs and reads its results; the physics and the verdict are here.
 #include <filesystem>
 #include <optional>
 #include <ostream>
@@ -101,8 +103,9 @@ struct CheckResult {
   std::vector<std::string> failures;   ///< one line per failed check
 };
 
-/// Runs ccx on `deck_dir`/impact.inp (in options.work_dir or the deck folder, output in
-/// impact.log), then parses impact.dat. Throws InputError naming the file, the step and the reason
+/// Runs the deck's solver (the first registered one that can run and whose files the deck has:
+/// ccx on `deck_dir`/impact.inp, in options.work_dir or the deck folder, output in impact.log),
+/// then reads its results (impact.dat). Throws InputError naming the file, the step and the reason
 /// when the folder is not a deck, ccx is missing, fails, is killed by a signal, runs past its
 /// timeout, or its output is incomplete (a missing print, a full disk); a check above its
 /// tolerance is reported in `passed`/`failures`.
@@ -111,13 +114,6 @@ CheckResult run_check(const std::filesystem::path& deck_dir, const CheckOptions&
 /// The same for the deck `written` has just written (write_decks / write_deck_files): its
 /// description and mesh are taken from memory, not read back from deck.json and mesh.inp.
 CheckResult run_check(const DeckResult& written, const CheckOptions& options = {});
-
-/// Runs ccx on `dir`/impact.inp (cwd = dir, output in impact.log, progress from impact.sta up to
-/// `end_time_s`) with options.timeout_s, or default_solver_timeout_s(nodes, solves); returns the
-/// wall time in s. Throws InputError when ccx is missing, fails or times out. The runner of
-/// run_check, for the full-contact model (contact_model.hpp).
-double run_ccx_job(const std::filesystem::path& dir, const CheckOptions& options, double end_time_s,
-                   std::size_t nodes, std::size_t solves);
 
 /// JSON of a check (keys documented in docs/fem.md).
 nlohmann::json to_json(const CheckResult& r);

@@ -23,7 +23,8 @@
 
 namespace impactdeck::fem_export {
 
-/// The job name of every deck: impact.inp (CalculiX), impact.comm / impact.export (Code_Aster).
+/// The job name of every deck: impact.inp (CalculiX), impact.comm / impact.export (Code_Aster);
+/// each solver's files (solver.hpp) are named after it.
 inline constexpr const char* kJobName = "impact";
 
 /// The solver's unit system of a deck: lengths in `length`, forces in N, times in s, so masses in
@@ -140,8 +141,12 @@ struct DeckOptions {
   /// (when finer than time_step_s); measured on the paper's case (69 us pulse), 7 steps of 1e-5 s
   /// miss 0.5 % of the impulse, 40 steps 5.4e-4, 160 steps 1.1e-4. 0 turns the refined phase off.
   int pulse_increments = -1;
-  bool code_aster = true;      ///< write impact.comm, impact.export and mesh.med
-  bool calculix = true;        ///< write impact.inp and mesh.inp
+  /// The solvers whose decks are written, by registry name (solver.hpp): "calculix" (impact.inp,
+  /// mesh.inp), "code_aster" (mesh.med, impact.comm, impact.export). Files are written in the
+  /// registry's order whatever the order here; an unknown name is refused.
+  std::vector<std::string> solvers = {"calculix", "code_aster"};
+  /// Whether `solvers` names `name`.
+  bool writes(const std::string& name) const;
   int aster_cpus = 1;           ///< impact.export `P ncpus` (OpenMP threads of each Code_Aster process)
   int aster_mpi_processes = 1;  ///< impact.export `P mpi_nbcpu` (MPI processes)
   /// Most tetrahedra a deck may have (scene key outputs.fem.max_elements). Checked before meshing
@@ -310,14 +315,5 @@ DeckResult write_deck_files(const DeckRequest& request, const std::filesystem::p
 /// write_deck_files in a transaction of its own on folder's parent (common/run_transaction.hpp):
 /// `folder` appears complete or not at all, and a previous `folder` is replaced only on success.
 DeckResult write_decks(const DeckRequest& request, const std::filesystem::path& folder);
-
-/// Text of the Code_Aster command file (exposed for tests). `patch`: the hertz-patch nodal forces
-/// (nullptr: the point load on LOAD); its nodes are the mesh's groups LP1, LP2, ... in order.
-std::string code_aster_comm(const DeckRequest& request, const TetMesh& mesh, const PatchLoad* patch = nullptr);
-/// Text of the run_aster .export file.
-std::string code_aster_export(const DeckRequest& request, const TetMesh& mesh);
-/// Text of the CalculiX main deck and of its included mesh.
-std::string calculix_inp(const DeckRequest& request, const TetMesh& mesh, const PatchLoad* patch = nullptr);
-std::string calculix_mesh_inp(const TetMesh& mesh, const DeckUnits& units = {});
 
 }  // namespace impactdeck::fem_export

@@ -16,6 +16,7 @@
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/common/version.hpp"
 #include "impactdeck/common/json_number.hpp"
+#include "calculix.hpp"
 
 namespace impactdeck::fem_export {
 namespace fs = std::filesystem;
@@ -487,7 +488,7 @@ ContactRunResult run_contact(const fs::path& folder, const json& cj, const Check
     // Contact: a few equation solves per increment (3-6 seen), and cutbacks: 8 per nominal one.
     std::size_t nodes = 0;
     for (const auto& b : cj.at("bodies")) nodes += b.at("node_count").get<std::size_t>();
-    r.wall_time_s = run_ccx_job(folder, options, end, nodes, 8 * cj.at("increments").get<std::size_t>());
+    r.wall_time_s = calculix::run_ccx_job(folder, options, end, nodes, 8 * cj.at("increments").get<std::size_t>());
   }
   const ContactDat d = read_contact_dat(folder / (std::string(kJobName) + ".dat"));
   const Eigen::Vector3d n = vec3(cj.at("normal"));

@@ -1,0 +1,40 @@
+#pragma once
+// CalculiX behind the solver interface (solver.hpp), private to fem_export: its deck dialect
+// (impact.inp, mesh.inp), the ccx run and the reading of impact.dat / impact.frd.
+#include <cstddef>
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "impactdeck/fem_export/check.hpp"
+#include "impactdeck/fem_export/decks.hpp"
+#include "impactdeck/fem_export/solver.hpp"
+
+namespace impactdeck::fem_export::calculix {
+
+class CalculixSolver final : public Solver {
+ public:
+  std::string name() const override { return "calculix"; }
+  std::string title() const override { return "CalculiX"; }
+  std::vector<std::string> write_deck(const DeckInput& in, const std::filesystem::path& folder) const override;
+  void describe(const DeckInput& in, bool selected, nlohmann::json& deck) const override;
+  bool can_run() const override { return true; }
+  TetMesh read_mesh(const std::filesystem::path& deck_dir, const DeckUnits& units) const override;
+  std::string mesh_file() const override { return "mesh.inp"; }
+  SolverOutput run(const SolverJob& job) const override;
+  std::optional<StressResult> stresses(const SolverJob& job, const StressInputs& in) const override;
+};
+
+/// Text of the CalculiX main deck (`patch`: the hertz-patch nodal forces, nullptr: the point load
+/// on LOAD) and of its included mesh (exposed for tests).
+std::string calculix_inp(const DeckRequest& request, const TetMesh& mesh, const PatchLoad* patch = nullptr);
+std::string calculix_mesh_inp(const TetMesh& mesh, const DeckUnits& units = {});
+
+/// Runs ccx on `dir`/impact.inp (cwd = dir, output in impact.log, progress from impact.sta up to
+/// `end_time_s`) with options.timeout_s, or default_solver_timeout_s(nodes, solves); returns the
+/// wall time in s. Throws InputError when ccx is missing, fails or times out. The runner of the
+/// hybrid check and of the full-contact model (contact_model.hpp).
+double run_ccx_job(const std::filesystem::path& dir, const CheckOptions& options, double end_time_s,
+                   std::size_t nodes, std::size_t solves);
+
+}  // namespace impactdeck::fem_export::calculix

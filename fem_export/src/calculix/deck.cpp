@@ -1,0 +1,158 @@
+// CalculiX's deck dialect: impact.inp and mesh.inp (docs/fem.md).
+#include <iomanip>
+#include <sstream>
+
+#include "calculix.hpp"
+#include "../deck_text.hpp"
+#include "impactdeck/common/atomic_file.hpp"
+#include "impactdeck/common/version.hpp"
+
+namespace impactdeck::fem_export {
+
+const char* to_string(CcxSolver s) {
+  switch (s) {
+    case CcxSolver::automatic: return "auto";
+    case CcxSolver::spooles: return "spooles";
+    case CcxSolver::iterative: return "iterative";
+  }
+  return "?";
+}
+
+CcxSolver ccx_solver_for(CcxSolver requested, std::size_t nodes) {
+  if (requested != CcxSolver::automatic) return requested;
+  return nodes >= kIterativeSolverMinNodes ? CcxSolver::iterative : CcxSolver::spooles;
+}
+
+
+}  // namespace impactdeck::fem_export
+
+namespace impactdeck::fem_export::calculix {
+using detail::num;
+using detail::header_lines;
+using detail::output_every;
+using detail::probe_groups;
+
+namespace {
+
+// Pairs (t, f) four to a line, as ccx's *AMPLITUDE reads them.
+void amplitude_rows(std::ostream& s, const std::vector<double>& t, const std::vector<double>& f) {
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    s << num(t[i]) << ", " << num(f[i]) << ((i % 4 == 3 || i + 1 == t.size()) ? "\n" : ", ");
+  }
+}
+
+}  // namespace
+
+std::string calculix_mesh_inp(const TetMesh& m, const DeckUnits& u) {
+  std::ostringstream s;
+  s << "** impactdeck " << kVersion << ": mesh of the target body (" << to_string(u.length)
+    << "), included by impact.inp\n";
+  s << "*NODE, NSET=BODYN\n" << std::setprecision(15);
+  for (std::size_t i = 0; i < m.nodes_m.size(); ++i) {
+    const Eigen::Vector3d x = m.nodes_m[i] * u.per_m();
+    s << i + 1 << ", " << num(x.x()) << ", " << num(x.y()) << ", " << num(x.z()) << "\n";
+  }
+  s << "*ELEMENT, TYPE=C3D4, ELSET=BODY\n";
+  for (std::size_t e = 0; e < m.tets.size(); ++e) {
+    const auto& t = m.tets[e];
+    s << e + 1 << ", " << t[0] + 1 << ", " << t[1] + 1 << ", " << t[2] + 1 << ", " << t[3] + 1 << "\n";
+  }
+  for (const auto& [g, n] : m.node_groups) s << "*NSET, NSET=" << g << "\n" << n + 1 << "\n";
+  return s.str();
+}
+
+std::string calculix_inp(const DeckRequest& r, const TetMesh& m, const PatchLoad* patch) {
+  const DeckOptions& o = r.options;
+  const TimeSchedule ts = deck_schedule(r);
+  const std::size_t every = output_every(o, ts, m.nodes_m.size());
+  std::ostringstream s;
+  s << header_lines("**", r, "CalculiX deck (ccx 2.20), run: ccx -i impact");
+  s << "** Step 1: implicit direct dynamics (fixed steps; refined while the force acts) through\n"
+       "** end_time_s, probe velocities, nodal stresses S and displacements U (impact.frd) every\n"
+       "** increment" << (every > 1 ? " (every " + std::to_string(every) + "th after the contact)" : std::string()) << ".\n"
+       "** Step 2: one increment printing every node's velocity and the total mass (the momentum check).\n"
+       "** The amplitudes use TOTAL TIME and stay at their closing zero.\n";
+  {
+    const ForceSampling fs = force_sampling(r.force, ts);
+    s << "** Increments: " << ts.pulse_increments << " across the contact ("
+      << (o.pulse_increments == kAutoPulseIncrements ? "at the force table's samples" : "as asked") << "), then "
+      << ts.main_increments << "; at them the force's impulse and peak\n** differ from the table's by "
+      << std::setprecision(3) << fs.impulse_relative_error << " and " << fs.peak_force_relative_error << ".\n";
+  }
+  if (patch) {
+    s << "** Load: the Hertz pressure of each instant's contact ellipse as nodal forces on "
+      << patch->nodes.size() << " surface nodes,\n** one amplitude per node (N), sum F(t), zero moment about the contact point.\n";
+  }
+  s << "*HEADING\nimpactdeck hybrid impact " << r.impact << "\n";
+  s << "*INCLUDE, INPUT=mesh.inp\n";
+  s << "*MATERIAL, NAME=BODYMAT\n*ELASTIC\n" << num(r.material.youngs_modulus_Pa * o.units.per_Pa()) << ", "
+    << num(r.material.poisson_ratio) << "\n*DENSITY\n" << num(r.material.density_kg_m3 * o.units.per_kg_m3()) << "\n";
+  s << "*SOLID SECTION, ELSET=BODY, MATERIAL=BODYMAT\n" << std::setprecision(15);
+  if (patch) {
+    for (std::size_t k = 0; k < patch->nodes.size(); ++k) {
+      s << "*AMPLITUDE, NAME=P" << k + 1 << ", TIME=TOTAL TIME\n";
+      amplitude_rows(s, patch->time_s, patch->force_N[k]);
+    }
+  } else {
+    s << "*AMPLITUDE, NAME=HERTZ, TIME=TOTAL TIME\n";
+    for (std::size_t i = 0; i < r.force.time_s.size(); ++i) {
+      s << num(r.force.time_s[i]) << ", " << num(r.force.force_N[i]) << "\n";
+    }
+  }
+  // The equation solver by deck size (CcxSolver; bench/bench_ccx.cpp measured the choice).
+  const char* dynamic = ccx_solver_for(o.solver, m.nodes_m.size()) == CcxSolver::iterative
+                            ? "*DYNAMIC, DIRECT, SOLVER=ITERATIVE SCALING\n"
+                            : "*DYNAMIC, DIRECT\n";
+  auto step = [&](std::size_t incs, double dt, double period, const std::string& what) {
+    s << "** " << what << "\n*STEP, INC=" << incs + 10 << "\n" << dynamic << num(dt) << ", " << num(period) << "\n";
+  };
+  auto loads_and_output = [&](std::size_t frequency) {
+    if (patch) {
+      for (std::size_t k = 0; k < patch->nodes.size(); ++k) {
+        s << "*CLOAD, AMPLITUDE=P" << k + 1 << "\n";
+        for (int c = 0; c < 3; ++c) s << patch->nodes[k] + 1 << ", " << c + 1 << ", " << num(r.direction[c]) << "\n";
+      }
+    } else {
+      s << "*CLOAD, AMPLITUDE=HERTZ\n";
+      for (int k = 0; k < 3; ++k) s << "LOAD, " << k + 1 << ", " << num(r.direction[k]) << "\n";
+    }
+    for (const auto& p : probe_groups(m)) s << "*NODE PRINT, NSET=" << p << ", FREQUENCY=" << frequency << "\nV\n";
+    s << "*NODE FILE, FREQUENCY=" << frequency << "\nU\n*EL FILE, FREQUENCY=" << frequency << "\nS\n";
+    s << "*END STEP\n";
+  };
+  if (!ts.pulse_segments.empty()) {
+    double begin = 0;
+    for (std::size_t i = 0; i < ts.pulse_segments.size(); ++i) {
+      const TimeSegment& g = ts.pulse_segments[i];
+      const bool last = i + 1 == ts.pulse_segments.size();
+      step(g.increments, g.step_s, g.end_s - begin,
+           std::string("Step 1a") + (ts.pulse_segments.size() > 1 ? "." + std::to_string(i + 1) : std::string()) +
+               (last ? ": through the end of the contact, refined" : ": refined, while the force acts"));
+      loads_and_output(1);
+      begin = g.end_s;
+    }
+    step(ts.main_increments, ts.main_step_s, o.end_time_s - ts.pulse_end_s, "Step 1b: free vibration through end_time_s");
+  } else {
+    step(ts.main_increments, ts.main_step_s, o.end_time_s, "Step 1: through end_time_s");
+  }
+  loads_and_output(every);
+  s << "** Step 2: one increment printing all velocities and the mass (momentum check)\n";
+  s << "*STEP, INC=10\n" << dynamic << num(ts.main_step_s) << ", " << num(ts.main_step_s) << "\n";
+  s << "*NODE PRINT, NSET=BODYN, FREQUENCY=1\nV\n";
+  s << "*EL PRINT, ELSET=BODY, TOTALS=ONLY, FREQUENCY=1\nEMAS\n";
+  s << "*END STEP\n";
+  return s.str();
+}
+
+std::vector<std::string> CalculixSolver::write_deck(const DeckInput& in, const std::filesystem::path& folder) const {
+  write_file_atomically(folder / "mesh.inp", calculix_mesh_inp(in.mesh, in.request.options.units));
+  write_file_atomically(folder / (std::string(kJobName) + ".inp"), calculix_inp(in.request, in.mesh, in.patch));
+  return {"mesh.inp", std::string(kJobName) + ".inp"};
+}
+
+void CalculixSolver::describe(const DeckInput& in, bool selected, nlohmann::json& deck) const {
+  Solver::describe(in, selected, deck);
+  deck["ccx_solver"] = to_string(ccx_solver_for(in.request.options.solver, in.mesh.nodes_m.size()));
+}
+
+}  // namespace impactdeck::fem_export::calculix
