@@ -36,6 +36,7 @@ struct Registry {
 
 // The built-in laws' factories, each defined in its law's file (src/NAME_law.cpp).
 std::shared_ptr<const ContactLaw> make_hertz_law(const LawOptions& options);
+std::shared_ptr<const ContactLaw> make_thornton_law(const LawOptions& options);
 
 namespace {
 
@@ -44,6 +45,7 @@ Registry& registry() {
   static Registry r{{},
                     {
                         {"hertz", make_hertz_law},
+                        {"thornton", make_thornton_law},
                     }};
   return r;
 }

@@ -72,9 +72,14 @@ class ContactLaw {
   virtual std::string describe_restitution(const LawResult& r, double approach_velocity_m_s) const;
 };
 
+/// Thornton's default limiting pressure p_y over the weaker body's yield strength: the onset of
+/// yield under a circular Hertz contact, p0 = 1.60 Y for nu = 0.3 (Johnson 1985, Sect. 6.2).
+inline constexpr double kThorntonYieldFactor = 1.6;
+
 /// What a scene says about the law of an impact (each law reads what it needs).
 struct LawOptions {
-  RestitutionModel restitution;  ///< "hertz": its restitution model
+  RestitutionModel restitution;     ///< "hertz": its restitution model
+  double limiting_pressure_Pa = 0;  ///< "thornton": p_y; 0: kThorntonYieldFactor x the yield strength
 };
 
 using ContactLawFactory = std::function<std::shared_ptr<const ContactLaw>(const LawOptions&)>;
