@@ -11,9 +11,6 @@ namespace impactdeck::collision {
 
 namespace {
 
-// x > 0 and finite (NaN fails both comparisons).
-bool finite_positive(double x) { return x > 0.0 && x <= std::numeric_limits<double>::max(); }
-
 // The compression phase a solved impact stands for, as far as F(t) reads it.
 CompressionPhase compression_of(const LawResult& r) {
   CompressionPhase c;
@@ -41,45 +38,9 @@ HertzLaw::HertzLaw(RestitutionModel restitution, const InputContext& ctx) : rest
   }
 }
 
-namespace {
-
-// k_H, x_max, F_max, t_m (closed forms, Eq. 1-12, 27); false when a number is not finite and positive.
-inline bool hertz_step(const LawInput& in, LawResult& r) {
-  r.stiffness = hertz_constant(in.effective_modulus_Pa, in.effective_radius_m);
-  const CompressionPhase c = compression_phase(in.reduced_mass_kg, in.approach_velocity_m_s, r.stiffness);
-  r.max_indentation_m = c.max_indentation_m;
-  r.max_force_N = c.max_force_N;
-  r.compression_time_s = c.compression_time_s;
-  r.impulse_compression_Ns = c.impulse_Ns;
-  if (!finite_positive(r.stiffness) || !finite_positive(r.max_indentation_m) || !finite_positive(r.max_force_N) ||
-      !finite_positive(r.compression_time_s) || !finite_positive(r.impulse_compression_Ns)) {
-    r.status = LawStatus::degenerate;
-    return false;
-  }
-  return true;
-}
-
-// Restitution (Eq. 13-15, 30), the total impulse and the times.
-inline void restitution_step(const RestitutionModel& model, const LawInput& in, LawResult& r) {
-  r.restitution = evaluate_restitution(model, in.reduced_mass_kg, in.approach_velocity_m_s, in.effective_radius_m);
-  if (r.restitution.refused) {
-    r.status = LawStatus::restitution_range;
-    return;
-  }
-  if (r.restitution.invalid) {
-    r.status = LawStatus::restitution_invalid;
-    return;
-  }
-  r.impulse_total_Ns = (1.0 + r.restitution.coefficient) * r.impulse_compression_Ns;
-  r.contact_time_s = collision::contact_time_s(r.compression_time_s, r.restitution.coefficient);
-  r.unloading_time_s = r.restitution.coefficient * r.compression_time_s;
-  r.status = LawStatus::ok;
-}
-
-}  // namespace
-
 void HertzLaw::solve_one(const LawInput& in, LawResult& r) const noexcept {
-  if (hertz_step(in, r)) restitution_step(restitution_, in, r);
+  r.status = hertz_compression(in, r, r.stiffness);
+  if (r.status == LawStatus::ok) r.status = hertz_restitution(restitution_, in, r);
 }
 
 void HertzLaw::solve(const LawInput* in, LawResult* out, std::size_t count) const noexcept {

@@ -10,21 +10,17 @@ namespace impactdeck::collision {
 
 namespace {
 
-// The law's result a kernel result carries.
-LawResult law_result_of(const KernelResult& k) {
+// The law's result for a solved kernel point: the law's step again on the point's normal-direction
+// input (deterministic: the kernel's numbers; a kernel result keeps no law-specific state).
+LawResult law_result_of(const ContactLaw& law, const KernelInput& k, const KernelResult& kr) {
+  LawInput in;
+  in.reduced_mass_kg = kr.reduced_mass_kg;
+  in.approach_velocity_m_s = kr.approach_velocity_m_s;
+  in.effective_modulus_Pa = k.effective_modulus_Pa;
+  in.effective_radius_m = kr.effective_radius_m;
+  in.yield_strength_Pa = k.yield_strength_Pa;
   LawResult l;
-  l.status = LawStatus::ok;
-  l.stiffness = k.hertz_constant;
-  l.max_indentation_m = k.max_indentation_m;
-  l.max_force_N = k.max_force_N;
-  l.compression_time_s = k.compression_time_s;
-  l.contact_time_s = k.contact_time_s;
-  l.unloading_time_s = k.unloading_time_s;
-  l.restitution = k.restitution;
-  l.impulse_compression_Ns = k.impulse_compression_Ns;
-  l.impulse_total_Ns = k.impulse_total_Ns;
-  l.residual_indentation_m = k.residual_indentation_m;
-  l.state = k.law_state;
+  law.solve(&in, &l, 1);
   return l;
 }
 
@@ -84,7 +80,7 @@ std::string explain_flag(const KernelInput& in, const KernelResult& r, const std
       break;
     case ContactFlag::restitution_range:
     case ContactFlag::restitution_invalid:
-      s << "restitution: " << in.law->describe_restitution(law_result_of(r), r.approach_velocity_m_s);
+      s << "restitution: " << in.law->describe_restitution(law_result_of(*in.law, in, r), r.approach_velocity_m_s);
       break;
     case ContactFlag::no_curvature:
       s << "the curvature of a surface cannot be estimated at the contact point (a mesh too coarse there)";
@@ -186,7 +182,7 @@ ImpactResult complete(const ImpactInput& in, std::shared_ptr<const ContactLaw> l
   r.restitution.energy_flux_density = std::exp(kr.restitution.ln_energy_flux);
   r.restitution.clamped = kr.restitution.clamped;
   if (kr.restitution.outside_range) {
-    r.restitution.warning = law->describe_restitution(law_result_of(kr), kr.approach_velocity_m_s);
+    r.restitution.warning = law->describe_restitution(law_result_of(*law, k, kr), kr.approach_velocity_m_s);
     r.warnings.push_back(r.restitution.warning);
   }
   r.target_jump = kr.target_jump;
@@ -195,7 +191,7 @@ ImpactResult complete(const ImpactInput& in, std::shared_ptr<const ContactLaw> l
   r.history.compression = compression_summary(kr);
   check_compression_range(r.history.compression, in.context, in.input_keys);
   r.history.restitution = kr.restitution.coefficient;
-  r.history.law_result = law_result_of(kr);
+  r.history.law_result = law_result_of(*law, k, kr);
   r.history.law = std::move(law);
 
   // Self-check 1 (Eq. 31): compression impulse by quadrature of the curve vs m_w v_w.

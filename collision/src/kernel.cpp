@@ -7,6 +7,7 @@
 
 #include "impactdeck/collision/compression.hpp"
 #include "impactdeck/collision/hertz.hpp"
+#include "impactdeck/collision/hertz_law.hpp"
 #include "impactdeck/common/error.hpp"
 
 namespace impactdeck::collision {
@@ -223,6 +224,17 @@ inline void law_input(const KernelInput& in, const KernelResult& r, LawInput& l)
   l.yield_strength_Pa = in.yield_strength_Pa;
 }
 
+// A law's status as the kernel's flag: false when the law failed (its numbers, or its restitution).
+inline bool take_status(LawStatus status, KernelResult& r) {
+  switch (status) {
+    case LawStatus::ok: return true;
+    case LawStatus::restitution_range: r.flag = ContactFlag::restitution_range; return false;
+    case LawStatus::restitution_invalid: r.flag = ContactFlag::restitution_invalid; return false;
+    case LawStatus::degenerate: r.flag = ContactFlag::degenerate; return false;
+  }
+  return false;
+}
+
 // The law's result into the kernel's: false when the law failed (its numbers, or its restitution).
 inline bool take_law(const LawResult& l, KernelResult& r) {
   r.hertz_constant = l.stiffness;
@@ -233,16 +245,9 @@ inline bool take_law(const LawResult& l, KernelResult& r) {
   r.restitution = l.restitution;
   r.contact_time_s = l.contact_time_s;
   r.unloading_time_s = l.unloading_time_s;
-  r.law_state = l.state;
   r.impulse_total_Ns = l.impulse_total_Ns;
   r.residual_indentation_m = l.residual_indentation_m;
-  switch (l.status) {
-    case LawStatus::ok: return true;
-    case LawStatus::restitution_range: r.flag = ContactFlag::restitution_range; return false;
-    case LawStatus::restitution_invalid: r.flag = ContactFlag::restitution_invalid; return false;
-    case LawStatus::degenerate: r.flag = ContactFlag::degenerate; return false;
-  }
-  return false;
+  return take_status(l.status, r);
 }
 
 // The contact ellipse at F_max and the peak pressure.
@@ -276,6 +281,24 @@ inline void step_jumps(const KernelInput& in, const KernelPoint& p, KernelResult
   }
 }
 
+// Any law but Hertz, once for the group's live points (one virtual call per group, not per point).
+inline void solve_law(const KernelInput& in, const RelativeCurvatures* rc, const EllipticalContact* ec, bool* live,
+                      KernelResult* const* r, std::size_t n) {
+  LawInput law_in[kKernelLanes];
+  LawResult law_out[kKernelLanes];
+  std::size_t lane[kKernelLanes], m = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    if (live[k]) law_input(in, *r[k], law_in[m]), lane[m++] = k;
+  }
+  if (m > 0) in.law->solve(law_in, law_out, m);
+  for (std::size_t j = 0; j < m; ++j) {
+    const std::size_t k = lane[j];
+    live[k] = take_law(law_out[j], *r[k]);
+    // The contact ellipse at F_max whenever the law gave its numbers (also for a refused restitution).
+    if (live[k] || law_out[j].status != LawStatus::degenerate) step_pressure(in, rc[k], ec[k], *r[k]);
+  }
+}
+
 }  // namespace
 
 void solve_kernel(const KernelInput& in, const KernelPoint* points, KernelResult* const* results,
@@ -284,6 +307,8 @@ void solve_kernel(const KernelInput& in, const KernelPoint* points, KernelResult
   // divisions, logs and exps are independent, so the processor overlaps them (one point alone
   // waits on its own chain).
   const CallInvariants ci(in);
+  // Hertz (the default law of every scene) is told apart once per call.
+  const auto* hertz = dynamic_cast<const HertzLaw*>(in.law);
   for (std::size_t begin = 0; begin < count; begin += kKernelLanes) {
     const std::size_t n = std::min(kKernelLanes, count - begin);
     const KernelPoint* p = points + begin;
@@ -293,19 +318,23 @@ void solve_kernel(const KernelInput& in, const KernelPoint* points, KernelResult
     EllipticalContact ec[kKernelLanes];
     for (std::size_t k = 0; k < n; ++k) live[k] = step_motion(in, ci, p[k], *r[k]);
     for (std::size_t k = 0; k < n; ++k) live[k] = live[k] && step_radius(in, p[k], *r[k], rc[k], ec[k]);
-    // The law, once for the group's live points (one virtual call per group, not per point).
-    LawInput law_in[kKernelLanes];
-    LawResult law_out[kKernelLanes];
-    std::size_t lane[kKernelLanes], m = 0;
-    for (std::size_t k = 0; k < n; ++k) {
-      if (live[k]) law_input(in, *r[k], law_in[m]), lane[m++] = k;
-    }
-    if (m > 0) in.law->solve(law_in, law_out, m);
-    for (std::size_t j = 0; j < m; ++j) {
-      const std::size_t k = lane[j];
-      live[k] = take_law(law_out[j], *r[k]);
-      // The contact ellipse at F_max whenever the law gave its numbers (also for a refused restitution).
-      if (live[k] || law_out[j].status != LawStatus::degenerate) step_pressure(in, rc[k], ec[k], *r[k]);
+    if (hertz != nullptr) {
+      // Hertz's fast path: the law's two steps inline, straight into the results, each over the
+      // group before the next (as the kernel's own steps).
+      LawInput law_in[kKernelLanes];
+      for (std::size_t k = 0; k < n; ++k) {
+        if (!live[k]) continue;
+        law_input(in, *r[k], law_in[k]);
+        live[k] = take_status(hertz_compression(law_in[k], *r[k], r[k]->hertz_constant), *r[k]);
+      }
+      for (std::size_t k = 0; k < n; ++k) {
+        if (live[k]) step_pressure(in, rc[k], ec[k], *r[k]);
+      }
+      for (std::size_t k = 0; k < n; ++k) {
+        if (live[k]) live[k] = take_status(hertz_restitution(hertz->restitution(), law_in[k], *r[k]), *r[k]);
+      }
+    } else {
+      solve_law(in, rc, ec, live, r, n);
     }
     for (std::size_t k = 0; k < n; ++k) {
       if (live[k]) step_jumps(in, p[k], *r[k]);

@@ -5,9 +5,45 @@
 //   R   from the model (energy flux Eq. 14 + 30, a constant, or a table)
 //   F(t) the compression curve, then its mirror stretched by R (force_history.hpp); t_c = (1 + R) t_m
 //   no dent
+#include <limits>
+
+#include "impactdeck/collision/compression.hpp"
 #include "impactdeck/collision/contact_law.hpp"
+#include "impactdeck/collision/force_history.hpp"
+#include "impactdeck/collision/hertz.hpp"
 
 namespace impactdeck::collision {
+
+/// Hertz's two steps for one impact, into any result with LawResult's field names (LawResult, or
+/// the kernel's KernelResult on its fast path): the one place of the Hertz law's numbers.
+/// Step 1: k_H (into `stiffness`), x_max, F_max, t_m (closed forms, Eq. 1-12, 27); degenerate when a
+/// number is not finite and positive.
+template <class Result>
+inline LawStatus hertz_compression(const LawInput& in, Result& r, double& stiffness) noexcept {
+  auto finite_positive = [](double x) { return x > 0.0 && x <= std::numeric_limits<double>::max(); };
+  stiffness = hertz_constant(in.effective_modulus_Pa, in.effective_radius_m);
+  const CompressionPhase c = compression_phase(in.reduced_mass_kg, in.approach_velocity_m_s, stiffness);
+  r.max_indentation_m = c.max_indentation_m;
+  r.max_force_N = c.max_force_N;
+  r.compression_time_s = c.compression_time_s;
+  r.impulse_compression_Ns = c.impulse_Ns;
+  const bool ok = finite_positive(stiffness) && finite_positive(r.max_indentation_m) &&
+                  finite_positive(r.max_force_N) && finite_positive(r.compression_time_s) &&
+                  finite_positive(r.impulse_compression_Ns);
+  return ok ? LawStatus::ok : LawStatus::degenerate;
+}
+
+/// Step 2: R from the model (Eq. 13-15, 30), the total impulse and the times.
+template <class Result>
+inline LawStatus hertz_restitution(const RestitutionModel& model, const LawInput& in, Result& r) noexcept {
+  r.restitution = evaluate_restitution(model, in.reduced_mass_kg, in.approach_velocity_m_s, in.effective_radius_m);
+  if (r.restitution.refused) return LawStatus::restitution_range;
+  if (r.restitution.invalid) return LawStatus::restitution_invalid;
+  r.impulse_total_Ns = (1.0 + r.restitution.coefficient) * r.impulse_compression_Ns;
+  r.contact_time_s = collision::contact_time_s(r.compression_time_s, r.restitution.coefficient);
+  r.unloading_time_s = r.restitution.coefficient * r.compression_time_s;
+  return LawStatus::ok;
+}
 
 class HertzLaw final : public ContactLaw {
  public:

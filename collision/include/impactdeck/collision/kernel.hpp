@@ -16,7 +16,6 @@
 //         energy flux (Eq. 14, 30), a constant, or a measured table
 //   Pi    = (1 + R) m_w v_w,  dv_i = -+Pi n/m_i,  dw_i = I_i^-1 (r_i x -+Pi n)  (Eq. 13, 22-23)
 // Body 1 is the target, n its outward unit normal; body 2 the impactor, pushed along +n.
-#include <array>
 #include <cstddef>
 #include <cstdint>
 
@@ -121,7 +120,6 @@ struct KernelResult {
   double impulse_compression_Ns = 0;  ///< Pi_1 = m_w v_w
   double impulse_total_Ns = 0;        ///< (1 + R) Pi_1
   double residual_indentation_m = 0;  ///< the dent the law leaves (0 for Hertz)
-  std::array<double, 4> law_state{};  ///< LawResult::state: the law's own numbers for its F(t)
   /// Contact ellipse at F_max (circular for the mean and paper rules) and the peak pressure.
   double contact_semi_axis_a_m = 0, contact_semi_axis_b_m = 0;
   double peak_pressure_Pa = 0;        ///< p0 = 3 F_max / (2 pi a b)
