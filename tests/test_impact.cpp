@@ -6,6 +6,7 @@
 
 #include "impactdeck/collision/impact.hpp"
 #include "impactdeck/common/error.hpp"
+#include "impact_cases.hpp"
 #include "tolerances.hpp"
 
 using namespace impactdeck;
@@ -15,17 +16,7 @@ using impactdeck::test::kSelfCheckRel;
 namespace {
 
 ImpactInput eccentric_case(double R) {
-  ImpactInput in;
-  in.target.mass_kg = 16440.0;
-  in.target.inertia_kg_m2 = (16440.0 / 5) * Eigen::Vector3d(0.5, 4.25, 4.25).asDiagonal();
-  in.impactor.mass_kg = 4.11;
-  in.impactor.inertia_kg_m2 = 0.4 * 4.11 * 0.0025 * Eigen::Matrix3d::Identity();
-  in.contact.point_m = {1.5, 0.33, 0.0};
-  in.contact.normal = Eigen::Vector3d(1.5 / 4.0, 0.33 / 0.25, 0).normalized();
-  in.impactor.center_of_mass_m = in.contact.point_m + 0.05 * in.contact.normal;
-  in.impactor.velocity_m_s = -10.0 * in.contact.normal;
-  in.target_curvature = ContactCurvature::sphere(0.04);  // R* = 0.04 m against a flat impactor
-  in.effective_modulus_Pa = 1.1e11;
+  ImpactInput in = impactdeck::test::eccentric_ball_input();
   in.restitution.kind = RestitutionModel::Kind::constant;
   in.restitution.constant = R;
   return in;

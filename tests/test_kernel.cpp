@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "impactdeck/collision/hertz_law.hpp"
 #include "impactdeck/collision/impact.hpp"
 #include "impactdeck/collision/kernel.hpp"
 #include "impactdeck/collision/validity.hpp"
@@ -27,7 +28,7 @@ RestitutionModel constant(double R) {
 }
 
 // A steel ball of radius r (m) against a fixed target, at 1 m/s along -z; both surfaces given.
-KernelInput ball_on_fixed(double r, const ContactCurvature& target, const RestitutionModel& rm) {
+KernelInput ball_on_fixed(double r, const ContactCurvature& target, const ContactLaw& law) {
   RigidBody wall;
   wall.mass_kg = INFINITY;
   RigidBody ball;
@@ -43,7 +44,7 @@ KernelInput ball_on_fixed(double r, const ContactCurvature& target, const Restit
   in.impactor.curvature = ContactCurvature::sphere(r);
   in.normal = {0, 0, 1};
   in.effective_modulus_Pa = 1.1e11;
-  in.restitution = &rm;
+  in.law = &law;
   return in;
 }
 
@@ -61,7 +62,7 @@ ContactCurvature principal(double k1, double k2) {
 TEST(Kernel, BallInAConcaveCupIsAConformingHertzContact) {
   // Ball r = 10 mm in a spherical cup of radius 50 mm: 1/R* = 1/r - 1/R_cup (Johnson, Sect. 4.2),
   // R* = r R / (R - r) = 12.5 mm, under every rule that uses curvatures.
-  const RestitutionModel rm = constant(0.5);
+  const HertzLaw rm(constant(0.5));
   for (ContactRule rule : {ContactRule::elliptical, ContactRule::mean}) {
     KernelInput in = ball_on_fixed(0.01, principal(-20.0, -20.0), rm);
     in.rule = rule;
@@ -79,7 +80,7 @@ TEST(Kernel, BallInAConcaveCupIsAConformingHertzContact) {
 }
 
 TEST(Kernel, FlagsWhereHertzDoesNotApply) {
-  const RestitutionModel rm = constant(0.5);
+  const HertzLaw rm(constant(0.5));
   // A saddle k = (10, -30) 1/m: a ball of 1/r = 20 is outweighed along the concave direction...
   EXPECT_EQ(solve_kernel(ball_on_fixed(0.05, principal(10.0, -30.0), rm)).flag, ContactFlag::saddle);
   // ... a ball of 1/r = 40 fits: A = (40 - 30)/2 = 5, B = (40 + 10)/2 = 25.
@@ -130,7 +131,7 @@ TEST(Kernel, BothBodiesEccentricMatchTheClosedFormAndConserveMomentum) {
   // is -R v_w, linear momentum and angular momentum about the contact point are conserved.
   std::mt19937_64 rng(42);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
-  const RestitutionModel rm = constant(0.6);
+  const HertzLaw rm(constant(0.6));
   for (int trial = 0; trial < 200; ++trial) {
     RigidBody a, b;
     auto random_body = [&](RigidBody& body) {
@@ -159,7 +160,7 @@ TEST(Kernel, BothBodiesEccentricMatchTheClosedFormAndConserveMomentum) {
     in.impactor.curvature = ContactCurvature::sphere(0.1);
     in.normal = c.normal;
     in.effective_modulus_Pa = 2e11;
-    in.restitution = &rm;
+    in.law = &rm;
     const KernelResult r = solve_kernel(in);
     ASSERT_EQ(r.flag, ContactFlag::none);
     EXPECT_NEAR(r.reduced_mass_kg, reduced_mass_kg(a, b, c), test::kReducedMassRel * r.reduced_mass_kg);
@@ -197,12 +198,14 @@ bool same_bits(const KernelResult& a, const KernelResult& b) {
                       a.relative_curvature_B_per_m, a.effective_radius_m, a.contact_ellipse_axis_ratio,
                       a.hertz_constant, a.max_indentation_m, a.max_force_N, a.compression_time_s,
                       a.restitution.coefficient, a.impulse_total_Ns, a.contact_semi_axis_a_m,
-                      a.contact_semi_axis_b_m, a.peak_pressure_Pa};
+                      a.contact_semi_axis_b_m, a.peak_pressure_Pa, a.contact_time_s, a.unloading_time_s,
+                      a.residual_indentation_m};
   const double y[] = {b.reduced_mass_kg, b.approach_velocity_m_s, b.relative_curvature_A_per_m,
                       b.relative_curvature_B_per_m, b.effective_radius_m, b.contact_ellipse_axis_ratio,
                       b.hertz_constant, b.max_indentation_m, b.max_force_N, b.compression_time_s,
                       b.restitution.coefficient, b.impulse_total_Ns, b.contact_semi_axis_a_m,
-                      b.contact_semi_axis_b_m, b.peak_pressure_Pa};
+                      b.contact_semi_axis_b_m, b.peak_pressure_Pa, b.contact_time_s, b.unloading_time_s,
+                      b.residual_indentation_m};
   return a.flag == b.flag && a.restitution.clamped == b.restitution.clamped &&
          std::memcmp(x, y, sizeof x) == 0 && a.direction_A == b.direction_A &&
          a.target_jump.delta_velocity_m_s == b.target_jump.delta_velocity_m_s &&
@@ -220,7 +223,7 @@ TEST(Kernel, PerPointFormReadsThePointAndWritesEveryField) {
   // solve_kernel(KernelInput), bit for bit: valid and flagged points.
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
-  const RestitutionModel flux = energy_flux_warn();
+  const HertzLaw flux(energy_flux_warn());
   int valid = 0, flagged = 0;
   for (const ContactRule rule : {ContactRule::elliptical, ContactRule::mean, ContactRule::paper}) {
     for (int trial = 0; trial < 100; ++trial) {
@@ -243,7 +246,7 @@ TEST(Kernel, PerPointFormReadsThePointAndWritesEveryField) {
       in.impactor.velocity_m_s -= 2.0 * u(rng) * in.normal;  // some approach, some do not
       in.rule = rule;
       in.effective_modulus_Pa = 1e11;
-      in.restitution = &flux;
+      in.law = &flux;
       const KernelResult whole = solve_kernel(in);
 
       KernelInput invariants = in;  // its per-point fields scrambled: they must not be read
@@ -273,7 +276,7 @@ TEST(Kernel, GroupedFormIsTheOnePointFormBitForBit) {
   // the groups.
   std::mt19937_64 rng(11);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
-  const RestitutionModel flux = energy_flux_warn();
+  const HertzLaw flux(energy_flux_warn());
   RigidBody a, b;
   a.mass_kg = 12.0;
   a.inertia_kg_m2 = Eigen::Vector3d(1.2, 2.0, 3.1).asDiagonal();
@@ -285,7 +288,7 @@ TEST(Kernel, GroupedFormIsTheOnePointFormBitForBit) {
   invariants.target = kernel_body(a);
   invariants.impactor = kernel_body(b);
   invariants.effective_modulus_Pa = 1e11;
-  invariants.restitution = &flux;
+  invariants.law = &flux;
   const std::size_t n = 203;  // not a multiple of kKernelLanes
   struct Point {
     Eigen::Vector3d normal, target_arm, impactor_arm, target_velocity, impactor_velocity;
@@ -353,7 +356,8 @@ TEST(Kernel, RestitutionTableInterpolatesAndObeysThePolicy) {
   rm.range_policy = RangePolicy::error;
   EXPECT_TRUE(at(0.1).refused);
   // Through the kernel: the flag and its message.
-  KernelInput in = ball_on_fixed(0.01, principal(20.0, 20.0), rm);
+  const HertzLaw law(rm);
+  KernelInput in = ball_on_fixed(0.01, principal(20.0, 20.0), law);
   in.impactor.velocity_m_s = {0, 0, -10};
   const KernelResult r = solve_kernel(in);
   EXPECT_EQ(r.flag, ContactFlag::restitution_range);
@@ -373,7 +377,7 @@ TEST(Kernel, RestitutionTableInterpolatesAndObeysThePolicy) {
 TEST(Kernel, ValidityReportAgainstHertzClosedForms) {
   // Sphere on a flat, fixed target: a = sqrt(R x_max) (Hertz), p0 = 3F/(2 pi a^2), and the yield
   // onset 1.60 sigma_y of the weaker material (Johnson, Sect. 6.2).
-  const RestitutionModel rm = constant(1.0);
+  const HertzLaw rm(constant(1.0));
   KernelInput in = ball_on_fixed(0.01, ContactCurvature::flat(), rm);
   in.impactor.velocity_m_s = {0, 0, -3};
   const KernelResult r = solve_kernel(in);

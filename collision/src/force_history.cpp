@@ -8,17 +8,36 @@
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_integration.h>
 
+#include "impactdeck/collision/hertz_law.hpp"
 #include "impactdeck/common/error.hpp"
 
 namespace impactdeck::collision {
 
-double ForceHistory::force_N(double t) const {
-  const double tm = compression.compression_time_s;
-  if (!(t > 0.0)) return 0.0;
-  if (t <= tm) return compression.force_N(t);
-  if (restitution <= 0.0 || t >= contact_time_s()) return 0.0;
-  return compression.force_N(restitution_mirror_s(t, tm, restitution));
+LawResult ForceHistory::result() const {
+  if (law) return law_result;
+  LawResult r;
+  r.stiffness = compression.hertz_constant;
+  r.max_indentation_m = compression.max_indentation_m;
+  r.max_force_N = compression.max_force_N;
+  r.compression_time_s = compression.compression_time_s;
+  r.restitution.coefficient = restitution;
+  r.contact_time_s = collision::contact_time_s(compression.compression_time_s, restitution);
+  r.unloading_time_s = restitution * compression.compression_time_s;
+  r.impulse_compression_Ns = compression.impulse_Ns;
+  r.impulse_total_Ns = impulse_total_Ns();
+  return r;
 }
+
+const ContactLaw& ForceHistory::curve_law() const {
+  static const HertzLaw hertz{RestitutionModel{}};  // F(t) does not read the restitution model
+  return law ? *law : hertz;
+}
+
+double ForceHistory::contact_time_s() const {
+  return law ? law_result.contact_time_s : collision::contact_time_s(compression.compression_time_s, restitution);
+}
+
+double ForceHistory::force_N(double t) const { return curve_law().force_N(result(), t); }
 
 double integrate_force_Ns(const ForceHistory& h, double t0, double t1) {
   if (!(t1 > t0)) return 0.0;
@@ -53,40 +72,37 @@ double integrate_force_Ns(const ForceHistory& h, double t0, double t1) {
 namespace {
 
 void fill_uniform(const ForceHistory& h, std::size_t n_comp, std::size_t n_rest, ForceTable& t) {
-  const double tm = h.compression.compression_time_s;
-  const double tr = h.restitution * tm;
+  const LawResult r = h.result();
+  const ContactLaw& law = h.curve_law();
+  const double tm = r.compression_time_s;
+  const double tr = r.unloading_time_s;
   const std::size_t n_total = n_comp + 1 + (tr > 0.0 ? n_rest : 1);
   t.time_s.resize(n_total);
   t.force_N.resize(n_total);
-  // Times, and the compression-phase times at which the force is evaluated (the restitution
-  // curve is the compression curve mirrored: F(t) = F_comp(t_m - (t - t_m)/R)).
-  std::vector<double> eval(n_total);
-  for (std::size_t i = 0; i <= n_comp; ++i) {
-    t.time_s[i] = tm * static_cast<double>(i) / static_cast<double>(n_comp);
-    eval[i] = t.time_s[i];
-  }
+  // The loading phase at its times, the unloading phase at its fractions u (t = t_m + u t_r).
+  for (std::size_t i = 0; i <= n_comp; ++i) t.time_s[i] = tm * static_cast<double>(i) / static_cast<double>(n_comp);
+  law.loading_forces(r, t.time_s.data(), t.force_N.data(), n_comp + 1);
   if (tr > 0.0) {
+    std::vector<double> u(n_rest);
     for (std::size_t i = 1; i <= n_rest; ++i) {
-      const double u = static_cast<double>(i) / static_cast<double>(n_rest);
-      t.time_s[n_comp + i] = tm + tr * u;
-      eval[n_comp + i] = tm * (1.0 - u);
+      u[i - 1] = static_cast<double>(i) / static_cast<double>(n_rest);
+      t.time_s[n_comp + i] = tm + tr * u[i - 1];
     }
+    law.unloading_forces(r, u.data(), t.force_N.data() + n_comp + 1, n_rest);
   } else {
     // Perfectly plastic impact: the force drops to zero at t_m (a step in the table).
     t.time_s[n_comp + 1] = tm;
-    eval[n_comp + 1] = 0.0;
   }
-  h.compression.force_curve(eval.data(), t.force_N.data(), n_total);
-  t.force_N[n_comp] = h.compression.max_force_N;  // t_m exactly, whatever t_m / t_m rounds to
+  t.force_N[n_comp] = r.max_force_N;  // t_m exactly, whatever t_m / t_m rounds to
   t.force_N.front() = 0.0;
   t.force_N.back() = 0.0;
-  t.time_s.back() = h.contact_time_s();
+  t.time_s.back() = r.contact_time_s;
   double imp = 0.0;
   for (std::size_t i = 1; i < t.time_s.size(); ++i) {
     imp += 0.5 * (t.force_N[i] + t.force_N[i - 1]) * (t.time_s[i] - t.time_s[i - 1]);
   }
   t.impulse_Ns = imp;
-  t.impulse_relative_error = std::abs(imp - h.impulse_total_Ns()) / h.impulse_total_Ns();
+  t.impulse_relative_error = std::abs(imp - r.impulse_total_Ns) / r.impulse_total_Ns;
 }
 
 }  // namespace
@@ -95,7 +111,7 @@ ForceTable sample_force_table(const ForceHistory& h, const ForceTableOptions& o)
   ForceTable t;
   t.impulse_tolerance = o.impulse_tolerance;
   const double tm = h.compression.compression_time_s;
-  const double tr = h.restitution * tm;
+  const double tr = h.result().unloading_time_s;
   if (o.time_step_s > 0.0) {
     auto count = [&](double span) { return std::max(1.0, std::ceil(span / o.time_step_s - 1e-9)); };
     const double n_comp = count(tm), n_rest = tr > 0.0 ? count(tr) : 1.0;

@@ -3,11 +3,39 @@
 #include <cmath>
 #include <sstream>
 
+#include "impactdeck/collision/hertz_law.hpp"
 #include "impactdeck/common/error.hpp"
 
 namespace impactdeck::collision {
 
 namespace {
+
+// The law's result for a solved kernel point: the law's step again on the point's normal-direction
+// input (deterministic: the kernel's numbers; a kernel result keeps no law-specific state).
+LawResult law_result_of(const ContactLaw& law, const KernelInput& k, const KernelResult& kr) {
+  LawInput in;
+  in.reduced_mass_kg = kr.reduced_mass_kg;
+  in.approach_velocity_m_s = kr.approach_velocity_m_s;
+  in.effective_modulus_Pa = k.effective_modulus_Pa;
+  in.effective_radius_m = kr.effective_radius_m;
+  in.yield_strength_Pa = k.yield_strength_Pa;
+  LawResult l;
+  law.solve(&in, &l, 1);
+  return l;
+}
+
+// The compression phase's summary of a kernel result (the force history's `compression`).
+CompressionPhase compression_summary(const KernelResult& k) {
+  CompressionPhase c;
+  c.reduced_mass_kg = k.reduced_mass_kg;
+  c.approach_velocity_m_s = k.approach_velocity_m_s;
+  c.hertz_constant = k.hertz_constant;
+  c.max_indentation_m = k.max_indentation_m;
+  c.max_force_N = k.max_force_N;
+  c.compression_time_s = k.compression_time_s;
+  c.impulse_Ns = k.impulse_compression_Ns;
+  return c;
+}
 
 std::string curvature_text(const ContactCurvature& c) {
   std::ostringstream s;
@@ -52,7 +80,7 @@ std::string explain_flag(const KernelInput& in, const KernelResult& r, const std
       break;
     case ContactFlag::restitution_range:
     case ContactFlag::restitution_invalid:
-      s << "restitution: " << describe_restitution(*in.restitution, r.restitution, r.approach_velocity_m_s);
+      s << "restitution: " << in.law->describe_restitution(law_result_of(*in.law, in, r), r.approach_velocity_m_s);
       break;
     case ContactFlag::no_curvature:
       s << "the curvature of a surface cannot be estimated at the contact point (a mesh too coarse there)";
@@ -69,8 +97,8 @@ std::string explain_flag(const KernelInput& in, const KernelResult& r, const std
 
 namespace {
 
-// The checks of solve_impact's and complete_impact's input (InputError naming the place).
-void validate(const ImpactInput& in) {
+// The checks of solve_impact's and complete_impact's input (InputError naming the place); the law.
+std::shared_ptr<const ContactLaw> validate(const ImpactInput& in) {
   const double nn = in.contact.normal.norm();
   if (!(nn > 0.0) || !std::isfinite(nn)) {
     throw in.context.error("contact normal", "must be a non-zero finite vector");
@@ -81,16 +109,7 @@ void validate(const ImpactInput& in) {
   if (!(in.effective_modulus_Pa > 0.0) || !std::isfinite(in.effective_modulus_Pa)) {
     throw in.context.error("effective modulus", "must be positive and finite");
   }
-  if (in.restitution.kind == RestitutionModel::Kind::constant &&
-      !(in.restitution.constant >= 0.0 && in.restitution.constant <= 1.0)) {
-    std::ostringstream s;
-    s << "must lie in [0, 1], got " << in.restitution.constant;
-    throw in.context.error("restitution", s.str());
-  }
-  if (in.restitution.kind == RestitutionModel::Kind::table) {
-    validate_restitution_table(in.restitution.table, in.context.at("restitution"));
-  }
-
+  return law_of(in);
 }
 
 // The contact as the kernel takes it: a unit normal is used as given (bit for bit what the kernel
@@ -103,12 +122,17 @@ Contact unit_contact(const ImpactInput& in) {
 }
 
 // The rest of the impact after the kernel (complete_impact), its input already validated.
-ImpactResult complete(const ImpactInput& in, const KernelInput& k, const KernelResult& kernel);
+ImpactResult complete(const ImpactInput& in, std::shared_ptr<const ContactLaw> law, const KernelInput& k,
+                      const KernelResult& kernel);
 
 }  // namespace
 
+std::shared_ptr<const ContactLaw> law_of(const ImpactInput& in) {
+  return in.law ? in.law : std::make_shared<const HertzLaw>(in.restitution, in.context);
+}
+
 ImpactResult solve_impact(const ImpactInput& in) {
-  validate(in);
+  std::shared_ptr<const ContactLaw> law = validate(in);
   const Contact c = unit_contact(in);
   KernelInput k;
   k.target = kernel_body(in.target, in.context.at("target"));
@@ -120,19 +144,21 @@ ImpactResult solve_impact(const ImpactInput& in) {
   k.normal = c.normal;
   k.rule = in.rule;
   k.effective_modulus_Pa = in.effective_modulus_Pa;
-  k.restitution = &in.restitution;
+  k.yield_strength_Pa = in.yield_strength_Pa;
+  k.law = law.get();
 
-  return complete(in, k, solve_kernel(k));
+  const KernelResult kernel = solve_kernel(k);
+  return complete(in, std::move(law), k, kernel);
 }
 
 ImpactResult complete_impact(const ImpactInput& in, const KernelInput& k, const KernelResult& kernel) {
-  validate(in);
-  return complete(in, k, kernel);
+  return complete(in, validate(in), k, kernel);
 }
 
 namespace {
 
-ImpactResult complete(const ImpactInput& in, const KernelInput& k, const KernelResult& kernel) {
+ImpactResult complete(const ImpactInput& in, std::shared_ptr<const ContactLaw> law, const KernelInput& k,
+                      const KernelResult& kernel) {
   const Contact c = unit_contact(in);
   ImpactResult r;
   r.kernel = kernel;
@@ -156,15 +182,17 @@ ImpactResult complete(const ImpactInput& in, const KernelInput& k, const KernelR
   r.restitution.energy_flux_density = std::exp(kr.restitution.ln_energy_flux);
   r.restitution.clamped = kr.restitution.clamped;
   if (kr.restitution.outside_range) {
-    r.restitution.warning = describe_restitution(in.restitution, kr.restitution, kr.approach_velocity_m_s);
+    r.restitution.warning = law->describe_restitution(law_result_of(*law, k, kr), kr.approach_velocity_m_s);
     r.warnings.push_back(r.restitution.warning);
   }
   r.target_jump = kr.target_jump;
   r.impactor_jump = kr.impactor_jump;
 
-  r.history.compression = compression_phase(kr.reduced_mass_kg, kr.approach_velocity_m_s, kr.hertz_constant);
+  r.history.compression = compression_summary(kr);
   check_compression_range(r.history.compression, in.context, in.input_keys);
   r.history.restitution = kr.restitution.coefficient;
+  r.history.law_result = law_result_of(*law, k, kr);
+  r.history.law = std::move(law);
 
   // Self-check 1 (Eq. 31): compression impulse by quadrature of the curve vs m_w v_w.
   ImpactChecks& ch = r.checks;

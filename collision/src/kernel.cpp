@@ -7,6 +7,7 @@
 
 #include "impactdeck/collision/compression.hpp"
 #include "impactdeck/collision/hertz.hpp"
+#include "impactdeck/collision/hertz_law.hpp"
 #include "impactdeck/common/error.hpp"
 
 namespace impactdeck::collision {
@@ -120,10 +121,10 @@ namespace {
 
 // What the kernel's steps read of the invariants, worked out once per call.
 struct CallInvariants {
-  bool valid;                          // E* finite and positive, a restitution model
+  bool valid;                          // E* finite and positive, a contact law
   bool target_spins, impactor_spins;  // a non-zero angular velocity (else w x r is left out: 0)
   explicit CallInvariants(const KernelInput& in)
-      : valid(finite_positive(in.effective_modulus_Pa) && in.restitution != nullptr),
+      : valid(finite_positive(in.effective_modulus_Pa) && in.law != nullptr),
         target_spins(!in.target.angular_velocity_rad_s.isZero(0)),
         impactor_spins(!in.impactor.angular_velocity_rad_s.isZero(0)) {}
 };
@@ -214,21 +215,39 @@ inline bool step_radius(const KernelInput& in, const KernelPoint& p, KernelResul
   return true;
 }
 
-// Hertz: k_H, x_max, F_max, t_m (closed forms, Eq. 1-12, 27).
-inline bool step_hertz(const KernelInput& in, KernelResult& r) {
-  r.hertz_constant = hertz_constant(in.effective_modulus_Pa, r.effective_radius_m);
-  const CompressionPhase c = compression_phase(r.reduced_mass_kg, r.approach_velocity_m_s, r.hertz_constant);
-  r.max_indentation_m = c.max_indentation_m;
-  r.max_force_N = c.max_force_N;
-  r.compression_time_s = c.compression_time_s;
-  r.impulse_compression_Ns = c.impulse_Ns;
-  if (!finite_positive(r.hertz_constant) || !finite_positive(r.max_indentation_m) ||
-      !finite_positive(r.max_force_N) || !finite_positive(r.compression_time_s) ||
-      !finite_positive(r.impulse_compression_Ns)) {
-    r.flag = ContactFlag::degenerate;
-    return false;
+// The law's input of a point that passed step_radius.
+inline void law_input(const KernelInput& in, const KernelResult& r, LawInput& l) {
+  l.reduced_mass_kg = r.reduced_mass_kg;
+  l.approach_velocity_m_s = r.approach_velocity_m_s;
+  l.effective_modulus_Pa = in.effective_modulus_Pa;
+  l.effective_radius_m = r.effective_radius_m;
+  l.yield_strength_Pa = in.yield_strength_Pa;
+}
+
+// A law's status as the kernel's flag: false when the law failed (its numbers, or its restitution).
+inline bool take_status(LawStatus status, KernelResult& r) {
+  switch (status) {
+    case LawStatus::ok: return true;
+    case LawStatus::restitution_range: r.flag = ContactFlag::restitution_range; return false;
+    case LawStatus::restitution_invalid: r.flag = ContactFlag::restitution_invalid; return false;
+    case LawStatus::degenerate: r.flag = ContactFlag::degenerate; return false;
   }
-  return true;
+  return false;
+}
+
+// The law's result into the kernel's: false when the law failed (its numbers, or its restitution).
+inline bool take_law(const LawResult& l, KernelResult& r) {
+  r.hertz_constant = l.stiffness;
+  r.max_indentation_m = l.max_indentation_m;
+  r.max_force_N = l.max_force_N;
+  r.compression_time_s = l.compression_time_s;
+  r.impulse_compression_Ns = l.impulse_compression_Ns;
+  r.restitution = l.restitution;
+  r.contact_time_s = l.contact_time_s;
+  r.unloading_time_s = l.unloading_time_s;
+  r.impulse_total_Ns = l.impulse_total_Ns;
+  r.residual_indentation_m = l.residual_indentation_m;
+  return take_status(l.status, r);
 }
 
 // The contact ellipse at F_max and the peak pressure.
@@ -244,22 +263,6 @@ inline void step_pressure(const KernelInput& in, const RelativeCurvatures& rc, c
     r.contact_semi_axis_a_m = r.contact_semi_axis_b_m = std::sqrt(r.effective_radius_m * r.max_indentation_m);
   }
   r.peak_pressure_Pa = hertz_peak_pressure_Pa(r.max_force_N, r.contact_semi_axis_a_m, r.contact_semi_axis_b_m);
-}
-
-// Restitution and the total impulse (Eq. 13-15, 30).
-inline bool step_restitution(const KernelInput& in, KernelResult& r) {
-  r.restitution = evaluate_restitution(*in.restitution, r.reduced_mass_kg, r.approach_velocity_m_s,
-                                       r.effective_radius_m);
-  if (r.restitution.refused) {
-    r.flag = ContactFlag::restitution_range;
-    return false;
-  }
-  if (r.restitution.invalid) {
-    r.flag = ContactFlag::restitution_invalid;
-    return false;
-  }
-  r.impulse_total_Ns = (1.0 + r.restitution.coefficient) * r.impulse_compression_Ns;
-  return true;
 }
 
 // Velocity jumps (Eq. 22-23): the impactor is pushed along +n, the target along -n.
@@ -278,6 +281,24 @@ inline void step_jumps(const KernelInput& in, const KernelPoint& p, KernelResult
   }
 }
 
+// Any law but Hertz, once for the group's live points (one virtual call per group, not per point).
+inline void solve_law(const KernelInput& in, const RelativeCurvatures* rc, const EllipticalContact* ec, bool* live,
+                      KernelResult* const* r, std::size_t n) {
+  LawInput law_in[kKernelLanes];
+  LawResult law_out[kKernelLanes];
+  std::size_t lane[kKernelLanes], m = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    if (live[k]) law_input(in, *r[k], law_in[m]), lane[m++] = k;
+  }
+  if (m > 0) in.law->solve(law_in, law_out, m);
+  for (std::size_t j = 0; j < m; ++j) {
+    const std::size_t k = lane[j];
+    live[k] = take_law(law_out[j], *r[k]);
+    // The contact ellipse at F_max whenever the law gave its numbers (also for a refused restitution).
+    if (live[k] || law_out[j].status != LawStatus::degenerate) step_pressure(in, rc[k], ec[k], *r[k]);
+  }
+}
+
 }  // namespace
 
 void solve_kernel(const KernelInput& in, const KernelPoint* points, KernelResult* const* results,
@@ -286,6 +307,8 @@ void solve_kernel(const KernelInput& in, const KernelPoint* points, KernelResult
   // divisions, logs and exps are independent, so the processor overlaps them (one point alone
   // waits on its own chain).
   const CallInvariants ci(in);
+  // Hertz (the default law of every scene) is told apart once per call.
+  const auto* hertz = dynamic_cast<const HertzLaw*>(in.law);
   for (std::size_t begin = 0; begin < count; begin += kKernelLanes) {
     const std::size_t n = std::min(kKernelLanes, count - begin);
     const KernelPoint* p = points + begin;
@@ -295,11 +318,24 @@ void solve_kernel(const KernelInput& in, const KernelPoint* points, KernelResult
     EllipticalContact ec[kKernelLanes];
     for (std::size_t k = 0; k < n; ++k) live[k] = step_motion(in, ci, p[k], *r[k]);
     for (std::size_t k = 0; k < n; ++k) live[k] = live[k] && step_radius(in, p[k], *r[k], rc[k], ec[k]);
-    for (std::size_t k = 0; k < n; ++k) live[k] = live[k] && step_hertz(in, *r[k]);
-    for (std::size_t k = 0; k < n; ++k) {
-      if (live[k]) step_pressure(in, rc[k], ec[k], *r[k]);
+    if (hertz != nullptr) {
+      // Hertz's fast path: the law's two steps inline, straight into the results, each over the
+      // group before the next (as the kernel's own steps).
+      LawInput law_in[kKernelLanes];
+      for (std::size_t k = 0; k < n; ++k) {
+        if (!live[k]) continue;
+        law_input(in, *r[k], law_in[k]);
+        live[k] = take_status(hertz_compression(law_in[k], *r[k], r[k]->hertz_constant), *r[k]);
+      }
+      for (std::size_t k = 0; k < n; ++k) {
+        if (live[k]) step_pressure(in, rc[k], ec[k], *r[k]);
+      }
+      for (std::size_t k = 0; k < n; ++k) {
+        if (live[k]) live[k] = take_status(hertz_restitution(hertz->restitution(), law_in[k], *r[k]), *r[k]);
+      }
+    } else {
+      solve_law(in, rc, ec, live, r, n);
     }
-    for (std::size_t k = 0; k < n; ++k) live[k] = live[k] && step_restitution(in, *r[k]);
     for (std::size_t k = 0; k < n; ++k) {
       if (live[k]) step_jumps(in, p[k], *r[k]);
     }

@@ -6,6 +6,7 @@
 #include <limits>
 #include <sstream>
 
+#include "impactdeck/collision/hertz_law.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/geometry/mesh_shape.hpp"
 
@@ -14,11 +15,18 @@ namespace impactdeck::contact {
 ContactModel::ContactModel(const PreparedBody& target, const PreparedBody& impactor, collision::ContactRule rule,
                            double effective_modulus_Pa, const collision::RestitutionModel& restitution,
                            const InputContext& ctx)
+    : ContactModel(target, impactor, rule, effective_modulus_Pa,
+                   std::make_shared<const collision::HertzLaw>(restitution, ctx), ctx) {}
+
+ContactModel::ContactModel(const PreparedBody& target, const PreparedBody& impactor, collision::ContactRule rule,
+                           double effective_modulus_Pa, std::shared_ptr<const collision::ContactLaw> law,
+                           const InputContext& ctx)
     : target_(target),
       impactor_(impactor),
       target_frame_(target.pose),
       impactor_frame_(impactor.pose),
       rule_(rule),
+      law_(std::move(law)),
       impactor_mesh_(dynamic_cast<const geometry::MeshShape*>(impactor.shape.get())),
       target_centroid_(target.centroid_world_m()),
       impactor_centroid_(impactor.centroid_world_m()) {
@@ -26,7 +34,10 @@ ContactModel::ContactModel(const PreparedBody& target, const PreparedBody& impac
   invariants_.impactor = collision::kernel_body(impactor.rigid_body(), ctx.at("impactor '" + impactor.name + "'"));
   invariants_.rule = rule;
   invariants_.effective_modulus_Pa = effective_modulus_Pa;
-  invariants_.restitution = &restitution;
+  invariants_.law = law_.get();
+  // The weaker body's yield strength (0: neither has one).
+  const double yt = target.yield_strength_Pa.value_or(0.0), yi = impactor.yield_strength_Pa.value_or(0.0);
+  invariants_.yield_strength_Pa = yt > 0.0 && yi > 0.0 ? std::min(yt, yi) : std::max(yt, yi);
   if (target.fixed() && impactor.fixed()) {
     throw ctx.error("bodies", "both bodies are fixed (infinite mass): nothing can move");
   }

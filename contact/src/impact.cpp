@@ -2,6 +2,8 @@
 
 #include <utility>
 
+#include "impactdeck/collision/hertz_law.hpp"
+
 namespace impactdeck::contact {
 
 collision::ImpactInput impact_input(const ContactModel& model, const ContactEvaluation& e) {
@@ -16,7 +18,10 @@ collision::ImpactInput impact_input(const ContactModel& model, const ContactEval
   in.impactor_curvature = e.input.impactor.curvature;
   in.rule = model.rule();
   in.effective_modulus_Pa = e.input.effective_modulus_Pa;
-  in.restitution = *e.input.restitution;
+  in.yield_strength_Pa = e.input.yield_strength_Pa;
+  in.law = model.law();
+  // The restitution model Hertz's report names (kind, flux unit); other laws give their own R.
+  if (const auto* hertz = dynamic_cast<const collision::HertzLaw*>(in.law.get())) in.restitution = hertz->restitution();
   return in;
 }
 

@@ -215,6 +215,7 @@ CompareReport compare_contact(const CompareInput& in, const CompareOptions& o) {
   {
     collision::ForceHistory elastic = ir.result.history;  // the same pulse with R = 1
     elastic.restitution = 1.0;
+    elastic.law = nullptr;  // Hertz's F(t) from the summary, not the law's result with its own R
     const int n = 200;
     for (int i = 0; i <= n; ++i) {
       const double t = elastic.contact_time_s() * i / n;

@@ -37,7 +37,7 @@ void record(const contact::ContactModel& model, const geometry::SurfacePoint& at
   r.compression_time_s = k.compression_time_s;
   r.restitution = k.restitution.coefficient;
   r.restitution_clamped = k.restitution.clamped;
-  r.contact_time_s = collision::contact_time_s(r.compression_time_s, r.restitution);
+  r.contact_time_s = k.contact_time_s;
   r.impulse_total_Ns = k.impulse_total_Ns;
   const geometry::PoseMap& frame = model.target_frame();
   r.target_delta_velocity_m_s = frame.direction_to_own(k.target_jump.delta_velocity_m_s);
@@ -120,9 +120,6 @@ SweepResult run_sweep(const SweepSetup& s, const std::vector<geometry::SurfacePo
     throw s.context.error("approach speed", "must be positive and finite");
   }
   if (o.curves && o.curve_samples < 2) throw s.context.error("curve samples", "must be at least 2");
-  if (s.restitution.kind == collision::RestitutionModel::Kind::table) {
-    collision::validate_restitution_table(s.restitution.table, s.context.at("restitution"));
-  }
   const contact::ContactModel model(s.target, s.impactor, s.rule, s.effective_modulus_Pa, s.restitution, s.context);
   SweepResult res;
   const std::size_t n = cloud.size();

@@ -8,9 +8,11 @@
 // The restitution curve is the compression curve mirrored and stretched by R in time: continuous
 // at F_max, impulse exactly R Pi_1 (the paper iterates a curve of the same family to 1 %).
 #include <cstddef>
+#include <memory>
 #include <vector>
 
 #include "impactdeck/collision/compression.hpp"
+#include "impactdeck/collision/contact_law.hpp"
 
 namespace impactdeck::collision {
 
@@ -25,11 +27,22 @@ inline double restitution_mirror_s(double t_s, double compression_time_s, double
   return compression_time_s - (t_s - compression_time_s) / restitution;
 }
 
+/// The force history of one impact: the summary every law gives (the compression phase's F_max,
+/// x_max, t_m, Pi_1 and Poisson's R) and the law's F(t). Without a law it is Hertz's curve
+/// (HertzLaw::force_N: the compression curve, then its mirror stretched by R).
 struct ForceHistory {
   CompressionPhase compression;
   double restitution = 0;  ///< Poisson's coefficient R in [0, 1]
+  /// The law whose F(t) this is and its result (complete_impact sets both); null: Hertz from
+  /// `compression` and `restitution`.
+  std::shared_ptr<const ContactLaw> law;
+  LawResult law_result;
 
-  double contact_time_s() const { return collision::contact_time_s(compression.compression_time_s, restitution); }
+  /// The law's result this history stands for (law_result, or Hertz's from the summary).
+  LawResult result() const;
+  /// The law of F(t) (`law`, or Hertz).
+  const ContactLaw& curve_law() const;
+  double contact_time_s() const;
   double impulse_compression_Ns() const { return compression.impulse_Ns; }
   double impulse_restitution_Ns() const { return restitution * compression.impulse_Ns; }
   double impulse_total_Ns() const { return (1.0 + restitution) * compression.impulse_Ns; }
@@ -56,8 +69,8 @@ struct ForceTableOptions {
   InputContext max_samples_context{"", "force_table_max_samples"};
 };
 
-/// Piecewise-linear force table: uniform spacing in each phase, t_m always a node, first and last
-/// force exactly 0.
+/// Piecewise-linear force table of the history's law: uniform spacing in each phase (loading and
+/// unloading), t_m always a node, first and last force exactly 0.
 struct ForceTable {
   std::vector<double> time_s;
   std::vector<double> force_N;

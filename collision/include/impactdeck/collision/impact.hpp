@@ -1,9 +1,11 @@
 #pragma once
 // One eccentric Hertz impact, end to end: reduced mass and approach velocity at the contact point,
 // Hertz constant, restitution, force history, velocity jumps and the paper's two self-checks.
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "impactdeck/collision/contact_law.hpp"
 #include "impactdeck/collision/eccentric.hpp"
 #include "impactdeck/collision/force_history.hpp"
 #include "impactdeck/collision/kernel.hpp"
@@ -26,7 +28,10 @@ struct ImpactInput {
   ContactCurvature impactor_curvature = ContactCurvature::flat();
   ContactRule rule = ContactRule::elliptical;
   double effective_modulus_Pa = 0;  ///< E* (Eq. 28 or Hertz)
-  RestitutionModel restitution;
+  double yield_strength_Pa = 0;     ///< of the weaker body, for the law; 0 when not known
+  /// The contact law; null: Hertz with `restitution` (HertzLaw, built by solve_impact).
+  std::shared_ptr<const ContactLaw> law;
+  RestitutionModel restitution;     ///< Hertz's restitution when `law` is null
   CheckThresholds thresholds;
   /// Where the input comes from (e.g. the scene file and "line 19, key 'impacts[0]': impact
   /// 'fig4'"): named by every error solve_impact throws. Empty: the errors name no file.
@@ -58,12 +63,16 @@ struct ImpactResult {
   double approach_velocity_m_s = 0;
   RestitutionModel::Kind restitution_kind = RestitutionModel::Kind::energy_flux;
   RestitutionResult restitution;  ///< coefficient always set; flux fields when from the flux
-  ForceHistory history;
+  ForceHistory history;  ///< the law's F(t) (history.law, history.law_result) and its summary
   VelocityJump target_jump;    ///< from the exact impulse (the kernel's)
   VelocityJump impactor_jump;
   ImpactChecks checks;
   std::vector<std::string> warnings;
 };
+
+/// The law an input stands for: `input.law`, or HertzLaw(input.restitution). Throws
+/// input.context.error("restitution", ...) for a constant outside [0, 1] or an invalid table.
+std::shared_ptr<const ContactLaw> law_of(const ImpactInput& input);
 
 /// Solves the impact through the physics kernel (solve_kernel), then completes it (complete_impact).
 /// Throws input.context.error(place, reason) for invalid input and where the kernel flags the point
@@ -73,7 +82,8 @@ ImpactResult solve_impact(const ImpactInput& input);
 
 /// The impact once the kernel has solved its point, without solving it again (`run` solves it once,
 /// in contact::ContactModel): `kernel` = solve_kernel(`k`), where `k` is the kernel's input that
-/// `input` stands for (the same bodies, point, normal, curvatures, E* and restitution). Adds the
+/// `input` stands for (the same bodies, point, normal, curvatures, E*; k.law is the law of F(t),
+/// which must be law_of(input) or the same law). Adds the
 /// force history, the velocity jumps and the paper's self-checks; the checks integrate the curve
 /// and take the jumps from `input`'s rigid bodies, independently of the kernel's closed form.
 /// Throws as solve_impact for invalid input and a flagged point.

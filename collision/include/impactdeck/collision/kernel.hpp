@@ -11,8 +11,9 @@
 //           C_i = k1 d1 d1^T + k2 d2 d2^T of body i (convex positive)         (Hertz 1882)
 //   R*    elliptical: R_eq of the contact ellipse; mean: 1/(H1 + H2); paper: 1/(k1 + k2) with
 //         k_i from Eq. 26 (a sphere: its radius)                            (Eq. 15, 26, 29)
-//   k_H   = 4/3 E* sqrt(R*), x_max, F_max, t_m                               (Eq. 1-12, 27)
-//   R     energy flux (Eq. 14, 30), a constant, or a measured table
+//   the contact law (contact_law.hpp) from m_w, v_w, E*, R*: F_max, x_max, t_m, t_c, R, the dent;
+//         Hertz (hertz_law.hpp): k_H = 4/3 E* sqrt(R*) and closed forms (Eq. 1-12, 27), R from the
+//         energy flux (Eq. 14, 30), a constant, or a measured table
 //   Pi    = (1 + R) m_w v_w,  dv_i = -+Pi n/m_i,  dw_i = I_i^-1 (r_i x -+Pi n)  (Eq. 13, 22-23)
 // Body 1 is the target, n its outward unit normal; body 2 the impactor, pushed along +n.
 #include <cstddef>
@@ -20,6 +21,7 @@
 
 #include <Eigen/Dense>
 
+#include "impactdeck/collision/contact_law.hpp"
 #include "impactdeck/collision/eccentric.hpp"
 #include "impactdeck/collision/elliptical.hpp"
 #include "impactdeck/collision/restitution.hpp"
@@ -75,7 +77,8 @@ struct KernelInput {
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  ///< target's outward unit normal, world
   ContactRule rule = ContactRule::elliptical;
   double effective_modulus_Pa = 0;                ///< E* (Eq. 28 or Hertz)
-  const RestitutionModel* restitution = nullptr;  ///< not owned; must outlive the call
+  const ContactLaw* law = nullptr;                ///< the contact law; not owned, must outlive the call
+  double yield_strength_Pa = 0;                   ///< of the weaker body, for the law; 0 when not known
 };
 
 /// Why the model does not apply at a point (flag_word gives the short word of sweep outputs).
@@ -87,7 +90,7 @@ enum class ContactFlag : std::uint8_t {
   line,                 ///< one relative curvature is zero: a line contact, not Hertzian
   flat,                 ///< both surfaces flat: a flat contact, not Hertzian
   no_approach,          ///< the bodies do not approach at the point (v_w <= 0)
-  restitution_range,    ///< outside the restitution model's range under policy "error"
+  restitution_range,    ///< outside the law's restitution range under policy "error"
   restitution_invalid,  ///< R outside [0, 1]
   degenerate,           ///< input or result not finite (under- or overflow)
   no_curvature,         ///< the surface's curvature cannot be estimated there (mesh too coarse)
@@ -107,13 +110,16 @@ struct KernelResult {
   Eigen::Vector3d direction_A = Eigen::Vector3d::UnitX();
   double effective_radius_m = 0;     ///< R* by the rule (R_eq for elliptical)
   double contact_ellipse_axis_ratio = 1;  ///< a/b (1 unless elliptical)
-  double hertz_constant = 0;         ///< k_H, N/m^1.5
+  double hertz_constant = 0;         ///< the law's stiffness (LawResult::stiffness; Hertz: k_H, N/m^1.5)
   double max_indentation_m = 0;
   double max_force_N = 0;
   double compression_time_s = 0;
+  double contact_time_s = 0;         ///< t_c, from the law
+  double unloading_time_s = 0;       ///< t_c - t_m, from the law
   RestitutionValue restitution;      ///< R and how it was found
   double impulse_compression_Ns = 0;  ///< Pi_1 = m_w v_w
   double impulse_total_Ns = 0;        ///< (1 + R) Pi_1
+  double residual_indentation_m = 0;  ///< the dent the law leaves (0 for Hertz)
   /// Contact ellipse at F_max (circular for the mean and paper rules) and the peak pressure.
   double contact_semi_axis_a_m = 0, contact_semi_axis_b_m = 0;
   double peak_pressure_Pa = 0;        ///< p0 = 3 F_max / (2 pi a b)
@@ -127,7 +133,7 @@ KernelResult solve_kernel(const KernelInput& input) noexcept;
 
 /// What changes from one contact point to the next: the per-point fields of a KernelInput (normal,
 /// both lever arms, velocities and surfaces), by reference. A sweep keeps one KernelInput of
-/// invariants (inverse masses and inertias, angular velocities, rule, E*, restitution) and passes
+/// invariants (inverse masses and inertias, angular velocities, rule, E*, law) and passes
 /// only this per point, instead of copying both KernelBody structs. The referenced values must
 /// outlive the call.
 struct KernelPoint {
@@ -144,7 +150,7 @@ struct KernelPoint {
 };
 
 /// The kernel on the invariants of `invariants` (both bodies' inverse mass, inverse inertia and
-/// angular velocity; rule, E*, restitution) and the point `point` (its normal, lever arms,
+/// angular velocity; rule, E*, law) and the point `point` (its normal, lever arms,
 /// velocities and surfaces; those fields of `invariants` are not read). Writes every field of
 /// `result`. solve_kernel(KernelInput) calls it; it runs the grouped kernel below with one point.
 void solve_kernel(const KernelInput& invariants, const KernelPoint& point, KernelResult& result) noexcept;

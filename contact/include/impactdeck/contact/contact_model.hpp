@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 
+#include "impactdeck/collision/contact_law.hpp"
 #include "impactdeck/collision/hertz.hpp"
 #include "impactdeck/collision/kernel.hpp"
 #include "impactdeck/common/error.hpp"
@@ -49,13 +50,18 @@ struct ContactPointResult {
   collision::KernelResult result;
 };
 
-/// One impact's invariants: both bodies, the rule, E*, the restitution model and the kernel bodies
-/// (inverse mass, world inverse inertia: computed once). Keeps references: the bodies and the
-/// restitution model must outlive it.
+/// One impact's invariants: both bodies, the rule, E*, the contact law and the kernel bodies
+/// (inverse mass, world inverse inertia: computed once). Keeps references to the bodies: they must
+/// outlive it; shares the law.
 class ContactModel {
  public:
   /// Throws ctx.error(...) for invalid masses or inertias (place "target 'NAME': mass", ...) and
   /// when both bodies are fixed (place "bodies"); `ctx` names the impact (a scene's file and place).
+  /// The law gets the yield strength of the weaker body (0 when neither has one).
+  ContactModel(const PreparedBody& target, const PreparedBody& impactor, collision::ContactRule rule,
+               double effective_modulus_Pa, std::shared_ptr<const collision::ContactLaw> law,
+               const InputContext& ctx = {});
+  /// Hertz with `restitution` (collision::HertzLaw; its errors name ctx's "restitution").
   ContactModel(const PreparedBody& target, const PreparedBody& impactor, collision::ContactRule rule,
                double effective_modulus_Pa, const collision::RestitutionModel& restitution,
                const InputContext& ctx = {});
@@ -86,6 +92,7 @@ class ContactModel {
   const geometry::PoseMap& target_frame() const { return target_frame_; }
   const PreparedBody& impactor() const { return impactor_; }
   collision::ContactRule rule() const { return rule_; }
+  const std::shared_ptr<const collision::ContactLaw>& law() const { return law_; }
 
  private:
   /// Point mode's placement: the impactor's touching point (own frame), the world point and normal,
@@ -113,8 +120,9 @@ class ContactModel {
   const PreparedBody& impactor_;
   geometry::PoseMap target_frame_, impactor_frame_;  ///< both poses, unrotated ones skipped
   collision::ContactRule rule_;
+  std::shared_ptr<const collision::ContactLaw> law_;  ///< invariants_.law points to it
   /// The kernel's invariants: both kernel bodies (inverse mass and world inverse inertia, computed
-  /// once; velocities), the rule, E* and the restitution model. Its per-point fields are unused.
+  /// once; velocities), the rule, E* and the law. Its per-point fields are unused.
   collision::KernelInput invariants_;
   const geometry::MeshShape* impactor_mesh_;  ///< the impactor as a mesh (smooth support point), or null
   Eigen::Vector3d target_centroid_, impactor_centroid_;  ///< world, as placed

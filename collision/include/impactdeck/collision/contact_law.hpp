@@ -1,0 +1,98 @@
+#pragma once
+// A contact law: the normal force law of an impact and its restitution, as one type. The kernel
+// (kernel.hpp) finds the contact point's reduced mass, approach speed and radius; the law turns
+// them into F_max, the times, the restitution, F(t) and what the impact leaves behind (a dent).
+// Hertz with the restitution models of restitution.hpp is one implementation (hertz_law.hpp).
+// A new law is its own file, one line in the registry (contact_law.cpp) and its tests
+// (docs/extending.md, "A contact law").
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "impactdeck/collision/restitution.hpp"
+
+namespace impactdeck::collision {
+
+/// The normal direction of one impact as a law sees it (SI).
+struct LawInput {
+  double reduced_mass_kg = 0;        ///< m_w at the contact point (Eq. 16-21)
+  double approach_velocity_m_s = 0;  ///< v_w > 0 along the normal
+  double effective_modulus_Pa = 0;   ///< E*
+  double effective_radius_m = 0;     ///< R* (the Hertz-equivalent radius of an elliptical contact)
+  double yield_strength_Pa = 0;      ///< of the weaker body; 0 when not known
+};
+
+/// Why a law gives no result for an impact (the kernel maps it to its ContactFlag).
+enum class LawStatus : std::uint8_t {
+  ok,
+  restitution_range,    ///< outside the restitution's validity range under policy "error"
+  restitution_invalid,  ///< R outside [0, 1]
+  degenerate,           ///< a number not finite or not positive (under- or overflow)
+};
+
+/// What a law gives for one impact. Every law fills every field; Poisson's restitution R is the
+/// restitution impulse over the compression impulse m_w v_w, so impulse_total_Ns = (1 + R) m_w v_w.
+struct LawResult {
+  LawStatus status = LawStatus::ok;
+  double stiffness = 0;               ///< the law's constant (Hertz: k_H in N/m^1.5)
+  double max_indentation_m = 0;       ///< x_max
+  double max_force_N = 0;             ///< F_max
+  double compression_time_s = 0;      ///< t_m, the time of x_max
+  double contact_time_s = 0;          ///< t_c, the force back at 0
+  double unloading_time_s = 0;        ///< t_c - t_m as the law computes it (exact for tables)
+  RestitutionValue restitution;       ///< R and how it was found
+  double impulse_compression_Ns = 0;  ///< m_w v_w
+  double impulse_total_Ns = 0;        ///< (1 + R) m_w v_w
+  double residual_indentation_m = 0;  ///< the dent left behind (0 for an elastic law)
+  std::array<double, 4> state{};      ///< the law's own numbers for its F(t); opaque to callers
+};
+
+/// The interface. solve() is the kernel's hot path: noexcept and allocation-free; the kernel calls
+/// it once per group of points (up to kKernelLanes), so a law's loop over the group is its own code.
+class ContactLaw {
+ public:
+  virtual ~ContactLaw() = default;
+  /// The registry's name ("hertz", ...), said in outputs.
+  virtual const char* name() const noexcept = 0;
+  /// out[k] for in[k], k < count. A failed impact comes back with out[k].status != ok (the values
+  /// computed up to there kept).
+  virtual void solve(const LawInput* in, LawResult* out, std::size_t count) const noexcept = 0;
+  /// F(t) in N of a solved impact: 0 for t <= 0 and t >= t_c.
+  virtual double force_N(const LawResult& r, double t_s) const noexcept = 0;
+  /// F at n times 0 <= t <= t_m of the loading phase (for tables; default: force_N at each).
+  virtual void loading_forces(const LawResult& r, const double* t_s, double* force_N, std::size_t n) const;
+  /// F at n fractions 0 <= u <= 1 of the unloading phase, t = t_m + u unloading_time_s (default: force_N).
+  virtual void unloading_forces(const LawResult& r, const double* u, double* force_N, std::size_t n) const;
+  /// One line on a restitution outside its range or invalid (for warnings and errors); empty when
+  /// `r` is inside the range. The default: the coefficient, when it lies outside [0, 1].
+  virtual std::string describe_restitution(const LawResult& r, double approach_velocity_m_s) const;
+};
+
+/// Thornton's default limiting pressure p_y over the weaker body's yield strength: the onset of
+/// yield under a circular Hertz contact, p0 = 1.60 Y for nu = 0.3 (Johnson 1985, Sect. 6.2).
+inline constexpr double kThorntonYieldFactor = 1.6;
+
+/// What a scene says about the law of an impact (each law reads what it needs).
+struct LawOptions {
+  RestitutionModel restitution;     ///< "hertz": its restitution model
+  double limiting_pressure_Pa = 0;  ///< "thornton": p_y; 0: kThorntonYieldFactor x the yield strength
+};
+
+using ContactLawFactory = std::function<std::shared_ptr<const ContactLaw>(const LawOptions&)>;
+
+/// Adds a law under `name`. Throws Error(internal_error) when the name is taken or empty.
+void register_contact_law(const std::string& name, ContactLawFactory factory);
+
+/// The law `name` built from `options`. Throws ctx.error("contact_law", ...) naming the known laws
+/// when `name` is not registered; the factory's own errors pass through.
+std::shared_ptr<const ContactLaw> make_contact_law(const std::string& name, const LawOptions& options,
+                                                   const InputContext& ctx = {});
+
+/// The registered names, sorted.
+std::vector<std::string> contact_law_names();
+
+}  // namespace impactdeck::collision

@@ -1,0 +1,91 @@
+#include "impactdeck/collision/contact_law.hpp"
+
+#include <algorithm>
+#include <map>
+#include <mutex>
+#include <sstream>
+
+#include "impactdeck/common/error.hpp"
+
+namespace impactdeck::collision {
+
+void ContactLaw::loading_forces(const LawResult& r, const double* t_s, double* f, std::size_t n) const {
+  for (std::size_t i = 0; i < n; ++i) f[i] = force_N(r, t_s[i]);
+}
+
+void ContactLaw::unloading_forces(const LawResult& r, const double* u, double* f, std::size_t n) const {
+  const double tm = r.compression_time_s, span = r.unloading_time_s;
+  for (std::size_t i = 0; i < n; ++i) f[i] = force_N(r, tm + u[i] * span);
+}
+
+std::string ContactLaw::describe_restitution(const LawResult& r, double) const {
+  if (!r.restitution.invalid) return "";
+  std::ostringstream s;
+  s << "R = " << r.restitution.coefficient << " lies outside [0, 1]";
+  return s.str();
+}
+
+namespace {
+
+struct Registry {
+  std::mutex mutex;
+  std::map<std::string, ContactLawFactory> laws;
+};
+
+}  // namespace
+
+// The built-in laws' factories, each defined in its law's file (src/NAME_law.cpp).
+std::shared_ptr<const ContactLaw> make_hertz_law(const LawOptions& options);
+std::shared_ptr<const ContactLaw> make_thornton_law(const LawOptions& options);
+
+namespace {
+
+// The built-in laws: one line each.
+Registry& registry() {
+  static Registry r{{},
+                    {
+                        {"hertz", make_hertz_law},
+                        {"thornton", make_thornton_law},
+                    }};
+  return r;
+}
+
+}  // namespace
+
+void register_contact_law(const std::string& name, ContactLawFactory factory) {
+  Registry& r = registry();
+  const std::lock_guard<std::mutex> lock(r.mutex);
+  if (name.empty() || !factory || r.laws.count(name) != 0) {
+    throw Error(ExitCode::internal_error, "contact law '" + name + "': empty, without a factory, or registered twice");
+  }
+  r.laws.emplace(name, std::move(factory));
+}
+
+std::vector<std::string> contact_law_names() {
+  Registry& r = registry();
+  const std::lock_guard<std::mutex> lock(r.mutex);
+  std::vector<std::string> names;
+  for (const auto& [name, factory] : r.laws) names.push_back(name);
+  return names;  // a std::map: sorted
+}
+
+std::shared_ptr<const ContactLaw> make_contact_law(const std::string& name, const LawOptions& options,
+                                                   const InputContext& ctx) {
+  ContactLawFactory factory;
+  {
+    Registry& r = registry();
+    const std::lock_guard<std::mutex> lock(r.mutex);
+    const auto it = r.laws.find(name);
+    if (it != r.laws.end()) factory = it->second;
+  }
+  if (!factory) {
+    std::ostringstream s;
+    s << "unknown contact law \"" << name << "\" (known:";
+    for (const std::string& n : contact_law_names()) s << " \"" << n << "\"";
+    s << ")";
+    throw ctx.error("contact_law", s.str());
+  }
+  return factory(options);
+}
+
+}  // namespace impactdeck::collision
