@@ -1,4 +1,4 @@
-// `impactdeck campaign plan|run|run-case|status|collect`: many cases of one scene
+// `impactdeck campaign plan|run|run-case|status|cancel|collect`: many cases of one scene
 // (docs/campaign-format.md), here or on a Slurm cluster.
 #include <filesystem>
 #include <iostream>
@@ -69,14 +69,26 @@ void register_campaign(CLI::App& app, Context& ctx) {
       o.cpus_per_task = a->cpus_per_task > 0 ? a->cpus_per_task : a->threads;
       o.sbatch_options = a->sbatch;
       o.executable = self_executable();
-      const fs::path script = campaign::write_sbatch(a->dir, o);
+      const campaign::SlurmScripts scripts = campaign::write_sbatch(a->dir, o);
+      std::string names;
+      for (const auto& arr : scripts.arrays) names += (names.empty() ? "" : ", ") + arr.script.string();
       if (a->dry_run) {
-        std::cout << "wrote " << script.string() << " (not submitted); submit it with:\n"
-                  << campaign::sbatch_command(a->dir, script, o) << "\n";
+        std::cout << "wrote " << names << " and " << scripts.collect_script.string() << " (not submitted: "
+                  << scripts.arrays.size() << " job array(s), MaxArraySize " << scripts.max_array_size
+                  << "); submit them with:\n";
+        for (const auto& line : campaign::sbatch_commands(a->dir, scripts, o)) std::cout << line << "\n";
         return;
       }
-      const std::string job = campaign::submit_sbatch(a->dir, script, o);
-      std::cout << "submitted job " << job << " (" << script.string() << "); follow it with 'impactdeck campaign status "
+      const campaign::SlurmSubmission sub = campaign::submit_sbatch(a->dir, scripts, o);
+      for (std::size_t i = 0; i < sub.array_jobs.size(); ++i) {
+        const campaign::SlurmArray& arr = scripts.arrays[i];
+        std::cout << "submitted job " << sub.array_jobs[i] << " (" << arr.script.string() << ": " << arr.tasks
+                  << " array task(s), cases " << arr.first_case << " ... " << arr.last_case << ")\n";
+      }
+      std::string after;
+      for (const auto& j : sub.array_jobs) after += (after.empty() ? "" : ", ") + j;
+      std::cout << "submitted job " << sub.collect_job << " (" << scripts.collect_script.string()
+                << ": 'campaign collect' after job(s) " << after << "); follow them with 'impactdeck campaign status "
                 << a->dir << "'\n";
       return;
     }
@@ -128,13 +140,32 @@ void register_campaign(CLI::App& app, Context& ctx) {
 
   CLI::App* status = top->add_subcommand("status", "Case states (and squeue's view of the campaign's jobs)");
   status->add_option("dir", a->dir, "Campaign folder")->required();
-  status->callback([a] { std::cout << campaign::status_report(a->dir); });
+  status->add_flag("--json", a->json, "Print one JSON document on stdout (keys: docs/cli.md)");
+  status->callback([a] { std::cout << campaign::status_report(a->dir, a->json); });
+
+  CLI::App* cancel = top->add_subcommand("cancel", "scancel the campaign's Slurm jobs (those in DIR/slurm/jobs.txt)");
+  cancel->add_option("dir", a->dir, "Campaign folder")->required();
+  cancel->callback([a] {
+    const std::vector<std::string> ids = campaign::cancel_jobs(a->dir);
+    if (ids.empty()) {
+      std::cout << "no Slurm job recorded for " << a->dir << ": nothing to cancel\n";
+      return;
+    }
+    std::string list;
+    for (const auto& i : ids) list += (list.empty() ? "" : " ") + i;
+    std::cout << "cancelled job(s) " << list << "\n";
+  });
 
   CLI::App* coll = top->add_subcommand("collect", "Table (CSV, JSON) of every case, the worst case, the map");
   coll->add_option("dir", a->dir, "Campaign folder")->required();
+  coll->add_flag("--json", a->json, "Print one JSON document on stdout (keys: docs/cli.md)");
   coll->callback([a, &ctx] {
     VerboseTimer timer(ctx, "campaign collect", "collect " + a->dir);
     const campaign::CollectResult r = campaign::collect(a->dir);
+    if (a->json) {
+      std::cout << campaign::collect_json(r);
+      return;
+    }
     std::cout << "collected " << r.done << " done, " << r.failed << " failed, " << r.pending << " pending: "
               << r.csv.string() << ", " << r.json.string() << "\n";
     if (r.worst_id) std::cout << "worst case: " << *r.worst_id << " (copied to " << r.worst_case->string() << ")\n";

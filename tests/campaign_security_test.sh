@@ -46,25 +46,29 @@ TOML
 mkdir fakebin slurmlog
 cat >fakebin/sbatch <<'SH'
 #!/bin/bash
-# A fake sbatch: records its arguments (NUL-separated), then runs the job array the way Slurm
-# does: in the --chdir folder, output to the #SBATCH --output pattern (relative to that folder),
-# each task the script run by bash with SLURM_ARRAY_TASK_ID set. FAKE_SBATCH_FAIL: refuse.
+# A fake sbatch: records its arguments (NUL-separated), then runs the job the way Slurm does: in
+# the --chdir folder, output to the #SBATCH --output pattern (relative to that folder); a job
+# array (job 4242) as each task the script run by bash with SLURM_ARRAY_TASK_ID set, a plain job
+# (the collect job, 4243, arguments in sbatch_collect.args) once. FAKE_SBATCH_FAIL: refuse.
 set -u
 log=$FAKE_SLURM_LOG
-printf '%s\0' "$@" >"$log/sbatch.args"
-if [ -n "${FAKE_SBATCH_FAIL:-}" ]; then echo "sbatch: error: Batch job submission failed: Invalid partition name specified" >&2; exit 1; fi
 script=${!#}
+range=$(sed -n 's/^#SBATCH --array=\([0-9]*-[0-9]*\).*/\1/p' "$script")
+if [ -n "$range" ]; then job=4242; printf '%s\0' "$@" >"$log/sbatch.args"; else job=4243; printf '%s\0' "$@" >"$log/sbatch_collect.args"; fi
+if [ -n "${FAKE_SBATCH_FAIL:-}" ]; then echo "sbatch: error: Batch job submission failed: Invalid partition name specified" >&2; exit 1; fi
 chdir=$PWD
 for a in "${@:1:$#-1}"; do case $a in --chdir=*) chdir=${a#--chdir=} ;; esac; done
-range=$(sed -n 's/^#SBATCH --array=\([0-9]*-[0-9]*\).*/\1/p' "$script")
 output=$(sed -n 's/^#SBATCH --output=//p' "$script")
-job=4242
 cd "$chdir" || { echo "sbatch: error: cannot chdir" >&2; exit 1; }
 printf '%s' "$PWD" >"$log/sbatch.pwd"
-for i in $(seq "${range%-*}" "${range#*-}"); do
-  out=${output//%A/$job}; out=${out//%a/$i}
-  SLURM_ARRAY_JOB_ID=$job SLURM_ARRAY_TASK_ID=$i bash "$script" >"$out" 2>&1
-done
+if [ -n "$range" ]; then
+  for i in $(seq "${range%-*}" "${range#*-}"); do
+    out=${output//%A/$job}; out=${out//%a/$i}
+    SLURM_ARRAY_JOB_ID=$job SLURM_ARRAY_TASK_ID=$i bash "$script" >"$out" 2>&1
+  done
+else
+  SLURM_JOB_ID=$job bash "$script" >"${output//%j/$job}" 2>&1
+fi
 echo "$job"
 SH
 cat >fakebin/squeue <<'SH'
@@ -105,10 +109,15 @@ for dir in "${names[@]}"; do
   expected=$(printf '%s\0' --parsable "--chdir=$camp" '--comment=$(touch '"${mark}"'_5)' '--comment=`touch '"${mark}"'_6`' \
     "--comment=a; touch ${mark}_7" "--comment=a b 'c' \"d\" #e" "$camp/campaign.sbatch" | od -c)
   check "folder $k: sbatch's argument vector" '[ "$(od -c <slurmlog/sbatch.args)" = "$expected" ]'
-  check "folder $k: the script holds none of the folder's or options' text in #SBATCH lines" \
-    '! grep "^#SBATCH" "$camp/campaign.sbatch" | grep -q -e "$tmp" -e comment'
+  expected=$(printf '%s\0' --parsable "--chdir=$camp" --dependency=afterany:4242 '--comment=$(touch '"${mark}"'_5)' \
+    '--comment=`touch '"${mark}"'_6`' "--comment=a; touch ${mark}_7" "--comment=a b 'c' \"d\" #e" "$camp/collect.sbatch" | od -c)
+  check "folder $k: the collect job's argument vector (after the array)" '[ "$(od -c <slurmlog/sbatch_collect.args)" = "$expected" ]'
+  check "folder $k: the collect job collected the campaign in its folder" \
+    '[ -f "$camp/collect/cases.csv" ] && [ -f "$camp/slurm/collect_4243.out" ] && [ "$(grep -c ",done," "$camp/collect/cases.csv")" = 2 ]'
+  check "folder $k: the scripts hold none of the folder's or options' text in #SBATCH lines" \
+    '! grep -h "^#SBATCH" "$camp/campaign.sbatch" "$camp/collect.sbatch" | grep -q -e "$tmp" -e comment'
   check "folder $k: squeue got the job id as its own argument" \
-    '[ "$(od -c <slurmlog/squeue.args)" = "$(printf "%s\0" -h -o "%i %T %R" -j 4242 | od -c)" ]'
+    '[ "$(od -c <slurmlog/squeue.args)" = "$(printf "%s\0" -h -o "%i %T %R" -j 4242,4243 | od -c)" ]'
 done
 
 # A newline (or any control character) in an option cannot be made safe in a #SBATCH line nor is
@@ -122,7 +131,7 @@ check "nothing submitted, no script written, no marker" '[ ! -e slurmlog/sbatch.
 "$bin" campaign run "$camp" --executor slurm --dry-run --sbatch-option='--comment=$(touch '"${mark}"'_9)' >out.txt
 rm -f "$camp"/cases/*/result.json
 out=$(cat out.txt)
-bash -c "${out#*submit it with:$'\n'}" >/dev/null 2>dry.err || cat dry.err
+bash -c "${out#*submit them with:$'\n'}" >/dev/null 2>dry.err || cat dry.err
 check "--dry-run's printed command submits with the right arguments, nothing injected" \
   '[ "$(cat slurmlog/sbatch.pwd)" = "$camp" ] && no_markers && [ "$(results "$camp")" = 2 ]'
 

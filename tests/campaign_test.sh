@@ -93,16 +93,55 @@ check "the table gives the failure's reason" 'grep -q "^0,failed,.*scene.toml: f
 
 # Slurm script, not submitted.
 out=$("$bin" campaign run clean --executor slurm --dry-run --jobs 3 --cpus-per-task 2 --sbatch-option=--partition=short)
-check "--dry-run writes the script only and prints how to submit it" '[[ "$out" == "wrote "*"campaign.sbatch (not submitted); submit it with:"* ]]'
+check "--dry-run writes the scripts only and prints how to submit them" \
+  '[[ "$out" == "wrote "*"campaign.sbatch and "*"collect.sbatch (not submitted: 1 job array(s), MaxArraySize "*"); submit them with:"* ]]'
+check "--dry-run prints the collect job's command, depending on the array's job id" \
+  'grep -qF -- "'"'"'--chdir=$tmp/clean'"'"' \"--dependency=afterany:\${job0%%;*}\" '"'"'--partition=short'"'"' '"'"'$tmp/clean/collect.sbatch'"'"'" <<<"$out"'
 check "the array covers every case with %K" 'grep -qx "#SBATCH --array=0-11%3" clean/campaign.sbatch'
-check "--cpus-per-task sets the ccx threads" 'grep -qx "#SBATCH --cpus-per-task=2" clean/campaign.sbatch && grep -q "SLURM_ARRAY_TASK_ID\" --threads 2$" clean/campaign.sbatch'
+check "--cpus-per-task sets the ccx threads" 'grep -qx "#SBATCH --cpus-per-task=2" clean/campaign.sbatch && grep -q "\"\$id\" --threads 2 || rc=\$?$" clean/campaign.sbatch'
+check "no [slurm] time: the documented default, 2 min x 1 case x 2" 'grep -qx "#SBATCH --time=0-00:04:00" clean/campaign.sbatch'
 want="'--chdir=$tmp/clean' '--partition=short' '$tmp/clean/campaign.sbatch'"
 check "extra sbatch options: arguments of the printed sbatch command, not #SBATCH lines" \
   'grep -qF -- "$want" <<<"$out" && ! grep -q partition clean/campaign.sbatch'
-check "each task runs run-case with absolute paths" "grep -qx \"exec '$bin' campaign run-case '$tmp/clean' \\\"\\\$SLURM_ARRAY_TASK_ID\\\" --threads 2\" clean/campaign.sbatch"
+check "each task runs run-case with absolute paths" "grep -qxF \"  '$bin' campaign run-case '$tmp/clean' \\\"\\\$id\\\" --threads 2 || rc=\\\$?\" clean/campaign.sbatch"
+check "the collect script runs collect with absolute paths" "grep -qxF \"exec '$bin' campaign collect '$tmp/clean'\" clean/collect.sbatch"
+# A task id that is not a number never reaches the shell's arithmetic (where a[\$(cmd)] would run).
+SLURM_ARRAY_TASK_ID='a[$(touch '"$tmp"'/PWNED_task)]' sh clean/campaign.sbatch >task.txt 2>&1
+rc=$?
+check "a task id that is not a number: exit 3, nothing run" '[ $rc = 3 ] && [ ! -e "$tmp/PWNED_task" ] && grep -q "is not an array task number" task.txt'
 # What the array does, run by hand: each task line with its id is a no-op on a done campaign.
 SLURM_ARRAY_TASK_ID=5 sh clean/campaign.sbatch >task.txt 2>&1
 check "the script's command runs a case" 'grep -qx "case 5: already done" task.txt'
+
+# MaxArraySize from `scontrol show config` (a fake one on the PATH says 5: arrays of at most 4
+# tasks) and [slurm] cases_per_task = 2: 12 cases, 6 tasks, arrays of 4 and 2.
+mkdir -p fakebin
+printf '#!/bin/sh\nprintf "%%s\\n" "MaxArraySize            = 5" "MaxJobCount             = 10000"\n' >fakebin/scontrol
+chmod +x fakebin/scontrol
+{ cat c.toml; printf '[slurm]\ncases_per_task = 2\ntime = 90\n'; } >c2.toml
+"$bin" campaign plan c2.toml --out split >/dev/null || echo "FAILED: plan with [slurm]"
+out=$(PATH="$tmp/fakebin:$PATH" "$bin" campaign run split --executor slurm --dry-run)
+check "MaxArraySize 5 splits 6 tasks into arrays of 4 and 2 ($out)" \
+  'grep -qx "#SBATCH --array=0-3" split/campaign.sbatch && grep -qx "#SBATCH --array=0-1" split/campaign.1.sbatch && [ ! -e split/campaign.2.sbatch ] && [[ "$out" == *"2 job array(s), MaxArraySize 5"* ]]'
+check "[slurm] time as minutes" 'grep -qx "#SBATCH --time=90" split/campaign.sbatch'
+# Run by hand: task 1 of the second array is campaign task 5, cases 10 and 11.
+"$bin" campaign run split --quiet >/dev/null
+SLURM_ARRAY_TASK_ID=1 sh split/campaign.1.sbatch >task.txt 2>&1
+check "a task runs its cases_per_task cases in sequence" '[ "$(cat task.txt)" = "$(printf "case 10: already done\ncase 11: already done")" ]'
+
+# --json on status and collect: one document on stdout.
+st=$("$bin" campaign status failing --json)
+check "status --json: counts and per-case states ($st)" "python3 -c 'import json, sys
+d = json.loads(sys.argv[1])
+assert d[\"counts\"] == {\"done\": 0, \"failed\": 1, \"running\": 0, \"planned\": 0}, d
+assert d[\"cases\"][0][\"state\"] == \"failed\" and \"scene.toml\" in d[\"cases\"][0][\"reason\"]
+assert d[\"slurm_jobs\"] == [] and d[\"squeue\"] is None' \"\$st\""
+co=$("$bin" campaign collect clean --json)
+check "collect --json: the table, the counts and the worst case ($co)" "python3 -c 'import json, sys
+d = json.loads(sys.argv[1]); w = d[\"worst_case\"]
+assert (d[\"done\"], d[\"failed\"], d[\"pending\"]) == (12, 0, 0)
+assert d[\"csv\"] == sys.argv[2] + \"/clean/collect/cases.csv\" and d[\"report_html\"].endswith(\"report.html\")
+assert w[\"by\"] == \"max_force_N\" and w[\"id\"] in (9, 10, 11) and w[\"value\"] > 0 and w[\"folder\"].endswith(\"worst_case\")' \"\$co\" \"$tmp\""
 
 # A point campaign over a part's surface and a drop campaign over the orientation sphere.
 # (the ball moves along the inward normal wherever it hits: every point is an impact)

@@ -44,7 +44,7 @@ input_error "--impact name" "did you mean 'fig4'\?" sweep "$src/samples/fig4_swe
 
 # 2. -q / -v and -o / --out on every command. Each runnable command's help lists them.
 cmds=(run sweep inspect mesh-ellipsoid fem-check compare-contact "study table1" "campaign plan" "campaign run"
-      "campaign run-case" "campaign status" "campaign collect")
+      "campaign run-case" "campaign status" "campaign cancel" "campaign collect")
 for c in "${cmds[@]}"; do
   "$bin" $c --help >"$tmp/h.txt" 2>&1
   check "'$c --help' lists -q,--quiet" grep -Eq -- "-q,--quiet" "$tmp/h.txt"
@@ -104,7 +104,8 @@ check "'impactdeck r' completes run" bash -c "[ \"\$(printf '%s' \"$(complete_wo
 check "'impactdeck ' offers every subcommand" bash -c "for s in run sweep study inspect mesh-ellipsoid fem-check compare-contact campaign; do printf '%s\n' \"$(complete_words '')\" | grep -qx \$s || exit 1; done"
 check "'impactdeck ' hides man and completion" bash -c "! printf '%s\n' \"$(complete_words '')\" | grep -qx 'man\|completion'"
 check "'impactdeck study t' completes table1" bash -c "[ \"$(complete_words study t)\" = table1 ]"
-check "'impactdeck campaign c' completes collect" bash -c "[ \"$(complete_words campaign c)\" = collect ]"
+check "'impactdeck campaign co' completes collect" bash -c "[ \"$(complete_words campaign co)\" = collect ]"
+check "'impactdeck campaign ca' completes cancel" bash -c "[ \"$(complete_words campaign ca)\" = cancel ]"
 check "'impactdeck run x --js' completes --json" bash -c "[ \"$(complete_words run x.toml --js)\" = --json ]"
 check "'impactdeck sweep --qu' completes --quiet" bash -c "[ \"$(complete_words sweep --qu)\" = --quiet ]"
 check "'impactdeck study table1 --sc' completes --scene" bash -c "[ \"$(complete_words study table1 --sc)\" = --scene ]"

@@ -5,6 +5,10 @@
 # campaign is submitted with `campaign run --executor slurm`, waited for and collected; its table
 # must equal the local executor's. The daemons are stopped by PID at the end. If they cannot
 # start, the test FAILS and says why: it is never skipped.
+# MaxArraySize is 3 (array indices 0-2): each campaign is split into job arrays of at most 2 tasks.
+# A campaign with a [slurm] table (partition, time, mem, a setup line that leaves a marker,
+# cases_per_task = 2 over 5 cases: 3 tasks in 2 arrays) runs with its collect as a dependent job;
+# a held campaign is cancelled with `campaign cancel` and never runs.
 # Usage: slurm_test.sh IMPACTDECK SOURCE_DIR
 set -uo pipefail
 exe=$(readlink -f "$1"); src=$(readlink -f "$2")
@@ -75,7 +79,8 @@ SelectTypeParameters=CR_CPU
 MpiDefault=none
 ReturnToService=2
 SlurmdTimeout=30
-NodeName=$node NodeAddr=127.0.0.1 CPUs=2 State=UNKNOWN
+MaxArraySize=3
+NodeName=$node NodeAddr=127.0.0.1 CPUs=2 RealMemory=1000 State=UNKNOWN
 PartitionName=test Nodes=$node Default=YES MaxTime=INFINITE State=UP
 CONF
 export SLURM_CONF="$tmp/slurm.conf"
@@ -106,17 +111,24 @@ TOML
 "$exe" campaign run local --jobs 2 --quiet >/dev/null || fail "campaign run (local)"
 out=$("$exe" campaign run slurm --executor slurm --jobs 2) || fail "campaign run --executor slurm: $out"
 echo "$out"
-job=$(echo "$out" | sed -n 's/^submitted job \([0-9]*\).*/\1/p')
+job=$(echo "$out" | sed -n 's/^submitted job \([0-9]*\).*/\1/p' | head -n 1)
 [ -n "$job" ] || fail "no job id in: $out"
-grep -q '^#SBATCH --array=0-3%2$' slurm/campaign.sbatch || fail "campaign.sbatch lacks '#SBATCH --array=0-3%2'"
-grep -q "^exec '$exe' campaign run-case '$tmp/slurm' \"\$SLURM_ARRAY_TASK_ID\"" slurm/campaign.sbatch ||
-  fail "campaign.sbatch does not run '$exe campaign run-case DIR \$SLURM_ARRAY_TASK_ID'"
-done_=0
-for _ in $(seq 200); do
-  if [ -z "$(squeue -h -j "$job" 2>/dev/null)" ]; then done_=1; break; fi
-  sleep 0.2
-done
-[ $done_ = 1 ] || fail "job $job still queued or running after 40 s: $(squeue -h 2>&1 | tr '\n' ' ')"
+# 4 tasks, MaxArraySize 3 (indices 0-2): two arrays of 2 tasks, then the collect job.
+[ "$(grep -c '^submitted job' <<<"$out")" = 3 ] || fail "expected 2 arrays and a collect job: $out"
+grep -q '^#SBATCH --array=0-1%2$' slurm/campaign.sbatch || fail "campaign.sbatch lacks '#SBATCH --array=0-1%2'"
+grep -q '^#SBATCH --array=0-1%2$' slurm/campaign.1.sbatch || fail "campaign.1.sbatch lacks '#SBATCH --array=0-1%2'"
+grep -q "^  '$exe' campaign run-case '$tmp/slurm' \"\$id\" --threads 1 || rc=\$?\$" slurm/campaign.sbatch ||
+  fail "campaign.sbatch does not run '$exe campaign run-case DIR \$id'"
+# wait_jobs DIR: until none of the campaign's jobs (slurm/jobs.txt) is queued or running.
+wait_jobs() {
+  local ids; ids=$(paste -sd, "$1/slurm/jobs.txt")
+  for _ in $(seq 300); do
+    [ -z "$(squeue -h -j "$ids" 2>/dev/null)" ] && return 0
+    sleep 0.2
+  done
+  fail "jobs $ids still queued or running after 60 s: $(squeue -h 2>&1 | tr '\n' ' ')"
+}
+wait_jobs slurm
 status=$("$exe" campaign status slurm) || fail "campaign status"
 echo "$status"
 echo "$status" | grep -q '4 cases, 4 done' || { cat slurm/slurm/*.out >&2 2>/dev/null; fail "not every case done under Slurm"; }
@@ -135,14 +147,77 @@ mkdir -p "$hostile"
 "$exe" campaign plan campaign.toml --out "$hostile/c" >/dev/null || fail "campaign plan (hostile folder name)"
 out=$("$exe" campaign run "$hostile/c" --executor slurm --sbatch-option='--comment=$(touch '"$mark"'.4)') ||
   fail "campaign run --executor slurm (hostile folder name): $out"
-job2=$(echo "$out" | sed -n 's/^submitted job \([0-9]*\).*/\1/p')
+job2=$(echo "$out" | sed -n 's/^submitted job \([0-9]*\).*/\1/p' | head -n 1)
 [ -n "$job2" ] || fail "no job id in: $out"
-for _ in $(seq 200); do
-  [ -z "$(squeue -h -j "$job2" 2>/dev/null)" ] && break
-  sleep 0.2
-done
+wait_jobs "$hostile/c"
 status=$("$exe" campaign status "$hostile/c") || fail "campaign status (hostile folder name)"
 echo "$status" | grep -q '4 cases, 4 done' || fail "not every case done in the hostile folder: $status"
 [ -f "$hostile/c/slurm/${job2}_0.out" ] || fail "the tasks' output is not in the hostile folder's slurm/"
 ! compgen -G "$mark.*" >/dev/null || fail "an injected command ran: $(compgen -G "$mark.*")"
-echo "ok: Slurm job $job ran 4 cases; the table equals the local executor's; job $job2 ran 4 cases in a hostile folder, nothing injected"
+[ -f "$hostile/c/collect/cases.csv" ] || fail "the dependent collect job did not collect the hostile folder"
+
+# [slurm]: partition, time, mem, a setup line leaving a marker per job, 2 cases per task over 5
+# cases (3 tasks: arrays of 2 and 1 under MaxArraySize 3), collect as a dependent job.
+cat >sl.toml <<'TOML'
+scene = "base.toml"
+[product]
+"impacts[0].restitution" = [1.0, 0.9, 0.8, 0.7, 0.6]
+[slurm]
+partition = "test"
+time = "0-00:10:00"
+mem = "200M"
+setup = ["touch \"setup-ran-$SLURM_JOB_ID\""]
+cases_per_task = 2
+TOML
+"$exe" campaign plan sl.toml --out sl >/dev/null || fail "campaign plan (with [slurm])"
+out=$("$exe" campaign run sl --executor slurm) || fail "campaign run --executor slurm (with [slurm]): $out"
+echo "$out"
+mapfile -t jobs3 < <(sed -n 's/^submitted job \([0-9]*\).*/\1/p' <<<"$out")
+[ "${#jobs3[@]}" = 3 ] || fail "expected 2 arrays and a collect job: $out"
+grep -q "cases 0 ... 3)" <<<"$out" && grep -q "cases 4 ... 4)" <<<"$out" || fail "the arrays should cover cases 0-3 and 4: $out"
+dep=$(scontrol show job "${jobs3[2]}" 2>&1 | tr ' ' '\n' | grep '^Dependency=')
+[[ "$dep" == *"afterany:${jobs3[0]}"*"afterany:${jobs3[1]}"* || "$dep" == *"afterany:${jobs3[0]}"*":${jobs3[1]}"* ]] ||
+  fail "the collect job ${jobs3[2]} does not depend on ${jobs3[0]} and ${jobs3[1]}: '$dep'"
+for f in sl/campaign.sbatch sl/campaign.1.sbatch sl/collect.sbatch; do
+  for l in '#SBATCH --partition=test' '#SBATCH --time=0-00:10:00' '#SBATCH --mem=200M' 'touch "setup-ran-$SLURM_JOB_ID"'; do
+    grep -qxF "$l" "$f" || fail "$f lacks the line '$l'"
+  done
+done
+grep -q '^#SBATCH --array=0-1$' sl/campaign.sbatch && grep -q '^#SBATCH --array=0-0$' sl/campaign.1.sbatch ||
+  fail "expected arrays 0-1 and 0-0: $(grep -h array sl/*.sbatch)"
+wait_jobs sl
+status=$("$exe" campaign status sl --json) || fail "campaign status --json"
+python3 -c 'import json, sys
+d = json.loads(sys.argv[1])
+assert d["case_count"] == 5 and d["counts"] == {"done": 5, "failed": 0, "running": 0, "planned": 0}, d["counts"]
+assert [c["state"] for c in d["cases"]] == ["done"] * 5
+assert d["slurm_jobs"] == sys.argv[2:], (d["slurm_jobs"], sys.argv[2:])' "$status" "${jobs3[@]}" ||
+  fail "campaign status --json: $status"
+[ "$(ls sl/setup-ran-* 2>/dev/null | wc -l)" = 4 ] || fail "the setup line did not run once per job (3 tasks + collect): $(ls sl)"
+# Each task ran its 2 cases in sequence (the last task 1): the cases' lines in the tasks' outputs.
+grep -qx "case 0: done" "sl/slurm/${jobs3[0]}_0.out" && grep -qx "case 1: done" "sl/slurm/${jobs3[0]}_0.out" &&
+  grep -qx "case 2: done" "sl/slurm/${jobs3[0]}_1.out" && grep -qx "case 3: done" "sl/slurm/${jobs3[0]}_1.out" &&
+  grep -qx "case 4: done" "sl/slurm/${jobs3[1]}_0.out" || fail "the tasks did not run cases 0-1, 2-3 and 4: $(head sl/slurm/*.out)"
+# The collect job ran after every case: its table has 5 done rows, its log is in slurm/.
+[ -f "sl/slurm/collect_${jobs3[2]}.out" ] || fail "no output of the collect job"
+[ "$(grep -c '^[0-9]*,done,' sl/collect/cases.csv)" = 5 ] || fail "the dependent collect did not see 5 done cases: $(cat sl/collect/cases.csv)"
+coll=$("$exe" campaign collect sl --json) || fail "campaign collect --json"
+python3 -c 'import json, sys
+d = json.loads(sys.argv[1])
+assert (d["done"], d["failed"], d["pending"]) == (5, 0, 0)
+assert d["csv"].endswith("/sl/collect/cases.csv") and d["worst_case"]["by"] == "max_force_N"
+assert d["worst_case"]["id"] in range(5) and d["worst_case"]["value"] > 0' "$coll" || fail "campaign collect --json: $coll"
+
+# campaign cancel: a held campaign (never started) is cancelled; released afterwards, nothing runs.
+"$exe" campaign plan campaign.toml --out held >/dev/null || fail "campaign plan (held)"
+out=$("$exe" campaign run held --executor slurm --sbatch-option=--hold) || fail "campaign run (held): $out"
+ids=$(paste -sd, held/slurm/jobs.txt)
+[ "$(squeue -h -j "$ids" -o %i | wc -l)" -ge 3 ] || fail "the held jobs $ids are not queued: $(squeue -h 2>&1 | tr '\n' ' ')"
+out=$("$exe" campaign cancel held) || fail "campaign cancel: $out"
+[ "$out" = "cancelled job(s) $(paste -sd' ' held/slurm/jobs.txt)" ] || fail "campaign cancel printed: $out"
+wait_jobs held
+scontrol release "$(paste -sd, held/slurm/jobs.txt)" >/dev/null 2>&1
+sleep 2
+! compgen -G "held/cases/*/result.json" >/dev/null || fail "a cancelled case ran"
+[ -z "$(squeue -h -j "$ids" 2>/dev/null)" ] || fail "cancelled jobs still queued: $(squeue -h -j "$ids")"
+echo "ok: Slurm job $job ran 4 cases in 2 arrays; the table equals the local executor's; job $job2 ran 4 cases in a hostile folder, nothing injected; [slurm] campaign ${jobs3[*]}: 5 cases, 2 per task, setup ran, dependent collect; held campaign cancelled"

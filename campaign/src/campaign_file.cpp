@@ -119,6 +119,47 @@ std::size_t body_index(const scene::Scene& sc, const std::string& name) {
   return sc.bodies.size();
 }
 
+// `[slurm]`: every value checked by slurm_value_error, the error naming the line and key.
+SlurmSettings read_slurm(const toml::table& t, const FileReader& fr) {
+  fr.only(t, "slurm", {"partition", "account", "qos", "time", "mem", "setup", "cases_per_task"});
+  SlurmSettings s;
+  // A name (string), or for time (minutes) and mem (megabytes) also a whole number.
+  auto text = [&](const char* key, bool number_too) -> std::string {
+    const toml::node* n = t.get(key);
+    if (!n) return {};
+    const std::string k = std::string("slurm.") + key;
+    std::string v;
+    if (const auto* str = n->as_string()) {
+      v = str->get();
+    } else if (const auto* i = n->as_integer(); i && number_too && i->get() >= 0) {
+      v = std::to_string(i->get());
+    } else {
+      fr.fail(n, k, number_too ? "must be a string or a whole number >= 0" : "must be a string");
+    }
+    if (const std::string why = slurm_value_error(key, v); !why.empty()) fr.fail(n, k, why);
+    return v;
+  };
+  s.partition = text("partition", false);
+  s.account = text("account", false);
+  s.qos = text("qos", false);
+  s.mem = text("mem", true);
+  s.time = text("time", true);
+  s.time_given = !s.time.empty();
+  if (t.contains("cases_per_task")) s.cases_per_task = fr.count(t, "slurm", "cases_per_task", kMaxCasesPerTask);
+  if (const toml::node* n = t.get("setup")) {
+    const toml::array* a = n->as_array();
+    if (!a) fr.fail(n, "slurm.setup", "must be a list of shell lines (strings)");
+    for (std::size_t i = 0; i < a->size(); ++i) {
+      const toml::node* e = a->get(i);
+      const std::string k = "slurm.setup[" + std::to_string(i) + "]";
+      if (!e->is_string()) fr.fail(e, k, "must be a shell line (string)");
+      if (const std::string why = slurm_value_error("setup", e->as_string()->get()); !why.empty()) fr.fail(e, k, why);
+      s.setup.push_back(e->as_string()->get());
+    }
+  }
+  return s;
+}
+
 }  // namespace
 
 Campaign read_campaign(const fs::path& file, std::size_t max_cases) {
@@ -133,7 +174,7 @@ Campaign read_campaign(const fs::path& file, std::size_t max_cases) {
     p << "line " << e.source().begin.line << ", column " << e.source().begin.column;
     throw InputError(fr.name(), p.str(), "TOML syntax error: " + std::string(e.description()));
   }
-  fr.only(root, "", {"scene", "impact", "cases", "product", "points", "orientations"});
+  fr.only(root, "", {"scene", "impact", "cases", "product", "points", "orientations", "slurm"});
 
   Campaign c;
   c.file = file;
@@ -256,6 +297,11 @@ Campaign read_campaign(const fs::path& file, std::size_t max_cases) {
     axis_places.push_back(place(n, "orientations"));
     c.generators.push_back("orientations");
   }
+  if (const toml::node* n = root.get("slurm")) {
+    const toml::table* t = n->as_table();
+    if (!t) fr.fail(n, "slurm", "must be a table");
+    c.slurm = read_slurm(*t, fr);
+  }
   if (axes.empty()) {
     throw InputError(fr.name(), "", "no case generator: give [product], [[cases]], [points] or [orientations]");
   }
@@ -299,8 +345,10 @@ Campaign read_campaign(const fs::path& file, std::size_t max_cases) {
                            "', the impact the campaign collects (set 'impact' to one the cases keep)" +
                            did_you_mean(c.impact, names));
     }
+    if (sc.outputs.fem && sc.outputs.fem->run == scene::FemOutputs::Run::calculix) c.runs_ccx = true;
     c.cases.push_back(std::move(k));
   }
+  if (!c.slurm.time_given) c.slurm.time = slurm_time_text(default_task_minutes(c.runs_ccx, c.slurm.cases_per_task));
   return c;
 }
 

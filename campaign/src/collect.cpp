@@ -378,6 +378,8 @@ CollectResult collect(const fs::path& dir_in) {
       out.worst_id = r.id;
     }
   }
+  out.worst_case_by = all_stress ? "peak_von_mises_Pa" : "max_force_N";
+  if (out.worst_id && std::isfinite(worst)) out.worst_value = worst;
 
   // Everything is checked before anything is written: `collect` a real folder (created by the
   // transaction when missing), the worst case's folder free of links.
@@ -391,7 +393,7 @@ CollectResult collect(const fs::path& dir_in) {
                     {"failed", out.failed},
                     {"pending", out.pending},
                     {"worst_case_id", out.worst_id ? json(*out.worst_id) : json(nullptr)},
-                    {"worst_case_by", all_stress ? "peak_von_mises_Pa" : "max_force_N"},
+                    {"worst_case_by", out.worst_case_by},
                     {"cases", cases}};
   // One transaction (common/run_transaction.hpp): every file and the worst case's copy appear
   // together, or nothing changes.
@@ -450,6 +452,23 @@ CollectResult collect(const fs::path& dir_in) {
   });
   refresh_states(dir);
   return out;
+}
+
+std::string collect_json(const CollectResult& r) {
+  auto path = [](const std::optional<fs::path>& p) { return p ? json(p->string()) : json(nullptr); };
+  const json doc = {{"csv", r.csv.string()},
+                    {"json", r.json.string()},
+                    {"report_html", r.report_html.string()},
+                    {"map_svg", path(r.map_svg)},
+                    {"map_vtp", path(r.map_vtp)},
+                    {"done", r.done},
+                    {"failed", r.failed},
+                    {"pending", r.pending},
+                    {"worst_case", {{"id", r.worst_id ? json(*r.worst_id) : json(nullptr)},
+                                    {"by", r.worst_case_by},
+                                    {"value", r.worst_value ? json(*r.worst_value) : json(nullptr)},
+                                    {"folder", path(r.worst_case)}}}};
+  return doc.dump(2, ' ', false, json::error_handler_t::replace) + "\n";
 }
 
 }  // namespace impactdeck::campaign

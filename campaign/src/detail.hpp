@@ -12,6 +12,8 @@
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
 
+#include "impactdeck/campaign/campaign.hpp"
+
 namespace impactdeck::campaign::detail {
 
 /// An exclusive flock on `path` (created if missing; a symbolic link there is refused with
@@ -62,11 +64,22 @@ struct PlanCase {
 struct Plan {
   std::filesystem::path dir, file;  ///< the campaign folder (absolute) and its campaign.json
   nlohmann::json doc;
+  SlurmSettings slurm;  ///< its "slurm" object (defaults for a plan written without one)
   std::string impact;
   std::vector<std::string> keys, generators;
   std::vector<PlanCase> cases;
 };
 Plan read_plan(const std::filesystem::path& dir);
+
+/// The [slurm] settings as campaign.json's "slurm" object, and back (every value checked again by
+/// slurm_value_error: a forged campaign.json gets no more into a job script than a campaign file).
+nlohmann::json slurm_json(const SlurmSettings& s);
+SlurmSettings slurm_from_json(const nlohmann::json& j, const std::string& file);
+
+/// The job ids `campaign run --executor slurm` recorded in slurm/jobs.txt, one per line: digits
+/// only. Anything else (a hand-edited or forged file) is refused (InputError naming the line)
+/// before any of it reaches squeue or scancel.
+std::vector<std::string> job_ids(const std::filesystem::path& dir);
 
 /// A case's result.json or failure.json, validated for what collect and status read.
 nlohmann::json read_result(const std::filesystem::path& dir, std::size_t id);
@@ -77,8 +90,10 @@ struct ProgramRun {
   int spawn_error = 0;  ///< errno of a program that could not be started (ENOENT: not found)
   int exit_code = -1;   ///< its exit status, -1 when killed by a signal
   std::string output;   ///< stdout (and stderr when merged), at most 1 MiB kept
+  bool timed_out = false;
 };
-ProgramRun run_program(const std::vector<std::string>& argv, bool merge_stderr);
+/// `timeout_s` > 0: a program still running then is killed (SIGKILL) and timed_out set.
+ProgramRun run_program(const std::vector<std::string>& argv, bool merge_stderr, double timeout_s = 0);
 
 /// The whole of a file the user gave (campaign file, scene, part): bounded by read_input_file.
 std::string read_text(const std::filesystem::path& p);

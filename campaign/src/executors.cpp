@@ -10,6 +10,7 @@
 #include <fstream>
 #include <algorithm>
 #include <map>
+#include <optional>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -29,7 +30,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr std::uintmax_t kMaxJobsBytes = std::uintmax_t{1} << 20;  // slurm/jobs.txt
+constexpr double kSqueueTimeoutS = 30;  // squeue answers in a second; a hung controller is not waited for
 
 pid_t spawn_case(const fs::path& exe, const fs::path& dir, std::size_t id, int threads) {
   const fs::path log = case_folder(dir, id) / "run.log";
@@ -67,36 +68,6 @@ void record_crash(const fs::path& dir, std::size_t id, int status) {
   reason += " (see " + (folder / "run.log").string() + ")";
   const nlohmann::json f = {{"id", id}, {"state", "failed"}, {"exit_code", 1}, {"reason", reason}};
   write_file_atomically(folder / "failure.json", f.dump(2) + "\n");
-}
-
-// The job ids `campaign run --executor slurm` recorded, one per line: digits only. Anything else
-// (a hand-edited or forged file) is refused before any of it reaches squeue.
-std::vector<std::string> job_ids(const fs::path& dir) {
-  std::vector<std::string> ids;
-  const fs::path rel = fs::path("slurm") / "jobs.txt";
-  if (!detail::check_inside(dir, rel, detail::Kind::file)) return ids;
-  const fs::path file = dir / rel;
-  std::istringstream in(read_input_file(file, "job list", kMaxJobsBytes));
-  std::size_t line_no = 0;
-  for (std::string line; std::getline(in, line);) {
-    ++line_no;
-    if (line.empty()) continue;
-    if (line.size() > 20 || line.find_first_not_of("0123456789") != std::string::npos) {
-      throw InputError(file.string(), "line " + std::to_string(line_no),
-                       "'" + line + "' is not a Slurm job id (digits only): the file was not written by impactdeck");
-    }
-    ids.push_back(line);
-  }
-  return ids;
-}
-
-// The sbatch command line that submits the script: everything taken from data (the campaign
-// folder, the user's options) is an argument of its own, never a line of the script.
-std::vector<std::string> sbatch_argv(const fs::path& dir, const fs::path& script, const SlurmOptions& o) {
-  std::vector<std::string> argv = {"sbatch", "--parsable", "--chdir=" + dir.string()};
-  argv.insert(argv.end(), o.sbatch_options.begin(), o.sbatch_options.end());
-  argv.push_back(script.string());
-  return argv;
 }
 
 }  // namespace
@@ -160,125 +131,75 @@ RunSummary run_local(const fs::path& dir_in, const LocalOptions& o) {
   return s;
 }
 
-void check_sbatch_options(const std::vector<std::string>& options) {
-  for (std::size_t i = 0; i < options.size(); ++i) {
-    const std::string& o = options[i];
-    const std::string place = "value " + std::to_string(i + 1) + " '" + o + "'";
-    if (o.size() < 2 || o[0] != '-') {
-      throw InputError("--sbatch-option", place, "must be one sbatch option such as --partition=short");
-    }
-    for (const char c : o) {
-      if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
-        throw InputError("--sbatch-option", place, "holds a control character (a newline, a tab, ...): refused");
-      }
-    }
-  }
-}
-
-fs::path write_sbatch(const fs::path& dir_in, const SlurmOptions& o) {
-  check_sbatch_options(o.sbatch_options);
+std::string status_report(const fs::path& dir_in, bool as_json) {
   const detail::Plan plan = detail::read_plan(dir_in);
   const fs::path& dir = plan.dir;
   const std::size_t n = plan.cases.size();
-  if (n == 0) throw InputError(plan.file.string(), "key 'cases'", "the campaign has no cases");
-  const fs::path exe = fs::absolute(o.executable);
-  if (!detail::check_inside(dir, "slurm", detail::Kind::folder)) detail::make_folder(dir / "slurm");
-  detail::check_inside(dir, "campaign.sbatch", detail::Kind::file);  // a link there is refused
-  // Only constants and sh-quoted paths: the folder and the user's options reach sbatch as
-  // arguments of its own (sbatch_argv), never as #SBATCH lines, whose text no quoting protects.
-  std::ostringstream s;
-  s << "#!/bin/sh\n"
-    << "# impactdeck campaign: one array task per case (docs/campaign-format.md). Each task is\n"
-    << "# idempotent: a case with a published result.json is not run again. Submit it with\n"
-    << "# 'impactdeck campaign run DIR --executor slurm', or as 'campaign run --dry-run' prints.\n"
-    << "#SBATCH --job-name=impactdeck-campaign\n"
-    << "#SBATCH --array=0-" << n - 1;
-  if (o.max_parallel > 0) s << "%" << o.max_parallel;
-  s << "\n#SBATCH --cpus-per-task=" << o.cpus_per_task << "\n"
-    << "#SBATCH --ntasks=1\n"
-    << "#SBATCH --output=slurm/%A_%a.out\n"  // relative to --chdir, the campaign folder
-    << "cd " << detail::sh_quote(dir.string()) << " || exit 3\n"
-    << "exec " << detail::sh_quote(exe.string()) << " campaign run-case " << detail::sh_quote(dir.string())
-    << " \"$SLURM_ARRAY_TASK_ID\" --threads " << o.cpus_per_task << "\n";
-  const fs::path script = dir / "campaign.sbatch";
-  write_file_atomically(script, s.str());
-  std::error_code ec;
-  fs::permissions(script, fs::perms::owner_exec | fs::perms::group_exec | fs::perms::others_exec,
-                  fs::perm_options::add | fs::perm_options::nofollow, ec);
-  return script;
-}
-
-std::string sbatch_command(const fs::path& dir_in, const fs::path& script, const SlurmOptions& o) {
-  std::string line;
-  for (const auto& a : sbatch_argv(fs::absolute(dir_in).lexically_normal(), script, o))
-    line += (line.empty() ? "" : " ") + detail::sh_quote(a);
-  return line;
-}
-
-std::string submit_sbatch(const fs::path& dir_in, const fs::path& script, const SlurmOptions& o) {
-  check_sbatch_options(o.sbatch_options);
-  const fs::path dir = fs::absolute(dir_in).lexically_normal();
-  job_ids(dir);  // the job list the id is added to must be sound before anything is submitted
-  const detail::ProgramRun run = detail::run_program(sbatch_argv(dir, script, o), /*merge_stderr=*/true);
-  if (run.spawn_error != 0) {
-    throw InputError("sbatch", "submit", std::string("cannot run 'sbatch': ") + std::strerror(run.spawn_error) +
-                                             " (is Slurm installed here? it must be on the PATH)");
-  }
-  const std::string id = run.output.substr(0, run.output.find_first_of(";\n"));
-  if (run.exit_code != 0 || id.empty() || id.size() > 20 || id.find_first_not_of("0123456789") != std::string::npos) {
-    std::string msg = run.output.substr(0, 2000);
-    while (!msg.empty() && (msg.back() == '\n' || msg.back() == '\r')) msg.pop_back();
-    for (char& c : msg) c = c == '\n' ? ' ' : c;
-    throw InputError(script.string(), "sbatch",
-                     (run.exit_code != 0 ? "sbatch refused it (exit " + std::to_string(run.exit_code) + ")"
-                                         : std::string("sbatch printed no job id")) +
-                         ": " + msg);
-  }
-  detail::FileLock lock(dir / ".campaign.lock", /*wait=*/true);
-  job_ids(dir);  // still sound under the lock
-  const fs::path jobs = dir / "slurm" / "jobs.txt";
-  std::string text;
-  if (detail::check_inside(dir, fs::path("slurm") / "jobs.txt", detail::Kind::file)) {
-    text = read_input_file(jobs, "job list", kMaxJobsBytes);
-  }
-  write_file_atomically(jobs, text + id + "\n");
-  return id;
-}
-
-std::string status_report(const fs::path& dir_in) {
-  const detail::Plan plan = detail::read_plan(dir_in);
-  const fs::path& dir = plan.dir;
-  const std::size_t n = plan.cases.size();
-  const auto ids = job_ids(dir);  // checked before anything is printed
+  const auto ids = detail::job_ids(dir);  // checked before anything is printed
+  std::vector<CaseState> states(n);
   std::map<CaseState, std::vector<std::size_t>> by;
-  for (std::size_t id = 0; id < n; ++id) by[case_state(dir, id)].push_back(id);
-  std::ostringstream s;
-  s << "campaign " << dir.string() << ": " << n << " cases";
-  for (CaseState st : {CaseState::done, CaseState::failed, CaseState::running, CaseState::planned}) {
-    s << ", " << by[st].size() << " " << to_string(st);
-  }
-  s << "\n";
-  for (CaseState st : {CaseState::failed, CaseState::running}) {
-    for (std::size_t id : by[st]) {
-      s << "  case " << id << ": " << to_string(st);
-      if (st == CaseState::failed) {
-        try {
-          s << ": " << InputError::one_line(detail::read_failure(dir, id)["reason"].get<std::string>());
-        } catch (const InputError& e) {
-          s << ": (" << e.what() << ")";
-        }
-      }
-      s << "\n";
+  for (std::size_t id = 0; id < n; ++id) by[states[id] = case_state(dir, id)].push_back(id);
+  auto reason = [&](std::size_t id) {
+    try {
+      return InputError::one_line(detail::read_failure(dir, id)["reason"].get<std::string>());
+    } catch (const InputError& e) {
+      return "(" + std::string(e.what()) + ")";
     }
-  }
+  };
+  const std::string list = [&] {
+    std::string l;
+    for (const auto& i : ids) l += (l.empty() ? "" : ",") + i;
+    return l;
+  }();
+  // squeue from its argument vector: the ids are digits (job_ids), and no shell is involved.
+  std::optional<detail::ProgramRun> q;
   if (!ids.empty()) {
-    std::string list;
-    for (const auto& i : ids) list += (list.empty() ? "" : ",") + i;
-    // squeue from its argument vector: the ids are digits (job_ids), and no shell is involved.
-    const detail::ProgramRun q = detail::run_program({"squeue", "-h", "-o", "%i %T %R", "-j", list}, false);
-    if (q.spawn_error == 0) {
-      s << "slurm jobs " << list << ": " << (q.output.empty() ? "none queued or running\n" : "\n" + q.output);
+    q = detail::run_program({"squeue", "-h", "-o", "%i %T %R", "-j", list}, false, kSqueueTimeoutS);
+    if (q->spawn_error != 0 || q->timed_out) q.reset();
+  }
+  std::ostringstream s;
+  if (as_json) {
+    nlohmann::json counts = nlohmann::json::object(), cases = nlohmann::json::array();
+    for (CaseState st : {CaseState::done, CaseState::failed, CaseState::running, CaseState::planned})
+      counts[to_string(st)] = by[st].size();
+    for (std::size_t id = 0; id < n; ++id) {
+      nlohmann::json c = {{"id", id}, {"state", to_string(states[id])}};
+      if (states[id] == CaseState::failed) c["reason"] = reason(id);
+      cases.push_back(std::move(c));
     }
+    nlohmann::json queue = nullptr;
+    if (q) {
+      queue = nlohmann::json::array();
+      std::istringstream lines(q->output);
+      for (std::string line; std::getline(lines, line);) {
+        std::istringstream words(line);
+        std::string job, state, why;
+        words >> job >> state;
+        std::getline(words >> std::ws, why);
+        if (!job.empty()) queue.push_back({{"job", job}, {"state", state}, {"reason", why}});
+      }
+    }
+    const nlohmann::json doc = {{"campaign", dir.string()},
+                                {"case_count", n},
+                                {"counts", counts},
+                                {"cases", cases},
+                                {"slurm_jobs", ids},
+                                {"squeue", queue}};
+    s << doc.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
+  } else {
+    s << "campaign " << dir.string() << ": " << n << " cases";
+    for (CaseState st : {CaseState::done, CaseState::failed, CaseState::running, CaseState::planned}) {
+      s << ", " << by[st].size() << " " << to_string(st);
+    }
+    s << "\n";
+    for (CaseState st : {CaseState::failed, CaseState::running}) {
+      for (std::size_t id : by[st]) {
+        s << "  case " << id << ": " << to_string(st);
+        if (st == CaseState::failed) s << ": " << reason(id);
+        s << "\n";
+      }
+    }
+    if (q) s << "slurm jobs " << list << ": " << (q->output.empty() ? "none queued or running\n" : "\n" + q->output);
   }
   refresh_states(dir);
   return s.str();

@@ -1,6 +1,8 @@
 // The campaign folder's files: locks, paths checked below the folder (no symbolic link followed),
 // bounded JSON, the validated plan and case results, and external programs run from argv.
 #include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
 #include <spawn.h>
 #include <sys/file.h>
 #include <sys/stat.h>
@@ -164,6 +166,7 @@ Plan read_plan(const fs::path& dir_in) {
     }
     p.cases.push_back(std::move(pc));
   }
+  if (const json* sl = member(p.doc, "slurm")) p.slurm = slurm_from_json(*sl, f);
   return p;
 }
 
@@ -198,7 +201,7 @@ nlohmann::json read_failure(const fs::path& dir, std::size_t id) {
   return r;
 }
 
-ProgramRun run_program(const std::vector<std::string>& args, bool merge_stderr) {
+ProgramRun run_program(const std::vector<std::string>& args, bool merge_stderr, double timeout_s) {
   ProgramRun r;
   int fds[2];
   if (::pipe2(fds, O_CLOEXEC) != 0) {
@@ -228,8 +231,20 @@ ProgramRun run_program(const std::vector<std::string>& args, bool merge_stderr) 
     return r;
   }
   constexpr std::size_t kKeep = std::size_t{1} << 20;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(static_cast<long long>(timeout_s * 1000));
   char buf[4096];
   for (;;) {
+    if (timeout_s > 0) {  // wait for output until the deadline; past it the program is killed
+      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+      struct pollfd pfd {fds[0], POLLIN, 0};
+      const int ready = left.count() > 0 ? ::poll(&pfd, 1, static_cast<int>(left.count())) : 0;
+      if (ready < 0 && errno == EINTR) continue;
+      if (ready <= 0) {
+        ::kill(pid, SIGKILL);
+        r.timed_out = true;
+        break;
+      }
+    }
     const ssize_t n = ::read(fds[0], buf, sizeof buf);
     if (n == 0) break;
     if (n < 0) {

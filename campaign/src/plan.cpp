@@ -109,6 +109,7 @@ PlanResult plan_campaign(const Campaign& c, const fs::path& dir_in) {
                                 {"keys", c.keys},
                                 {"input_hash", r.input_hash},
                                 {"case_count", c.cases.size()},
+                                {"slurm", detail::slurm_json(c.slurm)},
                                 {"cases", cases}};
     detail::write_new_file(txn.file("campaign.json", where, "campaign.json"), doc.dump(2) + "\n");
     txn.commit();

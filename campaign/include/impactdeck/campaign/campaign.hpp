@@ -20,6 +20,33 @@ struct Case {
   std::optional<Eigen::Quaterniond> orientation;      ///< [orientations]: the body's rotation
 };
 
+/// The campaign file's `[slurm]` table (docs/campaign-format.md, "Slurm"), validated by
+/// slurm_value_error: values written into the job scripts' #SBATCH lines are data of a strict form;
+/// `setup` is the user's own shell code, written verbatim (NUL and CR refused).
+struct SlurmSettings {
+  std::string partition, account, qos, mem;  ///< empty: not given (the cluster's default)
+  std::string time;                 ///< --time per array task; set by read_campaign (default_task_minutes)
+  bool time_given = false;          ///< `time` came from the file (else the default)
+  std::vector<std::string> setup;   ///< shell lines run before the cases (e.g. "module load calculix")
+  std::size_t cases_per_task = 1;   ///< cases each array task runs in sequence
+};
+
+/// Most cases one array task may run in sequence.
+inline constexpr std::size_t kMaxCasesPerTask = 100000;
+/// The estimated run time of one case, minutes, for the default `time`: a case whose scene runs
+/// ccx (outputs.fem.run = "calculix"), one that does not (docs/campaign-format.md).
+inline constexpr double kCaseMinutesCcx = 15.0, kCaseMinutesNoCcx = 2.0;
+/// The default `time` is the estimate times cases_per_task times this safety factor.
+inline constexpr double kTimeSafetyFactor = 2.0;
+
+/// Why `value` is not a valid `[slurm]` value of `key` (partition, account, qos, time, mem, or a
+/// setup line: "setup"); empty when it is valid.
+std::string slurm_value_error(const std::string& key, const std::string& value);
+/// The default `time` (minutes) of an array task of `cases_per_task` cases.
+double default_task_minutes(bool runs_ccx, std::size_t cases_per_task);
+/// Minutes as Slurm's D-HH:MM:SS (rounded up to a whole minute).
+std::string slurm_time_text(double minutes);
+
 struct Campaign {
   std::filesystem::path file;   ///< the campaign file
   std::filesystem::path scene;  ///< the base scene (absolute)
@@ -27,6 +54,8 @@ struct Campaign {
   std::vector<std::string> generators;  ///< in expansion order: cases, product, points, orientations
   std::vector<std::string> keys;        ///< every override key, in column order (no duplicates)
   std::vector<Case> cases;              ///< ids 0 ... N-1, row-major, last generator fastest
+  bool runs_ccx = false;                ///< a case's scene runs ccx (outputs.fem.run = "calculix")
+  SlurmSettings slurm;                  ///< [slurm] (defaults when absent)
 };
 
 /// At most this many cases (docs/campaign-format.md).

@@ -11,6 +11,8 @@ struct CollectResult {
   std::filesystem::path csv, json;
   std::optional<std::filesystem::path> worst_case;  ///< collect/worst_case (a copy of its folder)
   std::optional<std::size_t> worst_id;
+  std::string worst_case_by;            ///< "peak_von_mises_Pa" or "max_force_N"
+  std::optional<double> worst_value;    ///< the worst case's value of that quantity (finite)
   std::optional<std::filesystem::path> map_svg, map_vtp;  ///< point and drop campaigns
   /// collect/report.html: one self-contained page (verdict, counts, the cases' table, the map)
   std::filesystem::path report_html;
@@ -25,5 +27,8 @@ struct CollectResult {
 /// campaigns over the orientation sphere (map.svg, map.vtp); and report.html, a self-contained
 /// page of all that (verdict over the cases, checks, map). Every file is written atomically.
 CollectResult collect(const std::filesystem::path& dir);
+
+/// `campaign collect --json`: one JSON document of what collect wrote (keys: docs/cli.md).
+std::string collect_json(const CollectResult& result);
 
 }  // namespace impactdeck::campaign

@@ -56,32 +56,68 @@ struct SlurmOptions {
   std::size_t max_parallel = 0;  ///< `%K` of --array (0: no limit)
   int cpus_per_task = 1;         ///< --cpus-per-task, and the ccx threads of each case
   /// extra sbatch options, e.g. "--partition=short": each one argument of sbatch's command line
-  /// (never a line of the script); one with a control character, or not starting with '-', is refused
+  /// (never a line of the script), given to every submission (the arrays and the collect job);
+  /// one with a control character, or not starting with '-', is refused
   std::vector<std::string> sbatch_options;
   std::filesystem::path executable;
+  /// The cluster's MaxArraySize; 0: from `scontrol show config` (cluster_max_array_size).
+  std::size_t max_array_size = 0;
 };
 
-/// Writes `dir`/campaign.sbatch: a job array over the case ids, each task running
-/// `EXECUTABLE campaign run-case DIR $SLURM_ARRAY_TASK_ID --threads C` (absolute paths, quoted for
-/// sh). Its #SBATCH lines hold constants only; the folder and the user's options go on sbatch's
-/// command line (sbatch_command).
-std::filesystem::path write_sbatch(const std::filesystem::path& dir, const SlurmOptions& options);
+/// The default MaxArraySize of Slurm, used when scontrol is missing, fails or says nothing.
+inline constexpr std::size_t kDefaultMaxArraySize = 1001;
+/// MaxArraySize from `scontrol show config` (an argument vector, killed after 10 s), else
+/// kDefaultMaxArraySize.
+std::size_t cluster_max_array_size();
 
-/// The command that submits the script, each argument quoted for sh (what `--dry-run` prints):
-/// `sbatch --parsable --chdir=DIR [OPTIONS...] SCRIPT`.
-std::string sbatch_command(const std::filesystem::path& dir, const std::filesystem::path& script,
-                           const SlurmOptions& options);
+/// One job array: `script` runs array tasks first_task ... first_task + tasks - 1 of the campaign
+/// (its own indices 0 ... tasks - 1), task t the cases t*C ... t*C + C - 1 (C: cases_per_task).
+struct SlurmArray {
+  std::filesystem::path script;
+  std::size_t first_task = 0, tasks = 0, first_case = 0, last_case = 0;
+};
+struct SlurmScripts {
+  std::vector<SlurmArray> arrays;       ///< each at most max(1, MaxArraySize - 1) tasks
+  std::filesystem::path collect_script; ///< `campaign collect DIR`, submitted after the arrays
+  std::size_t max_array_size = 0, cases_per_task = 1;
+};
 
-/// Submits the script with that command (an argument vector, no shell), records the job id in
-/// `dir`/slurm/jobs.txt and returns it. Throws InputError (exit 3, an external tool's failure)
-/// when sbatch is missing or refuses.
-std::string submit_sbatch(const std::filesystem::path& dir, const std::filesystem::path& script,
-                          const SlurmOptions& options);
+/// Writes the job scripts into `dir`: campaign.sbatch (the first array), campaign.K.sbatch (the
+/// K-th further array when the tasks exceed MaxArraySize - 1) and collect.sbatch. Each array task
+/// runs its cases in sequence with `EXECUTABLE campaign run-case DIR ID --threads C` (absolute
+/// paths, quoted for sh). #SBATCH lines hold constants and the validated [slurm] values only; the
+/// folder and the user's options go on sbatch's command line (sbatch_commands); the [slurm] setup
+/// lines are written verbatim (the user's own shell code).
+SlurmScripts write_sbatch(const std::filesystem::path& dir, const SlurmOptions& options);
+
+/// The commands that submit the scripts, each argument quoted for sh (what `--dry-run` prints): a
+/// shell script of one line per array, `jobK=$(sbatch --parsable --chdir=DIR [OPTIONS...] SCRIPT)
+/// || exit`, then the collect job's `sbatch --parsable "--dependency=afterany:${job0%%;*}:..."
+/// --chdir=DIR [OPTIONS...] collect.sbatch`.
+std::vector<std::string> sbatch_commands(const std::filesystem::path& dir, const SlurmScripts& scripts,
+                                         const SlurmOptions& options);
+
+struct SlurmSubmission {
+  std::vector<std::string> array_jobs;  ///< one job id per array, in order
+  std::string collect_job;              ///< the collect job (--dependency=afterany:ARRAYS)
+};
+
+/// Submits every array, then the collect job depending on them (argument vectors, no shell);
+/// records each job id in `dir`/slurm/jobs.txt as soon as sbatch gives it. Throws InputError
+/// (exit 3, an external tool's failure) when sbatch is missing or refuses; the jobs submitted
+/// before stay recorded (`campaign cancel` removes them).
+SlurmSubmission submit_sbatch(const std::filesystem::path& dir, const SlurmScripts& scripts,
+                              const SlurmOptions& options);
+
+/// `campaign cancel`: `scancel ID...` of every job in slurm/jobs.txt (an argument vector; the ids
+/// digits only). Returns the ids (none: nothing to cancel). InputError when scancel is missing or fails.
+std::vector<std::string> cancel_jobs(const std::filesystem::path& dir);
 
 /// `campaign status`: the count per state, the cases not done, and squeue's lines for the
 /// campaign's jobs when squeue is on the PATH (run from an argument vector; slurm/jobs.txt must
 /// hold job ids, digits only, else InputError naming its line). Refreshes the states in campaign.json.
-std::string status_report(const std::filesystem::path& dir);
+/// `json`: one JSON document instead (keys: docs/cli.md).
+std::string status_report(const std::filesystem::path& dir, bool json = false);
 
 /// Rewrites the `state` of every case in campaign.json from the case folders (under a lock).
 void refresh_states(const std::filesystem::path& dir);
