@@ -1,11 +1,12 @@
 """`pip install .`: builds impactdeck with CMake and installs, stripped, the Python module with its
 type stubs, and the `impactdeck` command with its Gmsh plugins (docs/install.md, "pip").
 
-Everything goes to build-pip/ in the checkout, or to $IMPACTDECK_PIP_WORK: the CMake build in tree/
-(or $IMPACTDECK_PIP_BUILD_DIR), the staged install in stage/, setuptools' folders. It is configured as
-scripts/build configures build/ (RelWithDebInfo, ccache with the checkout as base dir, so objects
-compiled there before are cache hits) without tests and benchmarks, and only the module, the
-command and the plugins are built. $IMPACTDECK_BUILD_TREE instead names a configured build tree to
+The CMake build goes to build-pip/ in the checkout (or $IMPACTDECK_PIP_BUILD_DIR), configured as
+scripts/build configures build/ (RelWithDebInfo, ccache with the checkout as base dir; a folder
+beside build/, so that the compiler sees the same relative paths and objects compiled for any
+checkout's build/ are cache hits) without tests and benchmarks, and only the module, the command
+and the plugins are built. The staged install and setuptools' folders go to build-pip/pip/ (or
+$IMPACTDECK_PIP_WORK). $IMPACTDECK_BUILD_TREE instead names a configured build tree to
 take them from (e.g. build/, the one ctest runs): built there if out of date, nothing configured.
 Either way `cmake --install --component python|command --strip` stages them, and the wheel takes
 the staged files: the module and its stubs (and the plugins, which the module loads from beside
@@ -22,7 +23,7 @@ from setuptools import Extension, setup
 from setuptools.command.build_ext import build_ext
 
 ROOT = Path(__file__).resolve().parent
-WORK = Path(os.environ.get("IMPACTDECK_PIP_WORK", ROOT / "build-pip")).resolve()
+WORK = Path(os.environ.get("IMPACTDECK_PIP_WORK", ROOT / "build-pip" / "pip")).resolve()
 STAGE = WORK / "stage"  # fixed here: data_files are named before anything is built
 PLUGINS = ["libimpactdeck_gmsh_mesher.so", "libimpactdeck_gmsh_cad.so"]
 TARGETS = ["impactdeck_python", "impactdeck", "impactdeck_cli_docs", "impactdeck_gmsh_mesher", "impactdeck_gmsh_cad"]
@@ -44,7 +45,7 @@ class CMakeBuild(build_ext):
             if not (build / "CMakeCache.txt").is_file():
                 raise SystemExit(f"setup.py: IMPACTDECK_BUILD_TREE={tree} is not a configured CMake build tree")
         else:
-            build = Path(os.environ.get("IMPACTDECK_PIP_BUILD_DIR", WORK / "tree")).resolve()
+            build = Path(os.environ.get("IMPACTDECK_PIP_BUILD_DIR", ROOT / "build-pip")).resolve()
             # The interpreter running pip is the one the module is built for.
             run(cmake, "-S", ROOT, "-B", build, "-G", "Ninja", "-DCMAKE_BUILD_TYPE=RelWithDebInfo",
                 "-DIMPACTDECK_BUILD_TESTS=OFF", "-DIMPACTDECK_BUILD_BENCH=OFF", f"-DPYTHON_EXECUTABLE={sys.executable}",
