@@ -11,7 +11,7 @@ import numpy.typing as npt
 __version__: str
 
 _PathLike = Union[str, "os.PathLike[str]"]
-# An override's value, written as TOML: bool, int, float, str, and lists / dicts of them.
+# An override's value, written as TOML: bool, int, float, str, lists, tuples, dicts, numpy arrays and scalars.
 _OverrideValue = Any
 _Overrides = Optional[Mapping[str, _OverrideValue]]
 _Vector3 = Union[Sequence[float], npt.NDArray[np.float64]]

@@ -48,8 +48,8 @@ namespace {
 py::object to_python(const nlohmann::json& j) { return py::module_::import("json").attr("loads")(j.dump()); }
 
 // A Python value as the TOML value text of an override: bool, int, float, str (a TOML string),
-// lists/tuples (arrays) and dicts with str keys (inline tables). Anything else is refused naming
-// the override's key.
+// lists/tuples (arrays), dicts with str keys (inline tables), numpy arrays and scalars (as their
+// tolist()). Anything else is refused naming the override's key.
 std::string toml_value(const py::handle& v, const std::string& key) {
   if (py::isinstance<py::bool_>(v)) return v.cast<bool>() ? "true" : "false";
   if (py::isinstance<py::int_>(v)) return py::str(v).cast<std::string>();
@@ -72,6 +72,7 @@ std::string toml_value(const py::handle& v, const std::string& key) {
     }
     return "{" + out + "}";
   }
+  if (py::hasattr(v, "tolist")) return toml_value(v.attr("tolist")(), key);  // numpy arrays and scalars
   throw UsageError("overrides['" + key + "']: expected a bool, int, float, str, list, tuple or dict, not " +
                    py::str(py::type::handle_of(v).attr("__name__")).cast<std::string>());
 }

@@ -233,7 +233,8 @@ class Overrides(unittest.TestCase):
                                 "--set", "bodies[0].velocity_m_s=[1.5, 0, 0]", "--set", 'impacts[0].contact_radius="mean"')
             self.assertEqual(rc, 0)
             from_py = impactdeck.run(pathlib.Path(scene), out=pathlib.Path(out),
-                                     overrides={"impacts[0].restitution": 0.5, "bodies[0].velocity_m_s": (1.5, 0, 0),
+                                     overrides={"impacts[0].restitution": np.float32(0.5),
+                                                "bodies[0].velocity_m_s": np.array([1.5, 0, 0]),
                                                 "impacts[0].contact_radius": "mean"})
         self.assertEqual(without_times(from_py), without_times(json.loads(stdout)))
         self.assertEqual(from_py["impacts"][0]["restitution"], 0.5)
