@@ -32,15 +32,29 @@ install(TARGETS ${_impactdeck_targets} EXPORT impactdeckTargets
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
         INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(EXPORT impactdeckTargets NAMESPACE impactdeck:: DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/impactdeck)
+# CMake strips executables and shared objects only; a stripping install (IMPACTDECK_INSTALL_STRIP,
+# `--strip`) also drops the static libraries' debug sections (their symbols stay: they link).
+foreach(_t IN LISTS _impactdeck_targets)
+  get_target_property(_type ${_t} TYPE)
+  if(_type STREQUAL "STATIC_LIBRARY")
+    install(CODE "if(CMAKE_INSTALL_DO_STRIP)
+  execute_process(COMMAND \"${CMAKE_STRIP}\" --strip-debug
+                  \"\$ENV{DESTDIR}\${CMAKE_INSTALL_PREFIX}/${CMAKE_INSTALL_LIBDIR}/$<TARGET_FILE_NAME:${_t}>\"
+                  COMMAND_ERROR_IS_FATAL ANY)
+endif()")
+  endif()
+endforeach()
 
 if(NOT IMPACTDECK_CORE_ONLY)
   # The command and its plugins side by side: the plugin loader looks beside the executable.
-  install(TARGETS impactdeck RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
-  install(TARGETS impactdeck_gmsh_mesher impactdeck_gmsh_cad LIBRARY DESTINATION ${CMAKE_INSTALL_BINDIR})
+  # Component `command` (with `python`: what `pip install .` takes, setup.py).
+  install(TARGETS impactdeck RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT command)
+  install(TARGETS impactdeck_gmsh_mesher impactdeck_gmsh_cad LIBRARY DESTINATION ${CMAKE_INSTALL_BINDIR}
+          COMPONENT command)
   # Generated from the CLI definition at build time (cli/CMakeLists.txt).
-  install(FILES ${PROJECT_BINARY_DIR}/cli/impactdeck.1 DESTINATION ${CMAKE_INSTALL_MANDIR}/man1)
+  install(FILES ${PROJECT_BINARY_DIR}/cli/impactdeck.1 DESTINATION ${CMAKE_INSTALL_MANDIR}/man1 COMPONENT command)
   install(FILES ${PROJECT_BINARY_DIR}/cli/impactdeck.bash DESTINATION ${CMAKE_INSTALL_DATADIR}/bash-completion/completions
-          RENAME impactdeck)
+          RENAME impactdeck COMPONENT command)
 endif()
 
 configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/impactdeckConfig.cmake.in

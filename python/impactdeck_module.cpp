@@ -3,7 +3,8 @@
 //   impactdeck.inspect(path, length_unit, density_kg_m3=None, at=None) -> that of `inspect --json`
 // both built by the same library calls as the CLI (scene::to_json, geometry::inspect_part), so the
 // documents are the same. Also: solve_impact (plain numbers), load_part (mass properties, surface
-// queries), sweep (numpy arrays). Errors raise impactdeck.InputError (exit 3 of the CLI),
+// queries), sweep (numpy arrays), fem_check, compare_contact, campaign_plan/run/collect. Every path
+// argument takes str or os.PathLike; `overrides` ({KEY: value}) are `--set KEY=VALUE`. Errors raise impactdeck.InputError (exit 3 of the CLI),
 // CheckFailed (4), UsageError (2), InternalError (1), all derived from impactdeck.Error, with the
 // CLI's one-line message and the exit code in `exit_code`.
 #include <pybind11/numpy.h>
@@ -16,15 +17,22 @@
 #include <limits>
 #include <sstream>
 
+#include "impactdeck/campaign/campaign.hpp"
+#include "impactdeck/campaign/collect.hpp"
+#include "impactdeck/campaign/runner.hpp"
 #include "impactdeck/collision/elliptical.hpp"
 #include "impactdeck/collision/hertz.hpp"
 #include "impactdeck/collision/impact.hpp"
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/common/run_transaction.hpp"
 #include "impactdeck/common/version.hpp"
+#include "impactdeck/fem_export/check.hpp"
 #include "impactdeck/geometry/cad_shape.hpp"
 #include "impactdeck/geometry/inspect.hpp"
 #include "impactdeck/geometry/mass_properties.hpp"
 #include "impactdeck/geometry/part.hpp"
+#include "impactdeck/scene/compare_contact.hpp"
+#include "impactdeck/scene/overrides.hpp"
 #include "impactdeck/scene/pipeline.hpp"
 #include "impactdeck/scene/report.hpp"
 #include "impactdeck/study/cloud.hpp"
@@ -38,6 +46,60 @@ using namespace impactdeck;
 namespace {
 
 py::object to_python(const nlohmann::json& j) { return py::module_::import("json").attr("loads")(j.dump()); }
+
+// A Python value as the TOML value text of an override: bool, int, float, str (a TOML string),
+// lists/tuples (arrays), dicts with str keys (inline tables), numpy arrays and scalars (as their
+// tolist()). Anything else is refused naming the override's key.
+std::string toml_value(const py::handle& v, const std::string& key) {
+  if (py::isinstance<py::bool_>(v)) return v.cast<bool>() ? "true" : "false";
+  if (py::isinstance<py::int_>(v)) return py::str(v).cast<std::string>();
+  if (py::isinstance<py::float_>(v)) {
+    const double x = v.cast<double>();
+    if (std::isnan(x)) return "nan";
+    if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
+    return py::repr(v).cast<std::string>();  // shortest text that reads back as x
+  }
+  if (py::isinstance<py::str>(v)) return nlohmann::json(v.cast<std::string>()).dump();  // a TOML basic string
+  std::string out;
+  if (py::isinstance<py::list>(v) || py::isinstance<py::tuple>(v)) {
+    for (const py::handle e : v) out += (out.empty() ? "" : ", ") + toml_value(e, key);
+    return "[" + out + "]";
+  }
+  if (py::isinstance<py::dict>(v)) {
+    for (const auto& [k, e] : v.cast<py::dict>()) {
+      if (!py::isinstance<py::str>(k)) throw UsageError("overrides['" + key + "']: table keys must be str");
+      out += (out.empty() ? "" : ", ") + nlohmann::json(k.cast<std::string>()).dump() + " = " + toml_value(e, key);
+    }
+    return "{" + out + "}";
+  }
+  if (py::hasattr(v, "tolist")) return toml_value(v.attr("tolist")(), key);  // numpy arrays and scalars
+  throw UsageError("overrides['" + key + "']: expected a bool, int, float, str, list, tuple or dict, not " +
+                   py::str(py::type::handle_of(v).attr("__name__")).cast<std::string>());
+}
+
+// `overrides` ({KEY: value} or None) as the CLI's `--set KEY=VALUE` list: parsed by the same call
+// (scene::parse_override), so a bad key or value fails as on the command line, naming "--set KEY".
+std::vector<scene::Override> overrides_of(const py::object& overrides) {
+  std::vector<scene::Override> out;
+  if (overrides.is_none()) return out;
+  if (!py::isinstance<py::dict>(overrides)) throw UsageError("overrides: expected a dict {KEY: value}");
+  for (const auto& [k, v] : overrides.cast<py::dict>()) {
+    if (!py::isinstance<py::str>(k)) throw UsageError("overrides: keys must be str, e.g. 'impacts[0].restitution'");
+    const std::string key = k.cast<std::string>();
+    out.push_back(scene::parse_override(key + "=" + toml_value(v, key)));
+  }
+  return out;
+}
+
+// Raises `type` (CheckFailed, InputError) with the message and the complete document in its
+// `document` attribute: a call that completed but whose check failed (the CLI's exit 3 or 4).
+[[noreturn]] void raise_with_document(const py::handle& type, const std::string& message, py::object doc) {
+  py::object e = type(py::str(message));
+  e.attr("document") = std::move(doc);
+  PyErr_SetObject(type.ptr(), e.ptr());
+  throw py::error_already_set();
+}
+
 
 LengthUnit unit_of(const std::string& s) {
   const auto u = parse_length_unit(s);
@@ -119,9 +181,9 @@ struct PyPart {
   geometry::VolumeProperties volume;
 };
 
-PyPart load_part(const std::string& path, const std::string& length_unit, bool repair, bool accept_approximate) {
+PyPart load_part(const fs::path& path, const std::string& length_unit, bool repair, bool accept_approximate) {
   PyPart p;
-  p.file = path;
+  p.file = path.string();
   const LengthUnit u = unit_of(length_unit);
   if (const auto f = geometry::cad_format(path)) {
     p.shape = geometry::CadShape::load(path, u);
@@ -197,6 +259,11 @@ PYBIND11_MODULE(impactdeck, m) {
   py::module_::import("numpy");
   (void)py::array_t<double>(0);
   (void)py::array_t<bool>(0);
+  base.doc() = "Every error of impactdeck; `exit_code` is the command's exit code (docs/cli.md).";
+  usage.doc() = "A call made wrongly (the command's exit code 2).";
+  input.doc() = "Bad input: a file, scene key or value (exit code 3); the message names file, place and reason.";
+  check.doc() = "A physics self-check failed (exit code 4); `document` holds the complete document when there is one.";
+  internal.doc() = "A defect of impactdeck (exit code 1).";
   usage.attr("exit_code") = static_cast<int>(ExitCode::usage);
   input.attr("exit_code") = static_cast<int>(ExitCode::invalid_input);
   check.attr("exit_code") = static_cast<int>(ExitCode::check_failed);
@@ -216,12 +283,13 @@ PYBIND11_MODULE(impactdeck, m) {
 
   m.def(
       "run",
-      [](const fs::path& scene_path, std::optional<fs::path> out) -> py::object {
+      [](const fs::path& scene_path, std::optional<fs::path> out, py::object overrides) -> py::object {
+        const std::vector<scene::Override> set = overrides_of(overrides);
         nlohmann::json doc;
         bool passed = true;
         {
           py::gil_scoped_release release;
-          const scene::Scene sc = scene::load_scene(scene_path);
+          const scene::Scene sc = scene::load_scene(scene_path, set);
           const fs::path dir = out.value_or(fs::path("."));
           std::error_code ec;
           fs::create_directories(dir, ec);
@@ -232,20 +300,16 @@ PYBIND11_MODULE(impactdeck, m) {
           doc = scene::to_json(sc, rep);
           passed = rep.all_checks_passed();
         }
-        py::object d = to_python(doc);
-        if (!passed) {
-          // As the CLI: the document is complete, and the run fails with exit code 4.
-          py::object e = py::handle(check.ptr())(py::str("a physics self-check failed (see checks above)"));
-          e.attr("document") = d;
-          PyErr_SetObject(check.ptr(), e.ptr());
-          throw py::error_already_set();
-        }
-        return d;
+        // As the CLI: the document is complete, and the run fails with exit code 4.
+        if (!passed) raise_with_document(check, "a physics self-check failed (see checks above)", to_python(doc));
+        return to_python(doc);
       },
-      py::arg("scene_path"), py::arg("out") = py::none(),
-      "Runs a scene as `impactdeck run SCENE --out OUT --json` and returns its JSON document as a dict "
-      "(outputs go to `out`, default the current folder). A failed self-check raises CheckFailed whose "
-      "`document` attribute holds the document.");
+      py::arg("scene_path"), py::arg("out") = py::none(), py::arg("overrides") = py::none(),
+      "Runs a scene as `impactdeck run SCENE --out OUT [--set KEY=VALUE ...] --json` and returns its JSON "
+      "document as a dict (outputs go to `out`, default the current folder). `overrides`: {KEY: value}, "
+      "each applied as `--set KEY=VALUE` (value: bool, number, str, list or dict, written as TOML) and "
+      "validated like the file; an error names the override ('--set KEY'). A failed self-check raises "
+      "CheckFailed whose `document` attribute holds the document.");
 
   m.def(
       "inspect",
@@ -356,14 +420,26 @@ PYBIND11_MODULE(impactdeck, m) {
       "checks, and time_s / force_N arrays of `samples` points).");
 
   py::class_<PyPart>(m, "Part", "A part file loaded as a shape: mass properties and surface queries (SI, metres).")
-      .def_readonly("file", &PyPart::file)
-      .def_readonly("format", &PyPart::format)
-      .def_property_readonly("kind", [](const PyPart& p) { return p.shape->kind(); })
-      .def_property_readonly("volume_m3", [](const PyPart& p) { return p.volume.volume_m3; })
-      .def_property_readonly("area_m2", [](const PyPart& p) { return p.volume.area_m2; })
-      .def_property_readonly("center_of_mass_m", [](const PyPart& p) { return array(p.volume.centroid_m); })
-      .def_property_readonly("inertia_per_density_m5", [](const PyPart& p) { return array(p.volume.inertia_per_density_m5); })
-      .def_property_readonly("size_m", [](const PyPart& p) { return p.shape->size_m(); })
+      .def_readonly("file", &PyPart::file, "The part file, as given to load_part (str).")
+      .def_readonly("format", &PyPart::format, "The file's format: 'stl', 'obj', 'ply', 'off', 'step', 'iges' or 'brep'.")
+      .def_property_readonly("kind", [](const PyPart& p) { return p.shape->kind(); },
+                             "What the shape is: 'mesh' (a triangle mesh) or 'cad' (an OpenCASCADE B-rep).")
+      .def_property_readonly("volume_m3", [](const PyPart& p) { return p.volume.volume_m3; }, "Enclosed volume, m^3.")
+      .def_property_readonly("area_m2", [](const PyPart& p) { return p.volume.area_m2; }, "Surface area, m^2.")
+      .def_property_readonly("center_of_mass_m", [](const PyPart& p) { return array(p.volume.centroid_m); },
+                             "Centre of mass (the volume's centroid: uniform density), m, numpy array of 3.")
+      .def_property_readonly("inertia_per_density_m5", [](const PyPart& p) { return array(p.volume.inertia_per_density_m5); },
+                             "Inertia tensor about the centre of mass divided by the density, m^5, 3x3 numpy "
+                             "array (times rho in kg/m^3: kg m^2).")
+      .def_property_readonly("size_m", [](const PyPart& p) { return p.shape->size_m(); },
+                             "Largest extent of the part, m (the scale of relative tolerances).")
+      .def("__repr__", [](const PyPart& p) {
+        std::ostringstream r;
+        r.precision(6);
+        r << "<impactdeck.Part " << py::repr(py::str(p.file)).cast<std::string>() << " " << p.format << " ("
+          << p.shape->kind() << "), volume " << p.volume.volume_m3 << " m^3, size " << p.shape->size_m() << " m>";
+        return r.str();
+      })
       .def("closest_point", [](const PyPart& p, py::object q) {
         const Eigen::Vector3d x = query_point(q);
         geometry::SurfacePoint s;
@@ -372,7 +448,7 @@ PYBIND11_MODULE(impactdeck, m) {
           s = p.shape->closest_point(x);
         }
         return surface_point(s);
-      }, py::arg("point_m"))
+      }, py::arg("point_m"), "The surface point nearest to point_m (m): dict of point_m, normal (outward), distance_m.")
       .def("curvature", [](const PyPart& p, py::object q) {
         const Eigen::Vector3d x = query_point(q);
         geometry::Curvature c;
@@ -408,16 +484,18 @@ PYBIND11_MODULE(impactdeck, m) {
 
   m.def("load_part", &load_part, py::arg("path"), py::arg("length_unit"), py::arg("repair") = false,
         py::arg("accept_approximate") = false,
-        "Loads a mesh part (STL, OBJ, PLY, OFF) or a CAD part (STEP, IGES, BREP) as `inspect` does.");
+        "Loads a mesh part (STL, OBJ, PLY, OFF) or a CAD part (STEP, IGES, BREP) as `inspect` does. `path`: "
+        "str or os.PathLike; length_unit: the file's unit, m, cm, mm or in.");
 
   m.def(
       "sweep",
       [](const fs::path& scene_path, const std::string& impact, const std::string& cloud, std::size_t count,
-         std::uint64_t seed, int grid_steps, unsigned threads) {
+         std::uint64_t seed, int grid_steps, unsigned threads, py::object overrides) {
+        const std::vector<scene::Override> set = overrides_of(overrides);
         study::SweepResult r;
         {
           py::gil_scoped_release release;
-          const scene::Scene sc = scene::load_scene(scene_path);
+          const scene::Scene sc = scene::load_scene(scene_path, set);
           study::SweepRequest q;  // no out_dir: no files
           q.impact = impact;
           q.cloud = cloud;
@@ -461,7 +539,212 @@ PYBIND11_MODULE(impactdeck, m) {
         return d;
       },
       py::arg("scene_path"), py::arg("impact") = "", py::arg("cloud") = "auto", py::arg("count") = 2000,
-      py::arg("seed") = 1, py::arg("grid_steps") = 8, py::arg("threads") = 0,
+      py::arg("seed") = 1, py::arg("grid_steps") = 8, py::arg("threads") = 0, py::arg("overrides") = py::none(),
       "Force map of a scene's impact over the target's surface, as `impactdeck sweep`, with the per-point "
-      "results as numpy arrays (no files written).");
+      "results as numpy arrays (no files written). `overrides` as in run().");
+
+  m.def(
+      "fem_check",
+      [](const fs::path& deck_dir, const std::string& ccx, bool run_solver, double linear_tolerance,
+         double angular_tolerance, int threads, double solver_timeout_s) -> py::object {
+        if (threads < 0) throw UsageError("threads: expected 0 (all cores) or a positive number");
+        for (const double x : {linear_tolerance, angular_tolerance, solver_timeout_s}) {
+          if (!(std::isfinite(x) && x >= 0)) throw UsageError("tolerances and solver_timeout_s: finite numbers >= 0");
+        }
+        fem_export::CheckOptions o;
+        o.ccx = ccx;
+        o.run_solver = run_solver;
+        o.linear_tolerance = linear_tolerance;
+        o.angular_tolerance = angular_tolerance;
+        o.threads = threads;
+        o.timeout_s = solver_timeout_s;
+        nlohmann::json doc;
+        std::string failed;
+        {
+          py::gil_scoped_release release;
+          std::error_code ec;
+          if (!fs::is_directory(deck_dir, ec)) throw InputError(deck_dir.string(), "deck folder", "does not exist");
+          // As `fem-check`: ccx runs in a private folder of a transaction on the deck folder, and its
+          // results replace the folder's previous ones only when the run and the checks passed.
+          std::optional<RunTransaction> txn;
+          if (o.run_solver) {
+            txn.emplace(deck_dir, "deck folder");
+            o.work_dir = txn->scratch("ccx");
+          }
+          fem_export::CheckResult r = txn ? txn->run([&] { return fem_export::run_check(deck_dir, o); })
+                                          : fem_export::run_check(deck_dir, o);
+          if (r.passed && txn) {
+            txn->run([&] {
+              for (auto& f : r.solver_files) fs::rename(f, txn->file(f.filename().string(), deck_dir.string(), "ccx results"));
+              txn->commit();
+            });
+            for (auto& f : r.solver_files) f = deck_dir / f.filename();
+            if (r.stress)
+              for (auto& f : r.stress->files) f = deck_dir / f.filename();
+          }
+          for (std::size_t i = 0; i < r.failures.size(); ++i) failed += (i ? "; " : "") + r.failures[i];
+          doc = fem_export::to_json(r);
+        }
+        if (!failed.empty()) {
+          raise_with_document(check, (deck_dir / "impact.dat").string() + ": FEM check failed: " + failed, to_python(doc));
+        }
+        return to_python(doc);
+      },
+      py::arg("deck_dir"), py::kw_only(), py::arg("ccx") = "ccx", py::arg("run") = true,
+      py::arg("linear_tolerance") = 0.0, py::arg("angular_tolerance") = 0.0, py::arg("threads") = 0,
+      py::arg("solver_timeout_s") = 0.0,
+      "Runs CalculiX on a deck folder written by run() ([outputs.fem]) and checks momentum, the FE body and "
+      "stresses, as `impactdeck fem-check DIR --json`; returns its document (keys: docs/fem.md). run=False "
+      "checks the folder's existing impact.dat (--no-run); tolerances 0: the deck's. The folder changes only "
+      "when the checks pass; a failed check raises CheckFailed with the document in `document`.");
+
+  m.def(
+      "compare_contact",
+      [](const fs::path& scene_path, std::optional<fs::path> out, py::object overrides, const std::string& impact,
+         double threshold, int refine, bool hybrid, double solver_timeout_s) -> py::object {
+        const std::vector<scene::Override> set = overrides_of(overrides);
+        if (!(std::isfinite(threshold) && threshold > 0)) throw UsageError("threshold: a positive number");
+        if (refine < 0 || refine > 6) throw UsageError("refine: 0 to 6");
+        if (!(std::isfinite(solver_timeout_s) && solver_timeout_s >= 0)) throw UsageError("solver_timeout_s: a finite number >= 0");
+        nlohmann::json doc;
+        std::string in_doubt;
+        bool disagree = false;
+        {
+          py::gil_scoped_release release;
+          const scene::Scene sc = scene::load_scene(scene_path, set);
+          const fs::path dir = out.value_or(fs::path("."));
+          // As `compare-contact`: one transaction; the decks and results are published together.
+          RunTransaction txn(dir);
+          scene::CompareOptions o;
+          o.impact = impact;
+          o.threshold = threshold;
+          o.refine = refine;
+          o.run_hybrid = hybrid;
+          o.solver_timeout_s = solver_timeout_s;
+          o.out_dir = dir;
+          o.place_output = [&txn, &dir](const std::string& name, bool is_folder) {
+            return is_folder ? txn.folder(name, dir.string(), "out") : txn.file(name, dir.string(), "out");
+          };
+          scene::CompareReport r = txn.run([&] {
+            scene::CompareReport report = scene::compare_contact(sc, o);
+            txn.commit();
+            return report;
+          });
+          scene::map_paths(r, [&txn](const fs::path& p) { return txn.public_path(p); });
+          doc = scene::to_json(r);
+          disagree = r.verdict == scene::CompareVerdict::disagree;
+          in_doubt = r.in_doubt;
+        }
+        if (disagree) {
+          raise_with_document(check, "contact F_max differs from the analytic force beyond the threshold; in doubt: " +
+                                         in_doubt, to_python(doc));
+        }
+        return to_python(doc);
+      },
+      py::arg("scene_path"), py::arg("out") = py::none(), py::arg("overrides") = py::none(), py::kw_only(),
+      py::arg("impact") = "", py::arg("threshold") = 0.03, py::arg("refine") = 0, py::arg("hybrid") = true,
+      py::arg("solver_timeout_s") = 0.0,
+      "Runs an impact as the hybrid deck and as a full-contact CalculiX model and compares both with the analytic "
+      "Hertz force, as `impactdeck compare-contact SCENE --out OUT --json` (docs/contact-vs-hybrid.md); returns "
+      "its document. Outputs go to `out` (default the current folder) in one transaction. A verdict 'disagree' "
+      "raises CheckFailed with the document in `document`. Minutes of ccx per run.");
+
+  m.def(
+      "campaign_plan",
+      [](const fs::path& campaign_file, const fs::path& out) {
+        campaign::PlanResult r;
+        {
+          py::gil_scoped_release release;
+          r = campaign::plan_campaign(campaign::read_campaign(campaign_file), out);
+        }
+        py::dict d;
+        d["cases"] = r.cases;
+        d["already_planned"] = r.already_planned;
+        d["input_hash"] = r.input_hash;
+        d["warnings"] = r.warnings;
+        return d;
+      },
+      py::arg("campaign_file"), py::arg("out"),
+      "Expands a campaign file (docs/campaign-format.md) into case folders and campaign.json in `out`, as "
+      "`impactdeck campaign plan FILE --out OUT`. Returns {cases, already_planned, input_hash, warnings}.");
+
+  m.def(
+      "campaign_run",
+      [](const fs::path& dir, std::size_t jobs, int threads, std::optional<fs::path> executable) -> py::object {
+        if (jobs < 1 || jobs > 100000) throw UsageError("jobs: 1 to 100000");
+        if (threads < 1 || threads > 1024) throw UsageError("threads: 1 to 1024");
+        campaign::LocalOptions o;
+        o.jobs = jobs;
+        o.ccx_threads = threads;
+        o.progress_bar = false;
+        if (executable) {
+          o.executable = *executable;
+        } else {
+          // The command installed with the module (a venv's bin/ first), else the one on the PATH.
+          const fs::path beside = fs::path(py::module_::import("sys").attr("prefix").cast<std::string>()) / "bin" / "impactdeck";
+          const py::object which = py::module_::import("shutil").attr("which")("impactdeck");
+          std::error_code ec;
+          if (fs::is_regular_file(beside, ec)) o.executable = beside;
+          else if (!which.is_none()) o.executable = which.cast<std::string>();
+          else throw UsageError("campaign_run: no impactdeck command in " + beside.parent_path().string() +
+                                " or on the PATH: pass executable=");
+        }
+        campaign::RunSummary s;
+        {
+          py::gil_scoped_release release;
+          s = campaign::run_local(dir, o);
+        }
+        py::dict d;
+        d["total"] = s.total;
+        d["done"] = s.done;
+        d["skipped"] = s.skipped;
+        d["failed"] = s.failed;
+        d["checks_failed"] = s.checks_failed;
+        d["not_run"] = s.other;
+        d["failed_ids"] = s.failed_ids;
+        d["exit_code"] = s.exit_code();
+        if (s.failed || s.other) {
+          raise_with_document(input, fs::absolute(dir).lexically_normal().string() + ": " +
+                                         std::to_string(s.failed + s.other) + " of " + std::to_string(s.total) +
+                                         " case(s) failed or were not run (each failed case's failure.json says why)", d);
+        }
+        if (s.checks_failed) {
+          raise_with_document(check, fs::absolute(dir).lexically_normal().string() + ": " +
+                                         std::to_string(s.checks_failed) + " case(s) with a failed self-check", d);
+        }
+        return std::move(d);
+      },
+      py::arg("dir"), py::kw_only(), py::arg("jobs") = 1, py::arg("threads") = 1, py::arg("executable") = py::none(),
+      "Runs every case of a planned campaign that is not done, `jobs` at a time, each as the child process "
+      "`EXECUTABLE campaign run-case DIR ID` (as `impactdeck campaign run DIR --jobs J --threads T`; a killed "
+      "campaign resumes). executable: default the impactdeck installed beside this Python (sys.prefix/bin), "
+      "else the PATH's. Returns {total, done, skipped, failed, checks_failed, not_run, failed_ids, exit_code}; "
+      "failed cases raise InputError, failed self-checks CheckFailed, with that dict in `document`.");
+
+  m.def(
+      "campaign_collect",
+      [](const fs::path& dir) {
+        campaign::CollectResult r;
+        {
+          py::gil_scoped_release release;
+          r = campaign::collect(dir);
+        }
+        auto opt = [](const std::optional<fs::path>& p) { return p ? py::object(py::str(p->string())) : py::object(py::none()); };
+        py::dict d;
+        d["done"] = r.done;
+        d["failed"] = r.failed;
+        d["pending"] = r.pending;
+        d["csv"] = r.csv.string();
+        d["json"] = r.json.string();
+        d["report_html"] = r.report_html.string();
+        d["worst_id"] = r.worst_id ? py::object(py::int_(*r.worst_id)) : py::object(py::none());
+        d["worst_case"] = opt(r.worst_case);
+        d["map_svg"] = opt(r.map_svg);
+        d["map_vtp"] = opt(r.map_vtp);
+        return d;
+      },
+      py::arg("dir"),
+      "Collects a campaign folder as `impactdeck campaign collect DIR`: collect/cases.csv and cases.json, the "
+      "worst case's copy, the map and report.html. Returns {done, failed, pending, csv, json, report_html, "
+      "worst_id, worst_case, map_svg, map_vtp} (paths as str, None when not written).");
 }

@@ -21,6 +21,17 @@ check "generated version header installed" test -f "$tmp/full/include/impactdeck
 check "plugins beside the command" test -f "$tmp/full/bin/libimpactdeck_gmsh_cad.so" -a -f "$tmp/full/bin/libimpactdeck_gmsh_mesher.so"
 check "man page installed" test -s "$tmp/full/share/man/man1/impactdeck.1"
 check "bash completion installed" bash -c ". '$tmp/full/share/bash-completion/completions/impactdeck' && complete -p impactdeck"
+# Stripped by default (IMPACTDECK_INSTALL_STRIP, issue 32): no symbol tables or debug sections in
+# the command, the plugins and the Python module, no debug sections in the static libraries (their
+# symbols stay: the consumer below links them); the build tree keeps its debug information.
+unstripped() { readelf -S -W "$1" | grep -q -E '\.symtab|\.debug_info'; }
+for f in "$tmp/full/bin/impactdeck" "$tmp/full/bin/"lib*.so $(find "$tmp/full/lib" -name 'impactdeck*.so'); do
+  check "installed stripped: ${f#$tmp/full/}" bash -c "! readelf -S -W '$f' | grep -q -E '\.symtab|\.debug_info'"
+done
+for f in "$tmp/full/lib/"libimpactdeck_*.a; do
+  check "installed without debug sections: ${f#$tmp/full/}" bash -c "! readelf -S -W '$f' | grep -q '\.debug_info'"
+done
+check "the build tree's command keeps its debug information" unstripped "$build/cli/impactdeck"
 cmake -S "$src/tests/consumer" -B "$tmp/cfull" -G Ninja -DCMAKE_PREFIX_PATH="$tmp/full" > "$tmp/cfull.log" 2>&1
 check "consumer configures against the full package" test $? -eq 0
 cmake --build "$tmp/cfull" > "$tmp/cfull_build.log" 2>&1

@@ -1,8 +1,10 @@
 """The Python module `impactdeck` against the CLI and closed forms (run by ctest with Debian's
 python3 and PYTHONPATH=build/python):  test_python.py IMPACTDECK_EXE SOURCE_DIR"""
+import ast
 import json
 import math
 import os
+import pathlib
 import subprocess
 import sys
 import tempfile
@@ -219,6 +221,197 @@ print(len(results), results[0])
                 self.fail(f"try {attempt + 1}: the threads' first numpy calls deadlocked (no exit within 60 s)")
             self.assertEqual(p.returncode, 0, p.stderr)
             self.assertEqual(p.stdout.strip(), "8 (3,)")
+
+
+class Overrides(unittest.TestCase):
+    """`overrides` are `--set KEY=VALUE`: the same document, and the same errors naming the override."""
+
+    def test_run_with_overrides_is_run_with_set(self):
+        scene = os.path.join(SRC, "samples", "two_spheres.toml")
+        with tempfile.TemporaryDirectory() as out:
+            rc, stdout, _ = cli("run", scene, "--out", out, "--json", "--set", "impacts[0].restitution=0.5",
+                                "--set", "bodies[0].velocity_m_s=[1.5, 0, 0]", "--set", 'impacts[0].contact_radius="mean"')
+            self.assertEqual(rc, 0)
+            from_py = impactdeck.run(pathlib.Path(scene), out=pathlib.Path(out),
+                                     overrides={"impacts[0].restitution": np.float32(0.5),
+                                                "bodies[0].velocity_m_s": np.array([1.5, 0, 0]),
+                                                "impacts[0].contact_radius": "mean"})
+        self.assertEqual(without_times(from_py), without_times(json.loads(stdout)))
+        self.assertEqual(from_py["impacts"][0]["restitution"], 0.5)
+
+    def test_bad_overrides_fail_as_on_the_command_line(self):
+        scene = os.path.join(SRC, "samples", "two_spheres.toml")
+        for key, value, text in [("impacts[0].restitution", 2, "2"),          # out of range: validation
+                                 ("impacts[7].restitution", 0.5, "0.5"),      # no such impact
+                                 ("impacts[0].restitutio", 0.5, "0.5"),       # unknown key
+                                 ("bodies[0].velocity_m_s", "fast", '"fast"'),  # wrong type
+                                 ("impacts[0.restitution", 0.5, "0.5")]:      # malformed key
+            with tempfile.TemporaryDirectory() as out:
+                rc, _, stderr = cli("run", scene, "--out", out, "--set", f"{key}={text}")
+                self.assertEqual(rc, 3, key)
+                with self.assertRaises(impactdeck.InputError, msg=key) as e:
+                    impactdeck.run(scene, out=out, overrides={key: value})
+                self.assertEqual("impactdeck: error: " + str(e.exception), stderr.strip())
+                self.assertIn(key.split("[")[0], str(e.exception))
+                self.assertEqual(os.listdir(out), [], key)
+        with self.assertRaises(impactdeck.UsageError) as e:
+            impactdeck.run(scene, overrides={"impacts[0].restitution": object()})
+        self.assertIn("impacts[0].restitution", str(e.exception))
+        with self.assertRaises(impactdeck.UsageError):
+            impactdeck.run(scene, overrides=["impacts[0].restitution=0.5"])
+
+    def test_sweep_takes_overrides(self):
+        scene = os.path.join(SRC, "samples", "fig4_sweep.toml")
+        a = impactdeck.sweep(scene, cloud="uniform", count=50, seed=2)
+        b = impactdeck.sweep(pathlib.Path(scene), cloud="uniform", count=50, seed=2,
+                             overrides={"impacts[0].approach_speed_m_s": 2.0})
+        self.assertFalse(np.array_equal(a["max_force_N"], b["max_force_N"]))
+
+
+class PathLike(unittest.TestCase):
+    def test_every_path_argument_takes_a_path(self):
+        cube = pathlib.Path(SRC) / "tests" / "data" / "cube.off"
+        part = impactdeck.load_part(cube, "m")
+        self.assertEqual(part.file, str(cube))
+        self.assertEqual(impactdeck.inspect(cube, "m")["volume_m3"], impactdeck.inspect(str(cube), "m")["volume_m3"])
+        with self.assertRaises(impactdeck.InputError):
+            impactdeck.fem_check(pathlib.Path(SRC) / "no_such_deck")
+        with self.assertRaises(impactdeck.InputError):
+            impactdeck.campaign_collect(pathlib.Path(SRC) / "no_such_campaign")
+
+
+class FemCheck(unittest.TestCase):
+    def test_fem_check_is_fem_check_json(self):
+        # The paper's coarse FEM sample with its deck written but not run (overrides of a str and
+        # a bool), then checked from Python: ccx runs (seconds), the results are published in the
+        # deck folder, and `fem-check --no-run --json` reads the same numbers back from them.
+        scene = os.path.join(SRC, "samples", "paper_table2_fem.toml")
+        with tempfile.TemporaryDirectory() as out:
+            doc = impactdeck.run(scene, out=out, overrides={"outputs.fem.run": "none", "outputs.fem.code_aster": False})
+            deck = pathlib.Path(out) / "fem_table2"
+            self.assertFalse((deck / "impact.dat").exists())
+            self.assertNotIn("fem_run", doc["stages_run"])
+            r = impactdeck.fem_check(deck, threads=1)
+            self.assertTrue(r["passed"])
+            self.assertTrue((deck / "impact.dat").exists())
+            rc, stdout, _ = cli("fem-check", str(deck), "--no-run", "--json")
+            self.assertEqual(rc, 0)
+            c = json.loads(stdout)
+            for key in ("fe_mass_kg", "solver_mass_kg", "impulse_Ns", "linear_momentum_relative_error", "passed"):
+                self.assertEqual(r[key], c[key], key)
+            again = impactdeck.fem_check(deck, run=False)
+            self.assertEqual(again["linear_momentum_relative_error"], r["linear_momentum_relative_error"])
+            # A tolerance the run cannot meet: CheckFailed with the document, the folder unchanged.
+            before = sorted(os.listdir(deck))
+            with self.assertRaises(impactdeck.CheckFailed) as e:
+                impactdeck.fem_check(deck, run=False, linear_tolerance=1e-300)
+            self.assertFalse(e.exception.document["passed"])
+            self.assertIn("FEM check failed", str(e.exception))
+            self.assertEqual(sorted(os.listdir(deck)), before)
+
+
+class CompareContact(unittest.TestCase):
+    def test_refusals_are_the_commands(self):
+        # The full comparison takes minutes of ccx (tests/test_compare_contact.cpp runs it); here
+        # the binding's refusals, which must be the command's: an unknown impact.
+        scene = os.path.join(SRC, "samples", "two_spheres.toml")
+        with tempfile.TemporaryDirectory() as out:
+            rc, _, stderr = cli("compare-contact", scene, "--impact", "nope", "--out", out)
+            self.assertEqual(rc, 3)
+            with self.assertRaises(impactdeck.InputError) as e:
+                impactdeck.compare_contact(pathlib.Path(scene), out=out, impact="nope")
+            self.assertEqual("impactdeck: error: " + str(e.exception), stderr.strip())
+            self.assertEqual(os.listdir(out), [])
+        with self.assertRaises(impactdeck.UsageError):
+            impactdeck.compare_contact(scene, threshold=-1)
+
+
+class Campaign(unittest.TestCase):
+    TARGET = ('length_unit = "mm"\n[materials.steel]\nyoungs_modulus_Pa = 2.05e11\npoisson_ratio = 0.3\n'
+              'density_kg_m3 = 7850\nyield_strength_Pa = 3.5e8\n[[bodies]]\nname = "t"\nshape = "ellipsoid"\n'
+              'semi_axes = [200, 50, 50]\nmaterial = "steel"\n[[bodies]]\nname = "b"\nshape = "sphere"\nradius = 10\n'
+              'material = "steel"\n[[impacts]]\ntarget = "t"\nimpactor = "b"\npoint = [200, 0, 0]\n'
+              'approach_speed_m_s = 1\nrestitution = 0.5\n')
+    POINTS = 'scene = "target.toml"\n[points]\ncount = 6\n'
+
+    def test_plan_run_collect_as_the_commands(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            t = pathlib.Path(tmp)
+            (t / "target.toml").write_text(self.TARGET)
+            (t / "points.toml").write_text(self.POINTS)
+            for args in (["plan", "points.toml", "--out", "cli"], ["run", "cli", "--quiet"], ["collect", "cli"]):
+                rc, _, stderr = cli("campaign", *args, cwd=tmp)
+                self.assertEqual(rc, 0, stderr)
+            plan = impactdeck.campaign_plan(t / "points.toml", t / "py")
+            self.assertEqual(plan["cases"], 6)
+            self.assertFalse(plan["already_planned"])
+            self.assertTrue(impactdeck.campaign_plan(t / "points.toml", t / "py")["already_planned"])
+            run = impactdeck.campaign_run(t / "py", jobs=2, executable=pathlib.Path(EXE))
+            self.assertEqual((run["total"], run["done"], run["failed"], run["exit_code"]), (6, 6, 0, 0))
+            self.assertEqual(impactdeck.campaign_run(t / "py", executable=EXE)["skipped"], 6)
+            col = impactdeck.campaign_collect(t / "py")
+            self.assertEqual((col["done"], col["failed"], col["pending"]), (6, 0, 0))
+            self.assertTrue(os.path.exists(col["report_html"]) and os.path.exists(col["map_svg"]))
+            # The same table as the command's, but for the folder names in it.
+            ours = (t / "py" / "collect" / "cases.csv").read_text().replace(str(t / "py"), "DIR")
+            theirs = (t / "cli" / "collect" / "cases.csv").read_text().replace(str(t / "cli"), "DIR")
+            self.assertEqual(ours, theirs)
+
+    def test_failed_cases_raise_with_the_summary(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            t = pathlib.Path(tmp)
+            (t / "target.toml").write_text(self.TARGET)
+            # Case 1 of 2 loses its scene file after the plan (as tests/campaign_test.sh does).
+            (t / "c.toml").write_text('scene = "target.toml"\n[product]\n"impacts[0].restitution" = [0.5, 0.7]\n')
+            impactdeck.campaign_plan(t / "c.toml", t / "c")
+            (t / "c" / "cases" / "1" / "scene.toml").unlink()
+            with self.assertRaises(impactdeck.InputError) as e:
+                impactdeck.campaign_run(t / "c", executable=EXE)
+            self.assertEqual(e.exception.document["failed_ids"], [1])
+            self.assertEqual(e.exception.document["exit_code"], 3)
+
+
+class Documentation(unittest.TestCase):
+    """Docstrings and reprs on everything public, and the type stubs (python/impactdeck.pyi) naming
+    exactly the module's public names."""
+
+    def public(self, obj):
+        return {n for n in dir(obj) if not n.startswith("_")}
+
+    def test_docstrings_and_reprs(self):
+        for name in self.public(impactdeck):
+            obj = getattr(impactdeck, name)
+            if callable(obj):
+                self.assertTrue((obj.__doc__ or "").strip(), name)
+        for name in self.public(impactdeck.Part):
+            self.assertTrue((getattr(impactdeck.Part, name).__doc__ or "").strip(), "Part." + name)
+        part = impactdeck.load_part(os.path.join(SRC, "tests", "data", "cube.off"), "m")
+        self.assertRegex(repr(part), r"^<impactdeck.Part '.*cube.off' off \(mesh\), volume 8 m\^3, size [0-9.]+ m>$")
+
+    def test_stubs_name_every_public_name(self):
+        stub = os.environ.get("IMPACTDECK_STUB") or os.path.join(os.path.dirname(impactdeck.__file__), "impactdeck.pyi")
+        tree = ast.parse(pathlib.Path(stub).read_text())
+        names, part = set(), set()
+        for node in tree.body:
+            if isinstance(node, (ast.FunctionDef, ast.ClassDef)):
+                names.add(node.name)
+            elif isinstance(node, ast.AnnAssign):
+                names.add(node.target.id)
+            elif isinstance(node, ast.Assign):
+                names.update(t.id for t in node.targets)
+            if isinstance(node, ast.ClassDef) and node.name == "Part":
+                part = {n.name for n in node.body if isinstance(n, ast.FunctionDef)}
+        self.assertEqual({n for n in names if not n.startswith("_")} | {"__version__"},
+                         self.public(impactdeck) | {"__version__"})
+        self.assertEqual({n for n in part if not n.startswith("_")}, self.public(impactdeck.Part))
+        # Every function's parameters as in the module's own signature line.
+        for node in tree.body:
+            if isinstance(node, ast.FunctionDef):
+                sig = getattr(impactdeck, node.name).__doc__.splitlines()[0]
+                params = [a.arg for a in node.args.args + node.args.kwonlyargs]
+                self.assertEqual(params, [p.split(":")[0].strip().lstrip("*") for p in
+                                          sig[sig.index("(") + 1:sig.rindex(") ->")].split(", ") if p.strip() != "*"],
+                                 node.name)
 
 
 if __name__ == "__main__":
