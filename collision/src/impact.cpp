@@ -5,6 +5,7 @@
 
 #include "impactdeck/collision/hertz_law.hpp"
 #include "impactdeck/common/error.hpp"
+#include "law_input.hpp"
 
 namespace impactdeck::collision {
 
@@ -14,11 +15,7 @@ namespace {
 // input (deterministic: the kernel's numbers; a kernel result keeps no law-specific state).
 LawResult law_result_of(const ContactLaw& law, const KernelInput& k, const KernelResult& kr) {
   LawInput in;
-  in.reduced_mass_kg = kr.reduced_mass_kg;
-  in.approach_velocity_m_s = kr.approach_velocity_m_s;
-  in.effective_modulus_Pa = k.effective_modulus_Pa;
-  in.effective_radius_m = kr.effective_radius_m;
-  in.yield_strength_Pa = k.yield_strength_Pa;
+  detail::law_input(k, kr, in);
   LawResult l;
   law.solve(&in, &l, 1);
   return l;

@@ -9,6 +9,7 @@
 #include "impactdeck/collision/hertz.hpp"
 #include "impactdeck/collision/hertz_law.hpp"
 #include "impactdeck/common/error.hpp"
+#include "law_input.hpp"
 
 namespace impactdeck::collision {
 
@@ -215,15 +216,6 @@ inline bool step_radius(const KernelInput& in, const KernelPoint& p, KernelResul
   return true;
 }
 
-// The law's input of a point that passed step_radius.
-inline void law_input(const KernelInput& in, const KernelResult& r, LawInput& l) {
-  l.reduced_mass_kg = r.reduced_mass_kg;
-  l.approach_velocity_m_s = r.approach_velocity_m_s;
-  l.effective_modulus_Pa = in.effective_modulus_Pa;
-  l.effective_radius_m = r.effective_radius_m;
-  l.yield_strength_Pa = in.yield_strength_Pa;
-}
-
 // A law's status as the kernel's flag: false when the law failed (its numbers, or its restitution).
 inline bool take_status(LawStatus status, KernelResult& r) {
   switch (status) {
@@ -288,7 +280,7 @@ inline void solve_law(const KernelInput& in, const RelativeCurvatures* rc, const
   LawResult law_out[kKernelLanes];
   std::size_t lane[kKernelLanes], m = 0;
   for (std::size_t k = 0; k < n; ++k) {
-    if (live[k]) law_input(in, *r[k], law_in[m]), lane[m++] = k;
+    if (live[k]) detail::law_input(in, *r[k], law_in[m]), lane[m++] = k;
   }
   if (m > 0) in.law->solve(law_in, law_out, m);
   for (std::size_t j = 0; j < m; ++j) {
@@ -324,7 +316,7 @@ void solve_kernel(const KernelInput& in, const KernelPoint* points, KernelResult
       LawInput law_in[kKernelLanes];
       for (std::size_t k = 0; k < n; ++k) {
         if (!live[k]) continue;
-        law_input(in, *r[k], law_in[k]);
+        detail::law_input(in, *r[k], law_in[k]);
         live[k] = take_status(hertz_compression(law_in[k], *r[k], r[k]->hertz_constant), *r[k]);
       }
       for (std::size_t k = 0; k < n; ++k) {
