@@ -6,14 +6,12 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
-#include <optional>
 #include <sstream>
 
 #include "cli_limits.hpp"
 #include "commands.hpp"
 #include "conventions.hpp"
 #include "impactdeck/common/error.hpp"
-#include "impactdeck/common/run_transaction.hpp"
 #include "impactdeck/fem_export/check.hpp"
 
 namespace impactdeck::cli {
@@ -55,25 +53,16 @@ void register_fem_check(CLI::App& app, Context& ctx) {
                 << ", linear tolerance " << o.linear_tolerance << ", angular tolerance "
                 << o.angular_tolerance << ", threads " << o.threads << "\n";
     }
-    std::error_code ec;
-    if (!fs::is_directory(args->dir, ec)) throw InputError(args->dir, "deck folder", "does not exist");
-    // ccx runs in a private folder of a transaction on the deck folder: its results replace the
-    // folder's previous ones only when the run and the checks passed; otherwise nothing changes.
-    std::optional<RunTransaction> txn;
-    if (o.run_solver) {
-      txn.emplace(args->dir, "deck folder");
-      o.work_dir = txn->scratch("ccx");
-    }
-    auto check = [&] {
+    std::vector<std::string> warnings;
+    fem_export::CheckResult r = [&] {
       VerboseTimer timer(ctx, "fem-check", "ccx and the checks");
-      return fem_export::run_check(args->dir, o);
-    };
-    fem_export::CheckResult r = txn ? txn->run(check) : check();  // messages name the deck folder
+      return fem_export::check_deck_folder(args->dir, o, &warnings);
+    }();
     if (!r.passed) {
       std::ostringstream m;
       m << (fs::path(args->dir) / "impact.dat").string() << ": FEM check failed: ";
       for (std::size_t i = 0; i < r.failures.size(); ++i) m << (i ? "; " : "") << r.failures[i];
-      m << (txn ? " (the deck folder was left as it was)" : "");
+      m << (o.run_solver ? " (the deck folder was left as it was)" : "");
       if (args->json) {
         std::cout << fem_export::to_json(r).dump(2) << "\n";
       } else {
@@ -83,20 +72,7 @@ void register_fem_check(CLI::App& app, Context& ctx) {
       ctx.exit_code = static_cast<int>(ExitCode::check_failed);
       return;
     }
-    if (txn) {
-      txn->run([&] {
-        for (const auto& f : r.solver_files) {
-          const fs::path staged = txn->file(f.filename().string(), args->dir, "ccx results");
-          fs::rename(f, staged);
-        }
-        txn->commit();
-      });
-      for (auto& f : r.solver_files) f = fs::path(args->dir) / f.filename();
-      if (r.stress) {
-        for (auto& f : r.stress->files) f = fs::path(args->dir) / f.filename();
-      }
-      for (const auto& w : txn->warnings()) ctx.warn(w);
-    }
+    for (const auto& w : warnings) ctx.warn(w);
     if (args->json) {
       std::cout << fem_export::to_json(r).dump(2) << "\n";
     } else {

@@ -562,26 +562,8 @@ PYBIND11_MODULE(impactdeck, m) {
         std::string failed;
         {
           py::gil_scoped_release release;
-          std::error_code ec;
-          if (!fs::is_directory(deck_dir, ec)) throw InputError(deck_dir.string(), "deck folder", "does not exist");
-          // As `fem-check`: ccx runs in a private folder of a transaction on the deck folder, and its
-          // results replace the folder's previous ones only when the run and the checks passed.
-          std::optional<RunTransaction> txn;
-          if (o.run_solver) {
-            txn.emplace(deck_dir, "deck folder");
-            o.work_dir = txn->scratch("ccx");
-          }
-          fem_export::CheckResult r = txn ? txn->run([&] { return fem_export::run_check(deck_dir, o); })
-                                          : fem_export::run_check(deck_dir, o);
-          if (r.passed && txn) {
-            txn->run([&] {
-              for (auto& f : r.solver_files) fs::rename(f, txn->file(f.filename().string(), deck_dir.string(), "ccx results"));
-              txn->commit();
-            });
-            for (auto& f : r.solver_files) f = deck_dir / f.filename();
-            if (r.stress)
-              for (auto& f : r.stress->files) f = deck_dir / f.filename();
-          }
+          // As `fem-check`: one transaction on the deck folder.
+          const fem_export::CheckResult r = fem_export::check_deck_folder(deck_dir, o);
           for (std::size_t i = 0; i < r.failures.size(); ++i) failed += (i ? "; " : "") + r.failures[i];
           doc = fem_export::to_json(r);
         }

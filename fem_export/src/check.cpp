@@ -14,6 +14,7 @@
 #include "impactdeck/common/input_file.hpp"
 #include "impactdeck/common/json_read.hpp"
 #include "impactdeck/common/numeric.hpp"
+#include "impactdeck/common/run_transaction.hpp"
 #include "impactdeck/fem_export/decks.hpp"
 #include "impactdeck/fem_export/mesh.hpp"
 #include "impactdeck/common/json_number.hpp"
@@ -197,6 +198,26 @@ CheckResult check_deck(const fs::path& dir, const Deck& deck, const CheckOptions
 CheckResult run_check(const fs::path& dir, const CheckOptions& o) {
   if (!fs::is_directory(dir)) throw InputError(dir.string(), "deck folder", "does not exist");
   return check_deck(dir, read_deck(dir), o);
+}
+
+CheckResult check_deck_folder(const fs::path& dir, CheckOptions o, std::vector<std::string>* warnings) {
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) throw InputError(dir.string(), "deck folder", "does not exist");
+  if (!o.run_solver) return run_check(dir, o);
+  RunTransaction txn(dir, "deck folder");
+  o.work_dir = txn.scratch("ccx");
+  CheckResult r = txn.run([&] { return run_check(dir, o); });  // messages name the deck folder
+  if (!r.passed) return r;  // the transaction rolls back: the folder is as it was
+  txn.run([&] {
+    for (const auto& f : r.solver_files) fs::rename(f, txn.file(f.filename().string(), dir.string(), "ccx results"));
+    txn.commit();
+  });
+  for (auto& f : r.solver_files) f = dir / f.filename();
+  if (r.stress) {
+    for (auto& f : r.stress->files) f = dir / f.filename();
+  }
+  if (warnings) *warnings = txn.warnings();
+  return r;
 }
 
 CheckResult run_check(const DeckResult& written, const CheckOptions& o) {

@@ -111,6 +111,15 @@ struct CheckResult {
 /// tolerance is reported in `passed`/`failures`.
 CheckResult run_check(const std::filesystem::path& deck_dir, const CheckOptions& options = {});
 
+/// `fem-check DIR`: run_check as one transaction on the deck folder. The solver runs in a private
+/// folder of it, and its files (and the stress files) replace the folder's previous ones only when
+/// the run and every check passed; otherwise the folder is left as it was. Without
+/// options.run_solver the folder's results are only read. InputError when `deck_dir` is not a
+/// folder; the returned files name their places in `deck_dir`. `warnings` (optional) receives the
+/// transaction's warnings.
+CheckResult check_deck_folder(const std::filesystem::path& deck_dir, CheckOptions options,
+                              std::vector<std::string>* warnings = nullptr);
+
 /// The same for the deck `written` has just written (write_decks / write_deck_files): its
 /// description and mesh are taken from memory, not read back from deck.json and mesh.inp.
 CheckResult run_check(const DeckResult& written, const CheckOptions& options = {});
