@@ -38,6 +38,16 @@ Eigen::Matrix3d rotation() {
           Eigen::AngleAxisd(-0.4, Eigen::Vector3d::UnitZ())).toRotationMatrix();
 }
 
+// `mesh` as an OFF file in millimetres, every digit kept.
+fs::path write_off_mm(const fs::path& file, const TriangleMesh& mesh) {
+  std::ofstream f(file);
+  f.precision(17);
+  f << "OFF\n" << mesh.vertex_count() << " " << mesh.triangle_count() << " 0\n";
+  for (const auto& p : mesh.vertices_m) f << p.x() * 1e3 << " " << p.y() * 1e3 << " " << p.z() * 1e3 << "\n";
+  for (const auto& t : mesh.triangles) f << "3 " << t[0] << " " << t[1] << " " << t[2] << "\n";
+  return file;
+}
+
 MeshMassProperties mass_of(const TriangleMesh& m) { return compute_mass_properties(m, label_shells(m)); }
 
 using impactdeck::test::expect_input_error;
@@ -472,6 +482,63 @@ TEST(FileErrors, OpenInvertedNonManifoldPointsEmpty) {
   EXPECT_EQ(pv.non_manifold_edges, 0u);
   EXPECT_EQ(pv.shells, 2);
   EXPECT_NE(pv.approximation_reason().find("1 non-manifold vertices"), std::string::npos);
+}
+
+// An open part's holes are capped flat, and the volume's range over cone caps is stated. The
+// 100 mm cube without one face (open_cube.off): the flat cap restores the cube exactly; the
+// range runs from the cone reaching the far face (V - a^3/3) to the flat cap (V).
+TEST(OpenSurface, HolesAreCappedFlatWithTheVolumeRangeStated) {
+  PartOptions opt;
+  opt.length_unit = LengthUnit::mm;
+  opt.accept_approximate_mass = true;
+  const double a = 0.1, V = a * a * a;
+  auto check_cube = [&](const Part& p, const Eigen::Vector3d& centre, const Eigen::Matrix3d& R, double rel) {
+    ASSERT_TRUE(p.open_volume.has_value());
+    EXPECT_EQ(p.open_volume->holes, 1);
+    EXPECT_EQ(p.open_volume->boundary_edges, 4u);
+    const VolumeProperties& v = p.shape->volume_properties();
+    EXPECT_NEAR(v.volume_m3, V, rel * V);
+    EXPECT_NEAR(v.area_m2, 5 * a * a, rel * 5 * a * a);  // the surface, without its cap
+    EXPECT_LE((v.centroid_m - centre).norm(), rel * a);
+    const Eigen::Matrix3d I = R * (V * a * a / 6.0 * Eigen::Matrix3d::Identity()) * R.transpose();
+    EXPECT_LE((v.inertia_per_density_m5 - I).norm(), rel * I.norm());
+    EXPECT_LE(p.open_volume->volume_min_m3, v.volume_m3);
+    EXPECT_GE(p.open_volume->volume_max_m3, v.volume_m3);
+    bool said = false;
+    for (const auto& w : p.warnings) said = said || w.find("1 hole(s) capped flat") != std::string::npos;
+    EXPECT_TRUE(said);
+  };
+  const Part open = load_part(data("open_cube.off"), opt);
+  check_cube(open, Eigen::Vector3d::Constant(a / 2), Eigen::Matrix3d::Identity(), test::kClosedFormRel);
+  EXPECT_NEAR(open.open_volume->volume_min_m3, V - V / 3, test::kClosedFormRel * V);
+  EXPECT_NEAR(open.open_volume->volume_max_m3, V, test::kClosedFormRel * V);
+
+  // Rotated and 100 m from the origin: the flat cap is exact there too.
+  const Eigen::Matrix3d R = rotation();
+  const Eigen::Vector3d shift(1e2, -2e2, 3e1);
+  TriangleMesh m = load_mesh(data("open_cube.off"), LengthUnit::mm).mesh;
+  transform_mesh(m, R, shift);
+  const fs::path far = write_off_mm(temp_dir() / "open_cube_far.off", m);
+  const Part moved = load_part(far, opt);
+  check_cube(moved, R * Eigen::Vector3d::Constant(a / 2) + shift, R, test::kFarCubeInertiaRel);
+
+  // A real open part (assimp-testmodels' Wuson, 412 boundary edges): the capped volume does not
+  // depend on where the part lies (the sum about the bounding-box centre alone did), and it lies
+  // inside its stated range.
+  const Part wuson = load_part(data("Wuson.off"), opt);
+  TriangleMesh w = load_mesh(data("Wuson.off"), LengthUnit::mm).mesh;
+  transform_mesh(w, R, shift);
+  const fs::path wfar = write_off_mm(temp_dir() / "wuson_far.off", w);
+  const Part wuson_far = load_part(wfar, opt);
+  ASSERT_TRUE(wuson.open_volume && wuson_far.open_volume);
+  EXPECT_EQ(wuson.open_volume->boundary_edges, 412u);
+  RecordProperty("wuson_holes", wuson.open_volume->holes);
+  const double vw = wuson.shape->volume_properties().volume_m3, vf = wuson_far.shape->volume_properties().volume_m3;
+  EXPECT_NEAR(vf, vw, test::kFarCubeInertiaRel * vw);
+  EXPECT_LT(wuson.open_volume->volume_min_m3, vw);
+  EXPECT_GT(wuson.open_volume->volume_max_m3, vw);
+  // A closed part has no range.
+  EXPECT_FALSE(load_part(data("cube.off"), opt).open_volume.has_value());
 }
 
 TEST(FileErrors, LinesAreIgnoredWithAWarningAndSelfIntersectionsAreFound) {

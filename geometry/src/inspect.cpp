@@ -143,6 +143,14 @@ InspectReport inspect_part(const InspectOptions& a) {
     j["mass_properties_approximate"] = part.approximate_mass;
     j["approximation_reason"] = part.approximate_mass ? nlohmann::json(part.approximation_reason) : nlohmann::json(nullptr);
     j["volume_m3"] = json_number(vp.volume_m3);
+    if (const auto& ov = part.open_volume) {
+      j["open_surface"] = {{"holes", ov->holes},
+                           {"boundary_edges", ov->boundary_edges},
+                           {"volume_min_m3", json_number(ov->volume_min_m3)},
+                           {"volume_max_m3", json_number(ov->volume_max_m3)}};
+    } else {
+      j["open_surface"] = nullptr;
+    }
     j["area_m2"] = json_number(vp.area_m2);
     j["density_kg_m3"] = density ? json_number(*density) : nlohmann::json(nullptr);
     j["mass_kg"] = density ? json_number(*density * vp.volume_m3) : nlohmann::json(nullptr);
@@ -216,6 +224,10 @@ InspectReport inspect_part(const InspectOptions& a) {
     for (const auto& a : part.repairs.actions) o << "  repair: " << a << "\n";
     if (part.approximate_mass) o << "  MASS PROPERTIES ARE APPROXIMATE: " << part.approximation_reason << "\n";
     o << "  volume " << vp.volume_m3 << " m^3, area " << vp.area_m2 << " m^2\n";
+    if (const auto& ov = part.open_volume) {
+      o << "  open surface: " << ov->holes << " hole(s) capped flat; volume between " << ov->volume_min_m3 << " and "
+        << ov->volume_max_m3 << " m^3 for any cone-shaped cap with its apex inside the bounding box\n";
+    }
     if (density) o << "  mass " << *density * vp.volume_m3 << " kg (density " << *density << " kg/m^3)\n";
     o << "  centre of mass " << text(vp.centroid_m) << " m\n";
     const Eigen::Matrix3d& shown = density ? inertia : vp.inertia_per_density_m5;
@@ -273,6 +285,7 @@ InspectReport inspect_cad(const InspectOptions& a, const std::vector<Eigen::Vect
   j["closed"] = true;  // a B-rep solid is closed by construction
   j["mass_properties_approximate"] = false;
   j["approximation_reason"] = nullptr;
+  j["open_surface"] = nullptr;
   j["mass_properties_source"] = "exact (OpenCASCADE, B-rep solid)";
   j["mass_properties_relative_error_estimate"] = json_number(shape->mass_relative_error_estimate());
   j["triangulation"] = {{"triangles", shape->triangulation().mesh().triangle_count()},

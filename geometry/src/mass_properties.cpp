@@ -1,5 +1,6 @@
 #include "impactdeck/geometry/mass_properties.hpp"
 
+#include <array>
 #include <cmath>
 #include <sstream>
 
@@ -56,6 +57,73 @@ MeshMassProperties compute_mass_properties(const TriangleMesh& mesh, const Shell
   // Parallel-axis shift to the centroid, then I = tr(C) Id - C.
   const Eigen::Matrix3d c = second - v.volume_m3 * g * g.transpose();
   v.inertia_per_density_m5 = c.trace() * Eigen::Matrix3d::Identity() - c;
+  return out;
+}
+
+HoleCaps cap_holes(const TriangleMesh& mesh, const EdgeTable& edges) {
+  HoleCaps out;
+  // The boundary edges, directed as their one triangle runs them.
+  std::vector<std::array<int, 2>> boundary;
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t j = i + 1;
+    while (j < edges.size() && edges.key[j] == edges.key[i]) ++j;
+    const int lo = EdgeTable::lo(edges.key[i]), hi = EdgeTable::hi(edges.key[i]);
+    if (j == i + 1 && lo != hi) {
+      const auto& t = mesh.triangles[static_cast<std::size_t>(edges.face[i])];
+      int k = 0;
+      while (k < 3 && t[k] != lo) ++k;
+      boundary.push_back(k < 3 && t[(k + 1) % 3] == hi ? std::array<int, 2>{lo, hi} : std::array<int, 2>{hi, lo});
+    }
+    i = j;
+  }
+  out.boundary_edges = boundary.size();
+  out.capped = mesh;
+  if (boundary.empty()) return out;
+  // Loops: components of the boundary edges through shared vertices (union-find, path halving).
+  std::vector<int> parent(mesh.vertices_m.size(), -1);
+  auto find = [&](int v) {
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];
+    return v;
+  };
+  for (const auto& e : boundary)
+    for (int v : e)
+      if (parent[v] < 0) parent[v] = v;
+  for (const auto& e : boundary) parent[find(e[0])] = find(e[1]);
+  std::vector<int> loop_of_root(mesh.vertices_m.size(), -1);
+  struct Loop {
+    Eigen::Vector3d start_sum = Eigen::Vector3d::Zero();  // of the edges' start vertices, relative to o
+    Eigen::Vector3d vector_area = Eigen::Vector3d::Zero();
+    double starts = 0;
+  };
+  std::vector<Loop> loops;
+  std::vector<int> loop_of_edge(boundary.size());
+  const Eigen::Vector3d o = mesh.bounding_box_center_m();
+  for (std::size_t i = 0; i < boundary.size(); ++i) {
+    int& l = loop_of_root[find(boundary[i][0])];
+    if (l < 0) l = static_cast<int>(loops.size()), loops.emplace_back();
+    loop_of_edge[i] = l;
+    const Eigen::Vector3d a = mesh.vertices_m[boundary[i][0]] - o, b = mesh.vertices_m[boundary[i][1]] - o;
+    loops[l].start_sum += a;
+    loops[l].starts += 1;
+    loops[l].vector_area += 0.5 * a.cross(b);
+  }
+  out.loops = static_cast<int>(loops.size());
+  // Half extents of the bounding box (its centre is o).
+  Eigen::Vector3d lo = mesh.vertices_m.front(), hi = lo;
+  for (const auto& p : mesh.vertices_m) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  const Eigen::Vector3d h = 0.5 * (hi - lo);
+  const int first_cap_vertex = static_cast<int>(out.capped.vertices_m.size());
+  for (const Loop& l : loops) {
+    const Eigen::Vector3d g = l.start_sum / l.starts;  // relative to o
+    out.capped.vertices_m.push_back(o + g);
+    const double shift = g.dot(l.vector_area) / 3.0;  // apex g -> o: -(o - g)·A/3
+    const double spread = l.vector_area.cwiseAbs().dot(h) / 3.0;
+    out.volume_min_offset_m3 += shift - spread;
+    out.volume_max_offset_m3 += shift + spread;
+  }
+  // The fans run each boundary edge backwards, so the caps continue the surface's orientation.
+  for (std::size_t i = 0; i < boundary.size(); ++i)
+    out.capped.triangles.push_back({boundary[i][1], boundary[i][0], first_cap_vertex + loop_of_edge[i]});
   return out;
 }
 

@@ -119,15 +119,36 @@ Part load_part(const std::filesystem::path& file, const PartOptions& opt) {
     by.shells = ShellLabels();
     return std::move(by.mass);
   });
-  if (opt.build_surface_index) by.edges = EdgeTable();  // the index builds its own
+  // An open surface has no inside: its holes are capped flat, and the volume's range over other
+  // caps is stated (cap_holes).
+  std::optional<HoleCaps> caps;
+  auto integrate = [&] {
+    if (!part.approximate_mass || report.closed) return compute_mass_properties(mesh, label_shells(mesh));
+    caps = cap_holes(mesh, by.edges);
+    MeshMassProperties m = compute_mass_properties(caps->capped, label_shells(caps->capped));
+    m.volume.area_m2 = mass.volume.area_m2;  // the part's surface, not its caps
+    return m;
+  };
+  if (part.approximate_mass && !report.closed) mass = integrate();
   if (part.approximate_mass && mass.volume.volume_m3 < 0) {
-    // An open surface has no inside: a negative signed volume means its normals point the other
-    // way. Accepted approximation: take the orientation as reversed, and say so.
+    // A negative signed volume means the normals point the other way. Accepted approximation:
+    // take the orientation as reversed, and say so.
     for (auto& t : mesh.triangles) std::swap(t[1], t[2]);
-    mass = compute_mass_properties(mesh, label_shells(mesh));
+    mass = integrate();
     part.warnings.push_back(where + ": the open surface's signed volume was negative: its orientation "
                             "was taken as reversed for the approximation");
   }
+  if (caps) {
+    const double v = mass.volume.volume_m3;
+    part.open_volume = Part::OpenVolume{caps->loops, caps->boundary_edges, v + caps->volume_min_offset_m3,
+                                        v + caps->volume_max_offset_m3};
+    std::ostringstream s;
+    s << where << ": open surface: volume " << v << " m^3 with its " << caps->loops
+      << " hole(s) capped flat; any cone-shaped cap with its apex inside the bounding box gives "
+      << part.open_volume->volume_min_m3 << " to " << part.open_volume->volume_max_m3 << " m^3";
+    part.warnings.push_back(s.str());
+  }
+  if (opt.build_surface_index) by.edges = EdgeTable();  // the index builds its own
   if (!(mass.volume.volume_m3 > 0) || !mass.volume.inertia_per_density_m5.allFinite()) {
     std::ostringstream s;
     s << "the enclosed volume is not positive (" << mass.volume.volume_m3 << " m^3)";

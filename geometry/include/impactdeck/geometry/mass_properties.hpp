@@ -23,6 +23,23 @@ struct MeshMassProperties {
 /// Integrates over all triangles as oriented in `mesh`. `shells` gives per-shell volumes.
 MeshMassProperties compute_mass_properties(const TriangleMesh& mesh, const ShellLabels& shells);
 
+/// The holes of an open surface closed for the volume integrals. A hole is a boundary loop: a
+/// connected component of the edges that have one triangle. Each is closed by a flat cap, a fan
+/// of triangles from the loop's centroid g (exact when the hole is planar). The true closing
+/// surface is unknown. A cone cap from an apex c changes the volume by -(c - g)·A/3 (A: the loop's
+/// vector area), so over every apex inside the mesh's bounding box the volume lies in
+/// [flat-cap volume + volume_min_offset_m3, flat-cap volume + volume_max_offset_m3].
+struct HoleCaps {
+  int loops = 0;
+  std::size_t boundary_edges = 0;
+  TriangleMesh capped;  ///< the mesh, then one centroid vertex per loop and its fan
+  double volume_min_offset_m3 = 0;  ///< <= 0
+  double volume_max_offset_m3 = 0;  ///< >= 0
+};
+/// `edges`: build_edge_table(mesh), or one built before the triangles were reversed (only the
+/// undirected edges and their faces are used). O(F) plus a union-find over the boundary vertices.
+HoleCaps cap_holes(const TriangleMesh& mesh, const EdgeTable& edges);
+
 /// Principal moments (ascending) and axes (columns, right-handed) of an inertia tensor, with the
 /// relative gaps |I_j - I_i| / max(I) between neighbours: when a gap is small, the two axes of
 /// that pair are ill-defined (any direction in their plane is principal).

@@ -3,6 +3,7 @@
 // surface index. Used by `impactdeck inspect` and by mesh bodies in scenes.
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -45,6 +46,15 @@ struct Part {
   bool approximate_mass = false;     ///< mass properties of a non-solid, accepted by the user
   std::string approximation_reason;  ///< why
   MeshMassProperties mass;           ///< of the mesh as oriented for the shape
+  /// An open part accepted as approximate: its mass properties are those of the surface with its
+  /// holes capped flat (cap_holes), and the volume lies in [volume_min_m3, volume_max_m3] for any
+  /// cone cap with its apex inside the bounding box. Empty for a closed part.
+  struct OpenVolume {
+    int holes = 0;
+    std::size_t boundary_edges = 0;
+    double volume_min_m3 = 0, volume_max_m3 = 0;
+  };
+  std::optional<OpenVolume> open_volume;
   std::size_t sharp_edges = 0;       ///< edges sharper than options.shape.sharp_angle_deg
   double mean_edge_length_m = 0;
   /// The surface index; null when built without it (PartOptions::build_surface_index).
