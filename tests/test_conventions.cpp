@@ -70,6 +70,11 @@ TEST(Suggest, SpelledOutLengthUnitsNameTheirSymbol) {
   EXPECT_EQ(length_unit_suggestion("inches"), "; did you mean 'in'?");
   EXPECT_EQ(length_unit_suggestion("Inch"), "; did you mean 'in'?");
   EXPECT_EQ(length_unit_suggestion("mmm"), "; did you mean 'mm'?");  // a near miss, as did_you_mean
+  EXPECT_EQ(length_unit_suggestion("milimeter"), "; did you mean 'mm'?");  // misspelt names too
+  EXPECT_EQ(length_unit_suggestion("centimetres"), "; did you mean 'cm'?");
+  EXPECT_EQ(length_unit_suggestion("inchs"), "; did you mean 'in'?");
+  EXPECT_EQ(length_unit_suggestion("metter"), "; did you mean 'm'?");
+  EXPECT_EQ(length_unit_suggestion("km"), "; did you mean 'cm'?");
   EXPECT_EQ(length_unit_suggestion("furlong"), "");
   EXPECT_EQ(length_unit_suggestion(""), "");
 }

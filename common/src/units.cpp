@@ -35,6 +35,15 @@ std::string length_unit_suggestion(std::string_view text) {
   for (const auto& [name, unit] : spelled) {
     if (t == name) return std::string("; did you mean '") + unit + "'?";
   }
+  // A misspelt unit name ("milimeter") means its unit too; short words go by the symbols.
+  if (t.size() >= 4) {
+    std::vector<std::string> names;
+    for (const auto& [name, unit] : spelled) names.emplace_back(name);
+    const std::string n = nearest_name(t, names);
+    for (const auto& [name, unit] : spelled) {
+      if (!n.empty() && n == name) return std::string("; did you mean '") + unit + "'?";
+    }
+  }
   return did_you_mean(text, length_unit_names());
 }
 
