@@ -32,6 +32,7 @@ void register_campaign(CLI::App& app, Context& ctx) {
     int threads = 1, cpus_per_task = 0;
     bool dry_run = false, json = false;
     std::vector<std::string> sbatch;
+    double sbatch_timeout_s = campaign::kDefaultSbatchTimeoutS;
   };
   auto a = std::make_shared<Args>();
   CLI::App* top = app.add_subcommand("campaign", "Many cases of one scene, here or on a Slurm cluster (docs/campaign-format.md)");
@@ -60,6 +61,9 @@ void register_campaign(CLI::App& app, Context& ctx) {
   run->add_option("--sbatch-option", a->sbatch,
                   "slurm: an extra sbatch option, e.g. --partition=short (repeatable; one argument of sbatch's command line)")
       ->allow_extra_args(false);
+  run->add_option("--sbatch-timeout-s", a->sbatch_timeout_s,
+                  "slurm: seconds one sbatch may take before it is stopped (default 120)")
+      ->check(CLI::Range(1e-3, campaign::kMaxSbatchTimeoutS));
   run->add_flag("--dry-run", a->dry_run, "slurm: write campaign.sbatch, do not submit");
   run->callback([a, run, &ctx] {
     VerboseTimer timer(ctx, "campaign run", "cases of " + a->dir);
@@ -68,6 +72,7 @@ void register_campaign(CLI::App& app, Context& ctx) {
       o.max_parallel = run->count("--jobs") > 0 ? a->jobs : 0;  // no --jobs: no %K limit
       o.cpus_per_task = a->cpus_per_task > 0 ? a->cpus_per_task : a->threads;
       o.sbatch_options = a->sbatch;
+      o.sbatch_timeout_s = a->sbatch_timeout_s;
       o.executable = self_executable();
       const campaign::SlurmScripts scripts = campaign::write_sbatch(a->dir, o);
       std::string names;
@@ -92,8 +97,8 @@ void register_campaign(CLI::App& app, Context& ctx) {
                 << a->dir << "'\n";
       return;
     }
-    if (a->dry_run || a->cpus_per_task > 0 || !a->sbatch.empty()) {
-      throw UsageError("--dry-run, --cpus-per-task and --sbatch-option need --executor slurm");
+    if (a->dry_run || a->cpus_per_task > 0 || !a->sbatch.empty() || run->count("--sbatch-timeout-s") > 0) {
+      throw UsageError("--dry-run, --cpus-per-task, --sbatch-option and --sbatch-timeout-s need --executor slurm");
     }
     campaign::LocalOptions o;
     o.jobs = a->jobs;

@@ -49,12 +49,14 @@ cat >fakebin/sbatch <<'SH'
 # A fake sbatch: records its arguments (NUL-separated), then runs the job the way Slurm does: in
 # the --chdir folder, output to the #SBATCH --output pattern (relative to that folder); a job
 # array (job 4242) as each task the script run by bash with SLURM_ARRAY_TASK_ID set, a plain job
-# (the collect job, 4243, arguments in sbatch_collect.args) once. FAKE_SBATCH_FAIL: refuse.
+# (the collect job, 4243, arguments in sbatch_collect.args) once. FAKE_SBATCH_FAIL: refuse;
+# FAKE_SBATCH_HANG: never answer (a hung slurmctld).
 set -u
 log=$FAKE_SLURM_LOG
 script=${!#}
 range=$(sed -n 's/^#SBATCH --array=\([0-9]*-[0-9]*\).*/\1/p' "$script")
 if [ -n "$range" ]; then job=4242; printf '%s\0' "$@" >"$log/sbatch.args"; else job=4243; printf '%s\0' "$@" >"$log/sbatch_collect.args"; fi
+if [ -n "${FAKE_SBATCH_HANG:-}" ]; then exec sleep 600; fi
 if [ -n "${FAKE_SBATCH_FAIL:-}" ]; then echo "sbatch: error: Batch job submission failed: Invalid partition name specified" >&2; exit 1; fi
 chdir=$PWD
 for a in "${@:1:$#-1}"; do case $a in --chdir=*) chdir=${a#--chdir=} ;; esac; done
@@ -152,6 +154,11 @@ printf '4242\n' >"$camp/slurm/jobs.txt"
 # sbatch refusing: exit 3 (an external tool's failure, docs/cli.md), naming the script.
 expect_error "sbatch refused" 3 "campaign\.sbatch: sbatch: sbatch refused it \(exit 1\): sbatch: error: Batch job submission failed" \
   env FAKE_SBATCH_FAIL=1 "$bin" campaign run "$camp" --executor slurm
+# sbatch hanging: stopped after --sbatch-timeout-s, exit 3 naming the script (not a hang).
+expect_error "sbatch hanging" 3 "campaign\.sbatch: sbatch: sbatch did not answer within 1 s \(--sbatch-timeout-s\) and was stopped" \
+  env FAKE_SBATCH_HANG=1 "$bin" campaign run "$camp" --executor slurm --sbatch-timeout-s 1
+expect_error "--sbatch-timeout-s needs slurm" 2 "--sbatch-timeout-s need --executor slurm" \
+  "$bin" campaign run "$camp" --sbatch-timeout-s 5
 expect_error "sbatch missing" 3 "^impactdeck: error: sbatch: submit: cannot run 'sbatch'" \
   env PATH=/nonexistent "$bin" campaign run "$camp" --executor slurm
 

@@ -130,11 +130,17 @@ void check_sbatch_options(const std::vector<std::string>& options) {
 }
 
 // One sbatch run; the job id it prints, or InputError naming the script.
-std::string sbatch(const std::vector<std::string>& argv, const fs::path& script) {
-  const detail::ProgramRun run = detail::run_program(argv, /*merge_stderr=*/true);
+std::string sbatch(const std::vector<std::string>& argv, const fs::path& script, double timeout_s) {
+  const detail::ProgramRun run = detail::run_program(argv, /*merge_stderr=*/true, timeout_s);
   if (run.spawn_error != 0) {
     throw InputError("sbatch", "submit", std::string("cannot run 'sbatch': ") + std::strerror(run.spawn_error) +
                                              " (is Slurm installed here? it must be on the PATH)");
+  }
+  if (run.timed_out) {
+    std::ostringstream s;
+    s << "sbatch did not answer within " << timeout_s
+      << " s (--sbatch-timeout-s) and was stopped; the job may still have been submitted: check squeue";
+    throw InputError(script.string(), "sbatch", s.str());
   }
   const std::string id = run.output.substr(0, run.output.find_first_of(";\n"));
   if (run.exit_code != 0 || id.size() > 20 || !is_digits(id)) {
@@ -401,14 +407,18 @@ std::vector<std::string> sbatch_commands(const fs::path& dir_in, const SlurmScri
 
 SlurmSubmission submit_sbatch(const fs::path& dir_in, const SlurmScripts& sc, const SlurmOptions& o) {
   check_sbatch_options(o.sbatch_options);
+  if (!(o.sbatch_timeout_s > 0 && o.sbatch_timeout_s <= kMaxSbatchTimeoutS)) {
+    throw UsageError("--sbatch-timeout-s must lie in (0, " + std::to_string(static_cast<int>(kMaxSbatchTimeoutS)) + "]");
+  }
   const fs::path dir = fs::absolute(dir_in).lexically_normal();
   detail::job_ids(dir);  // the job list the ids are added to must be sound before anything is submitted
   SlurmSubmission r;
   for (const auto& a : sc.arrays) {
-    r.array_jobs.push_back(sbatch(sbatch_argv(dir, a.script, o, ""), a.script));
+    r.array_jobs.push_back(sbatch(sbatch_argv(dir, a.script, o, ""), a.script, o.sbatch_timeout_s));
     record_job(dir, r.array_jobs.back());
   }
-  r.collect_job = sbatch(sbatch_argv(dir, sc.collect_script, o, job_list(r.array_jobs, ":")), sc.collect_script);
+  r.collect_job = sbatch(sbatch_argv(dir, sc.collect_script, o, job_list(r.array_jobs, ":")), sc.collect_script,
+                         o.sbatch_timeout_s);
   record_job(dir, r.collect_job);
   return r;
 }

@@ -52,6 +52,10 @@ struct RunSummary {
 /// progress bar and ETA on a terminal. A killed campaign resumes: done cases are skipped.
 RunSummary run_local(const std::filesystem::path& dir, const LocalOptions& options);
 
+/// sbatch answers in a second; Slurm's own MessageTimeout is 10 s and sbatch retries a busy
+/// controller a few times, so the default waits well beyond that.
+inline constexpr double kDefaultSbatchTimeoutS = 120, kMaxSbatchTimeoutS = 3600;
+
 struct SlurmOptions {
   std::size_t max_parallel = 0;  ///< `%K` of --array (0: no limit)
   int cpus_per_task = 1;         ///< --cpus-per-task, and the ccx threads of each case
@@ -62,6 +66,9 @@ struct SlurmOptions {
   std::filesystem::path executable;
   /// The cluster's MaxArraySize; 0: from `scontrol show config` (cluster_max_array_size).
   std::size_t max_array_size = 0;
+  /// Seconds one sbatch may take before it is killed and the submission stops with an error
+  /// (a hung slurmctld is not waited for); in (0, kMaxSbatchTimeoutS].
+  double sbatch_timeout_s = kDefaultSbatchTimeoutS;
 };
 
 /// The default MaxArraySize of Slurm, used when scontrol is missing, fails or says nothing.
