@@ -202,7 +202,7 @@ int main(int argc, char** argv) {
     const double prate = n / best;
     char beside[96] = "";
     if (goal) std::snprintf(beside, sizeof beside, " (`hertz` in the same program: %.2f M points/s)", n / hertz_best / 1e6);
-    std::printf("| sweep physics with `%s` (%ld points, %.0f %% of them plastic), 2 threads | %.3f s, %.2f M points/s%s | | %s |\n",
+    std::printf("| sweep physics with `%s` (%ld points, %.0f %% of them plastic), 2 threads | %.3f s, %.3g M points/s%s | | %s |\n",
                 law, n, 100.0 * json_number(last.out, "below_elastic"), best, prate / 1e6, beside,
                 goal ? (prate >= 1e7 ? "yes (>= 10 M points/s)" : "NO (>= 10 M points/s)") : "(no goal)");
   }
