@@ -7,8 +7,10 @@
 //   4. `impactdeck sweep` of 1 M area-uniform points with the default outputs on 2 threads, points
 //      per second end to end (--out on disk, and on tmpfs when /dev/shm exists: the difference is
 //      the disk);
-//   5. the sweep physics alone (the point loop of the same runs, its own clock: JSON `seconds`).
-// Row 6 (ccx) is bench/bench_ccx. Wall times are those of the whole process; CPU times (user +
+//   5. the sweep physics alone (the point loop of the same runs, its own clock: JSON `seconds`);
+//   6. the same physics with the contact law "thornton" (bench/sweep_law_physics, in process:
+//      scenes do not choose a law yet), and "jackson-green" on a tenth of the points (no goal).
+// The ccx row is bench/bench_ccx. Wall times are those of the whole process; CPU times (user +
 // system) are printed beside them, since a shared machine inflates wall times.
 //   bench_goals [--repeats N] [--subdivisions N] [--points N]      (Markdown on stdout)
 #include <sys/resource.h>
@@ -178,6 +180,31 @@ int main(int argc, char** argv) {
       std::printf("| sweep physics alone (the point loop of those runs), 2 threads | %.3f s, %.2f M points/s | | %s (>= 10 M points/s) |\n",
                   physics_best, prate / 1e6, prate >= 1e7 ? "yes" : "NO");
     }
+  }
+  // Row 6: the sweep physics with a plastic law, in process (same geometry, speed and threads),
+  // alternating with "hertz" in the same program (the in-process side of row 5's physics).
+  const std::string law_exe = SWEEP_LAW_EXE;
+  auto law_rate = [&](const char* law, long n, double& best, Run& last) {
+    last = run({law_exe, law, "--points", std::to_string(n), "--threads", "2"}, out);
+    check(last, "sweep_law_physics");
+    const double s = json_number(last.out, "seconds");
+    if (best == 0 || s < best) best = s;
+  };
+  for (const char* law : {"thornton", "jackson-green"}) {
+    const bool goal = std::strcmp(law, "thornton") == 0;
+    const long n = goal ? points : std::max(1L, points / 10);
+    double best = 0, hertz_best = 0;
+    Run last, hertz_last;
+    for (int k = 0; k < repeats; ++k) {
+      law_rate(law, n, best, last);
+      if (goal) law_rate("hertz", n, hertz_best, hertz_last);
+    }
+    const double prate = n / best;
+    char beside[96] = "";
+    if (goal) std::snprintf(beside, sizeof beside, " (`hertz` in the same program: %.2f M points/s)", n / hertz_best / 1e6);
+    std::printf("| sweep physics with `%s` (%ld points, %.0f %% of them plastic), 2 threads | %.3f s, %.3g M points/s%s | | %s |\n",
+                law, n, 100.0 * json_number(last.out, "below_elastic"), best, prate / 1e6, beside,
+                goal ? (prate >= 1e7 ? "yes (>= 10 M points/s)" : "NO (>= 10 M points/s)") : "(no goal)");
   }
   std::printf("\nLoad average at the end: %s.\n", load_average().c_str());
   fs::remove_all(dir);

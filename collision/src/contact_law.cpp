@@ -37,6 +37,7 @@ struct Registry {
 // The built-in laws' factories, each defined in its law's file (src/NAME_law.cpp).
 std::shared_ptr<const ContactLaw> make_hertz_law(const LawOptions& options);
 std::shared_ptr<const ContactLaw> make_thornton_law(const LawOptions& options);
+std::shared_ptr<const ContactLaw> make_jackson_green_law(const LawOptions& options);
 
 namespace {
 
@@ -46,6 +47,7 @@ Registry& registry() {
                     {
                         {"hertz", make_hertz_law},
                         {"thornton", make_thornton_law},
+                        {"jackson-green", make_jackson_green_law},
                     }};
   return r;
 }

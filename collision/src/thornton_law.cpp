@@ -25,12 +25,11 @@
 #include "impactdeck/collision/compression.hpp"
 #include "impactdeck/collision/contact_law.hpp"
 #include "impactdeck/collision/hertz.hpp"
+#include "plastic_law.hpp"
 
 namespace impactdeck::collision {
 
 namespace {
-
-bool finite_positive(double x) { return x > 0.0 && x <= std::numeric_limits<double>::max(); }
 
 // state: [0] t_1 (end of the Hertz loading), [1] t_H, [2] F_H (the Hertz impact at V), [3] w.
 class ThorntonLaw final : public ContactLaw {
@@ -62,7 +61,7 @@ class ThorntonLaw final : public ContactLaw {
     const double m = in.reduced_mass_kg, V = in.approach_velocity_m_s, E = in.effective_modulus_Pa,
                  R = in.effective_radius_m;
     const double py = limiting_pressure_Pa_ > 0.0 ? limiting_pressure_Pa_ : kThorntonYieldFactor * in.yield_strength_Pa;
-    if (!finite_positive(py)) return;  // no limiting pressure: the caller refuses such an input first
+    if (!detail::finite_positive(py)) return;  // no limiting pressure: the caller refuses such an input first
     const double kH = hertz_constant(E, R);
     r.stiffness = kH;
     const CompressionPhase hertz = compression_phase(m, V, kH);  // the elastic impact at V
@@ -73,12 +72,7 @@ class ThorntonLaw final : public ContactLaw {
     const double energy = 0.5 * m * V * V;
     r.impulse_compression_Ns = m * V;
     if (!(energy > Wy)) {  // elastic: Hertz with e = 1
-      r.max_indentation_m = hertz.max_indentation_m;
-      r.max_force_N = hertz.max_force_N;
-      r.compression_time_s = hertz.compression_time_s;
-      r.unloading_time_s = hertz.compression_time_s;
-      r.contact_time_s = 2.0 * hertz.compression_time_s;
-      r.restitution.coefficient = 1.0;
+      detail::elastic_hertz_result(hertz, r);
       r.state = {hertz.compression_time_s, hertz.compression_time_s, hertz.max_force_N, 0.0};
     } else {
       const double kp = M_PI * py * R;
@@ -108,15 +102,7 @@ class ThorntonLaw final : public ContactLaw {
       r.residual_indentation_m = d_star - du;
       r.state = {t1, hertz.compression_time_s, hertz.max_force_N, w};
     }
-    r.impulse_total_Ns = (1.0 + r.restitution.coefficient) * r.impulse_compression_Ns;
-    const double must_be_positive[] = {r.stiffness,          r.max_indentation_m, r.max_force_N,
-                                       r.compression_time_s, r.unloading_time_s,  r.impulse_compression_Ns,
-                                       r.restitution.coefficient};
-    for (double x : must_be_positive) {
-      if (!finite_positive(x)) return;
-    }
-    if (!(r.restitution.coefficient <= 1.0) || !(r.residual_indentation_m >= 0.0)) return;
-    r.status = LawStatus::ok;
+    detail::finish_plastic_result(r);
   }
 
   double limiting_pressure_Pa_;

@@ -80,6 +80,12 @@ inline constexpr double kThorntonYieldFactor = 1.6;
 struct LawOptions {
   RestitutionModel restitution;     ///< "hertz": its restitution model
   double limiting_pressure_Pa = 0;  ///< "thornton": p_y; 0: kThorntonYieldFactor x the yield strength
+  /// "jackson-green": the yielding (weaker) body's material, the one whose yield strength the law
+  /// gets: its Poisson's ratio (C = 1.295 exp(0.736 nu)), its tangent modulus E_t in [0, E) (0:
+  /// perfectly plastic) and its Young's modulus E (read when E_t > 0: hardening by E_t/E).
+  double poisson_ratio = 0.3;
+  double tangent_modulus_Pa = 0;
+  double youngs_modulus_Pa = 0;
 };
 
 using ContactLawFactory = std::function<std::shared_ptr<const ContactLaw>(const LawOptions&)>;

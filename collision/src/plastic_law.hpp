@@ -1,0 +1,37 @@
+#pragma once
+// What the plastic contact laws (thornton_law.cpp, jackson_green_law.cpp) share: the Hertz impact
+// below their elastic limit, and the last step of a result. Private to collision/.
+#include <limits>
+
+#include "impactdeck/collision/compression.hpp"
+#include "impactdeck/collision/contact_law.hpp"
+
+namespace impactdeck::collision::detail {
+
+inline bool finite_positive(double x) { return x > 0.0 && x <= std::numeric_limits<double>::max(); }
+
+/// r's phases as the Hertz impact `hertz` with e = 1 and no dent: t_c = 2 t_m.
+inline void elastic_hertz_result(const CompressionPhase& hertz, LawResult& r) {
+  r.max_indentation_m = hertz.max_indentation_m;
+  r.max_force_N = hertz.max_force_N;
+  r.compression_time_s = hertz.compression_time_s;
+  r.unloading_time_s = hertz.compression_time_s;
+  r.contact_time_s = 2.0 * hertz.compression_time_s;
+  r.restitution.coefficient = 1.0;
+}
+
+/// The total impulse (1 + e) m V, then r.status ok when every number that must be positive is
+/// finite and positive, e <= 1 and the dent >= 0 (else it stays as it was: degenerate).
+inline void finish_plastic_result(LawResult& r) {
+  r.impulse_total_Ns = (1.0 + r.restitution.coefficient) * r.impulse_compression_Ns;
+  const double must_be_positive[] = {r.stiffness,          r.max_indentation_m, r.max_force_N,
+                                     r.compression_time_s, r.unloading_time_s,  r.impulse_compression_Ns,
+                                     r.restitution.coefficient};
+  for (double x : must_be_positive) {
+    if (!finite_positive(x)) return;
+  }
+  if (!(r.restitution.coefficient <= 1.0) || !(r.residual_indentation_m >= 0.0)) return;
+  r.status = LawStatus::ok;
+}
+
+}  // namespace impactdeck::collision::detail
