@@ -28,15 +28,13 @@ Scene grid_scene(double mass_ratio, double aspect, double modulus, double veloci
   s.materials["mat"] = m;
   BodySpec target;
   target.name = "target";
-  target.shape = ShapeKind::ellipsoid;
   // Smaller semi-axis 20 x the impactor radius (docs/table1.md's preset), a = aspect * b.
   const double b = 20 * radius;
-  target.semi_axes_m = {aspect * b, b, b};
+  target.shape = ellipsoid_shape({aspect * b, b, b});
   target.material = "mat";
   BodySpec ball;
   ball.name = "ball";
-  ball.shape = ShapeKind::sphere;
-  ball.radius_m = radius;
+  ball.shape = sphere_shape(radius);
   ball.material = "mat";
   const double m_ball = 4.0 / 3.0 * M_PI * radius * radius * radius * 7850;
   ball.mass_kg = m_ball;
@@ -47,7 +45,7 @@ Scene grid_scene(double mass_ratio, double aspect, double modulus, double veloci
   i.target = "target";
   i.impactor = "ball";
   // An eccentric point: 60 % along the long axis, on the side.
-  const double x = 0.6 * target.semi_axes_m.x();
+  const double x = 0.6 * aspect * b;
   i.point_m = {x, b * std::sqrt(1 - 0.36), 0};
   i.approach_speed_m_s = velocity;
   i.restitution.kind = collision::RestitutionModel::Kind::energy_flux;
@@ -111,7 +109,7 @@ TEST(ExtremeScenes, GridFiniteOrNamedError) {
 TEST(ExtremeScenes, RestitutionValidityEdges) {
   // Choose the speed so that ln Phi (J/cm^3) is exactly at the edges -5 and 6, and beyond.
   Scene s = grid_scene(1.0, 1.0, 2e11, 1.0, 0.05);
-  s.bodies[0].semi_axes_m = {1.0, 1.0, 1.0};
+  s.bodies[0].shape = ellipsoid_shape({1.0, 1.0, 1.0});
   s.impacts[0].point_m = {0, 1.0, 0};
   const RunReport probe = run_scene(s);
   const double m_w = probe.impacts[0].result.reduced_mass_kg, r_w = probe.impacts[0].result.effective_radius_m;

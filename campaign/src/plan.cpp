@@ -44,7 +44,7 @@ PlanResult plan_campaign(const Campaign& c, const fs::path& dir_in) {
   std::string all = detail::read_text(c.file) + '\0' + detail::read_text(c.scene);
   std::set<fs::path> parts;
   for (const auto& b : scene::load_scene(c.scene).bodies)
-    if (!b.mesh_path.empty()) parts.insert(b.mesh_path);
+    for (const auto& f : b.shape->input_files()) parts.insert(f);
   for (const auto& p : parts) all += '\0' + detail::read_text(p);
   std::vector<std::string> case_hashes;
   for (const auto& t : texts) {

@@ -27,7 +27,7 @@ ContactModel::ContactModel(const PreparedBody& target, const PreparedBody& impac
       impactor_frame_(impactor.pose),
       rule_(rule),
       law_(std::move(law)),
-      impactor_mesh_(dynamic_cast<const geometry::MeshShape*>(impactor.shape.get())),
+      impactor_mesh_(impactor.shape ? impactor.shape->triangle_mesh() : nullptr),
       target_centroid_(target.centroid_world_m()),
       impactor_centroid_(impactor.centroid_world_m()) {
   invariants_.target = collision::kernel_body(target.rigid_body(), ctx.at("target '" + target.name + "'"));

@@ -63,9 +63,9 @@ Body classify(const PlacedShape& p) {
   Body b;
   b.shape = p.shape;
   b.pose = p.pose;
-  b.ellipsoid = dynamic_cast<const Ellipsoid*>(p.shape);
-  b.plane = dynamic_cast<const Plane*>(p.shape);
-  b.mesh = dynamic_cast<const MeshShape*>(p.shape);
+  b.ellipsoid = p.shape->analytic_ellipsoid();
+  b.plane = p.shape->half_space();
+  b.mesh = p.shape->triangle_mesh();
   return b;
 }
 
@@ -127,7 +127,7 @@ Hit plane_first(const Body& plane_body, const Body& other, bool plane_moves, con
   // support point nearby (normal exactly -n, second-order accurate where the vertex is first
   // order), reached O(h^2) later than the vertex.
   const char* feature = "vertex";  // a mesh's support point is one of its vertices
-  if (const auto* mesh = dynamic_cast<const MeshShape*>(other.shape)) {
+  if (const MeshShape* mesh = other.shape->triangle_mesh()) {
     if (const auto smooth = mesh->smooth_support_point(other.pose.direction_to_own(-n))) {
       sp = smooth;
       x = other.pose.to_world(sp->point_m);

@@ -77,7 +77,7 @@ fem_export::ContactBody contact_body(const fem_export::DeckRequest& own, const P
 void check_compare_bodies(const Scene& scene, const ImpactSpec& s, const InputContext& ctx) {
   for (const std::string* name : {&s.target, &s.impactor}) {
     const BodySpec& b = scene.body(*name);
-    if (b.shape == ShapeKind::plane) {
+    if (b.shape->half_space()) {
       throw ctx.error(b.place.describe(),
                       "impact '" + s.name + "': body '" + b.name +
                           "' is an infinite plane: the full-contact model meshes both bodies and a plane cannot be "
@@ -117,7 +117,7 @@ CompareInput compare_input(const Scene& scene, const ImpactReport& ir, const Pre
   in.impactor = &impactor;
   in.target_deck = hybrid_deck_request(scene, ir, target);
   in.impactor_deck = hybrid_deck_request(scene, ir, impactor);
-  in.impactor_mesh_size_m = default_mesh_size_m(scene.body(ir.spec->impactor), impactor);
+  in.impactor_mesh_size_m = default_mesh_size_m(*impactor.shape);
   in.warnings = compare_warnings(scene);
   return in;
 }

@@ -24,12 +24,8 @@ std::string value_text(double x) {
 Place key_of(const Place& table, const std::string& key) { return Place{table.line, table.key + "." + key}; }
 
 Place size_key(const BodySpec& b) {
-  switch (b.shape) {
-    case ShapeKind::sphere: return key_of(b.place, "radius");
-    case ShapeKind::ellipsoid: return key_of(b.place, "semi_axes");
-    case ShapeKind::mesh: return key_of(b.place, "mesh");
-  }
-  return b.place;
+  const std::string key = b.shape->size_key();
+  return key.empty() ? b.place : key_of(b.place, key);
 }
 
 Place mass_key(const Scene& scene, const BodySpec& b) {

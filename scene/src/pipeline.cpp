@@ -16,11 +16,6 @@
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/common/stage.hpp"
 #include "impactdeck/fem_export/force_table.hpp"
-#include "impactdeck/geometry/cad_shape.hpp"
-#include "impactdeck/geometry/ellipsoid.hpp"
-#include "impactdeck/geometry/mesh_shape.hpp"
-#include "impactdeck/geometry/part.hpp"
-#include "impactdeck/geometry/plane.hpp"
 #include "impactdeck/plot/force_plot.hpp"
 #include "impactdeck/scene/report_html.hpp"
 #include "numeric_checks.hpp"
@@ -99,39 +94,14 @@ Place output_place(const Scene& scene, const std::string& key) {
 
 std::shared_ptr<const geometry::Shape> make_shape(const BodySpec& b, const Scene& scene, RunReport* report) {
   // The shapes' own checks name the scene's body; a part file's errors name that file.
-  const InputContext ctx = body_context(scene, b);
-  switch (b.shape) {
-    case ShapeKind::sphere:
-      return std::make_shared<geometry::Ellipsoid>(geometry::Ellipsoid::sphere(b.radius_m, ctx));
-    case ShapeKind::ellipsoid:
-      return std::make_shared<geometry::Ellipsoid>(b.semi_axes_m.x(), b.semi_axes_m.y(), b.semi_axes_m.z(), ctx);
-    case ShapeKind::plane:
-      return std::make_shared<geometry::Plane>(b.plane_normal, ctx);
-    case ShapeKind::mesh: {
-      if (geometry::cad_format(b.mesh_path)) {  // STEP / IGES / BREP: exact B-rep queries
-        auto cad = geometry::CadShape::load(b.mesh_path, scene.length_unit);
-        if (report) {
-          add_stage(*report, Stage::mesh_load, cad->load_seconds());
-          for (const auto& w : cad->warnings()) report->warnings.push_back("body '" + b.name + "': " + w);
-        }
-        return cad;
-      }
-      geometry::PartOptions opt;
-      opt.length_unit = scene.length_unit;  // the scene's unit applies to the part file too
-      opt.repair = b.mesh_repair;
-      opt.accept_approximate_mass = b.mesh_approximate_mass;
-      opt.validation.check_self_intersections = b.mesh_self_intersection_check;
-      geometry::Part part = geometry::load_part(b.mesh_path, opt);
-      if (report) {
-        for (const auto& st : part.stages) add_stage(*report, st.name, st.seconds);  // as the loader measured them
-        for (const auto& w : part.warnings) report->warnings.push_back("body '" + b.name + "': " + w);
-        for (const auto& a : part.repairs.actions)
-          report->warnings.push_back("body '" + b.name + "': repaired: " + a);
-      }
-      return part.shape;
-    }
+  ShapeBuild build;
+  build.context = body_context(scene, b);
+  build.length_unit = scene.length_unit;
+  if (report) {
+    build.stage = [report](const std::string& stage, double seconds) { add_stage(*report, stage, seconds); };
+    build.warn = [report, &b](const std::string& w) { report->warnings.push_back("body '" + b.name + "': " + w); };
   }
-  throw Error(ExitCode::internal_error, "unknown shape kind");
+  return b.shape->make(build);
 }
 
 PreparedBody prepare_body(const BodySpec& b, const Scene& scene, RunReport* report) {
@@ -232,33 +202,7 @@ fem_export::DeckRequest fem_request(const Scene& scene, const ImpactReport& ir, 
   r.source = scene.file.string();
   r.impact = ir.spec->name;
   r.context = {where(scene), place.describe() + ": impact '" + ir.spec->name + "': FEM deck"};
-  switch (b.shape) {
-    case ShapeKind::sphere:
-      r.body.semi_axes_m = Eigen::Vector3d::Constant(b.radius_m);
-      break;
-    case ShapeKind::ellipsoid:
-      r.body.semi_axes_m = b.semi_axes_m;
-      break;
-    case ShapeKind::plane:  // fixed, refused above
-      break;
-    case ShapeKind::mesh: {
-      // The part as loaded, validated and repaired (whatever its file format), from memory.
-      if (const auto* cad = dynamic_cast<const geometry::CadShape*>(target.shape.get())) {
-        r.body.kind = fem_export::BodyKind::cad;  // meshed straight from the B-rep
-        r.body.cad = b.mesh_path;
-        // STEP/IGES: OpenCASCADE reads them in mm; a BREP is in the scene's unit.
-        r.body.cad_unit_m = cad->file_unit() ? 1e-3 : metres_per(scene.length_unit);
-        break;
-      }
-      const auto* part = dynamic_cast<const geometry::MeshShape*>(target.shape.get());
-      if (!part) throw Error(ExitCode::internal_error, "mesh body without a MeshShape");
-      r.body.kind = fem_export::BodyKind::part;
-      r.body.surface.vertices_m = part->mesh().vertices_m;
-      r.body.surface.triangles = part->mesh().triangles;
-      r.body.name = b.mesh_path.string();
-      break;
-    }
-  }
+  r.body = b.shape->fem_body(*target.shape, scene.length_unit);
   r.material.youngs_modulus_Pa = target.material.youngs_modulus_Pa;
   r.material.poisson_ratio = target.material.poisson_ratio;
   r.material.density_kg_m3 = target.mass_kg / target.volume.volume_m3;  // honours mass_kg
@@ -287,7 +231,7 @@ fem_export::DeckRequest fem_request(const Scene& scene, const ImpactReport& ir, 
                                                                  : fem_export::CcxSolver::automatic;
   r.options.aster_cpus = f.aster_cpus;
   r.options.aster_mpi_processes = f.aster_mpi_processes;
-  r.options.mesh.mesh_size_m = f.mesh_size_m.value_or(default_mesh_size_m(b, target));
+  r.options.mesh.mesh_size_m = f.mesh_size_m.value_or(default_mesh_size_m(*target.shape));
   r.options.adapt_mesh_size = !f.mesh_size_m;
   r.options.mesh.load_mesh_size_m = f.load_mesh_size_m.value_or(0.0);
   r.options.mesh.probes_m = f.probes_m;
@@ -328,7 +272,7 @@ ImpactReport solve_located_impact(const Scene& scene, const ImpactSpec& s, const
                                   ContactEvaluation located, std::vector<std::string>& warnings) {
   if (s.contact_radius == ContactRadiusRule::paper) {
     for (const PreparedBody* b : {&model.target(), &model.impactor()}) {
-      if (scene.body(b->name).shape == ShapeKind::mesh) {
+      if (scene.body(b->name).shape->frame_dependent_paper_radius()) {
         warnings.push_back("impact '" + s.name + "': contact_radius = \"paper\" on mesh body '" + b->name +
                            "': Eq. 26 cuts the part with planes normal to its file's axes, so the radius "
                            "depends on the part's coordinate frame; \"elliptical\" does not");
@@ -347,16 +291,6 @@ ImpactReport solve_located_impact(const Scene& scene, const ImpactSpec& s, const
     warnings.push_back("impact '" + s.name + "': " + w);
   }
   return ir;
-}
-
-double default_mesh_size_m(const BodySpec& b, const PreparedBody& p) {
-  switch (b.shape) {
-    case ShapeKind::sphere: return 0.5 * b.radius_m;
-    case ShapeKind::ellipsoid: return 0.5 * b.semi_axes_m.minCoeff();
-    case ShapeKind::mesh: return 0.25 * p.shape->size_m();
-    case ShapeKind::plane: break;
-  }
-  return 0.0;
 }
 
 fem_export::DeckRequest hybrid_deck_request(const Scene& scene, const ImpactReport& ir, const PreparedBody& body) {
@@ -395,7 +329,7 @@ StagedOutputs reserve_outputs(const Scene& scene, RunTransaction& txn) {
   // final path before anything is staged.
   std::vector<fs::path> inputs = {scene.file};
   for (const auto& b : scene.bodies)
-    if (b.shape == ShapeKind::mesh) inputs.push_back(b.mesh_path);
+    for (const fs::path& f : b.shape->input_files()) inputs.push_back(f);
   auto reserve = [&](const std::string& name, const std::string& place, bool folder) {
     const fs::path target_path = txn.out_dir() / RunTransaction::check_name(name, file, place);
     std::error_code ec;

@@ -129,10 +129,7 @@ std::string report_html(const Scene& scene, const RunReport& rep, const std::vec
   page.table({"material", "E", "Poisson ratio", "density", "yield strength"}, mats);
   std::vector<std::vector<std::string>> bodies;
   for (const auto& b : scene.bodies) {
-    std::string shape = to_string(b.shape);
-    if (b.shape == ShapeKind::sphere) shape += ", radius " + g(b.radius_m) + " m";
-    if (b.shape == ShapeKind::ellipsoid) shape += ", semi-axes " + vec3(b.semi_axes_m) + " m";
-    if (b.shape == ShapeKind::mesh) shape += ": " + b.mesh_path.string();
+    const std::string shape = b.shape->kind() + b.shape->describe([](double v) { return g(v); });
     bodies.push_back({b.name, shape, b.material, b.fixed ? "fixed" : b.mass_kg ? g(*b.mass_kg) + " kg" : "density x volume",
                       vec3(b.position_m) + " m", vec3(b.velocity_m_s) + " m/s"});
   }

@@ -24,16 +24,6 @@ std::string Place::describe() const {
   return s.str();
 }
 
-const char* to_string(ShapeKind k) {
-  switch (k) {
-    case ShapeKind::sphere: return "sphere";
-    case ShapeKind::ellipsoid: return "ellipsoid";
-    case ShapeKind::mesh: return "mesh";
-    case ShapeKind::plane: return "plane";
-  }
-  return "?";
-}
-
 const BodySpec& Scene::body(const std::string& name) const {
   for (const auto& b : bodies)
     if (b.name == name) return b;
@@ -246,48 +236,44 @@ Material read_material(const std::string& name, const toml::table& t, const Sour
   return m;
 }
 
+// A body table's keys as its shape reads them (body_shape.hpp), through the table's reader.
+class ReaderKeys final : public ShapeKeys {
+ public:
+  explicit ReaderKeys(Reader& r) : r_(r) {}
+  double positive(const std::string& key) override { return r_.positive(key); }
+  std::optional<Eigen::Vector3d> vec3(const std::string& key) override { return r_.vec3(key); }
+  std::string required_string(const std::string& key) override { return r_.required_string(key); }
+  std::optional<bool> boolean(const std::string& key) override { return r_.boolean(key); }
+  [[noreturn]] void fail(const std::string& key, const std::string& reason) const override { r_.fail(key, reason); }
+  [[noreturn]] void missing(const std::string& key) const override { r_.missing(key); }
+
+ private:
+  Reader& r_;
+};
+
+// `shape = "NAME"` among the registered shapes, and that shape's keys.
+std::shared_ptr<const ShapeSpec> read_shape(Reader& r, double to_m, const fs::path& base_dir) {
+  const std::vector<ShapeType>& types = shape_types();
+  std::vector<std::pair<std::string, std::size_t>> names;
+  for (std::size_t i = 0; i < types.size(); ++i) names.emplace_back(types[i].name, i);
+  const std::size_t chosen = r.choice<std::size_t>("shape", names, std::nullopt);
+  ReaderKeys keys(r);
+  keys.to_m = to_m;
+  keys.base_dir = base_dir;
+  return types[chosen].read(keys);
+}
+
 BodySpec read_body(std::size_t index, const toml::table& t, const Source& file,
                    double to_m, const fs::path& base_dir) {
   Reader r(t, "bodies[" + std::to_string(index) + "]", file);
-  r.allow({"name", "shape", "radius", "semi_axes", "mesh", "normal", "material", "mass_kg", "fixed",
-           "velocity_m_s", "angular_velocity_rad_s", "position", "orientation_axis", "orientation_angle_deg"});
+  r.allow({"name", "shape", "material", "mass_kg", "fixed", "velocity_m_s", "angular_velocity_rad_s", "position",
+           "orientation_axis", "orientation_angle_deg"});
+  for (const ShapeType& type : shape_types())  // every shape's keys (a key of another shape is ignored)
+    for (const std::string& k : type.keys) r.allow({k.c_str()});
   BodySpec b;
   b.place = r.self();
   b.name = r.required_string("name");
-  b.shape = r.choice<ShapeKind>("shape", {{"sphere", ShapeKind::sphere},
-                                          {"ellipsoid", ShapeKind::ellipsoid},
-                                          {"mesh", ShapeKind::mesh},
-                                          {"plane", ShapeKind::plane}}, std::nullopt);
-  switch (b.shape) {
-    case ShapeKind::sphere:
-      b.radius_m = r.positive("radius") * to_m;
-      break;
-    case ShapeKind::ellipsoid: {
-      auto e = r.vec3("semi_axes");
-      if (!e) r.missing("semi_axes");
-      if (!((*e).array() > 0.0).all()) r.fail("semi_axes", "every semi-axis must be > 0");
-      b.semi_axes_m = *e * to_m;
-      break;
-    }
-    case ShapeKind::mesh: {
-      const std::string p = r.required_string("mesh");
-      for (const char c : p)  // a NUL would cut the path short where the system reads it
-        if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) r.fail("mesh", "the path contains a control character");
-      b.mesh_path = fs::path(p).is_absolute() ? fs::path(p) : base_dir / p;
-      b.mesh_repair = r.boolean("repair").value_or(false);
-      b.mesh_approximate_mass = r.boolean("approximate_mass_properties").value_or(false);
-      b.mesh_self_intersection_check = r.boolean("self_intersection_check").value_or(true);
-      break;
-    }
-    case ShapeKind::plane: {
-      auto n = r.vec3("normal");
-      if (!n) r.missing("normal");
-      const double len = n->norm();
-      if (!(len > 0.0) || !std::isfinite(len)) r.fail("normal", "must be a non-zero vector (the plane's outward normal)");
-      b.plane_normal = *n / len;
-      break;
-    }
-  }
+  b.shape = read_shape(r, to_m, base_dir);
   b.material = r.required_string("material");
   if (r.has("mass_kg")) b.mass_kg = r.positive("mass_kg");
   const std::optional<bool> fixed = r.boolean("fixed");
@@ -295,7 +281,7 @@ BodySpec read_body(std::size_t index, const toml::table& t, const Source& file,
   if (b.fixed && b.mass_kg) r.fail("mass_kg", "a fixed body has infinite mass; remove mass_kg or fixed");
   b.velocity_m_s = r.vec3("velocity_m_s").value_or(Eigen::Vector3d::Zero());
   b.angular_velocity_rad_s = r.vec3("angular_velocity_rad_s").value_or(Eigen::Vector3d::Zero());
-  if (b.shape == ShapeKind::plane) {
+  if (b.shape->half_space()) {
     // A half-space: infinite mass, at rest (the other body carries the relative velocity).
     if (fixed && !*fixed) r.fail("fixed", "a plane is always fixed (infinite mass)");
     if (b.mass_kg) r.fail("mass_kg", "a plane has infinite mass; remove mass_kg");

@@ -57,7 +57,7 @@ const char* to_string(CloudKind k) {
 }
 
 std::vector<geometry::SurfacePoint> mesh_vertex_cloud(const geometry::Shape& target, const InputContext& context) {
-  const auto* m = dynamic_cast<const geometry::MeshShape*>(&target);
+  const geometry::MeshShape* m = target.triangle_mesh();
   if (!m) throw context.error("cloud", "the vertex cloud needs a mesh target; this target is a " + target.kind());
   std::vector<geometry::SurfacePoint> out;
   out.reserve(m->mesh().vertices_m.size());
@@ -88,7 +88,7 @@ std::vector<geometry::SurfacePoint> make_cloud(const geometry::Shape& target, Cl
   if (kind == CloudKind::vertices) return mesh_vertex_cloud(target, context);
   std::vector<geometry::SurfacePoint> cloud;
   if (kind != CloudKind::area_uniform) {
-    const auto* e = dynamic_cast<const geometry::Ellipsoid*>(&target);
+    const geometry::Ellipsoid* e = target.analytic_ellipsoid();
     if (!e) {
       throw context.error("cloud", "the paper grid needs an analytic ellipsoid or sphere; this target is a " +
                                         target.kind() + " (use the area-uniform cloud)");

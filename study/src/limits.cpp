@@ -9,7 +9,7 @@ namespace impactdeck::study {
 
 double cloud_size(const geometry::Shape& target, CloudKind kind, int grid_steps, std::size_t count) {
   if (kind == CloudKind::vertices) {
-    const auto* m = dynamic_cast<const geometry::MeshShape*>(&target);
+    const geometry::MeshShape* m = target.triangle_mesh();
     return m ? static_cast<double>(m->mesh().vertices_m.size()) : 0.0;
   }
   double n = 0;

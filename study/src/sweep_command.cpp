@@ -15,7 +15,7 @@ namespace fs = std::filesystem;
 
 CloudKind parse_cloud_kind(const std::string& text, const geometry::Shape& target, const std::string& option) {
   if (text == "auto") {
-    return dynamic_cast<const geometry::Ellipsoid*>(&target) != nullptr ? CloudKind::paper_grid : CloudKind::area_uniform;
+    return target.analytic_ellipsoid() != nullptr ? CloudKind::paper_grid : CloudKind::area_uniform;
   }
   if (text == "grid") return CloudKind::paper_grid;
   if (text == "uniform") return CloudKind::area_uniform;

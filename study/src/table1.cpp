@@ -65,7 +65,7 @@ void bounding_box(const geometry::TriangleMesh& m, Eigen::Vector3d& lo, Eigen::V
 // The cloud of a scene-driven row: the paper grid on a mesh is the projected grid of its box.
 std::vector<geometry::SurfacePoint> scene_cloud(const geometry::Shape& t, const Table1Options& o,
                                                 const InputContext& ctx) {
-  const auto* mesh = dynamic_cast<const geometry::MeshShape*>(&t);
+  const geometry::MeshShape* mesh = t.triangle_mesh();
   if (!mesh || (o.cloud != CloudKind::paper_grid && o.cloud != CloudKind::both)) {
     return make_cloud(t, o.cloud, o.grid_steps, o.uniform_count, o.seed, ctx);
   }
@@ -86,12 +86,12 @@ std::shared_ptr<const geometry::Shape> stretched_target(const geometry::Shape& t
   if (axis < 0 || axis > 2) throw ctx.error("stretch axis", "must be 0 (x), 1 (y) or 2 (z)");
   if (!(g > 0.0) || !std::isfinite(g)) throw ctx.error("geometric ratio", "must be positive and finite");
   const int ref = (axis + 1) % 3;
-  if (const auto* e = dynamic_cast<const geometry::Ellipsoid*>(&target)) {
+  if (const geometry::Ellipsoid* e = target.analytic_ellipsoid()) {
     Eigen::Vector3d semi = e->semi_axes_m();
     semi[axis] = g * semi[ref];
     return std::make_shared<geometry::Ellipsoid>(semi.x(), semi.y(), semi.z(), ctx);
   }
-  if (const auto* m = dynamic_cast<const geometry::MeshShape*>(&target)) {
+  if (const geometry::MeshShape* m = target.triangle_mesh()) {
     geometry::TriangleMesh mesh = m->mesh();
     Eigen::Vector3d lo, hi;
     bounding_box(mesh, lo, hi);

@@ -37,6 +37,7 @@ class Ellipsoid final : public Shape {
   std::optional<SurfacePoint> support_point(const Eigen::Vector3d& direction) const override;
   /// x^2/a^2 + y^2/b^2 + z^2/c^2 <= 1 (+ 16 ulps: points computed on the surface count).
   bool contains(const Eigen::Vector3d& own_point_m) const override;
+  const Ellipsoid* analytic_ellipsoid() const override { return this; }
   bool is_convex() const override { return true; }
 
   /// Outward unit normal at a surface point (Eq. 25).

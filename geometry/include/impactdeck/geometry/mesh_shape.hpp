@@ -73,6 +73,7 @@ class MeshShape final : public Shape {
   /// face a ray meets (outward: inside), retried along other rays when the hit is within 1e-9
   /// of an edge or grazing; after 16 ambiguous rays, the sign of the winding number.
   bool contains(const Eigen::Vector3d& own_point_m) const override;
+  const MeshShape* triangle_mesh() const override { return this; }
 
   /// Broad phase of continuous collision on the AABB tree: visits every face whose bounding box
   /// the box `moving` (own frame) meets while it translates by s * direction, s in

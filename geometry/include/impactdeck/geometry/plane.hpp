@@ -38,6 +38,7 @@ class Plane final : public Shape {
   std::optional<SurfacePoint> support_point(const Eigen::Vector3d& direction) const override;
   /// n.x <= 0, to rounding (16 ulps of |x|).
   bool contains(const Eigen::Vector3d& own_point_m) const override;
+  const Plane* half_space() const override { return this; }
   bool is_convex() const override { return true; }
   bool bounded() const override { return false; }
 

@@ -11,6 +11,10 @@
 
 namespace impactdeck::geometry {
 
+class Ellipsoid;
+class MeshShape;
+class Plane;
+
 /// Geometric mass properties of a solid of unit density.
 struct VolumeProperties {
   double volume_m3 = 0;
@@ -74,6 +78,17 @@ class Shape {
   virtual bool is_convex() const { return false; }
   /// False for an unbounded solid (a plane's half-space).
   virtual bool bounded() const { return true; }
+
+  // The exact algorithms of first contact and of the studies work on three kinds of geometry; a
+  // shape that is one of them says so here (null: it is not, and takes the generic routes).
+
+  /// The shape as an analytic ellipsoid (a sphere included).
+  virtual const Ellipsoid* analytic_ellipsoid() const { return nullptr; }
+  /// The shape as a plane's half-space.
+  virtual const Plane* half_space() const { return nullptr; }
+  /// The shape as a closed triangle mesh with its search trees (the mesh routes of first contact,
+  /// the smooth support point, the FEM mesher's triangulated route).
+  virtual const MeshShape* triangle_mesh() const { return nullptr; }
 };
 
 }  // namespace impactdeck::geometry

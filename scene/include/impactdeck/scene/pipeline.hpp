@@ -84,10 +84,6 @@ contact::ContactEvaluation locate_impact_contact(const Scene& scene, const Impac
 ImpactReport solve_located_impact(const Scene& scene, const ImpactSpec& s, const contact::ContactModel& model,
                                   contact::ContactEvaluation contact, std::vector<std::string>& warnings);
 
-/// The hybrid deck's far-field element size when the scene gives none: half the smallest semi-axis
-/// of an ellipsoid or sphere, a quarter of a part's size.
-double default_mesh_size_m(const BodySpec& body, const contact::PreparedBody& prepared);
-
 /// The scene's force-table options for impact `s`, their errors naming the [outputs] keys' lines
 /// and the impact (ForceTableOptions' contexts).
 collision::ForceTableOptions force_table_options(const Scene& scene, const ImpactSpec& s);

@@ -15,6 +15,7 @@
 #include "impactdeck/collision/validity.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/common/units.hpp"
+#include "impactdeck/scene/body_shape.hpp"
 #include "impactdeck/scene/overrides.hpp"
 
 namespace impactdeck::scene {
@@ -36,18 +37,11 @@ struct Material {
   Place place;
 };
 
-enum class ShapeKind { sphere, ellipsoid, mesh, plane };
-
 struct BodySpec {
   std::string name;
-  ShapeKind shape = ShapeKind::sphere;
-  double radius_m = 0;                                     ///< sphere
-  Eigen::Vector3d semi_axes_m = Eigen::Vector3d::Zero();   ///< ellipsoid
-  std::filesystem::path mesh_path;                         ///< mesh, resolved against the scene
-  Eigen::Vector3d plane_normal = Eigen::Vector3d::UnitZ();  ///< plane: outward unit normal (own frame)
-  bool mesh_repair = false;                  ///< mesh: `repair = true` (stitch, merge, orient outward)
-  bool mesh_approximate_mass = false;        ///< mesh: `approximate_mass_properties = true`
-  bool mesh_self_intersection_check = true;  ///< mesh: `self_intersection_check = false` skips it
+  /// The shape and its keys (`shape = "NAME"` and that shape's keys: body_shape.hpp). Never null
+  /// in a parsed scene.
+  std::shared_ptr<const ShapeSpec> shape;
   std::string material;
   std::optional<double> mass_kg;  ///< overrides density x volume; inertia scales with it
   bool fixed = false;             ///< infinite mass (always for a plane)
@@ -157,7 +151,5 @@ Scene load_scene(const std::filesystem::path& file, const std::vector<Override>&
 Scene parse_scene(const std::string& text, const std::string& name,
                   const std::filesystem::path& base_dir = ".", const std::vector<Override>& overrides = {},
                   const InputContext& context = {});
-
-const char* to_string(ShapeKind k);
 
 }  // namespace impactdeck::scene
