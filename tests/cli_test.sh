@@ -141,7 +141,7 @@ for r in ok:
 assert any(float(r["residual_indentation_m"]) > 0 for r in ok)
 views = [l for l in open(sys.argv[2] + "/sweep_drop.pos") if l.startswith("View")]
 assert any('"restitution"' in v for v in views) and any('"residual_indentation_m"' in v for v in views), views
-assert "# contact law: thornton" in open(sys.argv[2] + "/sweep_drop.csv").read()
+assert json.load(open(sys.argv[2] + "/sweep_drop.csv.json"))["metadata"]["contact_law"] == "thornton"
 curves = [l for l in open(sys.argv[2] + "/sweep_drop_curves.csv") if not l.startswith("#")]
 assert len(curves) == 1 + 21 * len(ok), len(curves)
 PY
