@@ -175,7 +175,7 @@ TEST_F(SweepFiles, CsvHasOneRowPerPoint) {
     EXPECT_EQ(line.find("inf"), std::string::npos);
     ++rows;
   }
-  EXPECT_EQ(header_cols, 28u);  // ... target_dwz_rad_s, contact_ellipse_axis_ratio, sharp_feature, flag
+  EXPECT_EQ(header_cols, 29u);  // ... residual_indentation_m, target_dv..., contact_ellipse_axis_ratio, sharp_feature, flag
   EXPECT_EQ(rows, result->points.size());
   EXPECT_EQ(result->points.size(), 690u);  // 390 grid + 300 uniform
 
@@ -197,9 +197,10 @@ TEST_F(SweepFiles, GmshPosViews) {
     }
     ++count;
   }
-  EXPECT_EQ(count, 3 * result->points.size());  // no sharp point on an ellipsoid: no fourth view
-  const std::regex view(R"re(View "(max_force_N|force_ratio|contact_ellipse_axis_ratio)" \{)re");
-  EXPECT_EQ(std::distance(std::sregex_iterator(pos.begin(), pos.end(), view), std::sregex_iterator()), 3);
+  EXPECT_EQ(count, 5 * result->points.size());  // no sharp point on an ellipsoid: no sixth view
+  const std::regex view(
+      R"re(View "(max_force_N|force_ratio|restitution|residual_indentation_m|contact_ellipse_axis_ratio)" \{)re");
+  EXPECT_EQ(std::distance(std::sregex_iterator(pos.begin(), pos.end(), view), std::sregex_iterator()), 5);
   EXPECT_EQ(std::count(pos.begin(), pos.end(), '{'), std::count(pos.begin(), pos.end(), '}'));
 }
 
@@ -278,13 +279,15 @@ TEST_F(SweepFiles, VtpIsBinaryPolyDataWithTheResultsArrays) {
     const std::size_t n = result->points.size();
     EXPECT_EQ(pieces[0]->UnsignedAttribute("NumberOfPoints"), n);
     EXPECT_EQ(pieces[0]->UnsignedAttribute("NumberOfVerts"), n);
-    EXPECT_EQ(v.arrays.size(), 12u);  // 8 scalars (flag included) + normals + points + connectivity + offsets
+    EXPECT_EQ(v.arrays.size(), 14u);  // 10 scalars (flag included) + normals + points + connectivity + offsets
     const double fmax = result->points[result->max_index].max_force_N;
     for (std::size_t i = 0; i < n; ++i) {
       const PointResult& p = result->points[i];
       // The same doubles as the result (bitwise: == on finite values, and no -0 written).
       ASSERT_EQ(v.arrays["max_force_N"].at(i), p.max_force_N);
       ASSERT_EQ(v.arrays["force_ratio"].at(i), p.max_force_N / fmax);
+      ASSERT_EQ(v.arrays["restitution"].at(i), p.restitution);
+      ASSERT_EQ(v.arrays["residual_indentation_m"].at(i), p.residual_indentation_m);
       ASSERT_EQ(v.arrays["reduced_mass_kg"].at(i), p.reduced_mass_kg);
       ASSERT_EQ(v.arrays["effective_radius_m"].at(i), p.effective_radius_m);
       ASSERT_EQ(v.arrays["target_radius_m"].at(i), p.target_radius_m);
@@ -365,7 +368,8 @@ TEST_F(SweepFiles, NumbersReadBackBitwise) {
                                p.normal.y(), p.normal.z(), p.target_radius_m, p.impactor_radius_m,
                                p.effective_radius_m, p.reduced_mass_kg, p.hertz_constant, p.max_indentation_m,
                                p.max_force_N, p.max_force_N / fmax, p.compression_time_s, p.restitution,
-                               p.contact_time_s, p.impulse_total_Ns, p.target_delta_velocity_m_s.x(),
+                               p.contact_time_s, p.impulse_total_Ns, p.residual_indentation_m,
+                               p.target_delta_velocity_m_s.x(),
                                p.target_delta_velocity_m_s.y(), p.target_delta_velocity_m_s.z(),
                                p.target_delta_angular_velocity_rad_s.x(), p.target_delta_angular_velocity_rad_s.y(),
                                p.target_delta_angular_velocity_rad_s.z(), p.contact_ellipse_axis_ratio,

@@ -30,6 +30,7 @@ for name in ["ellipsoid", "cube"]:
     # CSV column(s) of each VTP array; the CSV holds the shortest round-trip text of each double.
     expected = {
         "max_force_N": ["max_force_N"], "force_ratio": ["force_ratio"], "reduced_mass_kg": ["reduced_mass_kg"],
+        "restitution": ["restitution"], "residual_indentation_m": ["residual_indentation_m"],
         "effective_radius_m": ["effective_radius_m"], "target_radius_m": ["target_radius_m"],
         "contact_ellipse_axis_ratio": ["contact_ellipse_axis_ratio"], "sharp_feature": ["sharp_feature"],
         "normal": ["nx", "ny", "nz"],

@@ -152,7 +152,18 @@ CompareReport compare_contact(const Scene& scene_in, const CompareOptions& o) {
   const InputContext impact_ctx = ctx.at(InputContext::joined(s.place.describe(), "impact '" + s.name + "'"));
   const double e_star =
       collision::effective_modulus_Pa(target.material, impactor.material, scene.modulus_convention, impact_ctx);
-  const ContactModel model(target, impactor, s.contact_radius, e_star, s.restitution, impact_ctx);
+  // The full-contact model is elastic: "auto" runs Hertz here (impact_law), a plastic law is refused.
+  ImpactLaw law = impact_law(scene, s, impact_ctx);
+  if (law.automatic && law.name != "hertz") {  // as `run` with compare_contact = true chooses
+    Scene compared = scene;
+    compared.outputs.fem->compare_contact.emplace();
+    law = impact_law(compared, s, impact_ctx);
+  }
+  if (law.name != "hertz") {
+    throw impact_ctx.error("contact_law", "compare-contact compares with an elastic full-contact model: it needs "
+                                          "contact_law = \"hertz\" or \"auto\", got \"" + law.name + "\"");
+  }
+  const ContactModel model(target, impactor, s.contact_radius, e_star, law.law, impact_ctx);
   ContactEvaluation ev = locate_impact_contact(scene, s, model);
   if (ev.result.flag != collision::ContactFlag::none) {
     CompareReport rep;
@@ -167,7 +178,7 @@ CompareReport compare_contact(const Scene& scene_in, const CompareOptions& o) {
                       "): there is no analytic force to compare with and no hybrid deck to build";
     return rep;
   }
-  ImpactReport ir = solve_located_impact(scene, s, model, std::move(ev), notes.warnings);
+  ImpactReport ir = solve_located_impact(scene, s, law, model, std::move(ev), notes.warnings);
   ir.table = collision::sample_force_table(ir.result.history, force_table_options(scene, s));
   CompareInput in = compare_input(scene, ir, target, impactor, ctx);
   for (const auto& w : notes.warnings) in.warnings.push_back(w);

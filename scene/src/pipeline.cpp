@@ -256,6 +256,54 @@ fem_export::DeckRequest fem_request(const Scene& scene, const ImpactReport& ir, 
 
 }  // namespace
 
+namespace {
+
+// What the law did at a solved impact (docs/plastic.md): the law that ran, V_y, the dent's and the
+// unloading's radii; the validity of a plastic law (small strain up to d*/R* =
+// kPlasticMaxIndentationOverRadius, the contact circle a* = sqrt(R* d*) against the radii of
+// curvature; no yield warning: the law is the plastic one); the
+// warning of a scene whose `restitution` keeps Hertz where a plastic law applies.
+void describe_law(const Scene& scene, const ImpactSpec& s, const ImpactLaw& law, ImpactReport& ir) {
+  const collision::ImpactResult& r = ir.result;
+  const collision::LawResult& l = r.history.law_result;
+  ir.law = law;
+  if (law.limiting_pressure_Pa) {
+    ir.yield_velocity_m_s =
+        yield_velocity_m_s(r.reduced_mass_kg, r.effective_modulus_Pa, r.effective_radius_m, *law.limiting_pressure_Pa);
+  }
+  const bool elastic = ir.yield_velocity_m_s && r.approach_velocity_m_s <= *ir.yield_velocity_m_s;
+  ir.contact_law = law.automatic && law.name != "hertz" && elastic ? "hertz" : law.name;
+  const double unloading = l.max_indentation_m - l.residual_indentation_m;  // d* - d_p
+  const double k = 3.0 * l.max_force_N / (4.0 * r.effective_modulus_Pa * unloading * std::sqrt(unloading));
+  ir.unloading_radius_m = k * k;
+  ir.dent_radius_m = l.residual_indentation_m > 0.0 ? std::sqrt(r.effective_radius_m * l.max_indentation_m) : 0.0;
+  if (ir.plastic()) {
+    collision::ValidityLimits limits = scene.validity;
+    limits.max_indentation_over_radius = kPlasticMaxIndentationOverRadius;
+    // The plastic contact at F*: the circle of radius a* = sqrt(R* d*) (Thornton) under the mean
+    // pressure F* / (pi a*^2), not Hertz's ellipse of F*.
+    collision::KernelResult plastic = r.kernel;
+    const double a = std::sqrt(r.effective_radius_m * l.max_indentation_m);
+    plastic.contact_semi_axis_a_m = plastic.contact_semi_axis_b_m = a;
+    plastic.peak_pressure_Pa = l.max_force_N / (M_PI * a * a);
+    collision::ValidityReport v = collision::assess_validity(ir.contact.input, plastic, std::nullopt, std::nullopt, limits);
+    v.yield_onset_pressure_Pa = ir.validity.yield_onset_pressure_Pa;  // for the record: the law is the plastic one
+    if (v.yield_onset_pressure_Pa) v.peak_pressure_over_yield_onset = v.peak_pressure_Pa / *v.yield_onset_pressure_Pa;
+    v.yielding_body = ir.validity.yielding_body;
+    ir.validity = std::move(v);
+  } else if (law.automatic && s.restitution_given && !law.plastic_law.empty() && ir.yield_velocity_m_s && !elastic) {
+    std::ostringstream w;
+    w << "restitution is set and contact_law is not, so Hertz ran with that restitution (as before contact laws); "
+      << "V = " << r.approach_velocity_m_s << " m/s exceeds the yield velocity V_y = " << *ir.yield_velocity_m_s
+      << " m/s, where the plastic law \"" << law.plastic_law << "\" applies: set contact_law = \"" << law.plastic_law
+      << "\" and remove restitution (docs/plastic.md)";
+    ir.validity.warnings.push_back(w.str());
+    ir.validity.ok = false;
+  }
+}
+
+}  // namespace
+
 ContactEvaluation locate_impact_contact(const Scene& scene, const ImpactSpec& s, const ContactModel& model) {
   return locate_contact(scene, s, model);
 }
@@ -268,8 +316,8 @@ collision::ForceTableOptions force_table_options(const Scene& scene, const Impac
   return o;
 }
 
-ImpactReport solve_located_impact(const Scene& scene, const ImpactSpec& s, const ContactModel& model,
-                                  ContactEvaluation located, std::vector<std::string>& warnings) {
+ImpactReport solve_located_impact(const Scene& scene, const ImpactSpec& s, const ImpactLaw& law,
+                                  const ContactModel& model, ContactEvaluation located, std::vector<std::string>& warnings) {
   if (s.contact_radius == ContactRadiusRule::paper) {
     for (const PreparedBody* b : {&model.target(), &model.impactor()}) {
       if (scene.body(b->name).shape->frame_dependent_paper_radius()) {
@@ -285,7 +333,11 @@ ImpactReport solve_located_impact(const Scene& scene, const ImpactSpec& s, const
   const collision::ImpactInput in = impact_input(scene, s, model, located);
   detail::check_impact_magnitudes(scene, s, in, located.result.effective_radius_m);
   static_cast<contact::Impact&>(ir) = contact::complete_impact(model, std::move(located), in, scene.validity);
-  for (const auto& w : ir.validity.warnings) warnings.push_back("impact '" + s.name + "': validity of the Hertz model: " + w);
+  describe_law(scene, s, law, ir);
+  for (const auto& w : ir.validity.warnings) {
+    warnings.push_back("impact '" + s.name + "': validity of the " +
+                       (ir.plastic() ? ir.contact_law + " law: " : std::string("Hertz model: ")) + w);
+  }
   for (const auto& w : ir.result.warnings) warnings.push_back("impact '" + s.name + "': " + w);
   if (const std::string w = detail::indentation_warning(scene, s, ir.result); !w.empty()) {
     warnings.push_back("impact '" + s.name + "': " + w);
@@ -388,10 +440,11 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
     const PreparedBody& target = bodies.at(s.target);
     const PreparedBody& impactor = bodies.at(s.impactor);
     const InputContext ctx = impact_context(scene, s);
+    const ImpactLaw law = impact_law(scene, s, ctx);
     const ContactModel model(
         target, impactor, s.contact_radius,
-        collision::effective_modulus_Pa(target.material, impactor.material, scene.modulus_convention, ctx),
-        s.restitution, ctx);
+        collision::effective_modulus_Pa(target.material, impactor.material, scene.modulus_convention, ctx), law.law,
+        ctx);
     ContactEvaluation located = clock.run(Stage::contact_geometry, [&] { return locate_contact(scene, s, model); });
     if (located.result.flag != collision::ContactFlag::none) {
       const Place place{s.place.line, s.place.key + ".point"};
@@ -403,7 +456,7 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
                            (located.curvature_problem.empty() ? "" : " (" + located.curvature_problem + ")"));
     }
     ImpactReport ir = clock.run(
-        Stage::impact, [&] { return solve_located_impact(scene, s, model, std::move(located), report.warnings); });
+        Stage::impact, [&] { return solve_located_impact(scene, s, law, model, std::move(located), report.warnings); });
     report.impacts.push_back(std::move(ir));
   }
 

@@ -26,6 +26,13 @@ nlohmann::json body_json(const std::string& name, const collision::VelocityJump&
           {"principal_curvatures_1_per_m", {json_number(k.curvature.k1_per_m), json_number(k.curvature.k2_per_m)}}};
 }
 
+// The built law gives Hertz's restitution (its model: energy flux, constant, table).
+bool hertz_law(const ImpactReport& ir) { return !ir.law.law || ir.law.name == "hertz"; }
+
+nlohmann::json optional_number(const std::optional<double>& x) {
+  return x ? json_number(*x) : nlohmann::json(nullptr);
+}
+
 nlohmann::json validity_json(const collision::ValidityReport& v) {
   nlohmann::json j = {{"indentation_over_radius", json_number(v.indentation_over_radius)},
                       {"max_indentation_over_radius", v.limits.max_indentation_over_radius},
@@ -81,8 +88,17 @@ nlohmann::json to_json(const Scene& scene, const RunReport& rep) {
     i["effective_modulus_Pa"] = json_number(r.effective_modulus_Pa);
     i["hertz_constant_N_per_m1_5"] = json_number(r.hertz_constant);
     i["approach_velocity_m_s"] = json_number(r.approach_velocity_m_s);
-    i["restitution_model"] = collision::to_string(r.restitution_kind);
-    if (r.restitution_kind == collision::RestitutionModel::Kind::energy_flux) {
+    const bool hertz_restitution = hertz_law(ir);
+    i["contact_law"] = ir.contact_law;
+    i["contact_law_requested"] = ir.spec->contact_law;
+    i["limiting_pressure_Pa"] = optional_number(ir.law.limiting_pressure_Pa);
+    i["yield_velocity_m_s"] = optional_number(ir.yield_velocity_m_s);
+    i["validity"]["contact_law"] = ir.contact_law;
+    // A law other than Hertz gives its own restitution: its name is the restitution model.
+    i["restitution_model"] = hertz_restitution ? collision::to_string(r.restitution_kind) : ir.law.name.c_str();
+    if (!hertz_restitution) {
+      i["energy_flux_density"] = nullptr;
+    } else if (r.restitution_kind == collision::RestitutionModel::Kind::energy_flux) {
       i["energy_flux_density"] = json_number(r.restitution.energy_flux_density);
       i["energy_flux_density_unit"] = collision::to_string(ir.spec->restitution.flux_unit);
       i["energy_flux_density_J_m3"] = json_number(r.restitution.energy_flux_density_J_m3);
@@ -99,6 +115,9 @@ nlohmann::json to_json(const Scene& scene, const RunReport& rep) {
     i["contact_time_s"] = json_number(r.history.contact_time_s());
     i["impulse_compression_Ns"] = json_number(r.history.impulse_compression_Ns());
     i["impulse_total_Ns"] = json_number(r.history.impulse_total_Ns());
+    i["residual_indentation_m"] = json_number(r.history.law_result.residual_indentation_m);
+    i["dent_radius_m"] = json_number(ir.dent_radius_m);
+    i["unloading_radius_m"] = json_number(ir.unloading_radius_m);
     const auto& k = r.checks;
     i["checks"] = {{"impulse_relative_error", json_number(k.impulse_relative_error)},
                    {"energy_relative_error", json_number(k.energy_relative_error)},
@@ -184,7 +203,12 @@ std::string format_summary(const Scene& scene, const RunReport& rep) {
       << " rule)\n";
     o << "  effective modulus     " << r.effective_modulus_Pa << " Pa\n";
     o << "  Hertz constant        " << r.hertz_constant << " N/m^1.5\n";
-    if (r.restitution_kind == collision::RestitutionModel::Kind::energy_flux) {
+    o << "  contact law           " << ir.contact_law;
+    if (ir.law.limiting_pressure_Pa) o << " (p_y = " << *ir.law.limiting_pressure_Pa << " Pa";
+    if (ir.yield_velocity_m_s) o << ", V_y = " << *ir.yield_velocity_m_s << " m/s";
+    if (ir.law.limiting_pressure_Pa) o << ")";
+    o << "\n";
+    if (hertz_law(ir) && r.restitution_kind == collision::RestitutionModel::Kind::energy_flux) {
       o << "  energy flux density   " << r.restitution.energy_flux_density << " "
         << collision::to_string(ir.spec->restitution.flux_unit) << " (ln = " << r.restitution.ln_energy_flux
         << (r.restitution.clamped ? ", clamped" : "") << ")\n";
@@ -196,12 +220,17 @@ std::string format_summary(const Scene& scene, const RunReport& rep) {
     o << "  contact time          " << r.history.contact_time_s() << " s\n";
     o << "  impulse               " << r.history.impulse_total_Ns() << " N s (compression "
       << r.history.impulse_compression_Ns() << ")\n";
+    if (r.history.law_result.residual_indentation_m > 0.0) {
+      o << "  dent                  " << r.history.law_result.residual_indentation_m << " m deep (both bodies), radius "
+        << ir.dent_radius_m << " m; unloading radius " << ir.unloading_radius_m << " m\n";
+    }
     const auto& v = ir.validity;
     o << "  validity              x_max/R* " << v.indentation_over_radius << ", contact a = "
       << v.contact_semi_axis_a_m << " m, b = " << v.contact_semi_axis_b_m << " m, a/R_min "
       << v.contact_size_over_radius << ", p0 " << v.peak_pressure_Pa << " Pa";
     if (v.peak_pressure_over_yield_onset) o << " (" << *v.peak_pressure_over_yield_onset << " x onset of yield)";
-    o << (v.ok ? " -> within Hertz's assumptions" : " -> OUTSIDE Hertz's assumptions (see warnings)") << "\n";
+    const std::string model = ir.plastic() ? "the " + ir.contact_law + " law's" : "Hertz's";
+    o << (v.ok ? " -> within " + model + " assumptions" : " -> OUTSIDE " + model + " assumptions (see warnings)") << "\n";
     o << "  target   dv = " << text(r.target_jump.delta_velocity_m_s) << " m/s, dw = "
       << text(r.target_jump.delta_angular_velocity_rad_s) << " rad/s\n";
     o << "  impactor dv = " << text(r.impactor_jump.delta_velocity_m_s) << " m/s, dw = "

@@ -1,5 +1,6 @@
 #include "impactdeck/scene/scene.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 #include <sstream>
@@ -7,6 +8,7 @@
 
 #include <toml++/toml.h>
 
+#include "impactdeck/collision/contact_law.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/common/suggest.hpp"
 #include "overrides_toml.hpp"
@@ -221,7 +223,7 @@ class Reader {
 // All keys a reader may see are declared by reading them; sub-tables are read by their own reader.
 Material read_material(const std::string& name, const toml::table& t, const Source& file) {
   Reader r(t, "materials." + name, file);
-  r.allow({"youngs_modulus_Pa", "poisson_ratio", "density_kg_m3", "yield_strength_Pa"});
+  r.allow({"youngs_modulus_Pa", "poisson_ratio", "density_kg_m3", "yield_strength_Pa", "tangent_modulus_Pa"});
   Material m;
   m.name = name;
   m.place = r.self();
@@ -232,6 +234,13 @@ Material read_material(const std::string& name, const toml::table& t, const Sour
   }
   if (r.has("density_kg_m3")) m.density_kg_m3 = r.positive("density_kg_m3");
   if (r.has("yield_strength_Pa")) m.yield_strength_Pa = r.positive("yield_strength_Pa");
+  if (const std::optional<double> et = r.number("tangent_modulus_Pa")) {
+    if (!(*et >= 0.0 && *et < m.elastic.youngs_modulus_Pa)) {
+      r.fail("tangent_modulus_Pa", "must lie in [0, youngs_modulus_Pa) = [0, " + Reader::fmt(m.elastic.youngs_modulus_Pa) +
+                                       "), got " + Reader::fmt(*et));
+    }
+    m.tangent_modulus_Pa = et;
+  }
   r.reject_unknown();
   return m;
 }
@@ -338,7 +347,7 @@ ImpactSpec read_impact(std::size_t index, const toml::table& t, const Source& fi
                        double to_m, const collision::RestitutionModel& defaults) {
   Reader r(t, "impacts[" + std::to_string(index) + "]", file);
   r.allow({"name", "target", "impactor", "point", "restitution", "contact_radius",
-           "approach_speed_m_s", "max_projection_distance"});
+           "approach_speed_m_s", "max_projection_distance", "contact_law", "limiting_pressure_Pa"});
   ImpactSpec s;
   s.place = r.self();
   s.name = r.string("name").value_or("impact" + std::to_string(index + 1));
@@ -358,6 +367,25 @@ ImpactSpec read_impact(std::size_t index, const toml::table& t, const Source& fi
     r.missing("point");
   }
   s.restitution = defaults;
+  s.restitution_given = r.has("restitution");
+  if (const std::optional<std::string> law = r.string("contact_law")) {
+    std::vector<std::string> known = collision::contact_law_names();
+    known.insert(known.begin(), "auto");
+    if (std::find(known.begin(), known.end(), *law) == known.end()) {
+      std::string list;
+      for (const auto& k : known) list += (list.empty() ? "" : ", ") + ("\"" + k + "\"");
+      r.fail("contact_law", "unknown contact law \"" + *law + "\" (expected one of " + list + ")" + did_you_mean(*law, known));
+    }
+    s.contact_law = *law;
+    s.contact_law_given = true;
+    s.contact_law_place = r.place("contact_law");
+    // A plastic law gives its own restitution (docs/plastic.md): both keys contradict each other.
+    if (s.restitution_given && *law != "auto" && *law != "hertz") {
+      r.fail("contact_law", "contact_law = \"" + *law + "\" gives its own restitution, but " + r.key_path("restitution") +
+                                " is set too: remove " + r.key_path("restitution") + " or set contact_law = \"hertz\"");
+    }
+  }
+  if (r.has("limiting_pressure_Pa")) s.limiting_pressure_Pa = r.positive("limiting_pressure_Pa");
   if (const toml::node* n = r.get("restitution")) {
     if (n->is_string()) {
       if (n->value<std::string>().value() != "energy-flux") {
@@ -666,6 +694,19 @@ Scene build(const toml::table& root, const Source& file, const fs::path& base_di
                          "no body named '" + *who + "'" + did_you_mean(*who, names));
       }
     }
+    if (s.contact_law_given && s.contact_law != "auto" && s.contact_law != "hertz") {
+      // A plastic law needs the yield strength of at least one body (docs/plastic.md).
+      const Material& mt = sc.materials.at(sc.body(s.target).material);
+      const Material& mi = sc.materials.at(sc.body(s.impactor).material);
+      if (!mt.yield_strength_Pa && !mi.yield_strength_Pa) {
+        const std::string names = mt.name == mi.name ? "material '" + mt.name + "' has"
+                                                     : "materials '" + mt.name + "' and '" + mi.name + "' have";
+        throw file.error(s.contact_law_place, "contact_law = \"" + s.contact_law + "\" is a plastic law, but " + names +
+                                                  " no yield_strength_Pa: give " +
+                                                  (mt.name == mi.name ? "it" : "one of them") +
+                                                  " yield_strength_Pa or set contact_law = \"hertz\"");
+      }
+    }
     if (!s.first_contact) {
       const BodySpec& imp = sc.body(s.impactor);
       if (imp.placed && imp.position_m != Eigen::Vector3d::Zero()) {
@@ -685,6 +726,15 @@ Scene build(const toml::table& root, const Source& file, const fs::path& base_di
   if (sc.impacts.empty()) r.fail("impacts", "at least one impact is needed");
 
   if (const toml::node* n = r.get("outputs")) sc.outputs = read_outputs(sub_table(n, "outputs", file), file, to_m);
+  if (sc.outputs.fem && sc.outputs.fem->compare_contact) {
+    for (const ImpactSpec& s : sc.impacts) {
+      if (s.contact_law != "auto" && s.contact_law != "hertz") {
+        throw file.error(s.contact_law_place, "[outputs.fem] compare_contact = true compares with an elastic "
+                                              "full-contact model: it needs contact_law = \"hertz\" or \"auto\", got \"" +
+                                                  s.contact_law + "\"");
+      }
+    }
+  }
   r.reject_unknown();
   return sc;
 }

@@ -7,6 +7,7 @@
 
 #include "impactdeck/collision/compression.hpp"
 #include "impactdeck/collision/force_history.hpp"
+#include "impactdeck/collision/hertz_law.hpp"
 #include "impactdeck/common/error.hpp"
 #include "parallel.hpp"
 
@@ -39,6 +40,7 @@ void record(const contact::ContactModel& model, const geometry::SurfacePoint& at
   r.restitution_clamped = k.restitution.clamped;
   r.contact_time_s = k.contact_time_s;
   r.impulse_total_Ns = k.impulse_total_Ns;
+  r.residual_indentation_m = k.residual_indentation_m;
   const geometry::PoseMap& frame = model.target_frame();
   r.target_delta_velocity_m_s = frame.direction_to_own(k.target_jump.delta_velocity_m_s);
   r.target_delta_angular_velocity_rad_s = frame.direction_to_own(k.target_jump.delta_angular_velocity_rad_s);
@@ -102,6 +104,20 @@ void sample_curve(const PointResult& p, std::size_t samples, double* out) {
   if (R > 0.0) out[samples - 1] = 0.0;  // end of contact
 }
 
+void sample_curve(const collision::ContactLaw& law, const PointResult& p, double speed, double effective_modulus_Pa,
+                  double yield_strength_Pa, std::size_t samples, double* out) {
+  collision::LawInput in;
+  in.reduced_mass_kg = p.reduced_mass_kg;
+  in.approach_velocity_m_s = speed;
+  in.effective_modulus_Pa = effective_modulus_Pa;
+  in.effective_radius_m = p.effective_radius_m;
+  in.yield_strength_Pa = yield_strength_Pa;
+  collision::LawResult r;
+  law.solve(&in, &r, 1);
+  const double last = static_cast<double>(samples - 1);
+  for (std::size_t k = 0; k < samples; ++k) out[k] = law.force_N(r, r.contact_time_s * static_cast<double>(k) / last);
+}
+
 std::string flag_counts_text(const SweepResult& r) {
   std::ostringstream m;
   bool any = false;
@@ -120,7 +136,14 @@ SweepResult run_sweep(const SweepSetup& s, const std::vector<geometry::SurfacePo
     throw s.context.error("approach speed", "must be positive and finite");
   }
   if (o.curves && o.curve_samples < 2) throw s.context.error("curve samples", "must be at least 2");
-  const contact::ContactModel model(s.target, s.impactor, s.rule, s.effective_modulus_Pa, s.restitution, s.context);
+  const std::shared_ptr<const collision::ContactLaw> law =
+      s.law ? s.law : std::make_shared<const collision::HertzLaw>(s.restitution, s.context);
+  const contact::ContactModel model(s.target, s.impactor, s.rule, s.effective_modulus_Pa, law, s.context);
+  // A law other than Hertz draws its own F(t) (sample_curve with the law), with the yield strength
+  // the model hands it (the weaker body's; 0 when neither has one).
+  const collision::ContactLaw* curve_law = dynamic_cast<const collision::HertzLaw*>(law.get()) ? nullptr : law.get();
+  const double yt = s.target.yield_strength_Pa.value_or(0.0), yi = s.impactor.yield_strength_Pa.value_or(0.0);
+  const double yield_strength_Pa = yt > 0.0 && yi > 0.0 ? std::min(yt, yi) : std::max(yt, yi);
   SweepResult res;
   const std::size_t n = cloud.size();
   res.points.resize(n);  // every point writes only its own slot
@@ -135,7 +158,14 @@ SweepResult run_sweep(const SweepSetup& s, const std::vector<geometry::SurfacePo
         sweep_points(model, s.approach_speed_m_s, &cloud[begin], end - begin, &res.points[begin]);  // in place
         if (!o.curves) return;
         for (std::size_t i = begin; i < end; ++i) {
-          if (!res.points[i].flagged()) sample_curve(res.points[i], o.curve_samples, &res.curves_N[i * o.curve_samples]);
+          if (res.points[i].flagged()) continue;
+          double* curve = &res.curves_N[i * o.curve_samples];
+          if (curve_law) {
+            sample_curve(*curve_law, res.points[i], s.approach_speed_m_s, s.effective_modulus_Pa,
+                         yield_strength_Pa, o.curve_samples, curve);
+          } else {
+            sample_curve(res.points[i], o.curve_samples, curve);
+          }
         }
       },
       o.progress);

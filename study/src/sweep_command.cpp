@@ -32,6 +32,8 @@ nlohmann::json point_json(std::size_t index, const PointResult& p) {
           {"point_m", json_vector(p.point_m)},
           {"normal", json_vector(p.normal)},
           {"max_force_N", p.max_force_N},
+          {"restitution", p.restitution},
+          {"residual_indentation_m", p.residual_indentation_m},
           {"reduced_mass_kg", p.reduced_mass_kg},
           {"effective_radius_m", p.effective_radius_m},
           {"contact_ellipse_axis_ratio", p.contact_ellipse_axis_ratio},
@@ -128,6 +130,7 @@ void sweep_stages(const SweepCase& ss, const SweepRequest& q, RunTransaction* tx
     meta.target = ss.target;
     meta.impactor = ss.impactor;
     meta.cloud = rep.cloud;
+    meta.contact_law = rep.contact_law;
     SweepPicture picture;
     picture.target = &target;
     picture.centroid_m = ss.setup.target.volume.centroid_m;
@@ -146,6 +149,7 @@ void sweep_stages(const SweepCase& ss, const SweepRequest& q, RunTransaction* tx
 SweepReport run_sweep_command(const SweepCase& ss, const SweepRequest& q) {
   SweepReport rep;
   rep.scene = ss.source;
+  if (ss.setup.law) rep.contact_law = ss.setup.law->name();
   rep.output_length_unit = q.output_length_unit.value_or(ss.length_unit);
   if (q.out_dir.empty()) {
     sweep_stages(ss, q, nullptr, rep);
@@ -171,6 +175,7 @@ nlohmann::json to_json(const SweepReport& rep) {
   j["min"] = point_json(r.min_index, r.points.at(r.min_index));
   j["max"] = point_json(r.max_index, r.points.at(r.max_index));
   j["approach_speed_m_s"] = rep.approach_speed_m_s;
+  j["contact_law"] = rep.contact_law;
   j["restitution_clamped_points"] = r.restitution_clamped_count;
   j["sharp_points"] = r.sharp_count;
   j["flagged_points"] = r.flagged_count;
@@ -209,6 +214,7 @@ std::string format_sweep(const SweepReport& rep) {
   std::ostringstream o;
   o << "sweep of impact '" << rep.impact << "': " << rep.impactor << " hits " << rep.target << " at " << r.points.size()
     << " points (" << rep.cloud << "), " << rep.approach_speed_m_s << " m/s along the inward normal\n"
+    << "  contact law           " << rep.contact_law << "\n"
     << "  force ratio min/max   " << std::setprecision(6) << r.force_ratio << "\n"
     << "  reduced-mass part     " << r.mass_only_ratio << "\n"
     << "  min F_max             " << pmin.max_force_N << " N at " << pt(pmin) << " (point " << r.min_index << ")\n"

@@ -33,6 +33,7 @@ void header(std::ostream& o, const char* comment, const SweepMeta& m, const Swee
   if (!m.impact.empty())
     o << comment << " impact: " << m.impact << " (" << m.impactor << " hits " << m.target << " along the inward normal)\n";
   if (!m.cloud.empty()) o << comment << " cloud: " << m.cloud << ", " << r.points.size() << " points\n";
+  if (!m.contact_law.empty()) o << comment << " contact law: " << m.contact_law << "\n";
   o << comment << " units: SI (m, kg, N, s) but coordinates in " << to_string(unit) << " (metres per unit "
     << num(metres_per(unit)) << "), in the target's frame\n";
   o << comment << " force ratio min/max = " << num(r.force_ratio) << " (min at point " << r.min_index
@@ -53,6 +54,7 @@ std::vector<std::pair<std::string, std::string>> sidecar_metadata(const SweepMet
   if (!m.source.empty()) d.push_back({"scene", m.source});
   if (!m.impact.empty()) d.push_back({"impact", m.impact + " (" + m.impactor + " hits " + m.target + " along the inward normal)"});
   if (!m.cloud.empty()) d.push_back({"cloud", m.cloud + ", " + std::to_string(r.points.size()) + " points"});
+  if (!m.contact_law.empty()) d.push_back({"contact_law", m.contact_law});
   d.push_back({"frame", "coordinates in the target's frame, in " + std::string(to_string(unit)) + " (metres per unit " +
                             num(metres_per(unit)) + "); every other column SI"});
   d.push_back({"force_ratio", num(r.force_ratio) + " (min at point " + std::to_string(r.min_index) + ", max at point " +
@@ -109,6 +111,7 @@ void write_sweep_csv(const std::filesystem::path& path, const SweepResult& r, co
   t.number("restitution", [&](std::size_t i) { return P[i].restitution; });
   t.number("contact_time_s", [&](std::size_t i) { return P[i].contact_time_s; });
   t.number("impulse_total_Ns", [&](std::size_t i) { return P[i].impulse_total_Ns; });
+  t.number("residual_indentation_m", [&](std::size_t i) { return P[i].residual_indentation_m; });
   t.number("target_dvx_m_s", [&](std::size_t i) { return P[i].target_delta_velocity_m_s.x(); });
   t.number("target_dvy_m_s", [&](std::size_t i) { return P[i].target_delta_velocity_m_s.y(); });
   t.number("target_dvz_m_s", [&](std::size_t i) { return P[i].target_delta_velocity_m_s.z(); });
@@ -186,7 +189,7 @@ void write_sweep_pos(const std::filesystem::path& path, const SweepResult& r, co
     o << "// open with: gmsh " << path.filename().string() << "\n";
     // SP(x,y,z){v}; for the points of one view (chunks of points formatted in parallel). Progress
     // runs over all views: view k of m reports k n + done of m n.
-    const std::size_t views = 3 + (r.sharp_count > 0 ? 1 : 0) + (r.flagged_count > r.sharp_count ? 1 : 0);
+    const std::size_t views = 5 + (r.sharp_count > 0 ? 1 : 0) + (r.flagged_count > r.sharp_count ? 1 : 0);
     std::size_t views_done = 0;
     auto view = [&](const char* name, auto in_view, auto value) {
       detail::RowWriteOptions w = row_options(options);
@@ -209,6 +212,9 @@ void write_sweep_pos(const std::filesystem::path& path, const SweepResult& r, co
     // views of their own (value: the flag's number, collision::ContactFlag).
     view("max_force_N", [](const PointResult& p) { return !p.flagged(); }, [](const PointResult& p) { return p.max_force_N; });
     view("force_ratio", [](const PointResult& p) { return !p.flagged(); }, [&](const PointResult& p) { return p.max_force_N / fmax; });
+    view("restitution", [](const PointResult& p) { return !p.flagged(); }, [](const PointResult& p) { return p.restitution; });
+    view("residual_indentation_m", [](const PointResult& p) { return !p.flagged(); },
+         [](const PointResult& p) { return p.residual_indentation_m; });
     view("contact_ellipse_axis_ratio", [](const PointResult& p) { return !p.flagged(); },
          [](const PointResult& p) { return p.contact_ellipse_axis_ratio; });
     if (r.sharp_count > 0) {
@@ -286,6 +292,8 @@ void write_sweep_vtp(const std::filesystem::path& path, const SweepResult& r, co
   const std::vector<VtpArray> point_data = {
       scalar_array("max_force_N", P, [](const PointResult& p) { return p.max_force_N; }),
       scalar_array("force_ratio", P, [fmax](const PointResult& p) { return p.max_force_N / fmax; }),
+      scalar_array("restitution", P, [](const PointResult& p) { return p.restitution; }),
+      scalar_array("residual_indentation_m", P, [](const PointResult& p) { return p.residual_indentation_m; }),
       scalar_array("reduced_mass_kg", P, [](const PointResult& p) { return p.reduced_mass_kg; }),
       scalar_array("effective_radius_m", P, [](const PointResult& p) { return p.effective_radius_m; }),
       scalar_array("target_radius_m", P, [](const PointResult& p) { return radius_out(p.target_radius_m); }),

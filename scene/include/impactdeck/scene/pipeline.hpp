@@ -23,6 +23,16 @@ namespace impactdeck::scene {
 struct ImpactReport : contact::Impact {
   /// A copy of the scene's impact: the report stays valid after the Scene it came from is gone.
   std::shared_ptr<const ImpactSpec> spec;
+  /// The contact law (impact_law) and what it did (docs/plastic.md).
+  ImpactLaw law;
+  /// The law that ran, said in every output: law.name, except "hertz" where "auto" chose a plastic
+  /// law and V <= V_y (the plastic law is then exactly Hertz with R = 1).
+  std::string contact_law;
+  std::optional<double> yield_velocity_m_s;  ///< V_y at this impact's m*, E*, R* and p_y (unset: no p_y)
+  double dent_radius_m = 0;       ///< sqrt(R* d*) when the law leaves a dent, else 0
+  /// R_p of the unloading curve F = 4/3 E* sqrt(R_p) (d - d_p)^1.5 through (d*, F*): R* for Hertz.
+  double unloading_radius_m = 0;
+  bool plastic() const { return contact_law != "hertz"; }
   std::optional<collision::ForceTable> table;
   std::optional<std::filesystem::path> table_path;  ///< where the CSV was written
   std::optional<std::filesystem::path> plot_path;   ///< where the F(t) SVG was written
@@ -81,8 +91,10 @@ contact::ContactEvaluation locate_impact_contact(const Scene& scene, const Impac
 /// against double precision's range (naming the scene keys), the kernel's result completed
 /// (contact::complete_impact: the kernel is not solved again) and the validity assessed; its
 /// warnings appended to `warnings`. Throws InputError.
-ImpactReport solve_located_impact(const Scene& scene, const ImpactSpec& s, const contact::ContactModel& model,
-                                  contact::ContactEvaluation contact, std::vector<std::string>& warnings);
+/// `law` is impact_law(scene, s, ...), the law `model` holds.
+ImpactReport solve_located_impact(const Scene& scene, const ImpactSpec& s, const ImpactLaw& law,
+                                  const contact::ContactModel& model, contact::ContactEvaluation contact,
+                                  std::vector<std::string>& warnings);
 
 /// The scene's force-table options for impact `s`, their errors naming the [outputs] keys' lines
 /// and the impact (ForceTableOptions' contexts).

@@ -34,6 +34,9 @@ struct Material {
   /// Optional yield strength sigma_y (Pa): the validity report compares the peak Hertz pressure
   /// with the onset of yield, and the FEM verdict compares stresses with it.
   std::optional<double> yield_strength_Pa;
+  /// Optional tangent (hardening) modulus E_t of a bilinear elastic-plastic material, in [0, E)
+  /// (`tangent_modulus_Pa`; docs/plastic.md).
+  std::optional<double> tangent_modulus_Pa;
   Place place;
 };
 
@@ -68,6 +71,13 @@ struct ImpactSpec {
   bool first_contact = false;
   Eigen::Vector3d point_m = Eigen::Vector3d::Zero();
   collision::RestitutionModel restitution;            ///< unit and policy from the scene top level
+  bool restitution_given = false;  ///< `restitution` set in the scene (Hertz's, docs/plastic.md)
+  /// `contact_law`: "auto" (the default) or a registered law's name (collision::contact_law_names);
+  /// impact_law() turns it into the law that runs (docs/plastic.md).
+  std::string contact_law = "auto";
+  bool contact_law_given = false;  ///< `contact_law` set in the scene
+  Place contact_law_place;         ///< where (errors about the law name it)
+  std::optional<double> limiting_pressure_Pa;  ///< `limiting_pressure_Pa`: p_y of a plastic law
   ContactRadiusRule contact_radius = ContactRadiusRule::elliptical;
   std::optional<double> approach_speed_m_s;  ///< if set: impactor velocity = -speed * n
   std::optional<double> max_projection_distance_m;  ///< default: 1 % of the target's size
@@ -151,5 +161,33 @@ Scene load_scene(const std::filesystem::path& file, const std::vector<Override>&
 Scene parse_scene(const std::string& text, const std::string& name,
                   const std::filesystem::path& base_dir = ".", const std::vector<Override>& overrides = {},
                   const InputContext& context = {});
+
+/// d*/R* beyond which a plastic law's small-strain assumption is flagged (docs/plastic.md).
+inline constexpr double kPlasticMaxIndentationOverRadius = 0.1;
+
+/// The contact law an impact runs, chosen from its keys (docs/plastic.md):
+/// `contact_law` named: that law; "auto" (the default): "hertz" when `restitution` is set, when
+/// neither body's material has a yield strength, or when [outputs.fem] compare_contact = true (its
+/// full-contact model is elastic); else "thornton" (which is Hertz with R = 1 for V <= V_y).
+struct ImpactLaw {
+  std::string name;       ///< the registered law built ("hertz", "thornton", ...)
+  bool automatic = false; ///< chosen by "auto"
+  /// p_y: `limiting_pressure_Pa`, else collision::kThorntonYieldFactor x the weaker yield strength;
+  /// unset when neither is known.
+  std::optional<double> limiting_pressure_Pa;
+  /// The plastic law "auto" runs when a yield strength is known and no restitution is set (empty
+  /// when no yield strength is known): named by the warning of a scene that sets `restitution`.
+  std::string plastic_law;
+  std::shared_ptr<const collision::ContactLaw> law;
+};
+
+/// The law of impact `s`. Throws InputError (ctx) for a law the registry refuses.
+ImpactLaw impact_law(const Scene& scene, const ImpactSpec& s, const InputContext& ctx);
+
+/// Johnson's yield velocity (BEYOND_HERTZ.md; Johnson 1985, Sect. 11.4): the approach speed at which
+/// a Hertz impact first reaches the limiting pressure p_y,
+/// V_y = (pi / (2 E*))^2 (8 pi R*^3 / (15 m*))^(1/2) p_y^(5/2).
+double yield_velocity_m_s(double reduced_mass_kg, double effective_modulus_Pa, double effective_radius_m,
+                          double limiting_pressure_Pa);
 
 }  // namespace impactdeck::scene

@@ -36,7 +36,9 @@ struct SweepSetup {
   collision::ContactRule rule = collision::ContactRule::elliptical;
   double effective_modulus_Pa = 0;   ///< E* (Eq. 28 or Hertz convention)
   double approach_speed_m_s = 1.0;   ///< impactor velocity = -speed * n at every point
-  collision::RestitutionModel restitution;  ///< R, contact time and impulse at every point
+  collision::RestitutionModel restitution;  ///< R, contact time and impulse at every point (Hertz)
+  /// The contact law at every point (scene::impact_law); null: Hertz with `restitution`.
+  std::shared_ptr<const collision::ContactLaw> law;
   InputContext context;  ///< file and place run_sweep's errors name (e.g. the scene, "impact 'fig4'")
 };
 
@@ -82,6 +84,7 @@ struct PointResult {
   bool restitution_clamped = false; ///< outside the restitution model's range, clamped (policy "warn")
   double contact_time_s = 0;        ///< (1 + R) t_m
   double impulse_total_Ns = 0;      ///< (1 + R) m_w v_w
+  double residual_indentation_m = 0;  ///< the dent the law leaves (both bodies; 0 for Hertz)
   /// Velocity jumps of the target (Eq. 22-23) for that impulse; zero for a fixed target.
   Eigen::Vector3d target_delta_velocity_m_s = Eigen::Vector3d::Zero();
   Eigen::Vector3d target_delta_angular_velocity_rad_s = Eigen::Vector3d::Zero();
@@ -126,7 +129,12 @@ void sweep_points(const contact::ContactModel& model, double approach_speed_m_s,
 SweepResult run_sweep(const SweepSetup& setup, const std::vector<geometry::SurfacePoint>& cloud,
                       const SweepOptions& options = {});
 
-/// Samples F(t) of one point into `out` (size >= samples), uniform over [0, contact time].
+/// Samples F(t) of one point into `out` (size >= samples), uniform over [0, contact time]: Hertz's
+/// curve (the compression shape, mirrored and stretched by R).
 void sample_curve(const PointResult& p, std::size_t samples, double* out);
+/// The same for a point solved with `law` at the approach speed `approach_speed_m_s`, E* and the
+/// weaker yield strength of the sweep: the law's own F(t).
+void sample_curve(const collision::ContactLaw& law, const PointResult& p, double approach_speed_m_s,
+                  double effective_modulus_Pa, double yield_strength_Pa, std::size_t samples, double* out);
 
 }  // namespace impactdeck::study

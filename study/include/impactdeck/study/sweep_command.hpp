@@ -67,6 +67,7 @@ struct SweepReport {
   std::string cloud;  ///< what was swept, e.g. "area-uniform, 2000 area-uniform (seed 1)"
   LengthUnit output_length_unit = LengthUnit::m;
   double approach_speed_m_s = 0;
+  std::string contact_law = "hertz";  ///< the law at every point (SweepSetup::law's name)
   SweepResult result;
   std::vector<std::filesystem::path> files_written;  ///< final paths, in writing order
   std::vector<std::pair<Stage, double>> stage_times_s;  ///< the stages that ran, in order
@@ -78,7 +79,7 @@ struct SweepReport {
 SweepReport run_sweep_command(const SweepCase& sweep, const SweepRequest& request);
 
 /// `sweep --json` (docs/cli.md): scene, impact, cloud, output_length_unit, points, force_ratio,
-/// mass_only_ratio, min, max, approach_speed_m_s, restitution_clamped_points, sharp_points,
+/// mass_only_ratio, min, max, approach_speed_m_s, contact_law, restitution_clamped_points, sharp_points,
 /// flagged_points, flag_counts, threads, seconds, stages_run, stage_times_s, files_written, warnings.
 nlohmann::json to_json(const SweepReport& report);
 

@@ -25,6 +25,7 @@ struct SweepMeta {
   std::string target;    ///< body names
   std::string impactor;
   std::string cloud;     ///< e.g. "paper-grid (steps 8)"
+  std::string contact_law;  ///< the law at every point; empty: not said
 };
 
 /// How the large files are written: rows formatted in parallel chunks (numbers as the shortest
@@ -57,7 +58,8 @@ void write_sweep_csv(const std::filesystem::path& path, const SweepResult& r, co
 void write_sweep_curves_csv(const std::filesystem::path& path, const SweepResult& r, const SweepMeta& meta,
                             const SweepWriteOptions& options = {});
 
-/// Gmsh view file: views "max_force_N", "force_ratio" and "contact_ellipse_axis_ratio" as scalar
+/// Gmsh view file: views "max_force_N", "force_ratio", "restitution", "residual_indentation_m" and
+/// "contact_ellipse_axis_ratio" as scalar
 /// points SP(x,y,z){v} over the points off sharp features, and, when there are any, a view
 /// "sharp_feature" (value 1) of the points on sharp edges/corners.
 void write_sweep_pos(const std::filesystem::path& path, const SweepResult& r, const SweepMeta& meta,
