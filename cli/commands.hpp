@@ -21,10 +21,17 @@ struct Context {
   void note(const std::string& command, const std::string& text) const;
 };
 
+/// Writes `text` to stdout and flushes it, with SIGPIPE ignored meanwhile (a reader gone is
+/// EPIPE, not death). Throws InputError("stdout") when the write fails (closed, full, a broken
+/// pipe): `run` calls it before its commit, so that the run is then rolled back (issue 29).
+void write_stdout(const std::string& text);
+
 /// Checks, before a command that publishes files starts, that stdout can be written: a zero-byte
 /// write fails on a closed or read-only stdout (EBADF) and on a device that is always full
-/// (/dev/full: ENOSPC). Its output is printed after the files are published, so a stdout found
-/// unusable only then would leave them behind with exit 3 (issue 29). Throws InputError("stdout").
+/// (/dev/full: ENOSPC): refused in milliseconds, before any work. `sweep`, `study`, `fem-check` and
+/// `compare-contact` print after their commit, so a stdout found unusable only then would leave
+/// their files behind with exit 3 (issue 29); `run` writes stdout before its commit (write_stdout).
+/// Throws InputError("stdout").
 void check_stdout_writable();
 
 void register_run(CLI::App& app, Context& ctx);

@@ -1,8 +1,10 @@
 #include "conventions.hpp"
 
+#include <signal.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 
 #include <functional>
@@ -26,6 +28,25 @@ std::ostream* Context::progress() const { return quiet ? nullptr : &std::cerr; }
 
 void Context::note(const std::string& command, const std::string& text) const {
   if (verbose) std::cerr << "impactdeck: " << command << ": " << InputError::one_line(text) << "\n";
+}
+
+void write_stdout(const std::string& text) {
+  struct sigaction ignore {}, old {};
+  ignore.sa_handler = SIG_IGN;
+  ::sigaction(SIGPIPE, &ignore, &old);
+  std::cout.flush();  // what went before (std::cout shares stdout's buffer: synced with stdio)
+  errno = 0;
+  const bool written = std::fwrite(text.data(), 1, text.size(), stdout) == text.size();
+  int e = written ? 0 : errno;  // the first failure's reason
+  const bool flushed = std::fflush(stdout) == 0;
+  if (!flushed && e == 0) e = errno;
+  const bool failed = !written || !flushed || std::ferror(stdout) || !std::cout;
+  ::sigaction(SIGPIPE, &old, nullptr);
+  if (failed) {
+    throw InputError("stdout", "", std::string("write failed: ") +
+                                       (e ? std::strerror(e) : "disk full, or the output was closed") +
+                                       " (before the commit: the run was rolled back, nothing was published)");
+  }
 }
 
 VerboseTimer::VerboseTimer(const Context& ctx, std::string command, std::string stage)
