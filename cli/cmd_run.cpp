@@ -44,8 +44,8 @@ void register_run(CLI::App& app, Context& ctx) {
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand("run", "Run a scene: impacts, force tables and decks it asks for");
-  cmd->add_option("scene", args->scene, "Scene file (TOML, docs/scene-format.md)")->required();
-  cmd->add_flag("--json", args->json, "Print one JSON document on stdout (keys: docs/cli.md)");
+  cmd->add_option("scene", args->scene, "Scene file (TOML, docs/scene-format.md); - reads it from stdin")->required();
+  cmd->add_flag("--json", args->json, "Print one JSON document on stdout (keys: docs/cli.md); --json - is the same");
   cmd->add_option("-o,--out", args->out, "Output folder (created if missing; default: current folder). Everything "
                   "a run writes appears there only when every stage and check passed (docs/reliability.md)");
   cmd->add_option("--solver-timeout-s", args->solver_timeout_s,
@@ -57,10 +57,13 @@ void register_run(CLI::App& app, Context& ctx) {
       ->check(CLI::NonNegativeNumber);
   add_output_length_unit_option(cmd, args->output_length_unit);
   cmd->callback([args, &ctx] {
-    check_stdout_writable();  // a stdout that cannot be written is refused before any work
+    refuse_stdout_folder(args->out, "run");
+    // A stdout that cannot be written is refused before any work (-q without --json prints nothing).
+    if (args->json || !ctx.quiet) check_stdout_writable();
     if (!std::isfinite(args->solver_timeout_s)) throw UsageError("--solver-timeout-s must be a finite number of seconds");
     check_threads(static_cast<unsigned>(std::min(args->threads, 1 << 30)));
-    const scene::Scene sc = scene::load_scene(args->scene, overrides_from(args->set));
+    const scene::Scene sc = args->scene == kStdStream ? scene::load_scene_from_stdin(overrides_from(args->set))
+                                                      : scene::load_scene(args->scene, overrides_from(args->set));
     scene::RunOptions opt;
     opt.out_dir = args->out;
     opt.progress = ctx.progress();  // ccx progress when [outputs.fem] run = "calculix"
@@ -70,7 +73,7 @@ void register_run(CLI::App& app, Context& ctx) {
     // stdout is written before the commit: when it fails the run is rolled back (docs/reliability.md).
     opt.before_commit = [&](const scene::RunReport& r) {
       if (args->json) write_stdout(scene::to_json(sc, r).dump(2) + "\n");
-      else write_stdout(scene::format_summary(sc, r));
+      else if (!ctx.quiet) write_stdout(scene::format_summary(sc, r));
     };
     const scene::RunReport rep = scene::run_scene(sc, opt);
     for (const auto& st : rep.stages_run) {

@@ -39,6 +39,7 @@ std::string check_row_value(double error, double tolerance) {
 
 std::string scene_text(const Scene& scene) {
   if (scene.file.empty()) return "(scene given as text, not a file)";
+  if (scene.file == kStdinScene) return "(scene read from stdin: not kept)";
   std::ifstream in(scene.file, std::ios::binary);
   if (!in) return "(the scene file can no longer be read)";
   std::string t(kSceneTextLimit, '\0');
