@@ -42,11 +42,12 @@ void register_campaign(CLI::App& app, Context& ctx) {
   plan->add_option("file", a->file, "Campaign file (TOML)")->required();
   plan->add_option("-o,--out", a->out, "Campaign folder to create")->required();
   plan->callback([a, &ctx] {
+    refuse_stdout_folder(a->out, "campaign plan");
     VerboseTimer timer(ctx, "campaign plan", "plan " + a->file);
     const campaign::Campaign c = campaign::read_campaign(a->file);
     const campaign::PlanResult r = campaign::plan_campaign(c, a->out);
     for (const auto& w : r.warnings) ctx.warn(w);
-    std::cout << (r.already_planned ? "already planned: " : "planned: ") << r.cases << " cases in " << a->out
+    ctx.report() << (r.already_planned ? "already planned: " : "planned: ") << r.cases << " cases in " << a->out
               << " (input hash " << r.input_hash << ")\n";
   });
 
@@ -78,21 +79,21 @@ void register_campaign(CLI::App& app, Context& ctx) {
       std::string names;
       for (const auto& arr : scripts.arrays) names += (names.empty() ? "" : ", ") + arr.script.string();
       if (a->dry_run) {
-        std::cout << "wrote " << names << " and " << scripts.collect_script.string() << " (not submitted: "
+        ctx.report() << "wrote " << names << " and " << scripts.collect_script.string() << " (not submitted: "
                   << scripts.arrays.size() << " job array(s), MaxArraySize " << scripts.max_array_size
                   << "); submit them with:\n";
-        for (const auto& line : campaign::sbatch_commands(a->dir, scripts, o)) std::cout << line << "\n";
+        for (const auto& line : campaign::sbatch_commands(a->dir, scripts, o)) ctx.report() << line << "\n";
         return;
       }
       const campaign::SlurmSubmission sub = campaign::submit_sbatch(a->dir, scripts, o);
       for (std::size_t i = 0; i < sub.array_jobs.size(); ++i) {
         const campaign::SlurmArray& arr = scripts.arrays[i];
-        std::cout << "submitted job " << sub.array_jobs[i] << " (" << arr.script.string() << ": " << arr.tasks
+        ctx.report() << "submitted job " << sub.array_jobs[i] << " (" << arr.script.string() << ": " << arr.tasks
                   << " array task(s), cases " << arr.first_case << " ... " << arr.last_case << ")\n";
       }
       std::string after;
       for (const auto& j : sub.array_jobs) after += (after.empty() ? "" : ", ") + j;
-      std::cout << "submitted job " << sub.collect_job << " (" << scripts.collect_script.string()
+      ctx.report() << "submitted job " << sub.collect_job << " (" << scripts.collect_script.string()
                 << ": 'campaign collect' after job(s) " << after << "); follow them with 'impactdeck campaign status "
                 << a->dir << "'\n";
       return;
@@ -106,11 +107,11 @@ void register_campaign(CLI::App& app, Context& ctx) {
     o.executable = self_executable();
     o.progress_bar = !ctx.quiet;
     const campaign::RunSummary s = campaign::run_local(a->dir, o);
-    std::cout << "campaign: " << s.total << " cases: " << s.done << " run now, " << s.skipped << " already done, "
+    ctx.report() << "campaign: " << s.total << " cases: " << s.done << " run now, " << s.skipped << " already done, "
               << s.failed << " failed";
-    if (s.checks_failed) std::cout << ", " << s.checks_failed << " with a failed self-check";
-    if (s.other) std::cout << ", " << s.other << " not run (locked by another process)";
-    std::cout << "\n";
+    if (s.checks_failed) ctx.report() << ", " << s.checks_failed << " with a failed self-check";
+    if (s.other) ctx.report() << ", " << s.other << " not run (locked by another process)";
+    ctx.report() << "\n";
     if (s.failed) {  // the cases by their folders; each folder's failure.json says why
       const fs::path dir = fs::absolute(a->dir).lexically_normal();
       std::string list;
@@ -134,9 +135,9 @@ void register_campaign(CLI::App& app, Context& ctx) {
     VerboseTimer timer(ctx, "campaign run-case", "case " + std::to_string(a->id));
     const campaign::CaseOutcome o = campaign::run_case(a->dir, a->id, a->threads, ctx.progress());
     if (o.already_done) {
-      std::cout << "case " << a->id << ": already done\n";
+      ctx.report() << "case " << a->id << ": already done\n";
     } else if (o.state == campaign::CaseState::done) {
-      std::cout << "case " << a->id << ": done" << (o.checks_passed ? "" : " (a self-check failed)") << "\n";
+      ctx.report() << "case " << a->id << ": done" << (o.checks_passed ? "" : " (a self-check failed)") << "\n";
     } else {
       std::cerr << "impactdeck: error: case " << a->id << ": " << o.message << "\n";
     }
@@ -146,19 +147,23 @@ void register_campaign(CLI::App& app, Context& ctx) {
   CLI::App* status = top->add_subcommand("status", "Case states (and squeue's view of the campaign's jobs)");
   status->add_option("dir", a->dir, "Campaign folder")->required();
   status->add_flag("--json", a->json, "Print one JSON document on stdout (keys: docs/cli.md)");
-  status->callback([a] { std::cout << campaign::status_report(a->dir, a->json); });
+  status->callback([a, &ctx] {
+    const std::string text = campaign::status_report(a->dir, a->json);
+    if (a->json) write_stdout(text);  // data asked for: printed under -q too
+    else ctx.report() << text;
+  });
 
   CLI::App* cancel = top->add_subcommand("cancel", "scancel the campaign's Slurm jobs (those in DIR/slurm/jobs.txt)");
   cancel->add_option("dir", a->dir, "Campaign folder")->required();
-  cancel->callback([a] {
+  cancel->callback([a, &ctx] {
     const std::vector<std::string> ids = campaign::cancel_jobs(a->dir);
     if (ids.empty()) {
-      std::cout << "no Slurm job recorded for " << a->dir << ": nothing to cancel\n";
+      ctx.report() << "no Slurm job recorded for " << a->dir << ": nothing to cancel\n";
       return;
     }
     std::string list;
     for (const auto& i : ids) list += (list.empty() ? "" : " ") + i;
-    std::cout << "cancelled job(s) " << list << "\n";
+    ctx.report() << "cancelled job(s) " << list << "\n";
   });
 
   CLI::App* coll = top->add_subcommand("collect", "Table (CSV, JSON) of every case, the worst case, the map");
@@ -168,14 +173,14 @@ void register_campaign(CLI::App& app, Context& ctx) {
     VerboseTimer timer(ctx, "campaign collect", "collect " + a->dir);
     const campaign::CollectResult r = campaign::collect(a->dir);
     if (a->json) {
-      std::cout << campaign::collect_json(r);
+      write_stdout(campaign::collect_json(r));
       return;
     }
-    std::cout << "collected " << r.done << " done, " << r.failed << " failed, " << r.pending << " pending: "
+    ctx.report() << "collected " << r.done << " done, " << r.failed << " failed, " << r.pending << " pending: "
               << r.csv.string() << ", " << r.json.string() << "\n";
-    if (r.worst_id) std::cout << "worst case: " << *r.worst_id << " (copied to " << r.worst_case->string() << ")\n";
-    if (r.map_svg) std::cout << "map: " << r.map_svg->string() << ", " << r.map_vtp->string() << "\n";
-    std::cout << "report: " << r.report_html.string() << "\n";
+    if (r.worst_id) ctx.report() << "worst case: " << *r.worst_id << " (copied to " << r.worst_case->string() << ")\n";
+    if (r.map_svg) ctx.report() << "map: " << r.map_svg->string() << ", " << r.map_vtp->string() << "\n";
+    ctx.report() << "report: " << r.report_html.string() << "\n";
   });
 }
 

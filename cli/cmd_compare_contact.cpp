@@ -53,6 +53,7 @@ void register_compare_contact(CLI::App& app, Context& ctx) {
   cmd->add_flag("--no-hybrid", [args](std::int64_t) { args->options.run_hybrid = false; },
                 "Run the full-contact model only");
   cmd->callback([args, &ctx] {
+    refuse_stdout_folder(args->out, "compare-contact");
     check_stdout_writable();  // its output follows the commit: refused now, not after it
     const scene::Scene sc = scene::load_scene(args->scene, overrides_from(args->set));
     // One transaction (docs/reliability.md): the decks and ccx's results are staged inside --out
@@ -76,7 +77,7 @@ void register_compare_contact(CLI::App& app, Context& ctx) {
     if (args->json) {
       std::cout << scene::to_json(r).dump(2) << "\n";
     } else {
-      std::cout << scene::format_compare(r);
+      ctx.report() << scene::format_compare(r);
     }
     if (r.verdict == scene::CompareVerdict::disagree) {
       std::cerr << "impactdeck: error: contact F_max differs from the analytic force beyond the threshold; in doubt: "

@@ -66,7 +66,7 @@ void register_fem_check(CLI::App& app, Context& ctx) {
       if (args->json) {
         std::cout << fem_export::to_json(r).dump(2) << "\n";
       } else {
-        std::cout << fem_export::format_check(r);
+        ctx.report() << fem_export::format_check(r);
       }
       std::cerr << "impactdeck: error: " << m.str() << "\n";
       ctx.exit_code = static_cast<int>(ExitCode::check_failed);
@@ -76,7 +76,7 @@ void register_fem_check(CLI::App& app, Context& ctx) {
     if (args->json) {
       std::cout << fem_export::to_json(r).dump(2) << "\n";
     } else {
-      std::cout << fem_export::format_check(r);
+      ctx.report() << fem_export::format_check(r);
     }
   });
 }

@@ -73,7 +73,7 @@ void register_inspect(CLI::App& app, Context& ctx) {
       for (const auto& w : rep.warnings) ctx.warn(w);
       return;
     }
-    std::cout << rep.text;
+    ctx.report() << rep.text;
   });
 }
 

@@ -2,6 +2,7 @@
 // (subdivided icosahedron mapped onto the ellipsoid). Semi-axes in the file's own unit.
 #include <iostream>
 #include <memory>
+#include <sstream>
 
 #include "commands.hpp"
 #include "conventions.hpp"
@@ -25,15 +26,22 @@ void register_mesh_ellipsoid(CLI::App& app, Context& ctx) {
   cmd->add_option("B", args->b, "Semi-axis along y")->required();
   cmd->add_option("C", args->c, "Semi-axis along z")->required();
   cmd->add_option("--subdivisions", args->subdivisions, "Icosahedron subdivisions N, 0..10 (default 5: 20480 triangles)");
-  cmd->add_option("-o,--out,--output", args->out, "Output STL file (written atomically)")->required();
+  cmd->add_option("-o,--out,--output", args->out, "Output STL file (written atomically); - writes it to stdout")->required();
   cmd->add_flag("--ascii", args->ascii, "ASCII STL instead of binary");
   cmd->callback([args, &ctx] {
     VerboseTimer timer(ctx, "mesh-ellipsoid", "mesh and write");
     const auto mesh = geometry::make_ellipsoid_mesh(args->a, args->b, args->c, args->subdivisions);
+    if (args->out == kStdStream) {  // the STL alone on stdout (built whole first: a failure prints nothing)
+      std::ostringstream stl;
+      if (args->ascii) geometry::write_stl_ascii(stl, "stdout", mesh, LengthUnit::m, "ellipsoid");
+      else geometry::write_stl_binary(stl, "stdout", mesh, LengthUnit::m, "impactdeck mesh-ellipsoid");
+      write_stdout(stl.str());
+      return;
+    }
     if (args->ascii) geometry::write_stl_ascii(args->out, mesh, LengthUnit::m, "ellipsoid");
     else geometry::write_stl_binary(args->out, mesh, LengthUnit::m, "impactdeck mesh-ellipsoid");
-    std::cout << "wrote " << args->out << ": " << mesh.triangle_count() << " triangles, "
-              << mesh.vertex_count() << " vertices\n";
+    ctx.report() << "wrote " << args->out << ": " << mesh.triangle_count() << " triangles, " << mesh.vertex_count()
+                 << " vertices\n";
   });
 }
 

@@ -99,6 +99,7 @@ void register_study(CLI::App& app, Context& ctx) {
       ->check(positive_number());
   add_set_option(cmd, a->set);
   cmd->callback([a, &ctx] {
+    refuse_stdout_folder(a->out, "study table1");
     check_stdout_writable();  // its output follows the commit: refused now, not after it
     check_threads(a->threads);
     study::Table1Options o = study::table1_preset(a->preset);
@@ -180,8 +181,8 @@ void register_study(CLI::App& app, Context& ctx) {
     if (a->json) {
       std::cout << study::table1_json(r).dump(2) << "\n";
     } else {
-      std::cout << study::table1_markdown(r);
-      std::cout << "time " << std::setprecision(3) << r.seconds << " s; wrote " << (out / "table1.csv").string()
+      ctx.report() << study::table1_markdown(r);
+      ctx.report() << "time " << std::setprecision(3) << r.seconds << " s; wrote " << (out / "table1.csv").string()
                 << ", " << (out / "table1.md").string() << ", " << (out / "table1_heatmap.svg").string()
                 << (a->no_png ? "" : ", " + (out / "table1_heatmap.png").string()) << "\n";
     }

@@ -62,6 +62,7 @@ void register_sweep(CLI::App& app, Context& ctx) {
   add_set_option(cmd, a->set);
   add_output_length_unit_option(cmd, a->output_length_unit);
   cmd->callback([a, &ctx] {
+    refuse_stdout_folder(a->out, "sweep");
     check_stdout_writable();  // its output follows the commit: refused now, not after it
     check_threads(a->threads);
     study::SweepRequest q;
@@ -109,7 +110,7 @@ void register_sweep(CLI::App& app, Context& ctx) {
     if (a->json) {
       std::cout << study::to_json(rep).dump(2) << "\n";
     } else {
-      std::cout << study::format_sweep(rep);
+      ctx.report() << study::format_sweep(rep);
     }
   });
 }

@@ -10,7 +10,7 @@ namespace impactdeck::cli {
 
 struct Context {
   int exit_code = 0;
-  bool quiet = false;    ///< -q: no progress, no warnings on stderr (errors only); stdout unchanged
+  bool quiet = false;    ///< -q: errors only: no report on stdout, no progress, no warnings
   bool verbose = false;  ///< -v: also the settings and each stage's wall time on stderr
 
   /// "impactdeck: warning: TEXT" on stderr unless quiet (the warning stays in the report/JSON).
@@ -19,12 +19,28 @@ struct Context {
   std::ostream* progress() const;
   /// A line on stderr when verbose: "impactdeck: COMMAND: TEXT".
   void note(const std::string& command, const std::string& text) const;
+  /// Where a command's human-readable report goes: stdout, or nowhere when quiet. What the user
+  /// asked for as data (`--json`, `-o -`) goes to std::cout (or write_stdout) whatever -q says.
+  std::ostream& report() const;
 };
+
+/// The file name `-` (`run -`, `-o -`, `--json -`): stdin or stdout.
+inline constexpr const char* kStdStream = "-";
+
+/// Writes `text` to stdout and flushes it, with SIGPIPE ignored meanwhile (a reader gone is
+/// EPIPE, not death). Throws InputError("stdout") when the write fails (closed, full, a broken
+/// pipe): `run` calls it before its commit, so that the run is then rolled back (issue 29).
+void write_stdout(const std::string& text);
+
+/// `-o -` given to a command that writes a folder: a usage error naming the command.
+void refuse_stdout_folder(const std::string& out, const std::string& command);
 
 /// Checks, before a command that publishes files starts, that stdout can be written: a zero-byte
 /// write fails on a closed or read-only stdout (EBADF) and on a device that is always full
-/// (/dev/full: ENOSPC). Its output is printed after the files are published, so a stdout found
-/// unusable only then would leave them behind with exit 3 (issue 29). Throws InputError("stdout").
+/// (/dev/full: ENOSPC): refused in milliseconds, before any work. `sweep`, `study`, `fem-check` and
+/// `compare-contact` print after their commit, so a stdout found unusable only then would leave
+/// their files behind with exit 3 (issue 29); `run` writes stdout before its commit (write_stdout).
+/// Throws InputError("stdout").
 void check_stdout_writable();
 
 void register_run(CLI::App& app, Context& ctx);

@@ -1,8 +1,10 @@
 #include "conventions.hpp"
 
+#include <signal.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 
 #include <functional>
@@ -26,6 +28,36 @@ std::ostream* Context::progress() const { return quiet ? nullptr : &std::cerr; }
 
 void Context::note(const std::string& command, const std::string& text) const {
   if (verbose) std::cerr << "impactdeck: " << command << ": " << InputError::one_line(text) << "\n";
+}
+
+std::ostream& Context::report() const {
+  static std::ostream nowhere(nullptr);  // no buffer: every write is dropped
+  return quiet ? nowhere : std::cout;
+}
+
+void write_stdout(const std::string& text) {
+  struct sigaction ignore {}, old {};
+  ignore.sa_handler = SIG_IGN;
+  ::sigaction(SIGPIPE, &ignore, &old);
+  std::cout.flush();  // what went before (std::cout shares stdout's buffer: synced with stdio)
+  errno = 0;
+  const bool written = std::fwrite(text.data(), 1, text.size(), stdout) == text.size();
+  int e = written ? 0 : errno;  // the first failure's reason
+  const bool flushed = std::fflush(stdout) == 0;
+  if (!flushed && e == 0) e = errno;
+  const bool failed = !written || !flushed || std::ferror(stdout) || !std::cout;
+  ::sigaction(SIGPIPE, &old, nullptr);
+  if (failed) {
+    throw InputError("stdout", "", std::string("write failed: ") +
+                                       (e ? std::strerror(e) : "disk full, or the output was closed") +
+                                       " (before the commit: the run was rolled back, nothing was published)");
+  }
+}
+
+void refuse_stdout_folder(const std::string& out, const std::string& command) {
+  if (out == kStdStream) {
+    throw UsageError("-o -: '" + command + "' writes a folder of files, not one file: stdout cannot hold it (give a folder)");
+  }
 }
 
 VerboseTimer::VerboseTimer(const Context& ctx, std::string command, std::string stage)
@@ -216,7 +248,7 @@ void write_man_page(const CLI::App& app, std::ostream& out) {
          ".TP\n2\nusage error (unknown command or flag, missing argument)\n"
          ".TP\n3\ninvalid input: a file, key or value, a limit, a solver failure, an output that cannot be "
          "written; one line on stderr names file, place and reason\n"
-         ".TP\n4\na physics self-check failed; nothing is written\n"
+         ".TP\n4\na physics self-check failed; run publishes its outputs as the evidence (the report says FAILED)\n"
          ".SH ENVIRONMENT\n.TP\nIMPACTDECK_GMSH_PLUGIN\npath of the Gmsh mesher plugin (docs/fem.md)\n"
          ".SH SEE ALSO\n\\fBgmsh\\fR(1), \\fBccx\\fR(1); docs/cli.md, docs/scene-format.md\n";
 }
@@ -254,18 +286,18 @@ void register_generated_docs(CLI::App& app, Context& /*ctx*/) {
   // Both print on stdout, or write FILE atomically with -o (the build writes them so, to install).
   auto out = std::make_shared<std::string>();
   auto emit = [out](const std::function<void(std::ostream&)>& write) {
-    if (out->empty()) return write(std::cout);
+    if (out->empty() || *out == kStdStream) return write(std::cout);
     write_file_atomically(*out, [&](std::ostream& o) { write(o); });
   };
   CLI::App* man = app.add_subcommand("man", "Print the man page (roff), generated from this command's definition");
   man->group("");  // hidden: not in --help, the man page or the completion
-  man->add_option("-o,--out", *out, "Write the page to this file instead of stdout");
+  man->add_option("-o,--out", *out, "Write the page to this file instead of stdout (- : stdout)");
   man->callback([&app, emit] { emit([&app](std::ostream& o) { write_man_page(app, o); }); });
   CLI::App* completion = app.add_subcommand("completion", "Print a shell completion script");
   completion->group("");
   auto shell = std::make_shared<std::string>();
   completion->add_option("shell", *shell, "Shell: bash")->required()->check(CLI::IsMember({"bash"}));
-  completion->add_option("-o,--out", *out, "Write the script to this file instead of stdout");
+  completion->add_option("-o,--out", *out, "Write the script to this file instead of stdout (- : stdout)");
   completion->callback([&app, emit, shell] { emit([&app](std::ostream& o) { write_bash_completion(app, o); }); });
 }
 

@@ -28,8 +28,18 @@ int main(int argc, char** argv) {
   impactdeck::cli::register_campaign(app, ctx);
   impactdeck::cli::register_generated_docs(app, ctx);
   impactdeck::cli::add_verbosity_flags(app, ctx);
+  // `--json -` (or `--json=-`) is `--json`: the document goes to stdout (docs/cli.md). A `-` right
+  // after `--json` belongs to it, so `run --json - SCENE` and `run SCENE --json -` both work.
+  std::vector<std::string> args;
+  for (int i = argc - 1; i >= 1; --i) {  // CLI11 takes them in reverse order
+    const std::string a = argv[i];
+    if (a == "-" && i >= 2 && std::string(argv[i - 1]) == "--json") continue;
+    args.push_back(a == "--json=-" ? std::string("--json") : a);
+  }
+  if (argc > 0) app.name(argv[0]);  // as parse(argc, argv) names it (in help texts)
   try {
-    app.parse(argc, argv);
+    std::vector<std::string> consumed = args;  // parse() takes its arguments away
+    app.parse(consumed);
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
   } catch (const CLI::CallForAllHelp& e) {
@@ -37,7 +47,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    const std::string why = impactdeck::cli::explain_command_line(app, std::vector<std::string>(argv + 1, argv + argc));
+    const std::string why = impactdeck::cli::explain_command_line(app, std::vector<std::string>(args.rbegin(), args.rend()));
     std::cerr << "impactdeck: usage error: " << impactdeck::InputError::one_line(why.empty() ? e.what() : why)
               << " (run 'impactdeck --help')\n";  // one line, as every error
     return static_cast<int>(ExitCode::usage);

@@ -12,7 +12,8 @@
 # tests/data/bad/fem (fake solvers). {FIFO} is a fresh named pipe nobody writes to: reading it
 # would block forever, so it must be refused by its type. Every command runs under a timeout of
 # 300 s: a hang fails its case instead of stopping the suite. A case expecting exit 4 (a failed
-# self-check) may print its report on stdout.
+# self-check) may print its report on stdout, and publishes its outputs as evidence (issue 32): its
+# output folder must hold report.html and nothing hidden (no staging folder, no journal).
 # usage: bad_inputs.sh IMPACTDECK SOURCE_DIR
 set -u
 bin=$1; src=$2
@@ -59,7 +60,12 @@ while IFS=$'\t' read -r name args code pattern; do
       esac
     fi
   fi
-  [ -z "$(ls -A "$out" 2>/dev/null)" ] || problems="$problems output folder not empty: $(ls -A "$out");"
+  if [ "$code" = 4 ]; then
+    [ -s "$out/report.html" ] || problems="$problems exit 4 without its evidence (no report.html);"
+    [ -z "$(ls -A "$out" 2>/dev/null | grep '^\.')" ] || problems="$problems hidden files left: $(ls -A "$out");"
+  else
+    [ -z "$(ls -A "$out" 2>/dev/null)" ] || problems="$problems output folder not empty: $(ls -A "$out");"
+  fi
   if [ -d "$deck" ]; then
     changed=$(diff -rq "$bad/fem/deck" "$deck" 2>&1)
     [ -z "$changed" ] || problems="$problems the deck folder changed: $changed;"

@@ -74,6 +74,74 @@ check "mesh-ellipsoid -v: its time" grep -Eq "^impactdeck: mesh-ellipsoid: mesh 
 check "mesh-ellipsoid --out: file written" test -s "$tmp/e2.stl"
 check "mesh-ellipsoid -q: stderr empty" test ! -s "$tmp/me.err"
 
+# -q prints nothing but errors: no report on stdout either; --json (data asked for) stays.
+"$bin" run "$src/samples/paper_table2.toml" -o "$tmp/q2" -q >"$tmp/q2.out" 2>"$tmp/q2.err"
+check "run -q: exit 0" test $? -eq 0
+check "run -q: stdout empty (no report)" test ! -s "$tmp/q2.out"
+check "run -q: stderr empty" test ! -s "$tmp/q2.err"
+check "run -q: the files written" test -s "$tmp/q2/force_table2.csv"
+"$bin" run "$src/samples/paper_table2.toml" -o "$tmp/q2c" -q >&- 2>"$tmp/q2c.err"
+check "run -q with stdout closed: exit 0 (nothing to print)" test $? -eq 0
+check "run -q with stdout closed: the files written" test -s "$tmp/q2c/force_table2.csv"
+"$bin" run "$src/samples/paper_table2.toml" -o "$tmp/q3" >"$tmp/q3.out" 2>/dev/null
+check "run without -q: the report on stdout" grep -q "^impact 'table2'" "$tmp/q3.out"
+"$bin" mesh-ellipsoid 2 1 1 --subdivisions 1 -o "$tmp/e3.stl" -q >"$tmp/me.out" 2>/dev/null
+check "mesh-ellipsoid -q: stdout empty" test ! -s "$tmp/me.out"
+"$bin" run "$src/samples/two_spheres.toml" -o "$tmp/q4" -q --set checks.impulse_relative=1e-99 >"$tmp/q4.out" 2>"$tmp/q4.err"
+check "run -q, a failed check: exit 4" test $? -eq 4
+check "run -q, a failed check: stdout empty" test ! -s "$tmp/q4.out"
+check "run -q, a failed check: one stderr line naming the check" \
+  bash -c "[ \$(wc -l <'$tmp/q4.err') = 1 ] && grep -q 'impulse check (Eq. 31) failed' '$tmp/q4.err'"
+"$bin" campaign status "$tmp/nowhere" -q >"$tmp/q5.out" 2>"$tmp/q5.err"
+check "campaign status -q of a missing folder: the error still shown" test -s "$tmp/q5.err"
+
+# `-`: the scene from stdin, --json - and -o - to stdout (a single file only).
+"$bin" run - -o "$tmp/stdin" --json <"$src/samples/two_spheres.toml" >"$tmp/stdin.json" 2>"$tmp/stdin.err"
+check "run - (scene on stdin): exit 0 ($(head -c 200 "$tmp/stdin.err"))" test $? -eq 0
+check "run -: the scene is named '-'" python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); assert d["scene"] == "-", d["scene"]' "$tmp/stdin.json"
+check "run -: its outputs written" test -s "$tmp/stdin/force_two_spheres.csv"
+check "run -: the same numbers as the file" python3 -c '
+import json, subprocess, sys
+a = json.load(open(sys.argv[1]))["impacts"][0]["max_force_N"]
+b = json.loads(subprocess.run([sys.argv[2], "run", sys.argv[3], "--json", "-o", sys.argv[4]], capture_output=True).stdout)["impacts"][0]["max_force_N"]
+assert a == b, (a, b)' "$tmp/stdin.json" "$bin" "$src/samples/two_spheres.toml" "$tmp/stdin_file"
+(cd "$src/samples" && "$bin" run - -o "$tmp/stdin_parts" -q <two_parts.toml 2>"$tmp/parts.err")
+check "run -: a relative part path resolves against the current folder" test $? -eq 0
+(cd "$tmp" && "$bin" run - -o "$tmp/stdin_parts2" -q <"$src/samples/two_parts.toml" 2>"$tmp/parts2.err")
+check "run - elsewhere: the part is looked up in the current folder (exit 3)" test $? -eq 3
+check "run - elsewhere: the message names the part as given" grep -q "parts/cgal_handle.off" "$tmp/parts2.err"
+sed 's/^poisson_ratio = 0.3$/poisson_ratio = 0.7/' "$src/samples/two_spheres.toml" | "$bin" run - -o "$tmp/stdin_bad" >/dev/null 2>"$tmp/stdin_bad.err"
+check "run - with a bad value: exit 3" test $? -eq 3
+check "run - with a bad value: the message names '-', the line and the key" grep -Eq "^impactdeck: error: -: line 11, key 'materials.steel.poisson_ratio'" "$tmp/stdin_bad.err"
+check "run - with a bad value: nothing written" test ! -e "$tmp/stdin_bad"
+head -c 17000000 /dev/zero | "$bin" run - -o "$tmp/stdin_big" >/dev/null 2>"$tmp/stdin_big.err"
+check "run - beyond the scene limit: exit 3" test $? -eq 3
+check "run - beyond the scene limit: says so" grep -q "^impactdeck: error: -: stdin: the scene on stdin is longer than the limit of 16 MiB" "$tmp/stdin_big.err"
+check "run - beyond the scene limit: nothing written" test ! -e "$tmp/stdin_big"
+for form in "--json - $src/samples/two_spheres.toml" "$src/samples/two_spheres.toml --json -" "$src/samples/two_spheres.toml --json=-"; do
+  # shellcheck disable=SC2086
+  "$bin" run $form -o "$tmp/jd" >"$tmp/jd.json" 2>/dev/null
+  check "run $form: exit 0, the JSON on stdout" python3 -c 'import json,sys; json.load(open(sys.argv[1]))["impacts"]' "$tmp/jd.json"
+done
+check "--json -: no file named '-'" test ! -e ./- -a ! -e "$tmp/jd/-"
+(cd "$tmp" && "$bin" mesh-ellipsoid 2 1 1 --subdivisions 1 -o - >"$tmp/stdout.stl" 2>"$tmp/stdout.err")
+check "mesh-ellipsoid -o -: exit 0" test $? -eq 0
+check "mesh-ellipsoid -o -: no file named '-'" test ! -e "$tmp/-"
+check "mesh-ellipsoid -o -: stdout is the binary STL alone (84 + 50 x 80 triangles bytes)" test "$(stat -c %s "$tmp/stdout.stl")" -eq 4084
+"$bin" mesh-ellipsoid 2 1 1 --subdivisions 1 -o "$tmp/file.stl" -q
+check "mesh-ellipsoid -o -: the same bytes as -o FILE" cmp -s "$tmp/stdout.stl" "$tmp/file.stl"
+(cd "$tmp" && "$bin" mesh-ellipsoid 2 1 1 --subdivisions 1 --ascii -o - >"$tmp/stdout_ascii.stl")
+check "mesh-ellipsoid --ascii -o -: an ASCII STL on stdout" bash -c "head -1 '$tmp/stdout_ascii.stl' | grep -q '^solid ellipsoid' && tail -1 '$tmp/stdout_ascii.stl' | grep -q '^endsolid'"
+"$bin" man -o - >"$tmp/man_stdout.1"
+check "man -o -: the page on stdout" grep -q "EXIT STATUS" "$tmp/man_stdout.1"
+for c in "run $src/samples/two_spheres.toml" "sweep $src/samples/fig4_sweep.toml" "study table1" "compare-contact $src/samples/two_spheres.toml" "campaign plan $src/samples/point_campaign.toml"; do
+  # shellcheck disable=SC2086
+  (cd "$tmp" && "$bin" $c -o - >"$tmp/dash.out" 2>"$tmp/dash.err")
+  rc=$?
+  check "$c -o -: usage error (exit 2, got $rc), a folder is not stdout" bash -c "[ $rc = 2 ] && grep -q \"writes a folder of files, not one file\" '$tmp/dash.err'"
+  check "$c -o -: no folder named '-'" test ! -e "$tmp/-"
+done
+
 # 3. The man page: renders without warnings, names every subcommand and flag.
 "$bin" man >"$tmp/impactdeck.1"
 check "man: exit 0" test $? -eq 0

@@ -83,13 +83,15 @@ check "message is one line" test "$(wc -l <"$tmp/bad.err")" -eq 1
 check "no output written" test ! -e "$tmp/out3/force_table2.csv"
 "$bin" run "$tmp/does-not-exist.toml" >/dev/null 2>&1; check "missing file exit 3" test $? -eq 3
 
-# 5. A failing self-check: exit 4 and no output file (threshold set impossibly low).
+# 5. A failing self-check: exit 4, and the outputs published as its evidence (threshold set
+# impossibly low; tests/cli_evidence_test.sh has the rest).
 sed 's/^restitution_range_policy = "warn"/restitution_range_policy = "warn"\n[checks]\nimpulse_relative = 1e-30/' \
   "$src/samples/paper_table2.toml" >"$tmp/strict.toml"
-"$bin" run "$tmp/strict.toml" --out "$tmp/out4" >/dev/null 2>"$tmp/strict.err"
+"$bin" run "$tmp/strict.toml" --out "$tmp/out4" >"$tmp/strict.out" 2>"$tmp/strict.err"
 rc=$?
 check "failed check exit 4 (got $rc)" test $rc -eq 4
-check "failed check writes nothing" test ! -e "$tmp/out4/force_table2.csv"
+check "failed check publishes the evidence" test -s "$tmp/out4/force_table2.csv" -a -s "$tmp/out4/report.html"
+check "failed check: the report says FAILED first" grep -q "^FAILED: " <(sed -n 2p "$tmp/strict.out")
 
 # 6. Sweep: files, JSON summary, quiet progress, errors.
 "$bin" sweep "$src/samples/fig4_sweep.toml" --out "$tmp/sw" --json --quiet --no-png >"$tmp/sw.json" 2>"$tmp/sw.err"

@@ -2,6 +2,8 @@
 # Failures found after the work is done must not leave a half-published run (issue 29):
 #  - a stdout that cannot be written (/dev/full, closed) is refused before the run, exit 3 naming
 #    stdout, and the output folder stays as it was;
+#  - a stdout that fails only when `run` writes its report (a broken pipe) rolls the run back: run
+#    writes stdout before its commit;
 #  - `sweep` onto a full file system (a tmpfs of 256 KiB, mounted in a private mount namespace
 #    when the test may mount) exits 3 naming the file that could not be written, and leaves the
 #    folder as it was.
@@ -37,6 +39,29 @@ check "run with a read-only stdout: the output folder as before" unchanged
 "$bin" sweep "$sweep_scene" --out "$out" --json --quiet >/dev/full 2>"$tmp/err"; rc=$?
 check "sweep > /dev/full: exit 3" [ "$rc" = 3 ]
 check "sweep > /dev/full: the output folder as before" unchanged
+
+# A stdout that passes the check before the run but fails when the report is written: a pipe
+# whose reader has gone (a zero-byte write succeeds on it). `run` writes stdout before its commit,
+# so the failure rolls the run back: exit 3, one line naming stdout, the folder as before — with
+# SIGPIPE ignored (EPIPE) and with its default action (killing, as `| head` would).
+for sigpipe in ignored default; do
+  python3 - "$bin" "$scene" "$out" "$tmp/pipe_$sigpipe" "$sigpipe" <<'PY'
+import os, signal, subprocess, sys
+binary, scene, out, prefix, sigpipe = sys.argv[1:]
+r, w = os.pipe()
+os.close(r)  # the reader is gone before the run starts
+def child():
+    signal.signal(signal.SIGPIPE, signal.SIG_IGN if sigpipe == "ignored" else signal.SIG_DFL)
+with open(prefix + ".err", "wb") as err:
+    p = subprocess.run([binary, "run", scene, "--out", out, "--json"], stdout=w, stderr=err,
+                       stdin=subprocess.DEVNULL, preexec_fn=child, restore_signals=False)
+open(prefix + ".rc", "w").write(str(p.returncode))
+PY
+  check "run > a broken pipe (SIGPIPE $sigpipe): exit 3 (got $(cat "$tmp/pipe_$sigpipe.rc"))" [ "$(cat "$tmp/pipe_$sigpipe.rc")" = 3 ]
+  check "run > a broken pipe (SIGPIPE $sigpipe): one line naming stdout" \
+    bash -c "[ \$(wc -l <'$tmp/pipe_$sigpipe.err') = 1 ] && grep -q '^impactdeck: error: stdout: write failed: Broken pipe (before the commit: the run was rolled back, nothing was published)' '$tmp/pipe_$sigpipe.err'"
+  check "run > a broken pipe (SIGPIPE $sigpipe): the output folder as before" unchanged
+done
 
 # The same commands with a usable stdout publish (the checks above are not refusing everything).
 "$bin" run "$scene" --out "$out" --json >"$tmp/doc.json" 2>"$tmp/err"; rc=$?

@@ -129,6 +129,22 @@ std::string read_input_file(const fs::path& path, const std::string& noun, std::
   return text;
 }
 
+std::string read_standard_input(const std::string& noun, std::uintmax_t max_bytes) {
+  std::string text;
+  char buf[1 << 16];
+  for (;;) {
+    const ssize_t n = ::read(STDIN_FILENO, buf, sizeof buf);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) throw InputError("-", "stdin", "the " + noun + " cannot be read from stdin: " + std::strerror(errno));
+    if (n == 0) return text;
+    if (text.size() + static_cast<std::size_t>(n) > max_bytes) {
+      throw InputError("-", "stdin", "the " + noun + " on stdin is longer than the limit of " +
+                                         format_bytes(static_cast<double>(max_bytes)) + " (docs/reliability.md, \"Limits\")");
+    }
+    text.append(buf, static_cast<std::size_t>(n));
+  }
+}
+
 std::uintmax_t available_memory_bytes() {
   std::uintmax_t avail = meminfo_bytes("MemAvailable:");
   const std::uintmax_t max = read_number("/sys/fs/cgroup/memory.max");

@@ -215,51 +215,57 @@ void put_f32(std::ostream& o, float x) {
 }
 }  // namespace
 
-void write_stl_binary(const fs::path& file, const TriangleMesh& mesh, LengthUnit unit,
+void write_stl_binary(std::ostream& o, const std::string& name, const TriangleMesh& mesh, LengthUnit unit,
                       const std::string& header) {
   const double s = 1.0 / metres_per(unit);
-  check_float32(file, mesh, s);
-  write_file_atomically(file, [&](std::ostream& o) {
-    char h[80] = {};
-    std::string text = header;
-    if (text.rfind("solid", 0) == 0) text = "binary " + text;  // readers sniff "solid" as ascii
-    std::memcpy(h, text.data(), std::min<std::size_t>(text.size(), 80));
-    o.write(h, 80);
-    const std::uint32_t n = static_cast<std::uint32_t>(mesh.triangles.size());
-    char nb[4];
-    std::memcpy(nb, &n, 4);
-    o.write(nb, 4);
-    for (const auto& t : mesh.triangles) {
-      const Eigen::Vector3d &a = mesh.vertices_m[t[0]], &b = mesh.vertices_m[t[1]], &c = mesh.vertices_m[t[2]];
-      Eigen::Vector3d nrm = (b - a).cross(c - a);
-      if (nrm.norm() > 0) nrm.normalize();
-      for (int i = 0; i < 3; ++i) put_f32(o, static_cast<float>(nrm[i]));
-      for (const auto* p : {&a, &b, &c})
-        for (int i = 0; i < 3; ++i) put_f32(o, static_cast<float>((*p)[i] * s));
-      o.write("\0\0", 2);
-    }
-  });
+  check_float32(name, mesh, s);
+  char h[80] = {};
+  std::string text = header;
+  if (text.rfind("solid", 0) == 0) text = "binary " + text;  // readers sniff "solid" as ascii
+  std::memcpy(h, text.data(), std::min<std::size_t>(text.size(), 80));
+  o.write(h, 80);
+  const std::uint32_t n = static_cast<std::uint32_t>(mesh.triangles.size());
+  char nb[4];
+  std::memcpy(nb, &n, 4);
+  o.write(nb, 4);
+  for (const auto& t : mesh.triangles) {
+    const Eigen::Vector3d &a = mesh.vertices_m[t[0]], &b = mesh.vertices_m[t[1]], &c = mesh.vertices_m[t[2]];
+    Eigen::Vector3d nrm = (b - a).cross(c - a);
+    if (nrm.norm() > 0) nrm.normalize();
+    for (int i = 0; i < 3; ++i) put_f32(o, static_cast<float>(nrm[i]));
+    for (const auto* p : {&a, &b, &c})
+      for (int i = 0; i < 3; ++i) put_f32(o, static_cast<float>((*p)[i] * s));
+    o.write("\0\0", 2);
+  }
 }
 
-void write_stl_ascii(const fs::path& file, const TriangleMesh& mesh, LengthUnit unit,
+void write_stl_ascii(std::ostream& o, const std::string& file, const TriangleMesh& mesh, LengthUnit unit,
                      const std::string& name) {
   const double s = 1.0 / metres_per(unit);
   check_float32(file, mesh, s);
-  write_file_atomically(file, [&](std::ostream& o) {
-    o << std::setprecision(9) << "solid " << name << "\n";
-    for (const auto& t : mesh.triangles) {
-      const Eigen::Vector3d &a = mesh.vertices_m[t[0]], &b = mesh.vertices_m[t[1]], &c = mesh.vertices_m[t[2]];
-      Eigen::Vector3d nrm = (b - a).cross(c - a);
-      if (nrm.norm() > 0) nrm.normalize();
-      o << "  facet normal " << nrm.x() + 0.0 << " " << nrm.y() + 0.0 << " " << nrm.z() + 0.0 << "\n    outer loop\n";
-      for (const auto* p : {&a, &b, &c})
-        // The float32 values a binary STL would hold, printed with 9 digits (float round trip).
-        o << "      vertex " << static_cast<float>((*p)[0] * s) + 0.0f << " " << static_cast<float>((*p)[1] * s) + 0.0f
-          << " " << static_cast<float>((*p)[2] * s) + 0.0f << "\n";
-      o << "    endloop\n  endfacet\n";
-    }
-    o << "endsolid " << name << "\n";
-  });
+  o << std::setprecision(9) << "solid " << name << "\n";
+  for (const auto& t : mesh.triangles) {
+    const Eigen::Vector3d &a = mesh.vertices_m[t[0]], &b = mesh.vertices_m[t[1]], &c = mesh.vertices_m[t[2]];
+    Eigen::Vector3d nrm = (b - a).cross(c - a);
+    if (nrm.norm() > 0) nrm.normalize();
+    o << "  facet normal " << nrm.x() + 0.0 << " " << nrm.y() + 0.0 << " " << nrm.z() + 0.0 << "\n    outer loop\n";
+    for (const auto* p : {&a, &b, &c})
+      // The float32 values a binary STL would hold, printed with 9 digits (float round trip).
+      o << "      vertex " << static_cast<float>((*p)[0] * s) + 0.0f << " " << static_cast<float>((*p)[1] * s) + 0.0f
+        << " " << static_cast<float>((*p)[2] * s) + 0.0f << "\n";
+    o << "    endloop\n  endfacet\n";
+  }
+  o << "endsolid " << name << "\n";
+}
+
+void write_stl_binary(const fs::path& file, const TriangleMesh& mesh, LengthUnit unit, const std::string& header) {
+  check_float32(file, mesh, 1.0 / metres_per(unit));  // before the file is created
+  write_file_atomically(file, [&](std::ostream& o) { write_stl_binary(o, file.string(), mesh, unit, header); });
+}
+
+void write_stl_ascii(const fs::path& file, const TriangleMesh& mesh, LengthUnit unit, const std::string& name) {
+  check_float32(file, mesh, 1.0 / metres_per(unit));
+  write_file_atomically(file, [&](std::ostream& o) { write_stl_ascii(o, file.string(), mesh, unit, name); });
 }
 
 }  // namespace impactdeck::geometry

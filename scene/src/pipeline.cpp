@@ -426,6 +426,16 @@ StagedOutputs reserve_outputs(const Scene& scene, RunTransaction& txn) {
   return st;
 }
 
+// stages_skipped: every stage not in stages_run, in pipeline order.
+void note_skipped_stages(RunReport& report) {
+  report.stages_skipped.clear();
+  for (const auto& st : all_stages()) {
+    bool ran = false;
+    for (const auto& r : report.stages_run) ran = ran || r.name == st;
+    if (!ran) report.stages_skipped.push_back(st);
+  }
+}
+
 void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, RunReport& report, StageClock& clock) {
   const StagedOutputs staged = reserve_outputs(scene, txn);
 
@@ -460,11 +470,9 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
     report.impacts.push_back(std::move(ir));
   }
 
+  // A failed check does not stop the run: every output is still written and published, as the
+  // evidence of what went wrong (the CLI exits 4 naming the check; failed_checks.hpp).
   const bool want_fem = scene.outputs.fem.has_value();
-  if (!report.all_checks_passed()) {
-    report.warnings.push_back("a self-check failed: no output file was written");
-    return;
-  }
   if (scene.outputs.force_table_csv || want_fem) {
     clock.run(Stage::force_table, [&] {
       for (auto& ir : report.impacts) {
@@ -502,10 +510,10 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
     if (scene.outputs.fem->run == FemOutputs::Run::calculix) {
       clock.run(Stage::fem_run, [&] {
         for (auto& ir : report.impacts) {
-          // A mesh that misses the body checks is not worth a solver run (it fails anyway).
+          // A mesh that misses the body checks still runs: its results are the evidence to look at.
           if (!ir.fem_deck->body_check.passed) {
-            report.warnings.push_back("impact '" + ir.spec->name + "': FEM deck fails its body checks: ccx not run");
-            continue;
+            report.warnings.push_back("impact '" + ir.spec->name +
+                                      "': FEM deck fails its body checks: ccx run anyway, its results kept as evidence");
           }
           fem_export::CheckOptions co;
           co.progress = opt.progress;
@@ -574,10 +582,6 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
       }
     });
   }
-  if (!report.all_checks_passed()) {
-    report.warnings.push_back("a self-check failed: no output file was written");
-    return;  // the transaction is rolled back: nothing of this run is visible
-  }
   // The report page shows the stress pictures ccx's run left in the staged deck folders.
   std::vector<std::vector<ReportPicture>> pictures(report.impacts.size());
   if (staged.report) {
@@ -634,11 +638,13 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
                                          }),
                           page.warnings.end());
       write_file_atomically(*staged.report, report_html(scene, page, pictures));
-      txn.commit();
     });
-  } else {
-    txn.commit();
   }
+  // Everything is staged: the caller's last word (the CLI prints stdout here, so that a stdout
+  // that fails rolls the run back), then the commit publishes it all.
+  note_skipped_stages(report);
+  if (opt.before_commit) opt.before_commit(report);
+  txn.commit();
 }
 
 }  // namespace
@@ -651,11 +657,7 @@ RunReport run_scene(const Scene& scene, const RunOptions& opt) {
   RunTransaction txn(opt.out_dir);
   for (const auto& w : txn.warnings()) report.warnings.push_back(w);
   txn.run([&] { run_stages(scene, opt, txn, report, clock); });  // messages name the final paths
-  for (const auto& st : all_stages()) {
-    bool ran = false;
-    for (const auto& r : report.stages_run) ran = ran || r.name == st;
-    if (!ran) report.stages_skipped.push_back(st);
-  }
+  note_skipped_stages(report);
   return report;
 }
 

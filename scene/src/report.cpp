@@ -6,6 +6,7 @@
 
 #include "impactdeck/common/version.hpp"
 #include "impactdeck/common/json_number.hpp"
+#include "impactdeck/scene/failed_checks.hpp"
 
 namespace impactdeck::scene {
 namespace {
@@ -180,6 +181,7 @@ nlohmann::json to_json(const Scene& scene, const RunReport& rep) {
   for (const auto& f : rep.files_written) files.push_back(f.string());
   j["files_written"] = files;
   j["all_checks_passed"] = rep.all_checks_passed();
+  j["failed_checks"] = to_json(failed_checks(rep));
   return j;
 }
 
@@ -187,6 +189,11 @@ std::string format_summary(const Scene& scene, const RunReport& rep) {
   std::ostringstream o;
   o << std::setprecision(6);
   o << "impactdeck " << kVersion << " — " << scene.file.string() << "\n";
+  // A failed check first: the outputs were published as its evidence.
+  if (const auto failed = failed_checks(rep); !failed.empty()) {
+    o << "FAILED: " << failed.size() << " self-check(s) failed (exit 4); the outputs below are the evidence\n";
+    for (const auto& f : failed) o << "  impact '" << f.impact << "': " << f.reason << "\n";
+  }
   for (const auto& ir : rep.impacts) {
     const auto& r = ir.result;
     const auto& c = r.history.compression;
@@ -285,29 +292,6 @@ std::string format_summary(const Scene& scene, const RunReport& rep) {
   for (const auto& s : rep.stages_run) o << " " << s.name;
   o << "\n";
   return o.str();
-}
-
-std::string failed_checks_summary(const Scene& scene, const RunReport& rep) {
-  std::ostringstream o;
-  o << std::setprecision(3);
-  for (const auto& ir : rep.impacts) {
-    const auto& k = ir.result.checks;
-    if (!k.passed) {
-      o << "; impact '" << ir.spec->name << "': impulse check (Eq. 31) relative error " << k.impulse_relative_error
-        << " (limit " << k.thresholds.impulse_relative << "), Carnot energy check (Eq. 32) relative error "
-        << k.energy_relative_error << " (limit " << k.thresholds.energy_relative << ")";
-    }
-    if (ir.fem_check && !ir.fem_check->passed) {
-      o << "; impact '" << ir.spec->name << "': FEM momentum check of deck 'fem_" << ir.spec->name << "'";
-      for (const auto& f : ir.fem_check->failures) o << ": " << f;
-    }
-    if (ir.compare && ir.compare->verdict == CompareVerdict::disagree) {
-      o << "; impact '" << ir.spec->name << "': full-contact F_max differs from the analytic one by "
-        << 100 * ir.compare->finest()->max_force_relative_difference << " % (compare_contact_threshold "
-        << 100 * ir.compare->threshold << " %), in doubt: " << ir.compare->in_doubt;
-    }
-  }
-  return scene.file.string() + ": physics self-check failed" + o.str() + "; nothing was written";
 }
 
 }  // namespace impactdeck::scene

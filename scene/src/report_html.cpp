@@ -8,6 +8,7 @@
 
 #include "impactdeck/fem_export/stress.hpp"
 #include "impactdeck/scene/compare_contact.hpp"
+#include "impactdeck/scene/failed_checks.hpp"
 #include "impactdeck/plot/force_plot.hpp"
 #include "impactdeck/plot/html.hpp"
 #include "impactdeck/scene/report.hpp"
@@ -38,6 +39,7 @@ std::string check_row_value(double error, double tolerance) {
 
 std::string scene_text(const Scene& scene) {
   if (scene.file.empty()) return "(scene given as text, not a file)";
+  if (scene.file == kStdinScene) return "(scene read from stdin: not kept)";
   std::ifstream in(scene.file, std::ios::binary);
   if (!in) return "(the scene file can no longer be read)";
   std::string t(kSceneTextLimit, '\0');
@@ -78,7 +80,20 @@ std::string report_html(const Scene& scene, const RunReport& rep, const std::vec
   const std::string name = scene.file.empty() ? std::string("(scene text)") : scene.file.filename().string();
   plot::HtmlPage page("impactdeck run: " + name);
 
-  // Verdict first.
+  // A failed self-check first, each named: the page and the files beside it are its evidence.
+  if (const auto failed = failed_checks(rep); !failed.empty()) {
+    page.html("<p id=\"failed\" class=\"verdict fail\">" +
+              plot::html_escape("FAILED: " + std::to_string(failed.size()) +
+                                " self-check(s) failed (exit 4); the outputs of this run are the evidence") +
+              "</p>");
+    std::vector<std::vector<std::string>> rows;
+    for (const auto& f : failed) {
+      rows.push_back({f.impact, f.name, f.value ? g(*f.value, 3) : "-", f.limit ? g(*f.limit, 3) : "-", f.reason});
+    }
+    page.table({"impact", "failed check", "value", "limit", "reason"}, rows);
+  }
+
+  // Then the verdict.
   ImpactVerdict::Kind overall = ImpactVerdict::Kind::none;
   double worst = 0;
   std::vector<std::vector<std::string>> verdict_rows;

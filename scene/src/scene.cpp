@@ -766,4 +766,10 @@ Scene load_scene(const fs::path& file, const std::vector<Override>& overrides, c
   return s;
 }
 
+Scene load_scene_from_stdin(const std::vector<Override>& overrides) {
+  Scene s = parse_scene(read_standard_input("scene", kMaxSceneBytes), kStdinScene, ".", overrides);
+  s.file = kStdinScene;
+  return s;
+}
+
 }  // namespace impactdeck::scene

@@ -22,6 +22,12 @@ std::uintmax_t check_input_file(const std::filesystem::path& path, const std::st
 std::string read_input_file(const std::filesystem::path& path, const std::string& noun,
                             std::uintmax_t max_bytes, const std::string& limit_hint = "");
 
+/// The whole of standard input (`-` given as a file), read up to `max_bytes`: more is refused
+/// without reading further (`/dev/zero` as stdin ends), as is a stdin that cannot be read (closed,
+/// a folder). A pipe or terminal is read until its end, as any program reading `-` does.
+/// Throws InputError("-", "stdin", reason).
+std::string read_standard_input(const std::string& noun, std::uintmax_t max_bytes);
+
 /// What a stat(2) mode is, for messages: "a file", "a directory", "a symbolic link", "a FIFO
 /// (named pipe)", "a socket", "a character device", "a block device".
 std::string file_type_text(unsigned mode);

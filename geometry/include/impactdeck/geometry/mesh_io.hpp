@@ -2,6 +2,7 @@
 // Reading triangulated parts (STL ascii/binary, OBJ, PLY, OFF, via assimp) and writing STL.
 // The length unit of a file is always declared by the user, never guessed.
 #include <filesystem>
+#include <iosfwd>
 #include <string>
 #include <vector>
 
@@ -33,6 +34,12 @@ void write_stl_binary(const std::filesystem::path& file, const TriangleMesh& mes
                       LengthUnit unit = LengthUnit::m, const std::string& header = "impactdeck");
 /// Writes an ASCII STL with 9 significant digits, atomically.
 void write_stl_ascii(const std::filesystem::path& file, const TriangleMesh& mesh,
+                     LengthUnit unit = LengthUnit::m, const std::string& solid_name = "impactdeck");
+
+/// The same STL written to a stream (`-o -`: stdout); `name` names the output in messages.
+void write_stl_binary(std::ostream& out, const std::string& name, const TriangleMesh& mesh,
+                      LengthUnit unit = LengthUnit::m, const std::string& header = "impactdeck");
+void write_stl_ascii(std::ostream& out, const std::string& name, const TriangleMesh& mesh,
                      LengthUnit unit = LengthUnit::m, const std::string& solid_name = "impactdeck");
 
 }  // namespace impactdeck::geometry

@@ -3,6 +3,7 @@
 // Stages run only when the scene needs them; the report says which ran, which were skipped and
 // how long each took.
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -66,6 +67,10 @@ struct RunOptions {
   int solver_threads = 0;               ///< threads for ccx ([outputs.fem] run); 0: all cores
   /// Length unit of every geometric output (--output-length-unit); unset: the scene's length_unit.
   std::optional<LengthUnit> output_length_unit;
+  /// Called with the complete report after every output is staged, just before the commit
+  /// publishes them (files_written and the stages final). The CLI prints stdout here: when that
+  /// fails it throws, and the run is rolled back (nothing published).
+  std::function<void(const RunReport&)> before_commit;
 };
 
 /// Builds the shape of a body (analytic or mesh). Throws InputError.
@@ -78,9 +83,10 @@ std::shared_ptr<const geometry::Shape> make_shape(const BodySpec& body, const Sc
 contact::PreparedBody prepare_body(const BodySpec& body, const Scene& scene, RunReport* report = nullptr);
 
 /// Runs everything the scene asks for. Throws InputError on bad input; a failed self-check is
-/// reported (see all_checks_passed), not thrown. One transaction (common/run_transaction.hpp):
-/// every output, deck folders and solver results included, is staged inside `out_dir` and
-/// published only when every stage and check passed; after any failure nothing is visible.
+/// reported (see all_checks_passed, failed_checks.hpp), not thrown. One transaction
+/// (common/run_transaction.hpp): every output, deck folders and solver results included, is staged
+/// inside `out_dir` and published at once when every stage has run, even when a self-check failed
+/// (the outputs are the evidence); after an error (an exception) nothing is visible.
 RunReport run_scene(const Scene& scene, const RunOptions& options = {});
 
 /// Where the bodies of impact `s` touch, as `run` finds it (point mode: the projected point, else

@@ -11,7 +11,5 @@ namespace impactdeck::scene {
 
 nlohmann::json to_json(const Scene& scene, const RunReport& report);
 std::string format_summary(const Scene& scene, const RunReport& report);
-/// One line naming every failed self-check: "SCENE: impact 'hit': physics self-check failed: ...".
-std::string failed_checks_summary(const Scene& scene, const RunReport& report);
 
 }  // namespace impactdeck::scene

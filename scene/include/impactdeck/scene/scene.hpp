@@ -157,6 +157,12 @@ struct Scene {
 Scene load_scene(const std::filesystem::path& file, const std::vector<Override>& overrides = {},
                  const InputContext& context = {});
 
+/// The file name `-`: the scene is read from standard input (`impactdeck run -`).
+inline constexpr const char* kStdinScene = "-";
+/// load_scene of `-`: standard input read whole (bounded as a scene file, kMaxSceneBytes); messages
+/// name it `-`, and relative paths in it (parts) resolve against the current folder.
+Scene load_scene_from_stdin(const std::vector<Override>& overrides = {});
+
 /// Same from text; `name` is used in messages and relative mesh paths resolve against `base_dir`.
 Scene parse_scene(const std::string& text, const std::string& name,
                   const std::filesystem::path& base_dir = ".", const std::vector<Override>& overrides = {},
