@@ -155,20 +155,21 @@ std::string rotation_text(const Eigen::Matrix3d& r) {
 
 // The part drawing of impact `ir` (both bounded bodies as they touch; a plane as the floor), or
 // empty when no body can be drawn. `caption` gets what it shows.
-std::string part_picture(const ImpactReport& ir, const std::map<std::string, contact::PreparedBody>& bodies,
-                         LengthUnit unit, std::string& caption) {
-  const auto t = bodies.find(ir.spec->target);
-  const auto i = bodies.find(ir.spec->impactor);
+std::string part_picture(const ImpactSpec& spec, const Eigen::Vector3d& point_m, const Eigen::Vector3d& normal,
+                         const Eigen::Vector3d& impactor_translation_m,
+                         const std::map<std::string, contact::PreparedBody>& bodies, LengthUnit unit, std::string& caption) {
+  const auto t = bodies.find(spec.target);
+  const auto i = bodies.find(spec.impactor);
   if (t == bodies.end() || i == bodies.end() || !t->second.shape || !i->second.shape) return "";
   const auto ts = own_surface(*t->second.shape);
   const auto is = own_surface(*i->second.shape);
   if (!ts && !is) return "";
   plot::PartSurface surface;
   if (ts) append(surface, *ts, t->second.pose, Eigen::Vector3d::Zero());
-  if (is) append(surface, *is, i->second.pose, ir.contact.impactor_translation_m);
+  if (is) append(surface, *is, i->second.pose, impactor_translation_m);
   plot::PartMarkers mk;
-  const Eigen::Vector3d n = ir.contact.normal;  // the target's outward normal
-  mk.contact_point = ir.contact.point_m;
+  const Eigen::Vector3d n = normal;  // the target's outward normal
+  mk.contact_point = point_m;
   // The drawn part: the target, unless it is the plane (then the impactor; the normal and the
   // force are the part's own).
   const bool part_is_target = ts.has_value();
@@ -177,15 +178,15 @@ std::string part_picture(const ImpactReport& ir, const std::map<std::string, con
   mk.force = -*mk.normal;  // the other body pushes the part inwards along its normal
   if (!ts || !is) mk.floor_normal = -*mk.normal;
   mk.frame = part.pose.rotation;
-  mk.frame_origin = part.centroid_world_m() + (part_is_target ? Eigen::Vector3d::Zero() : ir.contact.impactor_translation_m);
+  mk.frame_origin = part.centroid_world_m() + (part_is_target ? Eigen::Vector3d::Zero() : impactor_translation_m);
   plot::PartDrawingOptions o;
-  o.title = "Impact '" + ir.spec->name + "': " + part.name + (ts && is ? " and " + (part_is_target ? i : t)->second.name : std::string()) +
+  o.title = "Impact '" + spec.name + "': " + part.name + (ts && is ? " and " + (part_is_target ? i : t)->second.name : std::string()) +
             " as they touch";
   o.length_unit = to_string(unit);
   o.length_unit_size = metres_per(unit);
   caption = "'" + part.name + "' as it touches " + (ts && is ? "'" : "the plane '") +
             (part_is_target ? i : t)->second.name + "' (world frame; " + rotation_text(part.pose.rotation) +
-            "): contact point at " + vec3(ir.contact.point_m, 1.0 / metres_per(unit), 3) + " " + to_string(unit) +
+            "): contact point at " + vec3(point_m, 1.0 / metres_per(unit), 3) + " " + to_string(unit) +
             ", the part's outward normal n, the force on the part along -n" +
             (mk.floor_normal ? ", the floor through the contact point" : "") +
             ". Drawn from the part's triangles (flat shading; decimated above " + std::to_string(o.max_triangles) +
@@ -262,6 +263,20 @@ std::string stress_picture(const ImpactReport& ir, std::string& caption) {
 }
 
 }  // namespace
+
+std::string impact_part_svg(const Scene& scene, const std::string& impact, const Eigen::Vector3d& point_m,
+                            const Eigen::Vector3d& normal, std::string& caption) {
+  const auto s = std::find_if(scene.impacts.begin(), scene.impacts.end(), [&](const ImpactSpec& i) { return i.name == impact; });
+  if (s == scene.impacts.end()) return "";
+  const BodySpec& target = scene.body(s->target);
+  const BodySpec& impactor = scene.body(s->impactor);
+  // The impactor is drawn where it touches only when it is the plane (a floor: a line through the
+  // contact point); a moving part would need its travel, which the caller does not have.
+  if (impactor.shape != ShapeKind::plane || target.shape == ShapeKind::plane) return "";
+  std::map<std::string, contact::PreparedBody> bodies;
+  for (const BodySpec* b : {&target, &impactor}) bodies.emplace(b->name, prepare_body(*b, scene));
+  return part_picture(*s, point_m, normal, Eigen::Vector3d::Zero(), bodies, scene.length_unit, caption);
+}
 
 ImpactVerdict impact_verdict(const ImpactReport& ir) {
   ImpactVerdict v;
@@ -346,7 +361,9 @@ std::string report_html(const Scene& scene, const RunReport& rep, const std::vec
   for (std::size_t k = 0; k < rep.impacts.size(); ++k) {
     const ImpactReport& ir = rep.impacts[k];
     std::string caption, svg;
-    if (bodies) svg = part_picture(ir, *bodies, rep.output_length_unit, caption);
+    if (bodies)
+      svg = part_picture(*ir.spec, ir.contact.point_m, ir.contact.normal, ir.contact.impactor_translation_m, *bodies,
+                         rep.output_length_unit, caption);
     std::string field_caption, field;
     if (ir.fem_deck && ir.fem_check && ir.fem_check->stress) field = stress_picture(ir, field_caption);
     if ((svg.empty() && field.empty())) continue;

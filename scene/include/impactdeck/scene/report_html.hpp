@@ -33,6 +33,14 @@ struct ImpactVerdict {
 };
 ImpactVerdict impact_verdict(const ImpactReport& ir);
 
+/// The page's picture of the bodies of impact `impact` of `scene` as they touch (plot::part_drawing),
+/// for a target hit by a plane (a drop onto the floor: the target stays where the scene puts it):
+/// the contact point and the target's outward normal in the world (m, as `run --json` gives them).
+/// Loads the bodies again. Empty when the impactor is not a plane or nothing can be drawn; `caption`
+/// gets what it shows. Throws InputError as `run` on the scene's bodies.
+std::string impact_part_svg(const Scene& scene, const std::string& impact, const Eigen::Vector3d& point_m,
+                            const Eigen::Vector3d& normal, std::string& caption);
+
 /// The page. `pictures[k]`: the extra pictures of impact k (may be shorter than the impacts).
 /// The paths in `report` are shown as they are (pass the public ones). `bodies`: the run's
 /// prepared bodies by name (their shapes and poses: the part's picture); null: no part picture.
