@@ -9,6 +9,7 @@ set -u
 bin=$1; src=$2
 command -v chromium >/dev/null 2>&1 || { echo "chromium is not installed: skipped"; exit 77; }
 . "$(dirname "$0")/check_lib.sh"
+. "$(dirname "$0")/page_height.sh"
 
 # render FILE OUT: the DOM after loading (stdout) and Chromium's log (stderr, console included).
 render() {
@@ -64,20 +65,7 @@ check "drop run exit 0" test $? -eq 0
 render "$tmp/drop/report.html" "$tmp/drop_page"
 check "drop page rendered" test -s "$tmp/drop_page.dom"
 check "no console message (drop)" no_console_errors "$tmp/drop_page"
-# The page's height at 1200 px (a parent page with a script reads the report's scroll height; the
-# report itself runs no script).
-measure() {  # measure PAGE: prints the page's height in px
-  cat >"$tmp/measure.html" <<HTML
-<!DOCTYPE html><html><body style="margin:0"><iframe id="f" src="file://$1" style="width:1200px;height:600px;border:0"></iframe>
-<script>document.getElementById("f").addEventListener("load", function () {
-  document.body.setAttribute("data-height", this.contentDocument ? this.contentDocument.documentElement.scrollHeight : -1); });</script>
-</body></html>
-HTML
-  timeout 60 chromium --headless --disable-gpu --no-sandbox --no-first-run --user-data-dir="$tmp/profile" \
-    --allow-file-access-from-files --virtual-time-budget=3000 --dump-dom "file://$tmp/measure.html" 2>/dev/null |
-    sed -n 's/.*data-height="\([0-9-]*\)".*/\1/p'
-}
-height=$(measure "$tmp/drop/report.html")
+height=$(page_height "$tmp/drop/report.html")
 echo "drop test page: ${height:-?} px tall at 1200 px"
 check "drop page height measured" test "${height:-0}" -gt 0
 python3 - "$tmp/drop_page.dom" "$tmp/drop/report.html" "$tmp/drop.json" "$tmp/drop" "$src/samples/drop_test.toml" <<'PY' || { echo "FAILED: drop page content"; fails=$((fails+1)); }
