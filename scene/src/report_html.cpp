@@ -493,6 +493,8 @@ std::string report_html(const Scene& scene, const RunReport& rep, const std::vec
   // Provenance: the version, the inputs' date and hashes. The page holds no clock time (the same
   // inputs give the same bytes, docs/reliability.md): its date is the newest input's.
   page.heading("Provenance");
+  // A part file is read once, by its loader (docs/architecture.md, one_read_test): its hash is not
+  // taken here; the scene's text is (the page shows it too).
   std::vector<std::filesystem::path> inputs;
   if (!scene.file.empty()) inputs.push_back(scene.file);
   for (const auto& b : scene.bodies)
@@ -503,7 +505,8 @@ std::string report_html(const Scene& scene, const RunReport& rep, const std::vec
   for (const auto& f : inputs) {
     const std::string when = modified_utc(f);
     newest = std::max(newest, when);
-    hashes.push_back({f.string(), when.empty() ? "-" : when, sha256_file(f)});
+    hashes.push_back({f.string(), when.empty() ? "-" : when,
+                      f == scene.file ? sha256_file(f) : "(not hashed: a part file is read once, by its loader)"});
   }
   page.html("<p id=\"provenance\">impactdeck " + plot::html_escape(kVersion) + "; inputs dated " +
             plot::html_escape(newest.empty() ? std::string("(unknown)") : newest) +
