@@ -41,6 +41,9 @@ find_package(PkgConfig QUIET)
 impactdeck_require(PKG_CONFIG_FOUND "pkg-config" pkgconf)
 pkg_check_modules(Cairo QUIET IMPORTED_TARGET cairo)
 impactdeck_require(Cairo_FOUND "cairo" libcairo2-dev)
+# nettle: the SHA-256 of the input files on the report page.
+pkg_check_modules(Nettle QUIET IMPORTED_TARGET nettle)
+impactdeck_require(Nettle_FOUND "nettle" nettle-dev)
 
 # The tests parse the written SVG / VTP files back with tinyxml2.
 if(IMPACTDECK_BUILD_TESTS)

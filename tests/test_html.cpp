@@ -1,4 +1,5 @@
 // plot/html.hpp: the report pages' building blocks (issue 18).
+#include <cmath>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -6,6 +7,7 @@
 
 #include "impactdeck/plot/drawing.hpp"
 #include "impactdeck/plot/html.hpp"
+#include "impactdeck/plot/part_drawing.hpp"
 
 using namespace impactdeck::plot;
 
@@ -90,4 +92,46 @@ TEST(Html, ControlCharactersInNamesGiveWellFormedSvgAndHtml) {
   p.table({name}, {{name}});
   EXPECT_EQ(forbidden_xml_bytes(p.str()), "");
   EXPECT_EQ(html_escape("a\tb\nc"), "a\tb\nc");  // white space kept
+}
+
+// Issue 32: the part drawing's work is bounded whatever the mesh: a fine sphere (a UV grid of
+// 2 x 96 x 192 = 36,864 triangles) is decimated by vertex clustering to at most max_triangles,
+// stays a closed-looking surface (most of the triangles kept), and the drawing's four views hold
+// at most 4 x max_triangles polygons (front faces only), the markers and legend on top.
+TEST(PartDrawing, DecimatesABigMeshToTheBoundAndDrawsFourViews) {
+  impactdeck::plot::PartSurface s;
+  const int rings = 96, segments = 192;
+  for (int i = 0; i <= rings; ++i)
+    for (int j = 0; j < segments; ++j) {
+      const double th = M_PI * i / rings, ph = 2 * M_PI * j / segments;
+      s.vertices.emplace_back(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th));
+    }
+  auto v = [&](int i, int j) { return i * segments + (j % segments); };
+  for (int i = 0; i < rings; ++i)
+    for (int j = 0; j < segments; ++j) {
+      s.triangles.push_back({v(i, j), v(i + 1, j), v(i + 1, j + 1)});
+      s.triangles.push_back({v(i, j), v(i + 1, j + 1), v(i, j + 1)});
+    }
+  ASSERT_GT(s.triangles.size(), 36000u);
+  const std::size_t bound = 3000;
+  const impactdeck::plot::PartSurface d = impactdeck::plot::decimate(s, bound);
+  EXPECT_LE(d.triangles.size(), bound);
+  EXPECT_GT(d.triangles.size(), bound / 4);  // a coarser sphere, not a handful of triangles
+
+  impactdeck::plot::PartMarkers m;
+  m.contact_point = Eigen::Vector3d(0, 0, -1);
+  m.normal = Eigen::Vector3d(0, 0, -1);
+  m.force = Eigen::Vector3d(0, 0, 1);
+  m.floor_normal = Eigen::Vector3d(0, 0, 1);
+  impactdeck::plot::PartDrawingOptions o;
+  o.max_triangles = bound;
+  const std::string svg = impactdeck::plot::to_svg(impactdeck::plot::part_drawing(s, m, o));
+  std::size_t polygons = 0;
+  for (std::size_t k = svg.find("<polygon"); k != std::string::npos; k = svg.find("<polygon", k + 1)) ++polygons;
+  EXPECT_GT(polygons, 4 * bound / 8);        // every view shows the sphere's front half
+  EXPECT_LE(polygons, 4 * bound + 16);       // plus the arrowheads
+  for (const char* label : {"front: x right, z up", "side: y right, z up", "top: x right, y up", "isometric", "floor"})
+    EXPECT_NE(svg.find(label), std::string::npos) << label;
+  tinyxml2::XMLDocument doc;
+  EXPECT_EQ(doc.Parse(svg.c_str()), tinyxml2::XML_SUCCESS);
 }

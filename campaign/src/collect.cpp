@@ -19,6 +19,7 @@
 #include "impactdeck/plot/drawing.hpp"
 #include "impactdeck/plot/html.hpp"
 #include "impactdeck/common/units.hpp"
+#include "impactdeck/scene/report_html.hpp"
 #include "impactdeck/scene/scene.hpp"
 #include "detail.hpp"
 
@@ -139,12 +140,14 @@ std::string vtp(const std::vector<Eigen::Vector3d>& pts, const std::vector<doubl
   return s.str();
 }
 
-// The map picture: each case a disc coloured by its max force (viridis, low dark). Point
-// campaigns: an oblique orthographic view of the points (target frame); drop campaigns: the
-// orientation sphere as longitude / latitude of the drop direction in the part's frame.
-std::string map_svg(const std::vector<Eigen::Vector3d>& pts, const std::vector<double>& force, bool sphere,
+// The map picture: each case a disc coloured by its max force (viridis, low dark), labelled with
+// its id, the worst case ringed, a colour bar in N. Point campaigns: an oblique orthographic view
+// of the points (target frame); drop campaigns: the orientation sphere as longitude / latitude of
+// the drop direction in the part's frame, with its axes.
+std::string map_svg(const std::vector<Eigen::Vector3d>& pts, const std::vector<double>& force,
+                    const std::vector<std::size_t>& ids, std::optional<std::size_t> worst, bool sphere,
                     const std::string& title) {
-  const double W = 720, H = 480, margin = 60;
+  const double W = 820, H = 500, left = 70, right = W - 130, top = 50, bottom = H - 70;
   plot::Drawing d(W, H);
   const double fmin = *std::min_element(force.begin(), force.end());
   const double fmax = *std::max_element(force.begin(), force.end());
@@ -156,33 +159,88 @@ std::string map_svg(const std::vector<Eigen::Vector3d>& pts, const std::vector<d
     }
   } else {
     const double az = -62 * M_PI / 180, el = 22 * M_PI / 180;
-    const Eigen::Vector3d right(-std::sin(az), std::cos(az), 0);
+    const Eigen::Vector3d r(-std::sin(az), std::cos(az), 0);
     const Eigen::Vector3d up(-std::sin(el) * std::cos(az), -std::sin(el) * std::sin(az), std::cos(el));
-    for (const auto& p : pts) xy.push_back({p.dot(right), p.dot(up)});
+    for (const auto& p : pts) xy.push_back({p.dot(r), p.dot(up)});
   }
   double x0 = sphere ? -180 : xy[0].x, x1 = sphere ? 180 : xy[0].x, y0 = sphere ? -90 : xy[0].y, y1 = sphere ? 90 : xy[0].y;
-  for (const auto& p : xy) {
-    x0 = std::min(x0, p.x), x1 = std::max(x1, p.x), y0 = std::min(y0, p.y), y1 = std::max(y1, p.y);
-  }
+  for (const auto& p : xy) x0 = std::min(x0, p.x), x1 = std::max(x1, p.x), y0 = std::min(y0, p.y), y1 = std::max(y1, p.y);
   const double span = std::max({x1 - x0, y1 - y0, 1e-30});
-  const double scale = std::min((W - 2 * margin) / (sphere ? x1 - x0 : span), (H - 2 * margin) / (sphere ? y1 - y0 : span));
+  const double scale = std::min((right - left - 20) / (sphere ? x1 - x0 : span), (bottom - top - 20) / (sphere ? y1 - y0 : span));
+  const double cx = 0.5 * (left + right), cy = 0.5 * (top + bottom);
   auto to_px = [&](const plot::Point2& p) {
-    return plot::Point2{W / 2 + (p.x - 0.5 * (x0 + x1)) * scale, H / 2 - (p.y - 0.5 * (y0 + y1)) * scale};
+    return plot::Point2{cx + (p.x - 0.5 * (x0 + x1)) * scale, cy - (p.y - 0.5 * (y0 + y1)) * scale};
   };
-  if (sphere) {
-    const plot::Style grid{plot::Colour{0.7, 0.7, 0.7}, 0.5};
-    for (int lon = -180; lon <= 180; lon += 45) d.line(to_px({double(lon), -90}), to_px({double(lon), 90}), grid);
-    for (int lat = -90; lat <= 90; lat += 30) d.line(to_px({-180, double(lat)}), to_px({180, double(lat)}), grid);
+  if (sphere) {  // axes: longitude and latitude in degrees
+    std::vector<plot::Tick> xt, yt;
+    for (int lon = -180; lon <= 180; lon += 45) xt.push_back({to_px({double(lon), 0}).x, std::to_string(lon)});
+    for (int lat = -90; lat <= 90; lat += 30) yt.push_back({to_px({0, double(lat)}).y, std::to_string(lat)});
+    plot::chart_frame(d, to_px({-180, 0}).x, to_px({0, 90}).y, to_px({180, 0}).x, to_px({0, -90}).y, xt, yt,
+                      "longitude of the drop direction in the part's frame [deg]", "latitude [deg]");
+  } else {
+    d.text({left, bottom + 30}, "oblique view of the impact points (the target's frame)", 11);
   }
   for (std::size_t i = 0; i < xy.size(); ++i) {
     const double t = fmax > fmin ? (force[i] - fmin) / (fmax - fmin) : 0.5;
-    d.circle(to_px(xy[i]), 6, plot::Style{plot::kBlack, 0.4, 1, plot::viridis(t), 1});
+    const plot::Point2 p = to_px(xy[i]);
+    d.circle(p, 6, plot::Style{plot::kBlack, 0.4, 1, plot::viridis(t), 1});
+    d.text({p.x + 8, p.y - 6}, std::to_string(ids[i]), 10);
+    if (worst && ids[i] == *worst) {
+      d.circle(p, 11, plot::Style{plot::Colour{0.84, 0.1, 0.1}, 2.5});
+      d.text({p.x + 14, p.y + 14}, "worst", 11, plot::Anchor::start, plot::Colour{0.84, 0.1, 0.1}, true);
+    }
   }
-  d.text({W / 2, 24}, title, 15, plot::Anchor::middle, plot::kBlack, true);
-  char legend[160];
-  std::snprintf(legend, sizeof legend, "max force: %.4g N (dark) to %.4g N (yellow); %zu cases", fmin, fmax, force.size());
-  d.text({W / 2, H - 16}, legend, 12, plot::Anchor::middle);
-  if (sphere) d.text({margin, H - 34}, "drop direction in the part's frame: longitude (x), latitude (y), degrees", 11);
+  d.text({left, 28}, title + " (" + std::to_string(force.size()) + " cases)", 15, plot::Anchor::start, plot::kBlack, true);
+  // Colour bar: max force, N.
+  const double bx = W - 90, by = top + 20, bh = bottom - top - 40, bw = 16;
+  for (int i = 0; i < 40; ++i) {
+    plot::Style st{plot::kBlack, -1, 1, plot::viridis((i + 0.5) / 40), 1};
+    d.rect(bx, by + bh - bh * (i + 1) / 40, bw, bh / 40 + 0.5, st);
+  }
+  d.rect(bx, by, bw, bh, plot::Style{plot::kBlack, 1});
+  const double lo = fmax > fmin ? fmin : fmin - 0.5, hi = fmax > fmin ? fmax : fmax + 0.5;
+  for (double v : plot::nice_ticks(lo, hi, 5)) {
+    const double y = by + bh - bh * (v - lo) / (hi - lo);
+    d.line({bx + bw, y}, {bx + bw + 4, y}, plot::Style{plot::kBlack, 1});
+    d.text({bx + bw + 6, y + 4}, plot::format_number(v), 10);
+  }
+  d.text({bx - 10, by - 10}, "max force [N]", 11, plot::Anchor::start, plot::kBlack, true);
+  return plot::to_svg(d);
+}
+
+// The histogram of the judged cases' safety factors (bins of a nice width), the line at 1.
+std::string histogram_svg(const std::vector<double>& factors) {
+  const double W = 820, H = 300, left = 70, right = W - 30, top = 46, bottom = H - 60;
+  plot::Drawing d(W, H);
+  const double fmax = *std::max_element(factors.begin(), factors.end());
+  const double hi = std::max(1.0, fmax) * 1.0001;
+  const std::vector<double> edges_hint = plot::nice_ticks(0.0, hi, 12);
+  const double bin = edges_hint.size() >= 2 ? edges_hint[1] - edges_hint[0] : hi;
+  const auto bins = static_cast<std::size_t>(std::ceil(hi / bin));
+  std::vector<std::size_t> count(bins, 0);
+  for (double f : factors) count[std::min(bins - 1, static_cast<std::size_t>(std::max(0.0, f) / bin))]++;
+  const std::size_t cmax = *std::max_element(count.begin(), count.end());
+  const double x_hi = bin * static_cast<double>(bins);
+  auto X = [&](double v) { return left + (right - left) * v / x_hi; };
+  auto Y = [&](double c) { return bottom - (bottom - top) * c / static_cast<double>(std::max<std::size_t>(cmax, 1)); };
+  std::vector<plot::Tick> xt, yt;
+  for (double v : plot::nice_ticks(0.0, x_hi, 8)) xt.push_back({X(v), plot::format_number(v)});
+  for (double v : plot::nice_ticks(0.0, static_cast<double>(std::max<std::size_t>(cmax, 1)), 4))
+    if (v == std::floor(v)) yt.push_back({Y(v), plot::format_number(v)});
+  plot::chart_frame(d, left, top, right, bottom, xt, yt, "safety factor (yield strength / governing stress)", "cases");
+  for (std::size_t k = 0; k < bins; ++k) {
+    if (!count[k]) continue;
+    const double x = X(bin * static_cast<double>(k)), w = X(bin * static_cast<double>(k + 1)) - x;
+    const bool below = bin * static_cast<double>(k + 1) <= 1.0;
+    d.rect(x + 1, Y(static_cast<double>(count[k])), w - 2, bottom - Y(static_cast<double>(count[k])),
+           plot::Style{plot::kBlack, 0.6, 1, below ? plot::Colour{0.84, 0.37, 0.0} : plot::Colour{0.0, 0.45, 0.70}, 1});
+  }
+  plot::Style one{plot::Colour{0.75, 0.1, 0.1}, 1.5};
+  one.dash = 6;
+  d.line({X(1.0), top}, {X(1.0), bottom}, one);
+  d.text({X(1.0) + 4, top + 12}, "1: yield", 11, plot::Anchor::start, plot::Colour{0.75, 0.1, 0.1});
+  d.text({left, 28}, "Safety factors of the " + std::to_string(factors.size()) + " judged cases", 15, plot::Anchor::start,
+         plot::kBlack, true);
   return plot::to_svg(d);
 }
 
@@ -193,10 +251,24 @@ std::string number_text(const json& v, int digits = 4) {
   return b;
 }
 
+// A case's input for the page, short: numbers (also inside the JSON text an override holds) to
+// 3 significant digits, a vector as (x, y, z).
+std::string compact_input(const json& v) {
+  json x = v.is_string() ? json::parse(v.get<std::string>(), nullptr, false) : v;
+  if (x.is_discarded()) return v.get<std::string>();
+  if (x.is_number()) return plot::format_number(x.get<double>(), 3);
+  if (x.is_array() && !x.empty() && std::all_of(x.begin(), x.end(), [](const json& e) { return e.is_number(); })) {
+    std::string o = "(";
+    for (const auto& e : x) o += (o.size() > 1 ? ", " : "") + plot::format_number(e.get<double>(), 3);
+    return o + ")";
+  }
+  return v.is_string() ? v.get<std::string>() : v.dump();
+}
+
 // The campaign's report page: the verdict over the cases, the counts, the table, the map.
 std::string report_page(const fs::path& dir, const std::string& impact, const std::vector<std::string>& keys,
                         const std::vector<Row>& rows, const CollectResult& out, bool all_stress,
-                        const std::string& map_svg) {
+                        const std::string& map_svg, const std::string& worst_svg, const std::string& worst_caption) {
   plot::HtmlPage page("impactdeck campaign: " + dir.filename().string());
   // Verdict per case: the FEM stress verdict where ccx ran, else the Hertz peak pressure against
   // the yield onset 1.60 sigma_y (safety factor 1 / ratio).
@@ -240,39 +312,92 @@ std::string report_page(const fs::path& dir, const std::string& impact, const st
              {{dir.string(), impact, std::to_string(out.done), std::to_string(out.failed), std::to_string(out.pending),
                out.worst_id ? std::to_string(*out.worst_id) + (all_stress ? " (largest peak von Mises)" : " (largest max force)")
                             : "-"}});
-  if (!map_svg.empty()) page.figure(plot::inline_svg(map_svg), "Max force of each case (map.svg)");
 
+  // The five cases closest to yielding (smallest safety factor; by max force when none is judged).
+  std::vector<std::size_t> order;
+  for (std::size_t k = 0; k < rows.size(); ++k)
+    if (rows[k].state == CaseState::done) order.push_back(k);
+  auto factor = [&](std::size_t k) { return factors[k].empty() ? 1e300 : std::strtod(factors[k].c_str(), nullptr); };
+  auto force = [&](std::size_t k) {
+    const json f = at(rows[k].impact, "/max_force_N");
+    return f.is_number() ? f.get<double>() : 0.0;
+  };
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) {
+    return judged ? factor(x) < factor(y) : force(x) > force(y);
+  });
+  if (!order.empty()) {
+    page.heading(judged ? "Top 5: the smallest safety factors" : "Top 5: the largest max forces");
+    std::vector<std::vector<std::string>> top;
+    for (std::size_t n = 0; n < std::min<std::size_t>(5, order.size()); ++n) {
+      const Row& r = rows[order[n]];
+      std::string inputs;
+      for (const auto& key : keys)
+        if (r.inputs.contains(key)) inputs += (inputs.empty() ? "" : "; ") + key + " = " + compact_input(r.inputs[key]);
+      top.push_back({std::to_string(r.id), verdicts[order[n]], factors[order[n]], number_text(at(r.impact, "/max_force_N")),
+                     number_text(at(r.impact, "/fem/check/stress/verdict/governing/max_von_mises_Pa")), inputs});
+    }
+    page.table({"case", "verdict", "safety factor", "max force (N)", "peak von Mises (Pa)", "inputs"}, top);
+  }
+  if (!map_svg.empty())
+    page.html("<figure class=\"campaign-map\">" + plot::inline_svg(map_svg) +
+              "<figcaption>Max force of each case (map.svg): case ids beside the discs, the worst case ringed"
+              "</figcaption></figure>");
+  if (!worst_svg.empty())
+    page.html("<figure class=\"part-drawing\" id=\"worst-case\">" + plot::inline_svg(worst_svg) + "<figcaption>Worst case " +
+              std::to_string(*out.worst_id) + ": " + plot::html_escape(worst_caption) + "</figcaption></figure>");
+  std::vector<double> judged_factors;
+  for (const auto& f : factors)
+    if (!f.empty()) judged_factors.push_back(std::strtod(f.c_str(), nullptr));
+  if (!judged_factors.empty())
+    page.html("<figure class=\"safety-histogram\">" + plot::inline_svg(histogram_svg(judged_factors)) +
+              "<figcaption>Histogram of the safety factors (below 1: yields)</figcaption></figure>");
+
+  // One compact row per case; its warnings folded (they repeat from case to case).
   std::vector<std::string> header = {"case", "state"};
   header.insert(header.end(), keys.begin(), keys.end());
   for (const char* h : {"max force (N)", "impulse error (Eq. 31)", "energy error (Eq. 32)", "FEM momentum error",
                         "checks", "verdict", "safety factor", "warnings / reason"})
     header.push_back(h);
-  std::vector<std::vector<std::string>> table;
+  std::string t = "<table class=\"cases\">\n<tr>";
+  for (const auto& h : header) t += "<th>" + plot::html_escape(h) + "</th>";
+  t += "</tr>\n";
+  auto td = [](const std::string& c) {
+    const std::size_t marker = std::string(plot::HtmlPage::kPass).size();
+    if (c.rfind(plot::HtmlPage::kPass, 0) == 0) return "<td class=\"pass\">" + plot::html_escape(c.substr(marker)) + "</td>";
+    if (c.rfind(plot::HtmlPage::kFail, 0) == 0) return "<td class=\"fail\">" + plot::html_escape(c.substr(marker)) + "</td>";
+    return "<td>" + plot::html_escape(c) + "</td>";
+  };
   for (std::size_t k = 0; k < rows.size(); ++k) {
     const Row& r = rows[k];
-    std::vector<std::string> row = {std::to_string(r.id), to_string(r.state)};
-    for (const auto& key : keys) row.push_back(r.inputs.contains(key) ? r.inputs[key].dump() : "");
-    row.push_back(number_text(at(r.impact, "/max_force_N"), 6));
-    row.push_back(number_text(at(r.impact, "/checks/impulse_relative_error"), 3));
-    row.push_back(number_text(at(r.impact, "/checks/energy_relative_error"), 3));
-    row.push_back(number_text(at(r.impact, "/fem/check/linear_momentum_relative_error"), 3));
+    t += "<tr>" + td(std::to_string(r.id)) + td(to_string(r.state));
+    for (const auto& key : keys) t += td(r.inputs.contains(key) ? compact_input(r.inputs[key]) : "");
+    t += td(number_text(at(r.impact, "/max_force_N"), 4));
+    t += td(number_text(at(r.impact, "/checks/impulse_relative_error"), 3));
+    t += td(number_text(at(r.impact, "/checks/energy_relative_error"), 3));
+    t += td(number_text(at(r.impact, "/fem/check/linear_momentum_relative_error"), 3));
     const json passed = r.result.is_null() ? json(nullptr) : r.result.value("all_checks_passed", json(nullptr));
-    row.push_back(passed.is_boolean() ? std::string(passed.get<bool>() ? plot::HtmlPage::kPass : plot::HtmlPage::kFail) +
-                                            (passed.get<bool>() ? "passed" : "failed")
-                                      : "");
-    row.push_back(verdicts[k]);
-    row.push_back(factors[k]);
-    std::string notes;
-    if (!r.failure.is_null()) notes = r.failure.value("reason", "");
+    t += td(passed.is_boolean() ? std::string(passed.get<bool>() ? plot::HtmlPage::kPass : plot::HtmlPage::kFail) +
+                                      (passed.get<bool>() ? "passed" : "failed")
+                                : "");
+    t += td(verdicts[k]) + td(factors[k]);
+    // The run's warnings hold the validity warnings already: each once.
+    std::vector<std::string> notes;
+    if (!r.failure.is_null()) notes.push_back(r.failure.value("reason", ""));
     for (const auto& w : r.result.is_null() ? json::array() : r.result.value("warnings", json::array()))
-      if (w.is_string()) notes += (notes.empty() ? "" : "; ") + w.get<std::string>();
-    for (const auto& w : at(r.impact, "/validity/warnings").is_array() ? at(r.impact, "/validity/warnings") : json::array())
-      if (w.is_string()) notes += (notes.empty() ? "" : "; ") + w.get<std::string>();
-    row.push_back(notes);
-    table.push_back(std::move(row));
+      if (w.is_string() && std::find(notes.begin(), notes.end(), w.get<std::string>()) == notes.end())
+        notes.push_back(w.get<std::string>());
+    if (notes.empty()) {
+      t += "<td></td>";
+    } else {
+      t += "<td><details><summary>" + std::to_string(notes.size()) + (notes.size() == 1 ? " note" : " notes") +
+           "</summary><ul>";
+      for (const auto& n : notes) t += "<li>" + plot::html_escape(n) + "</li>";
+      t += "</ul></details></td>";
+    }
+    t += "</tr>\n";
   }
   page.heading("Cases");
-  page.table(header, table);
+  page.html("<div class=\"wide\">" + t + "</table></div>");
   return page.str();
 }
 
@@ -434,12 +559,28 @@ CollectResult collect(const fs::path& dir_in) {
       }
       if (!pts.empty()) {
         const std::string title = drops ? "Max force over the drop orientations" : "Max force over the impact points";
-        map_text = map_svg(pts, force, drops, title);
+        map_text = map_svg(pts, force, ids, out.worst_id, drops, title);
         out.map_svg = add("map.svg", map_text);
         out.map_vtp = add("map.vtp", vtp(pts, force, ids, unit));
       }
     }
-    out.report_html = add("report.html", report_page(dir, impact, keys, rows, out, all_stress, map_text));
+    // The worst case of a drop campaign as it touches the floor (its orientation).
+    std::string worst_svg, worst_caption;
+    if (drops && out.worst_id) {
+      for (const Row& r : rows) {
+        const json p = at(r.impact, "/contact_point_m"), n = at(r.impact, "/contact_normal");
+        auto vec3 = [](const json& v) {
+          return v.is_array() && v.size() == 3 && std::all_of(v.begin(), v.end(), [](const json& e) { return e.is_number(); });
+        };
+        if (r.id != *out.worst_id || !vec3(p) || !vec3(n)) continue;
+        const Eigen::Vector3d point(p[0].get<double>(), p[1].get<double>(), p[2].get<double>());
+        const Eigen::Vector3d normal(n[0].get<double>(), n[1].get<double>(), n[2].get<double>());
+        worst_svg = scene::impact_part_svg(scene::load_scene(case_folder(dir, r.id) / "scene.toml"), impact, point,
+                                           normal, worst_caption);
+      }
+    }
+    out.report_html = add("report.html", report_page(dir, impact, keys, rows, out, all_stress, map_text, worst_svg,
+                                                     worst_caption));
     if (out.worst_id) {  // a copy of the worst case's folder (scene, decks, result), checked above
       const fs::path stage = txn.folder("worst_case", where, "collect");
       std::error_code ec;

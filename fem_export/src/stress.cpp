@@ -51,6 +51,12 @@ std::string mm_text(const Eigen::Vector3d& p_m) {
   return s.str();
 }
 
+// The same, rounded to 3 significant digits for a picture's legend.
+std::string legend_mm(const Eigen::Vector3d& p_m) {
+  return "(" + plot::format_number(p_m.x() * 1e3, 3) + ", " + plot::format_number(p_m.y() * 1e3, 3) + ", " +
+         plot::format_number(p_m.z() * 1e3, 3) + ") mm";
+}
+
 // One pass over a ccx .frd (both readers below): the result blocks of every output time, each
 // "  100C" header's time, each " -4  NAME" block start, its " -1" node records and its " -3" end.
 // `block` says whether a block's records are wanted (false: skipped); `record` gets the node number
@@ -168,6 +174,8 @@ StressResult read_stresses(const fs::path& frd, const TetMesh& mesh, const Stres
       if (node >= 0 && v > p.von_mises_Pa) p = {v, t, node, mesh.nodes_m[node]};
     };
     update(r.outside_zone, out_max, out_node);
+    r.outside_zone_history_Pa.push_back(std::max(out_max, 0.0));
+    r.inside_zone_history_Pa.push_back(std::max(in_max, 0.0));
     update(r.inside_zone, in_max, in_node);
     const double governing = in.patch_load ? std::max(out_max, in_max) : out_max;
     if (in.yield_strength_Pa && governing > *in.yield_strength_Pa && !r.verdict.first_yield_time_s) {
@@ -392,10 +400,23 @@ void write_stress_files(const fs::path& dir, const TetMesh& m, StressResult& r, 
   if (r.time_s.size() >= 2) {
     std::vector<plot::StressSeries> ps;
     double lo = 1e300, hi = 0;
+    // The curve the verdict is taken from first (blue, bold in the legend's first line), then the
+    // probes, then the contact node in vermilion: a point load's node may climb far above the
+    // verdict's curve, which judges the stresses outside the contact zone.
+    const Verdict& v = r.verdict;
+    const bool inside_governs = v.governing_region == "inside the contact zone";
+    const std::vector<double>& governing = inside_governs ? r.inside_zone_history_Pa : r.outside_zone_history_Pa;
+    if (governing.size() == r.time_s.size()) {
+      ps.push_back({std::string("verdict: max ") + (inside_governs ? "inside" : "outside") +
+                        " the contact zone, peak " + plot::format_number(v.governing.von_mises_Pa * 1e-6, 3) +
+                        " MPa at " + legend_mm(v.governing.point_m),
+                    r.time_s, governing, 0});
+      lo = std::min(lo, v.governing.von_mises_Pa);
+      hi = std::max(hi, v.governing.von_mises_Pa);
+    }
     for (const auto* p : series) {
-      // The contact node in vermilion, the probes in the other colours.
-      ps.push_back({p->name + " " + mm_text(p->point_m), r.time_s, p->von_mises_Pa,
-                    p == &r.load ? plot::kVermilion : static_cast<int>(ps.size()) % plot::kVermilion});
+      ps.push_back({p->name + " at " + legend_mm(p->point_m) + (p == &r.load ? " (contact node)" : ""), r.time_s,
+                    p->von_mises_Pa, p == &r.load ? plot::kVermilion : 1 + static_cast<int>(ps.size()) % 4});
       lo = std::min(lo, p->max_von_mises_Pa);
       hi = std::max(hi, p->max_von_mises_Pa);
     }

@@ -168,6 +168,15 @@ std::string HtmlPage::str() const {
          ".warning{background:#fff4d6;padding:0.3em}\n"
          "figure{margin:1em 0}\nfigure svg,figure img{max-width:100%;height:auto;border:1px solid #ddd}\n"
          "pre{background:#f6f6f6;padding:0.5em;overflow-x:auto}\n"
+         ".governing{font-size:1.1em;margin-top:-0.3em}\n"
+         "figcaption{font-size:0.9em;color:#444}\n"
+         ".wide{overflow-x:auto}\ntable.cases{font-size:0.85em}\n"
+         "details>ul{margin:0.2em 0;padding-left:1.2em}\n"
+         // Printed (or saved as PDF): full width, pictures and tables not split across pages, the
+         // headings kept with what follows (folded blocks print folded).
+         "@media print{body{max-width:none;margin:0;font-size:10pt}figure,table,.verdict,.warning{break-inside:avoid}"
+         "h2,h3{break-after:avoid}a{color:inherit;text-decoration:none}"
+         ".verdict{border-width:3px}}\n"
          "</style>\n</head>\n<body>\n<h1>" + html_escape(title_) + "</h1>\n" + body_ + "</body>\n</html>\n";
 }
 

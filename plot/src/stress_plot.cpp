@@ -37,8 +37,12 @@ Drawing stress_time_drawing(const std::vector<StressSeries>& series, const Stres
   const double sf = opt.force_N ? (s_max >= 1e4 ? 1e-3 : 1.0) : s_max >= 1e6 ? 1e-6 : 1e-3;
   const char* su = opt.force_N ? (s_max >= 1e4 ? "kN" : "N") : s_max >= 1e6 ? "MPa" : "kPa";
 
-  Drawing d(opt.width_px, opt.height_px);
-  const double left = 84, top = 56, right = opt.width_px - 250, bottom = opt.height_px - 62;
+  // The legend goes under the chart, one line per entry (labels shortened to the width, never
+  // clipped by the canvas): the chart keeps the full width.
+  const std::size_t entries = series.size() + (opt.yield_strength_Pa ? 1 : 0);
+  const double legend_h = 20.0 * static_cast<double>(entries) + 8;
+  Drawing d(opt.width_px, opt.height_px + legend_h);
+  const double left = 84, top = 56, right = opt.width_px - 30, bottom = opt.height_px - 62;
   const double t_hi = t_max * tf;
   // Stress axis: linear from 0, or logarithmic over the decades the series span.
   const bool log = opt.log_scale;
@@ -78,8 +82,15 @@ Drawing stress_time_drawing(const std::vector<StressSeries>& series, const Stres
     d.line({X(*opt.contact_end_s), top}, {X(*opt.contact_end_s), bottom}, mark);
     d.text({X(*opt.contact_end_s) + 4, top + 12}, "end of contact", 11);
   }
-  const double lx = right + 22;
-  double ly = top + 8;
+  const double lx = left;
+  double ly = opt.height_px + 6;
+  const auto max_chars = static_cast<std::size_t>(std::max(10.0, (opt.width_px - lx - 40) / 7.0));
+  auto fit = [&](const std::string& label) {
+    if (label.size() <= max_chars) return label;
+    std::size_t cut = max_chars - 3;
+    while (cut > 0 && (static_cast<unsigned char>(label[cut]) & 0xC0) == 0x80) --cut;  // not inside a UTF-8 character
+    return label.substr(0, cut) + "...";
+  };
   if (opt.yield_strength_Pa) {
     Style ys;
     ys.stroke = {0.75, 0.1, 0.1};
@@ -101,7 +112,7 @@ Drawing stress_time_drawing(const std::vector<StressSeries>& series, const Stres
     for (std::size_t k = 0; k < s.time_s.size(); ++k) pts.push_back({X(s.time_s[k]), Y(s.von_mises_Pa[k])});
     d.polyline(std::move(pts), st);
     d.line({lx, ly - 4}, {lx + 26, ly - 4}, st);
-    d.text({lx + 34, ly}, s.label, 12);
+    d.text({lx + 34, ly}, fit(s.label), 12);
     ly += 20;
   }
   return d;

@@ -637,7 +637,7 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
                                                   folder_notes.end();
                                          }),
                           page.warnings.end());
-      write_file_atomically(*staged.report, report_html(scene, page, pictures));
+      write_file_atomically(*staged.report, report_html(scene, page, pictures, &bodies));
     });
   }
   // Everything is staged: the caller's last word (the CLI prints stdout here, so that a stdout

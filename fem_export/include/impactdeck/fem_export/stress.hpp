@@ -70,6 +70,9 @@ struct StressResult {
   ProbeStress load;                     ///< the contact node ("LOAD")
   double contact_zone_radius_m = 0;
   VonMisesPeak outside_zone, inside_zone;
+  /// At each of time_s: the largest von Mises over the nodes outside the contact zone and inside
+  /// it (0 when the zone has no node): the curves the verdict's peak is taken from.
+  std::vector<double> outside_zone_history_Pa, inside_zone_history_Pa;
   bool inside_zone_meaningful = false;  ///< false under a point load
   Verdict verdict;
   /// The fields of the .vtu / .msh: per node, the peak over time and its time; the von Mises and

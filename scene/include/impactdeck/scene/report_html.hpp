@@ -1,8 +1,13 @@
 #pragma once
-// `run`'s report page (report.html): one self-contained file (plot/html.hpp) with the inputs (the
-// scene's text, materials, bodies, units), each impact's results with their checks (impulse,
-// Eq. 31; Carnot, Eq. 32; the FEM checks), the validity warnings, the pictures (F(t), Fig. 15) and
-// the verdict (survives / yields, safety factor). Every text from the scene is escaped.
+// `run`'s report page (report.html): one self-contained file (plot/html.hpp). First the verdict
+// (survives / yields, the safety factor and the governing number: stress and place), then each
+// warning once, the part (three orthographic views and an isometric one drawn from its triangles,
+// with the contact point, the normal, the force and the floor), the stress field at its peak when
+// ccx ran, the inputs (the scene's text, materials, bodies, units), each impact's results with
+// their checks (impulse, Eq. 31; Carnot, Eq. 32; the FEM checks), the pictures (F(t), Fig. 15),
+// the version, the inputs' date and SHA-256 hashes, and links to every file written. Every text
+// from the scene is escaped.
+#include <map>
 #include <string>
 #include <vector>
 
@@ -28,9 +33,19 @@ struct ImpactVerdict {
 };
 ImpactVerdict impact_verdict(const ImpactReport& ir);
 
+/// The page's picture of the bodies of impact `impact` of `scene` as they touch (plot::part_drawing),
+/// for a target hit by a plane (a drop onto the floor: the target stays where the scene puts it):
+/// the contact point and the target's outward normal in the world (m, as `run --json` gives them).
+/// Loads the bodies again. Empty when the impactor is not a plane or nothing can be drawn; `caption`
+/// gets what it shows. Throws InputError as `run` on the scene's bodies.
+std::string impact_part_svg(const Scene& scene, const std::string& impact, const Eigen::Vector3d& point_m,
+                            const Eigen::Vector3d& normal, std::string& caption);
+
 /// The page. `pictures[k]`: the extra pictures of impact k (may be shorter than the impacts).
-/// The paths in `report` are shown as they are (pass the public ones).
+/// The paths in `report` are shown as they are (pass the public ones). `bodies`: the run's
+/// prepared bodies by name (their shapes and poses: the part's picture); null: no part picture.
 std::string report_html(const Scene& scene, const RunReport& report,
-                        const std::vector<std::vector<ReportPicture>>& pictures = {});
+                        const std::vector<std::vector<ReportPicture>>& pictures = {},
+                        const std::map<std::string, contact::PreparedBody>* bodies = nullptr);
 
 }  // namespace impactdeck::scene
