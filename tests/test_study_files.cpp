@@ -573,7 +573,7 @@ TEST(ForcePlot, RunWritesTheSvgNextToTheCsv) {
   for (const auto* t : all(root, "text")) texts += std::string(t->GetText() ? t->GetText() : "") + "|";
   EXPECT_NE(texts.find("t_m = "), std::string::npos) << texts;
   EXPECT_NE(texts.find("end = "), std::string::npos);
-  EXPECT_NE(texts.find("\xCE\xA0 = (1 + R)"), std::string::npos);  // total impulse in the legend
+  EXPECT_NE(texts.find("\xCE\xA0 = (1+R)"), std::string::npos);  // total impulse in the legend
   // The legend's total impulse is the core's, to the 4 digits shown.
   std::ostringstream pi;
   pi << plot::format_number(rep.impacts[0].result.history.impulse_total_Ns()) << " N s";

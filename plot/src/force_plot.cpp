@@ -122,7 +122,8 @@ Drawing force_time_drawing(const collision::ForceHistory& h, const ForcePlotOpti
   ly += 6;
   legend_text("\xCE\xA0\xE2\x82\x81 = " + format_number(h.impulse_compression_Ns()) + " N s");       // Π₁
   legend_text("\xCE\xA0\xE2\x82\x82 = R \xCE\xA0\xE2\x82\x81 = " + format_number(h.impulse_restitution_Ns()) + " N s");
-  legend_text("\xCE\xA0 = (1 + R) \xCE\xA0\xE2\x82\x81 = " + format_number(h.impulse_total_Ns()) + " N s");
+  // Compact: a small impulse's digits (0.0007762) must still fit the canvas.
+  legend_text("\xCE\xA0 = (1+R)\xCE\xA0\xE2\x82\x81 = " + format_number(h.impulse_total_Ns()) + " N s");
   return d;
 }
 
