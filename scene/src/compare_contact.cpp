@@ -155,9 +155,11 @@ CompareReport compare_contact(const Scene& scene_in, const CompareOptions& o) {
   // The full-contact model is elastic: "auto" runs Hertz here (impact_law), a plastic law is refused.
   ImpactLaw law = impact_law(scene, s, impact_ctx);
   if (law.automatic && law.name != "hertz") {  // as `run` with compare_contact = true chooses
-    Scene compared = scene;
-    compared.outputs.fem->compare_contact.emplace();
-    law = impact_law(compared, s, impact_ctx);
+    // (the scene may have no [outputs.fem] here: the impact asks for Hertz instead, still "auto")
+    ImpactSpec elastic = s;
+    elastic.contact_law = "hertz";
+    law = impact_law(scene, elastic, impact_ctx);
+    law.automatic = true;
   }
   if (law.name != "hertz") {
     throw impact_ctx.error("contact_law", "compare-contact compares with an elastic full-contact model: it needs "
