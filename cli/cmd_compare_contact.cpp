@@ -54,7 +54,7 @@ void register_compare_contact(CLI::App& app, Context& ctx) {
                 "Run the full-contact model only");
   cmd->callback([args, &ctx] {
     refuse_stdout_folder(args->out, "compare-contact");
-    check_stdout_writable();  // its output follows the commit: refused now, not after it
+    check_stdout_writable();  // refused before any work (a later failure rolls the comparison back)
     const scene::Scene sc = scene::load_scene(args->scene, overrides_from(args->set));
     // One transaction (docs/reliability.md): the decks and ccx's results are staged inside --out
     // and published together when the comparison completed, whatever its verdict; a failure or a
@@ -67,18 +67,16 @@ void register_compare_contact(CLI::App& app, Context& ctx) {
     o.place_output = [&txn, &args](const std::string& name, bool is_folder) {
       return is_folder ? txn.folder(name, args->out, "--out") : txn.file(name, args->out, "--out");
     };
-    scene::CompareReport r = txn.run([&] {
+    const scene::CompareReport r = txn.run([&] {
       VerboseTimer timer(ctx, "compare-contact", "hybrid and contact runs");
       scene::CompareReport report = scene::compare_contact(sc, o);
+      scene::map_paths(report, [&txn](const std::filesystem::path& p) { return txn.public_path(p); });
+      // stdout before the commit: when it fails the comparison is rolled back (docs/reliability.md).
+      if (args->json) write_stdout(scene::to_json(report).dump(2) + "\n");
+      else if (!ctx.quiet) write_stdout(scene::format_compare(report));
       txn.commit();
       return report;
     });
-    scene::map_paths(r, [&txn](const std::filesystem::path& p) { return txn.public_path(p); });
-    if (args->json) {
-      std::cout << scene::to_json(r).dump(2) << "\n";
-    } else {
-      ctx.report() << scene::format_compare(r);
-    }
     if (r.verdict == scene::CompareVerdict::disagree) {
       std::cerr << "impactdeck: error: contact F_max differs from the analytic force beyond the threshold; in doubt: "
                 << r.in_doubt << "\n";

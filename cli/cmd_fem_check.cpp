@@ -42,7 +42,7 @@ void register_fem_check(CLI::App& app, Context& ctx) {
                   "Wall-time limit of the ccx run (default: derived from the deck's size, stated in --json)")
       ->check(positive_number());
   cmd->callback([args, &ctx] {
-    check_stdout_writable();  // its output follows the commit: refused now, not after it
+    check_stdout_writable();  // refused before any work (a later failure leaves the folder as it was)
     check_threads(static_cast<unsigned>(std::min(args->options.threads, 1 << 30)));
     if (!std::isfinite(args->options.timeout_s)) throw UsageError("--solver-timeout-s must be a finite number of seconds");
     fem_export::CheckOptions o = args->options;
@@ -54,29 +54,24 @@ void register_fem_check(CLI::App& app, Context& ctx) {
                 << o.angular_tolerance << ", threads " << o.threads << "\n";
     }
     std::vector<std::string> warnings;
-    fem_export::CheckResult r = [&] {
+    // stdout is written before the results are published: when it fails, the folder stays as it was.
+    const auto print = [&](const fem_export::CheckResult& r) {
+      if (args->json) write_stdout(fem_export::to_json(r).dump(2) + "\n");
+      else if (!ctx.quiet) write_stdout(fem_export::format_check(r));
+    };
+    const fem_export::CheckResult r = [&] {
       VerboseTimer timer(ctx, "fem-check", "ccx and the checks");
-      return fem_export::check_deck_folder(args->dir, o, &warnings);
+      return fem_export::check_deck_folder(args->dir, o, &warnings, print);
     }();
+    if (!o.run_solver) print(r);  // only read: nothing is published
+    for (const auto& w : warnings) ctx.warn(w);
     if (!r.passed) {
       std::ostringstream m;
       m << (fs::path(args->dir) / "impact.dat").string() << ": FEM check failed: ";
       for (std::size_t i = 0; i < r.failures.size(); ++i) m << (i ? "; " : "") << r.failures[i];
-      m << (o.run_solver ? " (the deck folder was left as it was)" : "");
-      if (args->json) {
-        std::cout << fem_export::to_json(r).dump(2) << "\n";
-      } else {
-        ctx.report() << fem_export::format_check(r);
-      }
+      m << (o.run_solver ? " (the solver's results are published in the deck folder: the evidence)" : "");
       std::cerr << "impactdeck: error: " << m.str() << "\n";
       ctx.exit_code = static_cast<int>(ExitCode::check_failed);
-      return;
-    }
-    for (const auto& w : warnings) ctx.warn(w);
-    if (args->json) {
-      std::cout << fem_export::to_json(r).dump(2) << "\n";
-    } else {
-      ctx.report() << fem_export::format_check(r);
     }
   });
 }

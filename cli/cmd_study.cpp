@@ -100,7 +100,7 @@ void register_study(CLI::App& app, Context& ctx) {
   add_set_option(cmd, a->set);
   cmd->callback([a, &ctx] {
     refuse_stdout_folder(a->out, "study table1");
-    check_stdout_writable();  // its output follows the commit: refused now, not after it
+    check_stdout_writable();  // refused before any work (a later failure rolls the study back)
     check_threads(a->threads);
     study::Table1Options o = study::table1_preset(a->preset);
     if (!a->g.empty()) o.geometric_ratios = parse_list(a->g, "--geometric-ratios");
@@ -174,18 +174,20 @@ void register_study(CLI::App& app, Context& ctx) {
       const plot::Drawing heat = study::table1_heatmap(r);
       plot::write_svg(svg, heat);
       if (!a->no_png) plot::write_png(png, heat, 1.25);
+      // stdout before the commit: when it fails the study is rolled back (docs/reliability.md).
+      if (a->json) {
+        write_stdout(study::table1_json(r).dump(2) + "\n");
+      } else if (!ctx.quiet) {
+        std::ostringstream text;
+        text << study::table1_markdown(r) << "time " << std::setprecision(3) << r.seconds << " s; wrote "
+             << (out / "table1.csv").string() << ", " << (out / "table1.md").string() << ", "
+             << (out / "table1_heatmap.svg").string()
+             << (a->no_png ? "" : ", " + (out / "table1_heatmap.png").string()) << "\n";
+        write_stdout(text.str());
+      }
       txn.commit();
     });
     for (const auto& w : txn.warnings()) ctx.warn(w);
-
-    if (a->json) {
-      std::cout << study::table1_json(r).dump(2) << "\n";
-    } else {
-      ctx.report() << study::table1_markdown(r);
-      ctx.report() << "time " << std::setprecision(3) << r.seconds << " s; wrote " << (out / "table1.csv").string()
-                << ", " << (out / "table1.md").string() << ", " << (out / "table1_heatmap.svg").string()
-                << (a->no_png ? "" : ", " + (out / "table1_heatmap.png").string()) << "\n";
-    }
   });
 }
 

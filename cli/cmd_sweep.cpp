@@ -63,7 +63,7 @@ void register_sweep(CLI::App& app, Context& ctx) {
   add_output_length_unit_option(cmd, a->output_length_unit);
   cmd->callback([a, &ctx] {
     refuse_stdout_folder(a->out, "sweep");
-    check_stdout_writable();  // its output follows the commit: refused now, not after it
+    check_stdout_writable();  // refused before any work (a later failure rolls the sweep back)
     check_threads(a->threads);
     study::SweepRequest q;
     try {
@@ -98,6 +98,13 @@ void register_sweep(CLI::App& app, Context& ctx) {
         write_bar.update(done, total);
       }
     };
+    // stdout is written before the commit: when it fails the sweep is rolled back (docs/reliability.md).
+    q.before_commit = [&](const study::SweepReport& r) {
+      sweep_bar.finish();
+      write_bar.finish();
+      if (a->json) write_stdout(study::to_json(r).dump(2) + "\n");
+      else if (!ctx.quiet) write_stdout(study::format_sweep(r));
+    };
     const study::SweepReport rep = study::run_sweep_command(scene::sweep_case(sc, q.impact), q);
     sweep_bar.finish();
     write_bar.finish();
@@ -107,11 +114,6 @@ void register_sweep(CLI::App& app, Context& ctx) {
       ctx.note("sweep", t.str());
     }
     for (const auto& w : rep.warnings) ctx.warn(w);
-    if (a->json) {
-      std::cout << study::to_json(rep).dump(2) << "\n";
-    } else {
-      ctx.report() << study::format_sweep(rep);
-    }
   });
 }
 

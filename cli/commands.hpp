@@ -29,7 +29,8 @@ inline constexpr const char* kStdStream = "-";
 
 /// Writes `text` to stdout and flushes it, with SIGPIPE ignored meanwhile (a reader gone is
 /// EPIPE, not death). Throws InputError("stdout") when the write fails (closed, full, a broken
-/// pipe): `run` calls it before its commit, so that the run is then rolled back (issue 29).
+/// pipe): the commands that publish files call it before their commit, so that the run is then
+/// rolled back (issue 29).
 void write_stdout(const std::string& text);
 
 /// `-o -` given to a command that writes a folder: a usage error naming the command.
@@ -37,9 +38,8 @@ void refuse_stdout_folder(const std::string& out, const std::string& command);
 
 /// Checks, before a command that publishes files starts, that stdout can be written: a zero-byte
 /// write fails on a closed or read-only stdout (EBADF) and on a device that is always full
-/// (/dev/full: ENOSPC): refused in milliseconds, before any work. `sweep`, `study`, `fem-check` and
-/// `compare-contact` print after their commit, so a stdout found unusable only then would leave
-/// their files behind with exit 3 (issue 29); `run` writes stdout before its commit (write_stdout).
+/// (/dev/full: ENOSPC): refused in milliseconds, before any work. A stdout that fails only later
+/// (a broken pipe) is found by write_stdout, which every such command calls before its commit.
 /// Throws InputError("stdout").
 void check_stdout_writable();
 

@@ -8,7 +8,7 @@
 # the scene's path as given, then a line, a key, an override or "file" (the file itself missing or
 # unreadable): the context of an error raised deep in the library cannot get lost unnoticed.
 # {DECK} is a fresh copy of the one-tetrahedron deck tests/data/bad/fem/deck, which must come back
-# unchanged (fem-check leaves a deck folder as it was after any failure); {FEM} is
+# unchanged (fem-check leaves a deck folder as it was after an error); {FEM} is
 # tests/data/bad/fem (fake solvers). {FIFO} is a fresh named pipe nobody writes to: reading it
 # would block forever, so it must be refused by its type. Every command runs under a timeout of
 # 300 s: a hang fails its case instead of stopping the suite. A case expecting exit 4 (a failed

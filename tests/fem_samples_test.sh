@@ -85,6 +85,30 @@ PY
 # 4. Exit 4 above a threshold; exit 3 for a folder that is not a deck.
 "$bin" fem-check "$tmp/ecc/fem_eccentric" --no-run --linear-tolerance 1e-12 >/dev/null 2>"$tmp/e4.err"
 check "tight tolerance -> exit 4" test $? -eq 4
+# A failed check after a ccx run publishes ccx's results in the deck folder: the evidence (issue 32).
+cp -r "$tmp/ecc/fem_eccentric" "$tmp/evidence"
+rm -f "$tmp/evidence"/impact.{dat,frd,log,sta,cvg}
+"$bin" fem-check "$tmp/evidence" --linear-tolerance 1e-12 >"$tmp/ev.out" 2>"$tmp/ev.err"
+check "ccx run, tight tolerance -> exit 4" test $? -eq 4
+check "exit 4: impact.dat and impact.frd published as evidence" test -s "$tmp/evidence/impact.dat" -a -s "$tmp/evidence/impact.frd"
+check "exit 4: the line says the results are published" grep -q "FEM check failed: linear momentum .*results are published in the deck folder" "$tmp/ev.err"
+check "exit 4: the report printed" test -s "$tmp/ev.out"
+check "exit 4: nothing hidden left" bash -c "! ls -A '$tmp/evidence' | grep -q '^\\.'"
+# stdout is written before the results are published: a broken pipe then leaves the folder as it was.
+cp -r "$tmp/ecc/fem_eccentric" "$tmp/pipe"
+rm -f "$tmp/pipe"/impact.{dat,frd,log,sta,cvg}
+before=$(ls -A "$tmp/pipe")
+python3 - "$bin" "$tmp/pipe" "$tmp/pipe.rc" <<'PY'
+import os, signal, subprocess, sys
+binary, deck, rc = sys.argv[1:]
+r, w = os.pipe()
+os.close(r)  # the reader is gone before the check starts
+p = subprocess.run([binary, "fem-check", deck, "--json"], stdout=w, stderr=subprocess.DEVNULL,
+                   stdin=subprocess.DEVNULL, preexec_fn=lambda: signal.signal(signal.SIGPIPE, signal.SIG_IGN))
+open(rc, "w").write(str(p.returncode))
+PY
+check "fem-check > a broken pipe: exit 3 (got $(cat "$tmp/pipe.rc"))" [ "$(cat "$tmp/pipe.rc")" = 3 ]
+check "fem-check > a broken pipe: the deck folder as before" [ "$(ls -A "$tmp/pipe")" = "$before" ]
 "$bin" fem-check "$tmp/nowhere" >/dev/null 2>"$tmp/e3.err"
 check "missing deck folder -> exit 3" test $? -eq 3
 check "missing deck folder message" grep -q "nowhere: deck folder: does not exist" "$tmp/e3.err"

@@ -2,8 +2,9 @@
 # Failures found after the work is done must not leave a half-published run (issue 29):
 #  - a stdout that cannot be written (/dev/full, closed) is refused before the run, exit 3 naming
 #    stdout, and the output folder stays as it was;
-#  - a stdout that fails only when `run` writes its report (a broken pipe) rolls the run back: run
-#    writes stdout before its commit;
+#  - a stdout that fails only when `run`, `sweep`, `study table1` or `fem-check` writes its report
+#    (a broken pipe) rolls the run back: they write stdout before their commit (fem-check:
+#    tests/fem_samples_test.sh);
 #  - `sweep` onto a full file system (a tmpfs of 256 KiB, mounted in a private mount namespace
 #    when the test may mount) exits 3 naming the file that could not be written, and leaves the
 #    folder as it was.
@@ -61,6 +62,28 @@ PY
   check "run > a broken pipe (SIGPIPE $sigpipe): one line naming stdout" \
     bash -c "[ \$(wc -l <'$tmp/pipe_$sigpipe.err') = 1 ] && grep -q '^impactdeck: error: stdout: write failed: Broken pipe (before the commit: the run was rolled back, nothing was published)' '$tmp/pipe_$sigpipe.err'"
   check "run > a broken pipe (SIGPIPE $sigpipe): the output folder as before" unchanged
+done
+
+# sweep and study table1 write stdout before their commit too (a broken pipe, SIGPIPE ignored).
+for cmd in sweep study; do
+  case $cmd in
+    sweep) args=(sweep "$sweep_scene" --out "$out" --json --grid-steps 4 --formats csv) ;;
+    study) args=(study table1 --geometric-ratios 2 --mass-ratios 1 --grid-steps 4 --out "$out" --json --no-png) ;;
+  esac
+  python3 - "$tmp/pipe_$cmd" "$bin" "${args[@]}" <<'PY'
+import os, signal, subprocess, sys
+prefix, argv = sys.argv[1], sys.argv[2:]
+r, w = os.pipe()
+os.close(r)
+with open(prefix + ".err", "wb") as err:
+    p = subprocess.run(argv, stdout=w, stderr=err, stdin=subprocess.DEVNULL,
+                       preexec_fn=lambda: signal.signal(signal.SIGPIPE, signal.SIG_IGN))
+open(prefix + ".rc", "w").write(str(p.returncode))
+PY
+  check "$cmd > a broken pipe: exit 3 (got $(cat "$tmp/pipe_$cmd.rc"))" [ "$(cat "$tmp/pipe_$cmd.rc")" = 3 ]
+  check "$cmd > a broken pipe: names stdout, rolled back" \
+    grep -q '^impactdeck: error: stdout: write failed: Broken pipe (before the commit' "$tmp/pipe_$cmd.err"
+  check "$cmd > a broken pipe: the output folder as before" unchanged
 done
 
 # The same commands with a usable stdout publish (the checks above are not refusing everything).

@@ -200,22 +200,27 @@ CheckResult run_check(const fs::path& dir, const CheckOptions& o) {
   return check_deck(dir, read_deck(dir), o);
 }
 
-CheckResult check_deck_folder(const fs::path& dir, CheckOptions o, std::vector<std::string>* warnings) {
+CheckResult check_deck_folder(const fs::path& dir, CheckOptions o, std::vector<std::string>* warnings,
+                              const std::function<void(const CheckResult&)>& before_commit) {
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) throw InputError(dir.string(), "deck folder", "does not exist");
   if (!o.run_solver) return run_check(dir, o);
   RunTransaction txn(dir, "deck folder");
   o.work_dir = txn.scratch("ccx");
-  CheckResult r = txn.run([&] { return run_check(dir, o); });  // messages name the deck folder
-  if (!r.passed) return r;  // the transaction rolls back: the folder is as it was
-  txn.run([&] {
-    for (const auto& f : r.solver_files) fs::rename(f, txn.file(f.filename().string(), dir.string(), "ccx results"));
+  CheckResult r = txn.run([&] {  // messages name the deck folder
+    CheckResult result = run_check(dir, o);
+    // Published whether or not the checks passed: a failed check's results are its evidence (exit 4).
+    for (auto& f : result.solver_files) {
+      fs::rename(f, txn.file(f.filename().string(), dir.string(), "ccx results"));
+      f = dir / f.filename();
+    }
+    if (result.stress) {
+      for (auto& f : result.stress->files) f = dir / f.filename();
+    }
+    if (before_commit) before_commit(result);
     txn.commit();
+    return result;
   });
-  for (auto& f : r.solver_files) f = dir / f.filename();
-  if (r.stress) {
-    for (auto& f : r.stress->files) f = dir / f.filename();
-  }
   if (warnings) *warnings = txn.warnings();
   return r;
 }

@@ -140,8 +140,9 @@ void sweep_stages(const SweepCase& ss, const SweepRequest& q, RunTransaction* tx
     wo.length_unit = rep.output_length_unit;
     if (q.progress) wo.progress = [&q](std::size_t done, std::size_t total) { q.progress(Stage::write_outputs, done, total); };
     write_sweep_files(*staged_base, formats, rep.result, meta, picture, wo);
-    txn->commit();
   });
+  if (q.before_commit) q.before_commit(rep);
+  txn->commit();
 }
 
 }  // namespace
@@ -157,8 +158,8 @@ SweepReport run_sweep_command(const SweepCase& ss, const SweepRequest& q) {
   }
   // One transaction: the sweep's files appear together when all are written, or not at all.
   RunTransaction txn(q.out_dir);
-  txn.run([&] { sweep_stages(ss, q, &txn, rep); });  // messages name the final paths, not the staging folder
   rep.warnings = txn.warnings();  // an interrupted commit finished, stale staging folders removed
+  txn.run([&] { sweep_stages(ss, q, &txn, rep); });  // messages name the final paths, not the staging folder
   return rep;
 }
 

@@ -22,6 +22,7 @@
 // compare_body). Then the stresses are read back from the solver's results (CalculiX: impact.frd,
 // stress.hpp). The solver runs and reads its results; the physics and the verdict are here.
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <ostream>
 #include <string>
@@ -112,13 +113,16 @@ struct CheckResult {
 CheckResult run_check(const std::filesystem::path& deck_dir, const CheckOptions& options = {});
 
 /// `fem-check DIR`: run_check as one transaction on the deck folder. The solver runs in a private
-/// folder of it, and its files (and the stress files) replace the folder's previous ones only when
-/// the run and every check passed; otherwise the folder is left as it was. Without
-/// options.run_solver the folder's results are only read. InputError when `deck_dir` is not a
-/// folder; the returned files name their places in `deck_dir`. `warnings` (optional) receives the
+/// folder of it, and its files (and the stress files) replace the folder's previous ones when the
+/// run completed, whether or not every check passed (a failed check's results are its evidence);
+/// a run that throws leaves the folder as it was. `before_commit` (optional) gets the result, its
+/// files named at their places in `deck_dir`, just before they are published (the CLI prints
+/// there: when it throws, nothing is published). Without options.run_solver the folder's results
+/// are only read. InputError when `deck_dir` is not a folder. `warnings` (optional) receives the
 /// transaction's warnings.
 CheckResult check_deck_folder(const std::filesystem::path& deck_dir, CheckOptions options,
-                              std::vector<std::string>* warnings = nullptr);
+                              std::vector<std::string>* warnings = nullptr,
+                              const std::function<void(const CheckResult&)>& before_commit = {});
 
 /// The same for the deck `written` has just written (write_decks / write_deck_files): its
 /// description and mesh are taken from memory, not read back from deck.json and mesh.inp.

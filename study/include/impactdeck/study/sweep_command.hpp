@@ -40,6 +40,8 @@ struct SweepCase {
   double prepare_seconds = 0;  ///< wall time spent building it (the stage "scene")
 };
 
+struct SweepReport;
+
 struct SweepRequest {
   std::string impact;         ///< empty: the scene's first impact
   std::string cloud = "auto"; ///< parse_cloud_kind
@@ -60,6 +62,9 @@ struct SweepRequest {
   std::optional<LengthUnit> output_length_unit;  ///< of the files; empty: the scene's
   /// (stage, done, total): "sweep" while the points are computed, "write" while files are written.
   std::function<void(Stage, std::size_t, std::size_t)> progress;
+  /// Called with the finished report after every file is written and before the commit publishes
+  /// them (the CLI prints there: a stdout that fails then rolls the sweep back). May throw.
+  std::function<void(const SweepReport&)> before_commit;
 };
 
 struct SweepReport {
