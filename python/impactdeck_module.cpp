@@ -242,7 +242,14 @@ py::dict impact_dict(const collision::ImpactResult& r, std::size_t samples) {
 
 }  // namespace
 
-PYBIND11_MODULE(impactdeck, m) {
+namespace {
+
+// The Python types of InputError and CheckFailed, for the calls that raise them with a document
+// (set by define_errors; the exception objects live as long as the module).
+py::handle input_error_type, check_failed_type;
+
+/// The module's doc, version and exception types (each with the command's exit code), and the translation of impactdeck's errors to them.
+void define_errors(py::module_& m) {
   m.doc() = "impactdeck: eccentric Hertz impacts of mesh and CAD parts, as in `impactdeck run` (docs/python.md)";
   m.attr("__version__") = kVersion;
 
@@ -268,6 +275,8 @@ PYBIND11_MODULE(impactdeck, m) {
   input.attr("exit_code") = static_cast<int>(ExitCode::invalid_input);
   check.attr("exit_code") = static_cast<int>(ExitCode::check_failed);
   internal.attr("exit_code") = static_cast<int>(ExitCode::internal_error);
+  input_error_type = input;
+  check_failed_type = check;
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);
@@ -280,7 +289,10 @@ PYBIND11_MODULE(impactdeck, m) {
       }
     }
   });
+}
 
+/// run, inspect and solve_impact: a scene, a part's report, one impact from plain numbers.
+void define_impacts(py::module_& m) {
   m.def(
       "run",
       [](const fs::path& scene_path, std::optional<fs::path> out, py::object overrides) -> py::object {
@@ -301,7 +313,7 @@ PYBIND11_MODULE(impactdeck, m) {
           passed = rep.all_checks_passed();
         }
         // As the CLI: the document is complete, and the run fails with exit code 4.
-        if (!passed) raise_with_document(check, "a physics self-check failed (see checks above)", to_python(doc));
+        if (!passed) raise_with_document(check_failed_type, "a physics self-check failed (see checks above)", to_python(doc));
         return to_python(doc);
       },
       py::arg("scene_path"), py::arg("out") = py::none(), py::arg("overrides") = py::none(),
@@ -418,7 +430,10 @@ PYBIND11_MODULE(impactdeck, m) {
       "Radius: R* (radius_m) or each body's principal curvatures (k1, k2), with d1 directions when not "
       "isotropic (elliptical Hertz equivalent radius). restitution: R, or \"energy-flux\" (Eq. 30, J/cm^3). Returns a dict (max_force_N, impulse_Ns, jumps, "
       "checks, and time_s / force_N arrays of `samples` points).");
+}
 
+/// Part and load_part: a part file as a shape, with its surface queries.
+void define_part(py::module_& m) {
   py::class_<PyPart>(m, "Part", "A part file loaded as a shape: mass properties and surface queries (SI, metres).")
       .def_readonly("file", &PyPart::file, "The part file, as given to load_part (str).")
       .def_readonly("format", &PyPart::format, "The file's format: 'stl', 'obj', 'ply', 'off', 'step', 'iges' or 'brep'.")
@@ -486,7 +501,10 @@ PYBIND11_MODULE(impactdeck, m) {
         py::arg("accept_approximate") = false,
         "Loads a mesh part (STL, OBJ, PLY, OFF) or a CAD part (STEP, IGES, BREP) as `inspect` does. `path`: "
         "str or os.PathLike; length_unit: the file's unit, m, cm, mm or in.");
+}
 
+/// sweep, fem_check and compare_contact.
+void define_analyses(py::module_& m) {
   m.def(
       "sweep",
       [](const fs::path& scene_path, const std::string& impact, const std::string& cloud, std::size_t count,
@@ -568,7 +586,7 @@ PYBIND11_MODULE(impactdeck, m) {
           doc = fem_export::to_json(r);
         }
         if (!failed.empty()) {
-          raise_with_document(check, (deck_dir / "impact.dat").string() + ": FEM check failed: " + failed, to_python(doc));
+          raise_with_document(check_failed_type, (deck_dir / "impact.dat").string() + ": FEM check failed: " + failed, to_python(doc));
         }
         return to_python(doc);
       },
@@ -618,7 +636,7 @@ PYBIND11_MODULE(impactdeck, m) {
           in_doubt = r.in_doubt;
         }
         if (disagree) {
-          raise_with_document(check, "contact F_max differs from the analytic force beyond the threshold; in doubt: " +
+          raise_with_document(check_failed_type, "contact F_max differs from the analytic force beyond the threshold; in doubt: " +
                                          in_doubt, to_python(doc));
         }
         return to_python(doc);
@@ -630,7 +648,10 @@ PYBIND11_MODULE(impactdeck, m) {
       "Hertz force, as `impactdeck compare-contact SCENE --out OUT --json` (docs/contact-vs-hybrid.md); returns "
       "its document. Outputs go to `out` (default the current folder) in one transaction. A verdict 'disagree' "
       "raises CheckFailed with the document in `document`. Minutes of ccx per run.");
+}
 
+/// campaign_plan, campaign_run and campaign_collect.
+void define_campaigns(py::module_& m) {
   m.def(
       "campaign_plan",
       [](const fs::path& campaign_file, const fs::path& out) {
@@ -686,12 +707,12 @@ PYBIND11_MODULE(impactdeck, m) {
         d["failed_ids"] = s.failed_ids;
         d["exit_code"] = s.exit_code();
         if (s.failed || s.other) {
-          raise_with_document(input, fs::absolute(dir).lexically_normal().string() + ": " +
+          raise_with_document(input_error_type, fs::absolute(dir).lexically_normal().string() + ": " +
                                          std::to_string(s.failed + s.other) + " of " + std::to_string(s.total) +
                                          " case(s) failed or were not run (each failed case's failure.json says why)", d);
         }
         if (s.checks_failed) {
-          raise_with_document(check, fs::absolute(dir).lexically_normal().string() + ": " +
+          raise_with_document(check_failed_type, fs::absolute(dir).lexically_normal().string() + ": " +
                                          std::to_string(s.checks_failed) + " case(s) with a failed self-check", d);
         }
         return std::move(d);
@@ -729,4 +750,14 @@ PYBIND11_MODULE(impactdeck, m) {
       "Collects a campaign folder as `impactdeck campaign collect DIR`: collect/cases.csv and cases.json, the "
       "worst case's copy, the map and report.html. Returns {done, failed, pending, csv, json, report_html, "
       "worst_id, worst_case, map_svg, map_vtp} (paths as str, None when not written).");
+}
+
+}  // namespace
+
+PYBIND11_MODULE(impactdeck, m) {
+  define_errors(m);
+  define_impacts(m);
+  define_part(m);
+  define_analyses(m);
+  define_campaigns(m);
 }
