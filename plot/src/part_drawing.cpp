@@ -140,6 +140,208 @@ void arrow(Drawing& d, Point2 from, Point2 to, const Colour& c, double width) {
 const Colour kContact{0.84, 0.1, 0.1}, kNormal{0.0, 0.45, 0.70}, kForce{0.84, 0.37, 0.0}, kFloor{0.3, 0.3, 0.3};
 const Colour kAxes[3] = {{0.75, 0.1, 0.1}, {0.1, 0.55, 0.1}, {0.1, 0.2, 0.8}};
 
+// One view's panel in the drawing: its frame, and the projection of the world into it (one
+// scale for every view, so that they compare; centred on the view's box).
+struct Panel {
+  View view;
+  double x = 0, y = 0, w = 0, h = 0, label_h = 0;
+  double scale = 1, mx = 0, my = 0;  // pixels per world unit; the view box's centre (world)
+  Point2 project(const V3& p) const {
+    const double cx = x + w / 2, cy = y + label_h + (h - label_h) / 2;
+    return {cx + (p.dot(view.right) - mx) * scale, cy - (p.dot(view.up) - my) * scale};
+  }
+  bool clip_inside(Point2& a, Point2& b) const { return clip(a, b, x + 1, y + label_h, x + w - 1, y + h - 1); }
+};
+
+// The values shown as colours (field drawings) and their range; `values` null: plain shading.
+struct FieldRange {
+  const std::vector<double>* values = nullptr;
+  double lo = 0, hi = 1;
+};
+
+// The part's front faces, back to front (painter's algorithm), shaded or coloured by the field.
+void draw_faces(Drawing& d, const PartSurface& s, const Panel& p, const FieldRange& field) {
+  const V3 toward = p.view.toward();
+  const V3 light = (toward + 0.6 * p.view.up - 0.4 * p.view.right).normalized();
+  struct Face {
+    double depth;
+    std::size_t index;
+    double shade;
+  };
+  std::vector<Face> faces;
+  for (std::size_t f = 0; f < s.triangles.size(); ++f) {
+    const auto& t = s.triangles[f];
+    const V3& a = s.vertices[static_cast<std::size_t>(t[0])];
+    const V3& b = s.vertices[static_cast<std::size_t>(t[1])];
+    const V3& c = s.vertices[static_cast<std::size_t>(t[2])];
+    const V3 n = (b - a).cross(c - a);
+    const double len = n.norm();
+    if (!(len > 0) || n.dot(toward) <= 0) continue;
+    faces.push_back({(a + b + c).dot(toward), f, std::max(0.0, n.dot(light) / len)});
+  }
+  std::sort(faces.begin(), faces.end(), [](const Face& x, const Face& y) { return x.depth < y.depth; });
+  for (const Face& f : faces) {
+    const auto& t = s.triangles[f.index];
+    Colour c;
+    if (field.values) {
+      const std::vector<double>& v = *field.values;
+      const double val = (v[static_cast<std::size_t>(t[0])] + v[static_cast<std::size_t>(t[1])] +
+                          v[static_cast<std::size_t>(t[2])]) / 3;
+      c = mix(kBlack, viridis((val - field.lo) / (field.hi - field.lo)), 0.8 + 0.2 * f.shade);
+    } else {
+      const double g = 0.35 + 0.6 * f.shade;
+      c = {0.55 * g + 0.1, 0.62 * g + 0.1, 0.72 * g + 0.1};
+    }
+    Style st;
+    st.fill = c;
+    st.fill_opacity = 1;
+    st.stroke = c;
+    st.stroke_width = 0.4;
+    d.polygon({p.project(s.vertices[static_cast<std::size_t>(t[0])]), p.project(s.vertices[static_cast<std::size_t>(t[1])]),
+               p.project(s.vertices[static_cast<std::size_t>(t[2])])},
+              st);
+  }
+}
+
+// The floor through the contact point, as a hatched line where the view sees it edge-on enough.
+void draw_floor(Drawing& d, const Panel& p, const V3& point, const V3& floor_normal, double width_px) {
+  const V3 n = floor_normal.normalized();
+  const Point2 nn{n.dot(p.view.right), -n.dot(p.view.up)};  // screen direction of the normal
+  const double nl = std::hypot(nn.x, nn.y);
+  if (nl <= 0.2) return;  // seen nearly face-on: no line
+  const Point2 o = p.project(point);
+  const Point2 dir{-nn.y / nl, nn.x / nl};
+  Point2 a{o.x - dir.x * 2 * width_px, o.y - dir.y * 2 * width_px};
+  Point2 e{o.x + dir.x * 2 * width_px, o.y + dir.y * 2 * width_px};
+  if (!p.clip_inside(a, e)) return;
+  Style fl;
+  fl.stroke = kFloor;
+  fl.stroke_width = 2;
+  d.line(a, e, fl);
+  Style hatch = fl;
+  hatch.stroke_width = 1;
+  const double len = std::hypot(e.x - a.x, e.y - a.y);
+  const Point2 in{-nn.x / nl * 8, -nn.y / nl * 8};  // into the floor
+  for (double u = 6; u < len; u += 14) {
+    const Point2 q{a.x + (e.x - a.x) * u / len, a.y + (e.y - a.y) * u / len};
+    Point2 q0 = q, q1{q.x + in.x - dir.x * 6, q.y + in.y - dir.y * 6};
+    if (p.clip_inside(q0, q1)) d.line(q0, q1, hatch);
+  }
+}
+
+// The markers on top of the part: floor, own axes, force, normal, contact point, peak.
+// `size`: the part's extent; `reach`: the arrows' length (world units).
+void draw_markers(Drawing& d, const Panel& p, const PartMarkers& m, double size, double reach, double width_px) {
+  const bool has_point = m.contact_point && finite(*m.contact_point);
+  if (has_point && m.floor_normal && finite(*m.floor_normal)) draw_floor(d, p, *m.contact_point, *m.floor_normal, width_px);
+  if (m.frame) {
+    const Point2 o = p.project(m.frame_origin);
+    const char* names[3] = {"x'", "y'", "z'"};
+    for (int i = 0; i < 3; ++i) {
+      const V3 axis = m.frame->col(i);
+      if (!finite(axis)) continue;
+      const Point2 tip = p.project(m.frame_origin + axis.normalized() * 0.2 * size);
+      arrow(d, o, tip, kAxes[i], 1.5);
+      d.text({tip.x + 3, tip.y - 3}, names[i], 11, Anchor::start, kAxes[i], true);
+    }
+  }
+  if (has_point) {
+    const Point2 c = p.project(*m.contact_point);
+    if (m.force && finite(*m.force)) {
+      // Beside the normal (a normal force is collinear with it): shifted 9 px sideways.
+      const Point2 tail = p.project(*m.contact_point - m.force->normalized() * reach);
+      const double dx = c.x - tail.x, dy = c.y - tail.y, len = std::hypot(dx, dy);
+      const Point2 off = len > 6 ? Point2{-dy / len * 9, dx / len * 9} : Point2{0, 0};
+      arrow(d, {tail.x + off.x, tail.y + off.y}, {c.x + off.x, c.y + off.y}, kForce, 3);
+    }
+    if (m.normal && finite(*m.normal)) arrow(d, c, p.project(*m.contact_point + m.normal->normalized() * 0.6 * reach), kNormal, 1.5);
+    Style dot;
+    dot.fill = kContact;
+    dot.fill_opacity = 1;
+    dot.stroke = kBlack;
+    d.circle(c, 4.5, dot);
+  }
+  if (m.peak_point && finite(*m.peak_point)) {
+    const Point2 c = p.project(*m.peak_point);
+    Style ring;
+    ring.stroke = kBlack;
+    ring.stroke_width = 2;
+    d.circle(c, 7, ring);
+    ring.stroke = kWhite;
+    ring.stroke_width = 1;
+    d.circle(c, 9, ring);
+    d.text({c.x + 11, c.y - 8}, m.peak_label, 11, Anchor::start, kBlack, true);
+  }
+}
+
+// The scale bar (at most max_bar_px long; `scale` pixels per world unit) and the markers' legend on the
+// line at `ly`.
+void draw_legend(Drawing& d, const PartMarkers& m, double ly, double x0, double max_bar_px, double scale,
+                 const PartDrawingOptions& opt) {
+  const bool has_point = m.contact_point && finite(*m.contact_point);
+  const double unit = opt.length_unit_size > 0 && std::isfinite(opt.length_unit_size) ? opt.length_unit_size : 1.0;
+  const std::vector<double> nice = nice_ticks(0, max_bar_px / scale / unit, 2);
+  const double bar_len = nice.size() >= 2 ? nice[1] : max_bar_px / scale / unit;
+  const double bar_px = bar_len * unit * scale;
+  Style sb;
+  sb.stroke_width = 2;
+  d.line({x0, ly}, {x0 + bar_px, ly}, sb);
+  d.line({x0, ly - 4}, {x0, ly + 4}, sb);
+  d.line({x0 + bar_px, ly - 4}, {x0 + bar_px, ly + 4}, sb);
+  d.text({x0 + bar_px + 6, ly + 4}, format_number(bar_len) + " " + opt.length_unit, 11);
+  double lx = x0 + bar_px + 80;
+  const double ty = ly + 4;
+  auto entry = [&](const std::string& label, const Colour& c, int kind) {
+    Style st;
+    st.stroke = c;
+    st.stroke_width = kind == 2 ? 3 : 2;
+    if (kind == 0) {
+      st.fill = c;
+      st.fill_opacity = 1;
+      st.stroke = kBlack;
+      st.stroke_width = 1;
+      d.circle({lx + 6, ty - 4}, 4.5, st);
+    } else if (kind == 3) {
+      st.stroke = kBlack;
+      d.circle({lx + 6, ty - 4}, 6, st);
+    } else {
+      d.line({lx, ty - 4}, {lx + 18, ty - 4}, st);
+    }
+    d.text({lx + 24, ty}, label, 11);
+    lx += 24 + 6.5 * static_cast<double>(label.size()) + 14;
+  };
+  if (has_point) entry("contact point", kContact, 0);
+  if (has_point && m.normal) entry("normal n", kNormal, 1);
+  if (has_point && m.force) entry("force on the part", kForce, 2);
+  if (has_point && m.floor_normal) entry("floor", kFloor, 1);
+  if (m.frame) entry("own axes x' y' z'", kAxes[0], 1);
+  if (m.peak_point) entry(m.peak_label, kBlack, 3);
+}
+
+// The field's colour bar at (bx, by), bh tall, with its ticks (in value_scale units) and label.
+void draw_colour_bar(Drawing& d, double bx, double by, double bh, const FieldRange& field,
+                     const PartDrawingOptions& opt) {
+  const double bw = 18;
+  const int steps = 48;
+  for (int i = 0; i < steps; ++i) {
+    Style st;
+    st.fill = viridis((i + 0.5) / steps);
+    st.fill_opacity = 1;
+    st.stroke_width = -1;
+    d.rect(bx, by + bh - bh * (i + 1) / steps, bw, bh / steps + 0.5, st);
+  }
+  Style border;
+  border.stroke_width = 1;
+  d.rect(bx, by, bw, bh, border);
+  for (double tv : nice_ticks(field.lo * opt.value_scale, field.hi * opt.value_scale, 6)) {
+    const double y = by + bh - bh * (tv / opt.value_scale - field.lo) / (field.hi - field.lo);
+    if (y < by - 0.5 || y > by + bh + 0.5) continue;
+    d.line({bx + bw, y}, {bx + bw + 4, y}, border);
+    d.text({bx + bw + 6, y + 4}, format_number(tv), 11);
+  }
+  d.text({bx, by - 10}, opt.value_label, 11, Anchor::start, kBlack, true);
+}
+
 }  // namespace
 
 PartSurface decimate(const PartSurface& surface, std::size_t max_triangles, std::vector<double>* values) {
@@ -227,195 +429,36 @@ Drawing part_drawing(const PartSurface& surface, const PartMarkers& m, const Par
                       (panel_h - label_h - 2 * pad) / std::max(b[3] - b[2], 1e-9 * size)});
   }
 
-  double vlo = 0, vhi = 1;
+  FieldRange range;
   if (field) {
-    vlo = *std::min_element(values.begin(), values.end());
-    vhi = *std::max_element(values.begin(), values.end());
-    if (!(vhi > vlo)) vhi = vlo + 1;
+    range.values = &values;
+    range.lo = *std::min_element(values.begin(), values.end());
+    range.hi = *std::max_element(values.begin(), values.end());
+    if (!(range.hi > range.lo)) range.hi = range.lo + 1;
   }
 
   Style frame;
   frame.stroke = {0.8, 0.8, 0.8};
   for (std::size_t k = 0; k < views.size(); ++k) {
-    const View& v = views[k];
-    const double px = gap + static_cast<double>(k % 2) * (panel_w + gap);
-    const double py = title_h + static_cast<double>(k / 2) * (panel_h + gap);
-    d.rect(px, py, panel_w, panel_h, frame);
-    d.text({px + 6, py + 14}, v.name, 11, Anchor::start, {0.25, 0.25, 0.25});
-    const auto& b = boxes[k];
-    const double cx = px + panel_w / 2, cy = py + label_h + (panel_h - label_h) / 2;
-    const double mx = 0.5 * (b[0] + b[1]), my = 0.5 * (b[2] + b[3]);
-    auto P = [&](const V3& p) { return Point2{cx + (p.dot(v.right) - mx) * scale, cy - (p.dot(v.up) - my) * scale}; };
-    const V3 toward = v.toward();
-    const V3 light = (toward + 0.6 * v.up - 0.4 * v.right).normalized();
-
-    // Painter's algorithm over the front faces.
-    struct Face {
-      double depth;
-      std::size_t index;
-      double shade;
-    };
-    std::vector<Face> faces;
-    for (std::size_t f = 0; f < s.triangles.size(); ++f) {
-      const auto& t = s.triangles[f];
-      const V3& a = s.vertices[static_cast<std::size_t>(t[0])];
-      const V3& bb = s.vertices[static_cast<std::size_t>(t[1])];
-      const V3& c = s.vertices[static_cast<std::size_t>(t[2])];
-      const V3 n = (bb - a).cross(c - a);
-      const double len = n.norm();
-      if (!(len > 0) || n.dot(toward) <= 0) continue;
-      faces.push_back({(a + bb + c).dot(toward), f, std::max(0.0, n.dot(light) / len)});
-    }
-    std::sort(faces.begin(), faces.end(), [](const Face& x, const Face& y) { return x.depth < y.depth; });
-    for (const Face& f : faces) {
-      const auto& t = s.triangles[f.index];
-      Colour c;
-      if (field) {
-        const double val = (values[static_cast<std::size_t>(t[0])] + values[static_cast<std::size_t>(t[1])] +
-                            values[static_cast<std::size_t>(t[2])]) / 3;
-        c = mix(kBlack, viridis((val - vlo) / (vhi - vlo)), 0.8 + 0.2 * f.shade);
-      } else {
-        const double g = 0.35 + 0.6 * f.shade;
-        c = {0.55 * g + 0.1, 0.62 * g + 0.1, 0.72 * g + 0.1};
-      }
-      Style st;
-      st.fill = c;
-      st.fill_opacity = 1;
-      st.stroke = c;
-      st.stroke_width = 0.4;
-      d.polygon({P(s.vertices[static_cast<std::size_t>(t[0])]), P(s.vertices[static_cast<std::size_t>(t[1])]),
-                 P(s.vertices[static_cast<std::size_t>(t[2])])},
-                st);
-    }
-
-    // Markers on top.
-    if (has_point && m.floor_normal && finite(*m.floor_normal)) {
-      const V3 n = m.floor_normal->normalized();
-      const Point2 nn{n.dot(v.right), -n.dot(v.up)};  // screen direction of the normal
-      const double nl = std::hypot(nn.x, nn.y);
-      if (nl > 0.2) {  // the floor is seen edge-on enough to be a line
-        const Point2 o = P(*m.contact_point);
-        const Point2 dir{-nn.y / nl, nn.x / nl};
-        Point2 a{o.x - dir.x * 2 * opt.width_px, o.y - dir.y * 2 * opt.width_px};
-        Point2 e{o.x + dir.x * 2 * opt.width_px, o.y + dir.y * 2 * opt.width_px};
-        if (clip(a, e, px + 1, py + label_h, px + panel_w - 1, py + panel_h - 1)) {
-          Style fl;
-          fl.stroke = kFloor;
-          fl.stroke_width = 2;
-          d.line(a, e, fl);
-          Style hatch = fl;
-          hatch.stroke_width = 1;
-          const double len = std::hypot(e.x - a.x, e.y - a.y);
-          const Point2 in{-nn.x / nl * 8, -nn.y / nl * 8};  // into the floor
-          for (double u = 6; u < len; u += 14) {
-            const Point2 q{a.x + (e.x - a.x) * u / len, a.y + (e.y - a.y) * u / len};
-            Point2 q0 = q, q1{q.x + in.x - dir.x * 6, q.y + in.y - dir.y * 6};
-            if (clip(q0, q1, px + 1, py + label_h, px + panel_w - 1, py + panel_h - 1)) d.line(q0, q1, hatch);
-          }
-        }
-      }
-    }
-    if (m.frame) {
-      const Point2 o = P(m.frame_origin);
-      const char* names[3] = {"x'", "y'", "z'"};
-      for (int i = 0; i < 3; ++i) {
-        const V3 axis = m.frame->col(i);
-        if (!finite(axis)) continue;
-        const Point2 tip = P(m.frame_origin + axis.normalized() * 0.2 * size);
-        arrow(d, o, tip, kAxes[i], 1.5);
-        d.text({tip.x + 3, tip.y - 3}, names[i], 11, Anchor::start, kAxes[i], true);
-      }
-    }
-    if (has_point) {
-      const Point2 p = P(*m.contact_point);
-      if (m.force && finite(*m.force)) {
-        // Beside the normal (a normal force is collinear with it): shifted 9 px sideways.
-        const Point2 tail = P(*m.contact_point - m.force->normalized() * reach);
-        const double dx = p.x - tail.x, dy = p.y - tail.y, len = std::hypot(dx, dy);
-        const Point2 off = len > 6 ? Point2{-dy / len * 9, dx / len * 9} : Point2{0, 0};
-        arrow(d, {tail.x + off.x, tail.y + off.y}, {p.x + off.x, p.y + off.y}, kForce, 3);
-      }
-      if (m.normal && finite(*m.normal)) arrow(d, p, P(*m.contact_point + m.normal->normalized() * 0.6 * reach), kNormal, 1.5);
-      Style dot;
-      dot.fill = kContact;
-      dot.fill_opacity = 1;
-      dot.stroke = kBlack;
-      d.circle(p, 4.5, dot);
-    }
-    if (m.peak_point && finite(*m.peak_point)) {
-      const Point2 p = P(*m.peak_point);
-      Style ring;
-      ring.stroke = kBlack;
-      ring.stroke_width = 2;
-      d.circle(p, 7, ring);
-      ring.stroke = kWhite;
-      ring.stroke_width = 1;
-      d.circle(p, 9, ring);
-      d.text({p.x + 11, p.y - 8}, m.peak_label, 11, Anchor::start, kBlack, true);
-    }
+    Panel p;
+    p.view = views[k];
+    p.x = gap + static_cast<double>(k % 2) * (panel_w + gap);
+    p.y = title_h + static_cast<double>(k / 2) * (panel_h + gap);
+    p.w = panel_w;
+    p.h = panel_h;
+    p.label_h = label_h;
+    p.scale = scale;
+    p.mx = 0.5 * (boxes[k][0] + boxes[k][1]);
+    p.my = 0.5 * (boxes[k][2] + boxes[k][3]);
+    d.rect(p.x, p.y, p.w, p.h, frame);
+    d.text({p.x + 6, p.y + 14}, p.view.name, 11, Anchor::start, {0.25, 0.25, 0.25});
+    draw_faces(d, s, p, range);
+    draw_markers(d, p, m, size, reach, opt.width_px);
   }
 
   // Scale bar and legend under the panels.
-  const double ly = title_h + rows * (panel_h + gap) + 14;
-  const double unit = opt.length_unit_size > 0 && std::isfinite(opt.length_unit_size) ? opt.length_unit_size : 1.0;
-  const std::vector<double> nice = nice_ticks(0, panel_w * 0.3 / scale / unit, 2);
-  const double bar_len = nice.size() >= 2 ? nice[1] : panel_w * 0.3 / scale / unit;
-  Style sb;
-  sb.stroke_width = 2;
-  d.line({gap, ly}, {gap + bar_len * unit * scale, ly}, sb);
-  d.line({gap, ly - 4}, {gap, ly + 4}, sb);
-  d.line({gap + bar_len * unit * scale, ly - 4}, {gap + bar_len * unit * scale, ly + 4}, sb);
-  d.text({gap + bar_len * unit * scale + 6, ly + 4}, format_number(bar_len) + " " + opt.length_unit, 11);
-  double lx = gap + bar_len * unit * scale + 80;
-  const double ty = ly + 4;
-  auto entry = [&](const std::string& label, const Colour& c, int kind) {
-    Style st;
-    st.stroke = c;
-    st.stroke_width = kind == 2 ? 3 : 2;
-    if (kind == 0) {
-      st.fill = c;
-      st.fill_opacity = 1;
-      st.stroke = kBlack;
-      st.stroke_width = 1;
-      d.circle({lx + 6, ty - 4}, 4.5, st);
-    } else if (kind == 3) {
-      st.stroke = kBlack;
-      d.circle({lx + 6, ty - 4}, 6, st);
-    } else {
-      d.line({lx, ty - 4}, {lx + 18, ty - 4}, st);
-    }
-    d.text({lx + 24, ty}, label, 11);
-    lx += 24 + 6.5 * static_cast<double>(label.size()) + 14;
-  };
-  if (has_point) entry("contact point", kContact, 0);
-  if (has_point && m.normal) entry("normal n", kNormal, 1);
-  if (has_point && m.force) entry("force on the part", kForce, 2);
-  if (has_point && m.floor_normal) entry("floor", kFloor, 1);
-  if (m.frame) entry("own axes x' y' z'", kAxes[0], 1);
-  if (m.peak_point) entry(m.peak_label, kBlack, 3);
-
-  // Colour bar.
-  if (field) {
-    const double bx = opt.width_px - bar_w + 10, by = title_h + 30, bh = rows * (panel_h + gap) - 70, bw = 18;
-    const int steps = 48;
-    for (int i = 0; i < steps; ++i) {
-      Style st;
-      st.fill = viridis((i + 0.5) / steps);
-      st.fill_opacity = 1;
-      st.stroke_width = -1;
-      d.rect(bx, by + bh - bh * (i + 1) / steps, bw, bh / steps + 0.5, st);
-    }
-    Style border;
-    border.stroke_width = 1;
-    d.rect(bx, by, bw, bh, border);
-    for (double tv : nice_ticks(vlo * opt.value_scale, vhi * opt.value_scale, 6)) {
-      const double y = by + bh - bh * (tv / opt.value_scale - vlo) / (vhi - vlo);
-      if (y < by - 0.5 || y > by + bh + 0.5) continue;
-      d.line({bx + bw, y}, {bx + bw + 4, y}, border);
-      d.text({bx + bw + 6, y + 4}, format_number(tv), 11);
-    }
-    d.text({bx, by - 10}, opt.value_label, 11, Anchor::start, kBlack, true);
-  }
+  draw_legend(d, m, title_h + rows * (panel_h + gap) + 14, gap, panel_w * 0.3, scale, opt);
+  if (field) draw_colour_bar(d, opt.width_px - bar_w + 10, title_h + 30, rows * (panel_h + gap) - 70, range, opt);
   return d;
 }
 
