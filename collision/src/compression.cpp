@@ -137,6 +137,43 @@ double compression_shape_exact(double tau) {
   return std::exp(kA * std::log1p(-w));
 }
 
+double hertz_loading_time_factor(double u) {
+  if (!(u > 0.0)) return 1.0;
+  if (u >= 1.0) return compression_time_factor();
+  if (u > 0.5) {  // S = C_n I_u(1/p, 1/2) / z with z = u^(1/p)
+    gsl_sf_result r;
+    if (gsl_sf_beta_inc_e(kA, kB, u, &r) != GSL_SUCCESS) return std::numeric_limits<double>::quiet_NaN();
+    return compression_time_factor() * r.val / std::pow(u, kA);
+  }
+  // d_k = c_k / (p k + 1), c_{k+1} = c_k (2k + 1) / (2k + 2): up to u^k < 1e-17 at u = 1/2.
+  struct Coefficients {
+    std::array<double, 60> d{};
+    Coefficients() {
+      double c = 1.0;
+      for (std::size_t k = 0; k < d.size(); ++k) {
+        d[k] = c / (kP * static_cast<double>(k) + 1.0);
+        c *= (2.0 * static_cast<double>(k) + 1.0) / (2.0 * static_cast<double>(k) + 2.0);
+      }
+    }
+  };
+  static const Coefficients coefficients;
+  // The terms fall by at least u per step, so the tail after a term is below term u / (1 - u) <= term.
+  double sum = 0.0, uk = 1.0;
+  for (const double d : coefficients.d) {
+    const double term = d * uk;
+    sum += term;
+    if (term <= 1e-17 * sum) break;
+    uk *= u;
+  }
+  return sum;
+}
+
+double compression_time_fraction(double z) {
+  if (!(z > 0.0)) return 0.0;
+  if (z >= 1.0) return 1.0;
+  return z * hertz_loading_time_factor(z * z * std::sqrt(z)) / compression_time_factor();
+}
+
 double compression_shape(double tau) {
   if (!(tau > 0.0)) return 0.0;
   if (tau >= 1.0) return 1.0;

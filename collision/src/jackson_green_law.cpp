@@ -116,9 +116,8 @@ struct Phases {
     fH = h.max_force_N;
     tH = h.compression_time_s;
     const double z = kElasticLimit / h.max_indentation_m;
-    gsl_sf_result beta;
-    if (!(z > 0.0 && z < 1.0) || gsl_sf_beta_inc_e(0.4, 0.5, std::pow(z, 2.5), &beta) != GSL_SUCCESS) return false;
-    tau1 = tH * beta.val;
+    if (!(z > 0.0 && z < 1.0)) return false;
+    tau1 = tH * compression_time_fraction(z);
     const double u1_sq = v * v - 0.8 * std::pow(kElasticLimit, 2.5);
     u1 = u1_sq > 0.0 ? std::sqrt(u1_sq) : 0.0;
     return std::isfinite(tau1) && std::isfinite(u1) && std::isfinite(curve.B);

@@ -8,7 +8,8 @@
 //   restitution  1/2 m V_r^2 = 2/5 F* (d* - d_p) (the unloading's elastic energy), e = V_r / V
 // F(t) phase by phase, in closed form:
 //   1. Hertz loading at speed V up to d_y: F = F_H Phi(t / t_H) (compression.hpp's curve of the
-//      Hertz impact at V: F_H, t_H), reached at t_1 = t_H I_{z^p}(1/p, 1/2), z = d_y / x_H, p = 5/2
+//      Hertz impact at V: F_H, t_H), reached at t_1 = t_H I_{z^p}(1/p, 1/2), z = d_y / x_H, p = 5/2,
+//      computed as (d_y / V) S(z^p) (compression.hpp's hertz_loading_time_factor)
 //   2. plastic: m y'' = -k_p y with y = d - d_y + F_y/k_p, so F = F* cos(w (t_m - t)), w = sqrt(k_p/m),
 //      t_m = t_1 + (pi/2 - phi)/w, phi = atan2(F_y/k_p, V_1/w), V_1^2 = V^2 - 2 W_y/m
 //   3. Hertz unloading with k_u: half a Hertz cycle at speed V_r, F = F* Phi(1 - (t - t_m)/t_u),
@@ -18,9 +19,6 @@
 #include <cmath>
 #include <limits>
 #include <memory>
-
-#include <gsl/gsl_errno.h>
-#include <gsl/gsl_sf_gamma.h>
 
 #include "impactdeck/collision/compression.hpp"
 #include "impactdeck/collision/contact_law.hpp"
@@ -64,7 +62,6 @@ class ThorntonLaw final : public ContactLaw {
     if (!detail::finite_positive(py)) return;  // no limiting pressure: the caller refuses such an input first
     const double kH = hertz_constant(E, R);
     r.stiffness = kH;
-    const CompressionPhase hertz = compression_phase(m, V, kH);  // the elastic impact at V
     const double ay = M_PI * R * py / (2.0 * E);
     const double dy = ay * ay / R;
     const double Fy = kH * dy * std::sqrt(dy);
@@ -72,6 +69,7 @@ class ThorntonLaw final : public ContactLaw {
     const double energy = 0.5 * m * V * V;
     r.impulse_compression_Ns = m * V;
     if (!(energy > Wy)) {  // elastic: Hertz with e = 1
+      const CompressionPhase hertz = compression_phase(m, V, kH);
       detail::elastic_hertz_result(hertz, r);
       r.state = {hertz.compression_time_s, hertz.compression_time_s, hertz.max_force_N, 0.0};
     } else {
@@ -79,15 +77,18 @@ class ThorntonLaw final : public ContactLaw {
       const double excess = energy - Wy;                                   // F_y D + k_p D^2 / 2
       const double D = 2.0 * excess / (Fy + std::sqrt(Fy * Fy + 2.0 * kp * excess));  // no cancellation
       const double d_star = dy + D, F_star = Fy + kp * D;
-      const double Rp = 4.0 * E / (3.0 * F_star) * std::pow((2.0 * F_star + Fy) / (2.0 * M_PI * py), 1.5);
-      const double ku = hertz_constant(E, Rp);
-      const double du = std::cbrt((F_star / ku) * (F_star / ku));  // d* - d_p
+      // d* - d_p = (F*/k_u)^(2/3) with k_u = 4/3 E* sqrt(R_p) and R_p's closed form above: in one
+      // step, 3 F* / (4 E* sqrt(q)) with q = (2 F* + F_y) / (2 pi p_y) (no cube root).
+      const double q = (2.0 * F_star + Fy) / (2.0 * M_PI * py);
+      const double du = 0.75 * F_star / (E * std::sqrt(q));
       const double Vr = std::sqrt(0.8 * F_star * du / m);
-      // Phase 1: the Hertz impact at V reaches d_y at t_1 = t_H I_{z^p}(1/p, 1/2).
-      const double z = dy / hertz.max_indentation_m;
-      gsl_sf_result beta;
-      if (gsl_sf_beta_inc_e(0.4, 0.5, std::pow(z, 2.5), &beta) != GSL_SUCCESS) return;
-      const double t1 = hertz.compression_time_s * beta.val;
+      // Phase 1: Hertz loading from V to d_y takes t_1 = (d_y / V) S(u), u = W_y / (m V^2 / 2) the
+      // energy fraction stored at d_y (hertz_loading_time_factor). The Hertz impact at V that this
+      // loading follows (for F(t)): x_H = d_y / z with z = u^(1/p), t_H = C_n x_H / V, F_H = k_H x_H^(3/2).
+      const double u = Wy / energy;
+      const double t1 = dy / V * hertz_loading_time_factor(u);
+      const double z = std::pow(u, 0.4);
+      const double tH = compression_time_factor() * dy / (z * V), FH = Fy / (z * std::sqrt(z));
       // Phase 2: harmonic about -F_y/k_p, from (y0, V_1) to its top.
       const double w = std::sqrt(kp / m);
       const double V1 = std::sqrt(V * V - 2.0 * Wy / m);
@@ -100,7 +101,7 @@ class ThorntonLaw final : public ContactLaw {
       r.contact_time_s = r.compression_time_s + r.unloading_time_s;
       r.restitution.coefficient = Vr / V;
       r.residual_indentation_m = d_star - du;
-      r.state = {t1, hertz.compression_time_s, hertz.max_force_N, w};
+      r.state = {t1, tH, FH, w};
     }
     detail::finish_plastic_result(r);
   }

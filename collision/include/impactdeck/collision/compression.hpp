@@ -32,6 +32,19 @@ double compression_shape(double tau);
 /// per call). Absolute error below 1e-14.
 double compression_force_fraction(double tau);
 
+/// The time a Hertz contact takes to reach the depth d from the approach speed V, over d/V:
+/// S(u) = integral_0^1 (1 - u s^p)^(-1/2) ds, where u = 2 k_H d^p / (p m V^2) in [0, 1] is the
+/// fraction of the kinetic energy stored at d (u = 1: d = x_max, S = C_n). Where u <= 1/2 (every
+/// plastic impact beyond 1.4 times its yield velocity) by the series S = sum_k c_k u^k / (p k + 1),
+/// c_k = binom(2k, k) / 4^k, stopped when the tail bound falls below 1e-17 of the sum: tens of
+/// nanoseconds, relative error below 1e-15 (tests/test_compression.cpp against GSL); beyond, from
+/// GSL's beta_inc. u clamped to [0, 1].
+double hertz_loading_time_factor(double u);
+
+/// The inverse of compression_shape: tau = t/t_m at which x/x_max = z, i.e. I_{z^p}(1/p, 1/2)
+/// (Eq. 10) = z S(z^p) / C_n (hertz_loading_time_factor), z clamped to [0, 1].
+double compression_time_fraction(double z);
+
 /// Same, by direct inversion of the regularized incomplete beta function (GSL beta_inc plus a
 /// safeguarded Newton iteration, about a microsecond). Reference for tests and for building the
 /// fast expansion.
