@@ -10,6 +10,9 @@
 #include "impactdeck/collision/hertz_law.hpp"
 #include "impactdeck/geometry/ellipsoid.hpp"
 #include "impactdeck/geometry/plane.hpp"
+#include "impactdeck/scene/pipeline.hpp"
+#include "impactdeck/scene/report.hpp"
+#include "impactdeck/scene/scene.hpp"
 #include "impactdeck/sequence/sequence.hpp"
 
 namespace {
@@ -268,3 +271,243 @@ TEST(Sequence, RefusesBadInput) {
 }
 
 }  // namespace
+
+// --- against an independent integration -----------------------------------------------------
+
+namespace {
+
+// A tilted ellipsoid dropped on z = 0, written out here independently of sequence/: the rotation
+// by fixed-step RK4 of R' = [w]x R with w = R I^-1 R^T L (L constant in flight), the contact by a
+// scan of the ellipsoid's closed-form depth sqrt(z^T R M R^T z) (M = diag(a^2, b^2, c^2)) and
+// bisection, the impulse (1 + e) m_w v_w (Eq. 13, 16-23) with a constant restitution.
+struct Reference {
+  double m, a, b, c, e, g = 9.81;
+  Matrix3d I;  // own frame
+  struct State {
+    Vector3d x, v;
+    Matrix3d R;
+    Vector3d L;
+  };
+  Vector3d omega(const State& s) const { return s.R * I.inverse() * s.R.transpose() * s.L; }
+  State step(const State& s, double h) const {
+    auto f = [&](const Matrix3d& R) {
+      const Vector3d w = R * I.inverse() * R.transpose() * s.L;
+      Matrix3d W;
+      W << 0, -w.z(), w.y(), w.z(), 0, -w.x(), -w.y(), w.x(), 0;
+      return Matrix3d(W * R);
+    };
+    const Matrix3d k1 = f(s.R), k2 = f(s.R + 0.5 * h * k1), k3 = f(s.R + 0.5 * h * k2), k4 = f(s.R + h * k3);
+    State o = s;
+    o.R = s.R + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+    const Eigen::JacobiSVD<Matrix3d> svd(o.R, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    o.R = svd.matrixU() * svd.matrixV().transpose();  // back onto SO(3)
+    o.x = s.x + s.v * h + 0.5 * h * h * Vector3d(0, 0, -g);
+    o.v = s.v + h * Vector3d(0, 0, -g);
+    return o;
+  }
+  Vector3d lowest(const State& s) const {
+    const Matrix3d M = Vector3d(a * a, b * b, c * c).asDiagonal();
+    const Vector3d q = s.R * M * s.R.transpose() * Vector3d::UnitZ();
+    return s.x - q / std::sqrt(Vector3d::UnitZ().dot(q));
+  }
+  double gap(const State& s) const { return lowest(s).z(); }
+  // Flies from s to the next contact (approaching), scanning with step h.
+  State next(State s, double& t, double h) const {
+    for (;;) {
+      State n = step(s, h);
+      const Vector3d r = lowest(n) - n.x;
+      if (gap(n) <= 0 && (n.v + omega(n).cross(r)).z() < 0) {
+        double lo = 0, hi = h;
+        for (int k = 0; k < 60; ++k) (gap(step(s, 0.5 * (lo + hi))) > 0 ? lo : hi) = 0.5 * (lo + hi);
+        t += lo;
+        return step(s, lo);
+      }
+      s = n;
+      t += h;
+    }
+  }
+  void bounce(State& s) const {
+    const Vector3d n = Vector3d::UnitZ(), r = lowest(s) - s.x;
+    const Matrix3d Iw_inv = s.R * I.inverse() * s.R.transpose();
+    const double inv_mw = 1 / m + r.cross(n).dot(Iw_inv * r.cross(n));
+    const double vw = -(s.v + omega(s).cross(r)).dot(n);
+    const double P = (1 + e) * vw / inv_mw;
+    s.v += P * n / m;
+    s.L += r.cross(P * n);  // the impulse's moment about the centroid
+  }
+};
+
+}  // namespace
+
+TEST(Sequence, TiltedEllipsoidAgreesWithAnIndependentIntegration) {
+  const double a = 0.125, b = 0.015, c = 0.03, mass = 0.5, e = 0.6;
+  auto part = ellipsoid_body(a, b, c, mass);
+  part.pose.rotation = Eigen::AngleAxisd(0.35, Vector3d(1, 0.4, 0.2).normalized()).toRotationMatrix();
+  part.pose.position_m = Vector3d(0, 0, 0.5);
+  part.angular_velocity_rad_s = Vector3d(1.0, -3.0, 0.5);
+  sequence::SequenceInput in = input_with(part, e);
+  in.max_impacts = 4;
+  const sequence::SequenceResult res = sequence::run_sequence(in);
+  ASSERT_EQ(res.bounces.size(), 4u);
+
+  Reference ref{mass, a, b, c, e};
+  ref.I = part.inertia_kg_m2;
+  Reference::State s{part.pose.position_m, Vector3d::Zero(), part.pose.rotation,
+                     part.pose.rotation * part.inertia_kg_m2 * part.pose.rotation.transpose() *
+                         part.angular_velocity_rad_s};
+  double t = 0;
+  // Tolerances: the reference's RK4 at 2e-5 s steps (error ~ (w h)^4 per step) and its bisection.
+  constexpr double kTimeTolerance = 1e-8, kVelocityTolerance = 1e-6;
+  for (std::size_t k = 0; k < res.bounces.size(); ++k) {
+    s = ref.next(s, t, 2e-5);
+    const auto& b = res.bounces[k];
+    EXPECT_NEAR(b.time_s, t, kTimeTolerance) << k;
+    EXPECT_LT((b.contact.point_m - ref.lowest(s)).norm(), 1e-7) << k;
+    ref.bounce(s);
+    const double scale = std::max(1.0, s.v.norm());
+    EXPECT_LT((b.after.velocity_m_s - s.v).norm(), kVelocityTolerance * scale) << k;
+    EXPECT_LT((b.after.angular_velocity_rad_s - ref.omega(s)).norm(), kVelocityTolerance * 100 * scale) << k;
+  }
+}
+
+// --- scenes ---------------------------------------------------------------------------------
+
+namespace {
+
+std::string scene_text(const std::string& body, const std::string& sequence, const std::string& gravity = "[0, 0, -9.81]") {
+  return R"(length_unit = "mm"
+gravity_m_s2 = )" + gravity + R"(
+[materials.steel]
+youngs_modulus_Pa = 2.1e11
+poisson_ratio = 0.3
+density_kg_m3 = 7850
+yield_strength_Pa = 3.5e8
+
+[[bodies]]
+)" + body + R"(
+material = "steel"
+
+[[bodies]]
+name = "floor"
+shape = "plane"
+normal = [0, 0, 1]
+material = "steel"
+
+[[sequences]]
+name = "drop"
+body = "part"
+floor = "floor"
+)" + sequence;
+}
+
+std::filesystem::path fresh_dir(const std::string& name) {
+  const auto d = std::filesystem::temp_directory_path() / name;
+  std::filesystem::remove_all(d);
+  return d;
+}
+
+}  // namespace
+
+TEST(SequenceScene, SequencesOnlySceneRunsAndWritesItsFiles) {
+  const scene::Scene sc = scene::parse_scene(
+      scene_text("name = \"part\"\nshape = \"sphere\"\nradius = 10\nposition = [0, 0, 500]", "restitution = 0.8\n"),
+      "seq.toml");
+  EXPECT_TRUE(sc.impacts.empty());
+  ASSERT_EQ(sc.sequences.size(), 1u);
+  const auto out = fresh_dir("impactdeck_test_sequence_files");
+  const scene::RunReport r = scene::run_scene(sc, scene::RunOptions{out});
+  ASSERT_EQ(r.sequences.size(), 1u);
+  EXPECT_EQ(r.sequences[0].result.bounces.size(), 19u);  // e = 0.8 from 0.49 m: as the sphere test above
+  const nlohmann::json j = scene::to_json(sc, r);
+  ASSERT_EQ(j["sequences"].size(), 1u);
+  const auto& q = j["sequences"][0];
+  EXPECT_EQ(q["stop_reason"], "at_rest");
+  EXPECT_EQ(q["worst_impact_index"], 0);
+  const auto& i0 = q["impacts"][0];
+  for (const char* key : {"contact_point_m", "approach_velocity_m_s", "reduced_mass_kg", "max_force_N",
+                          "normal_impulse_Ns", "tangential_impulse_Ns", "time_s", "target", "impactor"}) {
+    EXPECT_TRUE(i0.contains(key)) << key;
+  }
+  EXPECT_EQ(i0["target"]["name"], "part");
+  EXPECT_TRUE(i0["target"].contains("delta_velocity_m_s"));
+  EXPECT_TRUE(i0["target"].contains("delta_angular_velocity_rad_s"));
+  EXPECT_EQ(i0["tangential_impulse_Ns"], 0.0);
+  EXPECT_GT(i0["max_force_N"].get<double>(), 0.0);
+  // The sequence's impact is the single impact's writer: a Hertz impact's own figures are there.
+  EXPECT_DOUBLE_EQ(i0["impulse_total_Ns"].get<double>(), i0["normal_impulse_Ns"].get<double>());
+  const auto stages = j["stages_run"];
+  EXPECT_NE(std::find(stages.begin(), stages.end(), "sequence"), stages.end());
+  for (const char* f : {"sequence_drop.csv", "sequence_drop.csv.json", "sequence_drop.pvd", "sequence_drop.svg",
+                        "report.html", "sequence_drop_frames/frame_0000.vtp"}) {
+    EXPECT_TRUE(std::filesystem::exists(out / f)) << f;
+  }
+  EXPECT_GT(r.sequences[0].vtk_frames, 1u);
+  EXPECT_LE(r.sequences[0].vtk_frames, 120u);
+}
+
+TEST(SequenceScene, PlasticLawRecordsTheDentOfAnEarlierImpact) {
+  // The vertical bounces of a sphere land on the same spot: from the second impact on, inside the
+  // first one's dent (the law "thornton", chosen by "auto" from the yield strength).
+  const scene::Scene sc = scene::parse_scene(
+      scene_text("name = \"part\"\nshape = \"sphere\"\nradius = 10\nposition = [0, 0, 500]", "max_impacts = 3\n"),
+      "seq.toml");
+  const scene::RunReport r = scene::run_scene(sc, scene::RunOptions{fresh_dir("impactdeck_test_sequence_dent")});
+  const auto& b = r.sequences[0].result.bounces;
+  ASSERT_EQ(b.size(), 3u);
+  EXPECT_EQ(r.sequences[0].impacts[0].contact_law, "thornton");
+  EXPECT_GT(b[0].dent_radius_m, 0.0);
+  EXPECT_EQ(b[0].in_dent_of, -1);
+  EXPECT_EQ(b[1].in_dent_of, 0);
+  EXPECT_EQ(b[2].in_dent_of, 0);
+}
+
+TEST(SequenceScene, MeshPartOnItsCornersGoesOnWithTheRigidImpulse) {
+  // A real CAD-like part (tests/data/box_200x100x60mm.stl), rotated and far from the origin: it
+  // lands on corners, where no Hertz force exists: flagged, null in JSON, the sequence goes on.
+  const std::string part = std::string("name = \"part\"\nshape = \"mesh\"\nmesh = \"") + IMPACTDECK_SOURCE_DIR +
+                           "/tests/data/box_200x100x60mm.stl\"\nposition = [-40000, 25000, 300]\n"
+                           "orientation_axis = [1, 0.5, 0.2]\norientation_angle_deg = 35";
+  const scene::Scene sc = scene::parse_scene(scene_text(part, "restitution = 0.5\nmax_impacts = 6\n"), "seq.toml");
+  const scene::RunReport r = scene::run_scene(sc, scene::RunOptions{fresh_dir("impactdeck_test_sequence_mesh")});
+  const auto& sr = r.sequences[0];
+  ASSERT_GE(sr.result.bounces.size(), 2u);
+  std::size_t corners = 0;
+  for (const auto& b : sr.result.bounces) {
+    if (!b.not_applicable.empty()) {
+      ++corners;
+      EXPECT_FALSE(b.impact.has_value());
+      EXPECT_TRUE(std::isnan(b.max_force_N()));
+      EXPECT_NEAR(b.restitution, 0.5, 0.0);
+      EXPECT_GT(b.normal_impulse_Ns, 0.0);
+    }
+  }
+  EXPECT_GT(corners, 0u);
+  const nlohmann::json j = scene::to_json(sc, r);
+  bool null_force = false;
+  for (const auto& i : j["sequences"][0]["impacts"]) null_force = null_force || i["max_force_N"].is_null();
+  EXPECT_TRUE(null_force);
+  bool warned = false;
+  for (const auto& w : r.warnings) warned = warned || w.find("edge_radius") != std::string::npos;
+  EXPECT_TRUE(warned);
+  EXPECT_EQ(sr.result.worst_impact_reason.find("largest"), 0u);
+}
+
+TEST(SequenceScene, BadKeysAreRefusedNamingThem) {
+  auto refused = [](const std::string& text, const std::string& key) {
+    try {
+      scene::parse_scene(text, "seq.toml");
+      ADD_FAILURE() << "accepted; expected an error naming " << key;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+    }
+  };
+  const std::string sphere = "name = \"part\"\nshape = \"sphere\"\nradius = 10\nposition = [0, 0, 500]";
+  refused(scene_text(sphere, "friction_coefficient = -0.1\n"), "sequences[0].friction_coefficient");
+  refused(scene_text(sphere, "max_impacts = 0\n"), "sequences[0].max_impacts");
+  refused(scene_text(sphere, "contact_law = \"thornto\"\n"), "sequences[0].contact_law");  // the impacts' reader
+  refused(scene_text(sphere, "restitution = 1.5\n"), "sequences[0].restitution");
+  refused(scene_text(sphere, "bounce = 1\n"), "sequences[0].bounce");
+  std::string no_gravity = scene_text(sphere, "");
+  no_gravity.replace(no_gravity.find("gravity_m_s2"), std::string("gravity_m_s2 = [0, 0, -9.81]").size(), "");
+  refused(no_gravity, "gravity_m_s2");
+}
