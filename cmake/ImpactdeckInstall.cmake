@@ -9,7 +9,7 @@ include(CMakePackageConfigHelpers)
 
 set(_impactdeck_modules common collision)
 if(NOT IMPACTDECK_CORE_ONLY)
-  list(APPEND _impactdeck_modules geometry contact fem_export plot scene study)
+  list(APPEND _impactdeck_modules geometry contact sequence fem_export plot scene study)
 endif()
 
 set(_impactdeck_targets)

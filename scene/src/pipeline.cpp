@@ -19,6 +19,7 @@
 #include "impactdeck/plot/force_plot.hpp"
 #include "impactdeck/scene/report_html.hpp"
 #include "numeric_checks.hpp"
+#include "sequence_files.hpp"
 
 namespace impactdeck::scene {
 
@@ -32,8 +33,10 @@ const std::vector<std::string>& all_stages() {
     std::vector<std::string> names;
     for (Stage st : {Stage::scene, Stage::mesh_load, Stage::mesh_validation, Stage::mass_properties,
                      Stage::curvature_index, Stage::contact_geometry, Stage::impact, Stage::force_table,
-                     Stage::fem_mesh, Stage::fem_decks, Stage::fem_run, Stage::compare_contact, Stage::write_outputs})
+                     Stage::fem_mesh, Stage::fem_decks, Stage::fem_run, Stage::compare_contact, Stage::write_outputs}) {
       names.push_back(stage_name(st));
+      if (st == Stage::impact) names.push_back(kSequenceStage);  // [[sequences]]: every impact of each
+    }
     return names;
   }();
   return s;
@@ -46,6 +49,9 @@ bool RunReport::all_checks_passed() const {
     if (i.fem_check && !i.fem_check->passed) return false;
     if (i.compare && i.compare->verdict == CompareVerdict::disagree) return false;
   }
+  for (const auto& sr : sequences)
+    for (const auto& i : sr.impacts)
+      if (i.force_not_applicable.empty() && !i.result.checks.passed) return false;
   return true;
 }
 
@@ -351,10 +357,84 @@ fem_export::DeckRequest hybrid_deck_request(const Scene& scene, const ImpactRepo
 
 namespace {
 
+// One [[sequences]] entry (docs/sequences.md): the sequence library with `run`'s impact route for
+// every Hertzian impact (solve_located_impact: the same checks, law figures and warnings as a
+// single impact), and the rigid impulse's report where no Hertz force exists.
+SequenceReport run_sequence(const Scene& scene, const SequenceSpec& q, const std::map<std::string, PreparedBody>& bodies,
+                            std::vector<std::string>& warnings) {
+  SequenceReport sr;
+  sr.spec = std::make_shared<const SequenceSpec>(q);
+  const InputContext ctx{where(scene), InputContext::joined(q.place.describe(), "sequence '" + q.name + "'")};
+  const ImpactLaw law = impact_law(scene, q.impact, ctx);
+  sequence::SequenceInput in;
+  in.body = bodies.at(q.body);
+  in.floor = bodies.at(q.floor);
+  in.gravity_m_s2 = *scene.gravity_m_s2;
+  in.rule = q.impact.contact_radius;
+  in.effective_modulus_Pa =
+      collision::effective_modulus_Pa(in.body.material, in.floor.material, scene.modulus_convention, ctx);
+  in.law = law.law;
+  if (q.impact.restitution_given && q.impact.restitution.kind == collision::RestitutionModel::Kind::constant) {
+    in.rigid_restitution = q.impact.restitution.constant;
+  }
+  in.max_impacts = q.max_impacts;
+  in.min_approach_speed_m_s = q.min_approach_speed_m_s;
+  in.friction_coefficient = q.friction_coefficient;
+  in.ctx = ctx;
+  auto named = [&q](std::size_t index) {
+    ImpactSpec s = q.impact;
+    s.name = q.name + " impact " + std::to_string(index);
+    return s;
+  };
+  std::map<std::size_t, ImpactReport> solved;
+  in.complete = [&](std::size_t index, const ContactModel& model, ContactEvaluation e) {
+    ImpactReport ir = solve_located_impact(scene, named(index), law, model, std::move(e), warnings);
+    contact::Impact impact = ir;
+    solved.emplace(index, std::move(ir));
+    return impact;
+  };
+  sr.result = sequence::run_sequence(in);
+  for (std::size_t i = 0; i < sr.result.bounces.size(); ++i) {
+    const sequence::Bounce& b = sr.result.bounces[i];
+    if (auto it = solved.find(i); it != solved.end()) {
+      sr.impacts.push_back(std::move(it->second));
+      continue;
+    }
+    // No Hertz force: the rigid impulse's figures, the rest not applicable.
+    ImpactReport ir;
+    ir.spec = std::make_shared<const ImpactSpec>(named(i));
+    ir.contact = b.contact;
+    ir.law = law;
+    ir.contact_law = law.name;
+    ir.result.kernel = b.contact.result;
+    ir.result.reduced_mass_kg = b.reduced_mass_kg;
+    ir.result.approach_velocity_m_s = b.approach_velocity_m_s;
+    ir.result.restitution_kind = collision::RestitutionModel::Kind::constant;
+    ir.result.restitution.coefficient = b.restitution;
+    ir.result.target_jump = b.body_jump;
+    ir.result.impactor_jump = b.floor_jump;
+    ir.force_not_applicable = b.not_applicable;
+    std::ostringstream w;
+    w << "sequence '" << q.name << "' impact " << i << " at t = " << b.time_s << " s: " << b.not_applicable
+      << "; the rigid impulse with restitution " << b.restitution
+      << " applies and the sequence goes on; max_force_N is not applicable (null): round the edge (an edge_radius "
+         "in the part) for a force";
+    warnings.push_back(w.str());
+    sr.impacts.push_back(std::move(ir));
+  }
+  return sr;
+}
+
 // Where each output of the scene goes, reserved in the run's transaction before any work (a bad
 // name fails at once): staged paths, one per impact.
 struct StagedOutputs {
   std::vector<fs::path> table, plot, fem, compare;
+  /// Per sequence: the trajectory CSV, the VTK series (.pvd and its frames folder), the picture.
+  struct Sequence {
+    fs::path csv, pvd, frames, svg;
+    std::string frames_name;
+  };
+  std::vector<Sequence> sequences;
   std::optional<fs::path> report;  ///< report.html: written beside any other output
 };
 
@@ -420,7 +500,20 @@ StagedOutputs reserve_outputs(const Scene& scene, RunTransaction& txn) {
       st.plot.push_back(reserve(per_impact(*scene.outputs.force_plot_svg, s, "force_plot_svg"), place_of("force_plot_svg"), false));
     }
   }
-  if (scene.outputs.fem || scene.outputs.force_table_csv || scene.outputs.force_plot_svg) {
+  // A sequence always writes its files (docs/sequences.md).
+  for (const auto& q : scene.sequences) {
+    const std::string place = Place{q.place.line, q.place.key + ".name"}.describe();
+    StagedOutputs::Sequence f;
+    const std::string stem = "sequence_" + q.name;
+    f.csv = reserve(stem + ".csv", place + " (the sequence's trajectory CSV)", false);
+    reserve(csv_sidecar_path(stem + ".csv").string(), place + " (its JSON sidecar)", false);
+    f.pvd = reserve(stem + ".pvd", place + " (the sequence's VTK series)", false);
+    f.frames_name = stem + "_frames";
+    f.frames = reserve(f.frames_name, place + " (the VTK series' frames)", true);
+    f.svg = reserve(stem + ".svg", place + " (the sequence's picture)", false);
+    st.sequences.push_back(std::move(f));
+  }
+  if (scene.outputs.fem || scene.outputs.force_table_csv || scene.outputs.force_plot_svg || !scene.sequences.empty()) {
     st.report = reserve(kReportHtml, "report.html (the run's report page, written beside its other outputs)", false);
   }
   return st;
@@ -445,6 +538,9 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
   for (const auto& s : scene.impacts)
     for (const std::string* name : {&s.target, &s.impactor})
       if (!bodies.count(*name)) bodies.emplace(*name, prepare_body(scene.body(*name), scene, &report));
+  for (const auto& q : scene.sequences)
+    for (const std::string* name : {&q.body, &q.floor})
+      if (!bodies.count(*name)) bodies.emplace(*name, prepare_body(scene.body(*name), scene, &report));
 
   for (const auto& s : scene.impacts) {
     const PreparedBody& target = bodies.at(s.target);
@@ -468,6 +564,10 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
     ImpactReport ir = clock.run(
         Stage::impact, [&] { return solve_located_impact(scene, s, law, model, std::move(located), report.warnings); });
     report.impacts.push_back(std::move(ir));
+  }
+  for (const auto& q : scene.sequences) {
+    ScopedTimer timer([&report](double sec) { add_stage(report, kSequenceStage, sec); });
+    report.sequences.push_back(run_sequence(scene, q, bodies, report.warnings));
   }
 
   // A failed check does not stop the run: every output is still written and published, as the
@@ -579,6 +679,29 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
           write_file_atomically(staged.plot[k], plot::to_svg(plot::force_time_drawing(ir.result.history, po)));
           ir.plot_path = txn.public_path(staged.plot[k]);
         }
+      }
+    });
+  }
+  if (!report.sequences.empty()) {
+    clock.run(Stage::write_outputs, [&] {
+      for (std::size_t k = 0; k < report.sequences.size(); ++k) {
+        SequenceReport& sr = report.sequences[k];
+        const StagedOutputs::Sequence& f = staged.sequences[k];
+        detail::write_trajectory_csv(f.csv, sr, scene.file.string());
+        sr.trajectory_csv = txn.public_path(f.csv);
+        sr.vtk_frames = detail::write_vtk_series(f.pvd, f.frames, f.frames_name, sr, bodies.at(sr.spec->body),
+                                                 report.output_length_unit);
+        if (sr.vtk_frames == 0) {
+          // No surface to place: an empty series, said so.
+          write_file_atomically(f.pvd, "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">"
+                                       "<Collection></Collection></VTKFile>\n");
+          report.warnings.push_back("sequence '" + sr.spec->name + "': the body's shape has no surface triangulation: "
+                                    "the VTK series is empty");
+        }
+        sr.trajectory_pvd = txn.public_path(f.pvd);
+        write_file_atomically(f.svg, detail::sequence_svg(sr, report.output_length_unit));
+        sr.plot_svg = txn.public_path(f.svg);
+        for (const fs::path& p : {*sr.trajectory_csv, *sr.trajectory_pvd, *sr.plot_svg}) report.files_written.push_back(p);
       }
     });
   }

@@ -52,6 +52,167 @@ nlohmann::json validity_json(const collision::ValidityReport& v) {
   return j;
 }
 
+// One impact's JSON object: `impacts[i]`, and `sequences[k].impacts[i]` with the sequence's keys
+// added (one writer for both).
+nlohmann::json impact_json(const ImpactReport& ir) {
+  const auto& r = ir.result;
+  const auto& c = r.history.compression;
+  nlohmann::json i;
+  i["name"] = ir.spec->name;
+  const collision::KernelInput& kin = ir.contact.input;
+  const collision::KernelResult& kr = r.kernel;
+  i["target"] = body_json(ir.spec->target, r.target_jump, kin.target);
+  i["impactor"] = body_json(ir.spec->impactor, r.impactor_jump, kin.impactor);
+  i["contact_mode"] = ir.spec->first_contact ? "first-contact" : "point";
+  i["contact_point_m"] = json_vector(ir.contact.point_m);
+  i["contact_normal"] = json_vector(ir.contact.normal);
+  i["travel_m"] = json_number(ir.contact.travel_m);
+  i["projection_distance_m"] = json_number(ir.contact.target_point.distance_m);
+  i["contact_radius_rule"] = to_string(ir.spec->contact_radius);
+  i["target_principal_curvatures_1_per_m"] = {json_number(kin.target.curvature.k1_per_m), json_number(kin.target.curvature.k2_per_m)};
+  i["target_contact_curvature_1_per_m"] = json_number(kin.target.curvature.rule_curvature_per_m(ir.spec->contact_radius));
+  i["impactor_contact_curvature_1_per_m"] = json_number(kin.impactor.curvature.rule_curvature_per_m(ir.spec->contact_radius));
+  i["relative_curvatures_1_per_m"] = {json_number(kr.relative_curvature_A_per_m), json_number(kr.relative_curvature_B_per_m)};
+  i["contact_ellipse_axis_ratio"] = json_number(kr.contact_ellipse_axis_ratio);
+  i["validity"] = validity_json(ir.validity);
+  i["reduced_mass_kg"] = json_number(r.reduced_mass_kg);
+  i["effective_radius_m"] = json_number(r.effective_radius_m);
+  i["effective_modulus_Pa"] = json_number(r.effective_modulus_Pa);
+  i["hertz_constant_N_per_m1_5"] = json_number(r.hertz_constant);
+  i["approach_velocity_m_s"] = json_number(r.approach_velocity_m_s);
+  const bool hertz_restitution = hertz_law(ir);
+  i["contact_law"] = ir.contact_law;
+  i["contact_law_requested"] = ir.spec->contact_law;
+  i["limiting_pressure_Pa"] = optional_number(ir.law.limiting_pressure_Pa);
+  i["yield_velocity_m_s"] = optional_number(ir.yield_velocity_m_s);
+  i["validity"]["contact_law"] = ir.contact_law;
+  // A law other than Hertz gives its own restitution: its name is the restitution model.
+  i["restitution_model"] = hertz_restitution ? collision::to_string(r.restitution_kind) : ir.law.name.c_str();
+  if (!hertz_restitution) {
+    i["energy_flux_density"] = nullptr;
+  } else if (r.restitution_kind == collision::RestitutionModel::Kind::energy_flux) {
+    i["energy_flux_density"] = json_number(r.restitution.energy_flux_density);
+    i["energy_flux_density_unit"] = collision::to_string(ir.spec->restitution.flux_unit);
+    i["energy_flux_density_J_m3"] = json_number(r.restitution.energy_flux_density_J_m3);
+    i["ln_energy_flux_density"] = json_number(r.restitution.ln_energy_flux);
+    i["restitution_clamped"] = r.restitution.clamped;
+  } else {
+    i["energy_flux_density"] = nullptr;
+    if (r.restitution_kind == collision::RestitutionModel::Kind::table) i["restitution_clamped"] = r.restitution.clamped;
+  }
+  i["restitution"] = json_number(r.restitution.coefficient);
+  i["max_indentation_m"] = json_number(c.max_indentation_m);
+  i["max_force_N"] = json_number(c.max_force_N);
+  i["compression_time_s"] = json_number(c.compression_time_s);
+  i["contact_time_s"] = json_number(r.history.contact_time_s());
+  i["impulse_compression_Ns"] = json_number(r.history.impulse_compression_Ns());
+  i["impulse_total_Ns"] = json_number(r.history.impulse_total_Ns());
+  i["residual_indentation_m"] = json_number(r.history.law_result.residual_indentation_m);
+  i["dent_radius_m"] = json_number(ir.dent_radius_m);
+  i["unloading_radius_m"] = json_number(ir.unloading_radius_m);
+  const auto& k = r.checks;
+  i["checks"] = {{"impulse_relative_error", json_number(k.impulse_relative_error)},
+                 {"energy_relative_error", json_number(k.energy_relative_error)},
+                 {"impulse_threshold", k.thresholds.impulse_relative},
+                 {"energy_threshold", k.thresholds.energy_relative},
+                 {"impulse_compression_numerical_Ns", json_number(k.impulse_compression_numerical_Ns)},
+                 {"carnot_loss_J", json_number(k.carnot_loss_J)},
+                 {"kinetic_energy_loss_J", json_number(k.kinetic_energy_loss_J)},
+                 {"passed", k.passed}};
+  if (ir.table) {
+    i["force_table"] = {{"samples", ir.table->time_s.size()},
+                        {"impulse_Ns", json_number(ir.table->impulse_Ns)},
+                        {"impulse_relative_error", json_number(ir.table->impulse_relative_error)},
+                        {"impulse_tolerance", ir.table->impulse_tolerance},
+                        {"tolerance_met", ir.table->tolerance_met}};
+    if (ir.table_path) i["force_table"]["path"] = ir.table_path->string();
+  }
+  if (ir.plot_path) i["force_plot_svg"] = ir.plot_path->string();
+  if (ir.fem_deck) {
+    const auto& d = *ir.fem_deck;
+    const auto& q = d.quality;
+    i["fem"] = {{"folder", d.folder.string()},
+                {"node_count", q.node_count},
+                {"tet_count", q.tet_count},
+                {"min_quality", q.min_quality},
+                {"min_gamma", q.min_gamma},
+                {"mesh_size_m", q.mesh_size_m},
+                {"load_mesh_size_m", q.load_mesh_size_m},
+                {"mesh_attempts", fem_export::to_json(q.attempts)},
+                {"fallback_used", q.attempts.size() > 1},
+                {"fe_volume_m3", q.fe_volume_m3},
+                {"part_volume_m3", q.part_volume_m3},
+                {"volume_relative_difference", q.volume_relative_difference},
+                {"load", fem_export::to_string(d.load)},
+                {"load_node_count", d.patch.load_node_count},
+                {"contact_zone_radius_m", d.contact_zone_radius_m},
+                {"body_check", fem_export::to_json(d.body_check)},
+                {"check", ir.fem_check ? fem_export::to_json(*ir.fem_check) : nlohmann::json(nullptr)}};
+    if (d.load == fem_export::LoadKind::hertz_patch) {
+      i["fem"]["largest_ellipse_elements"] = d.patch.largest_ellipse_elements;
+      i["fem"]["max_nodes_loaded_at_once"] = d.patch.max_nodes_loaded_at_once;
+      i["fem"]["load_sum_max_relative_error"] = d.patch.max_sum_relative_error;
+      i["fem"]["load_moment_max_relative"] = d.patch.max_moment_relative;
+    }
+    if (ir.compare) i["fem"]["compare_contact"] = to_json(*ir.compare);
+  }
+  return i;
+}
+
+// One sequence (docs/sequences.md): its impacts by impact_json plus time_s and the impulses; an
+// impact without a Hertz force (a sharp corner) has its force and the law's figures null.
+nlohmann::json sequence_json(const SequenceReport& sr) {
+  const sequence::SequenceResult& res = sr.result;
+  nlohmann::json q;
+  q["name"] = sr.spec->name;
+  q["body"] = sr.spec->body;
+  q["floor"] = sr.spec->floor;
+  q["stop_reason"] = sequence::to_string(res.stop);
+  q["max_impacts"] = sr.spec->max_impacts;
+  q["min_approach_speed_m_s"] = json_number(sr.spec->min_approach_speed_m_s);
+  q["friction_coefficient"] = json_number(sr.spec->friction_coefficient);
+  q["impact_count"] = res.bounces.size();
+  q["worst_impact_index"] = res.worst_impact_index >= 0 ? nlohmann::json(res.worst_impact_index) : nlohmann::json(nullptr);
+  q["worst_impact_reason"] = res.worst_impact_reason;
+  q["duration_s"] = json_number(res.trajectory.empty() ? 0.0 : res.trajectory.back().state.time_s);
+  nlohmann::json impacts = nlohmann::json::array();
+  for (std::size_t k = 0; k < res.bounces.size(); ++k) {
+    const sequence::Bounce& b = res.bounces[k];
+    const ImpactReport& ir = sr.impacts[k];
+    nlohmann::json i = impact_json(ir);
+    i["index"] = k;
+    i["time_s"] = json_number(b.time_s);
+    i["contact_mode"] = "sequence";
+    i["contact_point_own_m"] = json_vector(b.point_own_m);
+    i["normal_impulse_Ns"] = json_number(b.normal_impulse_Ns);
+    i["tangential_impulse_Ns"] = json_number(b.tangential_impulse_Ns);
+    i["force_applicable"] = ir.force_not_applicable.empty();
+    i["in_dent_of"] = b.in_dent_of >= 0 ? nlohmann::json(b.in_dent_of) : nlohmann::json(nullptr);
+    if (!ir.force_not_applicable.empty()) {
+      i["force_not_applicable"] = ir.force_not_applicable;
+      for (const char* key : {"max_force_N", "max_indentation_m", "compression_time_s", "contact_time_s",
+                              "impulse_compression_Ns", "impulse_total_Ns", "hertz_constant_N_per_m1_5",
+                              "effective_radius_m", "effective_modulus_Pa", "residual_indentation_m", "dent_radius_m",
+                              "unloading_radius_m", "relative_curvatures_1_per_m", "contact_ellipse_axis_ratio",
+                              "target_contact_curvature_1_per_m", "impactor_contact_curvature_1_per_m",
+                              "target_principal_curvatures_1_per_m", "validity", "checks", "yield_velocity_m_s",
+                              "energy_flux_density"}) {
+        i[key] = nullptr;
+      }
+      i["impulse_total_Ns"] = json_number(b.normal_impulse_Ns);
+    }
+    impacts.push_back(std::move(i));
+  }
+  q["impacts"] = std::move(impacts);
+  nlohmann::json files = nlohmann::json::object();
+  if (sr.trajectory_csv) files["trajectory_csv"] = sr.trajectory_csv->string();
+  if (sr.trajectory_pvd) files["trajectory_pvd"] = sr.trajectory_pvd->string();
+  if (sr.plot_svg) files["plot_svg"] = sr.plot_svg->string();
+  files["vtk_frames"] = sr.vtk_frames;
+  q["files"] = std::move(files);
+  return q;
+}
+
 }  // namespace
 
 nlohmann::json to_json(const Scene& scene, const RunReport& rep) {
@@ -64,110 +225,16 @@ nlohmann::json to_json(const Scene& scene, const RunReport& rep) {
       scene.modulus_convention == collision::ModulusConvention::hertz ? "hertz" : "paper";
   nlohmann::json impacts = nlohmann::json::array();
   for (const auto& ir : rep.impacts) {
-    const auto& r = ir.result;
-    const auto& c = r.history.compression;
-    nlohmann::json i;
-    i["name"] = ir.spec->name;
-    const collision::KernelInput& kin = ir.contact.input;
-    const collision::KernelResult& kr = r.kernel;
-    i["target"] = body_json(ir.spec->target, r.target_jump, kin.target);
-    i["impactor"] = body_json(ir.spec->impactor, r.impactor_jump, kin.impactor);
-    i["contact_mode"] = ir.spec->first_contact ? "first-contact" : "point";
-    i["contact_point_m"] = json_vector(ir.contact.point_m);
-    i["contact_normal"] = json_vector(ir.contact.normal);
-    i["travel_m"] = json_number(ir.contact.travel_m);
-    i["projection_distance_m"] = json_number(ir.contact.target_point.distance_m);
-    i["contact_radius_rule"] = to_string(ir.spec->contact_radius);
-    i["target_principal_curvatures_1_per_m"] = {json_number(kin.target.curvature.k1_per_m), json_number(kin.target.curvature.k2_per_m)};
-    i["target_contact_curvature_1_per_m"] = json_number(kin.target.curvature.rule_curvature_per_m(ir.spec->contact_radius));
-    i["impactor_contact_curvature_1_per_m"] = json_number(kin.impactor.curvature.rule_curvature_per_m(ir.spec->contact_radius));
-    i["relative_curvatures_1_per_m"] = {json_number(kr.relative_curvature_A_per_m), json_number(kr.relative_curvature_B_per_m)};
-    i["contact_ellipse_axis_ratio"] = json_number(kr.contact_ellipse_axis_ratio);
-    i["validity"] = validity_json(ir.validity);
-    i["reduced_mass_kg"] = json_number(r.reduced_mass_kg);
-    i["effective_radius_m"] = json_number(r.effective_radius_m);
-    i["effective_modulus_Pa"] = json_number(r.effective_modulus_Pa);
-    i["hertz_constant_N_per_m1_5"] = json_number(r.hertz_constant);
-    i["approach_velocity_m_s"] = json_number(r.approach_velocity_m_s);
-    const bool hertz_restitution = hertz_law(ir);
-    i["contact_law"] = ir.contact_law;
-    i["contact_law_requested"] = ir.spec->contact_law;
-    i["limiting_pressure_Pa"] = optional_number(ir.law.limiting_pressure_Pa);
-    i["yield_velocity_m_s"] = optional_number(ir.yield_velocity_m_s);
-    i["validity"]["contact_law"] = ir.contact_law;
-    // A law other than Hertz gives its own restitution: its name is the restitution model.
-    i["restitution_model"] = hertz_restitution ? collision::to_string(r.restitution_kind) : ir.law.name.c_str();
-    if (!hertz_restitution) {
-      i["energy_flux_density"] = nullptr;
-    } else if (r.restitution_kind == collision::RestitutionModel::Kind::energy_flux) {
-      i["energy_flux_density"] = json_number(r.restitution.energy_flux_density);
-      i["energy_flux_density_unit"] = collision::to_string(ir.spec->restitution.flux_unit);
-      i["energy_flux_density_J_m3"] = json_number(r.restitution.energy_flux_density_J_m3);
-      i["ln_energy_flux_density"] = json_number(r.restitution.ln_energy_flux);
-      i["restitution_clamped"] = r.restitution.clamped;
-    } else {
-      i["energy_flux_density"] = nullptr;
-      if (r.restitution_kind == collision::RestitutionModel::Kind::table) i["restitution_clamped"] = r.restitution.clamped;
-    }
-    i["restitution"] = json_number(r.restitution.coefficient);
-    i["max_indentation_m"] = json_number(c.max_indentation_m);
-    i["max_force_N"] = json_number(c.max_force_N);
-    i["compression_time_s"] = json_number(c.compression_time_s);
-    i["contact_time_s"] = json_number(r.history.contact_time_s());
-    i["impulse_compression_Ns"] = json_number(r.history.impulse_compression_Ns());
-    i["impulse_total_Ns"] = json_number(r.history.impulse_total_Ns());
-    i["residual_indentation_m"] = json_number(r.history.law_result.residual_indentation_m);
-    i["dent_radius_m"] = json_number(ir.dent_radius_m);
-    i["unloading_radius_m"] = json_number(ir.unloading_radius_m);
-    const auto& k = r.checks;
-    i["checks"] = {{"impulse_relative_error", json_number(k.impulse_relative_error)},
-                   {"energy_relative_error", json_number(k.energy_relative_error)},
-                   {"impulse_threshold", k.thresholds.impulse_relative},
-                   {"energy_threshold", k.thresholds.energy_relative},
-                   {"impulse_compression_numerical_Ns", json_number(k.impulse_compression_numerical_Ns)},
-                   {"carnot_loss_J", json_number(k.carnot_loss_J)},
-                   {"kinetic_energy_loss_J", json_number(k.kinetic_energy_loss_J)},
-                   {"passed", k.passed}};
-    if (ir.table) {
-      i["force_table"] = {{"samples", ir.table->time_s.size()},
-                          {"impulse_Ns", json_number(ir.table->impulse_Ns)},
-                          {"impulse_relative_error", json_number(ir.table->impulse_relative_error)},
-                          {"impulse_tolerance", ir.table->impulse_tolerance},
-                          {"tolerance_met", ir.table->tolerance_met}};
-      if (ir.table_path) i["force_table"]["path"] = ir.table_path->string();
-    }
-    if (ir.plot_path) i["force_plot_svg"] = ir.plot_path->string();
-    if (ir.fem_deck) {
-      const auto& d = *ir.fem_deck;
-      const auto& q = d.quality;
-      i["fem"] = {{"folder", d.folder.string()},
-                  {"node_count", q.node_count},
-                  {"tet_count", q.tet_count},
-                  {"min_quality", q.min_quality},
-                  {"min_gamma", q.min_gamma},
-                  {"mesh_size_m", q.mesh_size_m},
-                  {"load_mesh_size_m", q.load_mesh_size_m},
-                  {"mesh_attempts", fem_export::to_json(q.attempts)},
-                  {"fallback_used", q.attempts.size() > 1},
-                  {"fe_volume_m3", q.fe_volume_m3},
-                  {"part_volume_m3", q.part_volume_m3},
-                  {"volume_relative_difference", q.volume_relative_difference},
-                  {"load", fem_export::to_string(d.load)},
-                  {"load_node_count", d.patch.load_node_count},
-                  {"contact_zone_radius_m", d.contact_zone_radius_m},
-                  {"body_check", fem_export::to_json(d.body_check)},
-                  {"check", ir.fem_check ? fem_export::to_json(*ir.fem_check) : nlohmann::json(nullptr)}};
-      if (d.load == fem_export::LoadKind::hertz_patch) {
-        i["fem"]["largest_ellipse_elements"] = d.patch.largest_ellipse_elements;
-        i["fem"]["max_nodes_loaded_at_once"] = d.patch.max_nodes_loaded_at_once;
-        i["fem"]["load_sum_max_relative_error"] = d.patch.max_sum_relative_error;
-        i["fem"]["load_moment_max_relative"] = d.patch.max_moment_relative;
-      }
-      if (ir.compare) i["fem"]["compare_contact"] = to_json(*ir.compare);
-    }
+    nlohmann::json i = impact_json(ir);
     impacts.push_back(std::move(i));
   }
   j["impacts"] = std::move(impacts);
+  if (!rep.sequences.empty() || !scene.sequences.empty()) {
+    nlohmann::json seqs = nlohmann::json::array();
+    for (const auto& sr : rep.sequences) seqs.push_back(sequence_json(sr));
+    j["sequences"] = std::move(seqs);
+    j["gravity_m_s2"] = scene.gravity_m_s2 ? json_vector(*scene.gravity_m_s2) : nlohmann::json(nullptr);
+  }
   nlohmann::json run = nlohmann::json::array(), times = nlohmann::json::object();
   for (const auto& s : rep.stages_run) {
     run.push_back(s.name);
@@ -285,6 +352,24 @@ std::string format_summary(const Scene& scene, const RunReport& rep) {
       std::istringstream lines(format_compare(*ir.compare));
       for (std::string l; std::getline(lines, l);) o << "  compare-contact: " << l << "\n";
     }
+  }
+  for (const auto& sr : rep.sequences) {
+    const auto& res = sr.result;
+    o << "\nsequence '" << sr.spec->name << "': " << sr.spec->body << " dropped on " << sr.spec->floor << ", "
+      << res.bounces.size() << " impact(s), stopped: " << sequence::to_string(res.stop) << "\n";
+    for (std::size_t i = 0; i < res.bounces.size(); ++i) {
+      const auto& b = res.bounces[i];
+      const double f = b.max_force_N();
+      o << "  impact " << i << "  t = " << b.time_s << " s  v = " << b.approach_velocity_m_s << " m/s  F_max = "
+        << (std::isfinite(f) ? std::to_string(f) + " N" : std::string("not applicable")) << "  impulse "
+        << b.normal_impulse_Ns << " N s  R = " << b.restitution << "\n";
+    }
+    if (res.worst_impact_index >= 0) {
+      o << "  worst impact          " << res.worst_impact_index << " (" << res.worst_impact_reason << ")\n";
+    }
+    if (sr.trajectory_csv) o << "  trajectory            " << sr.trajectory_csv->string() << "\n";
+    if (sr.trajectory_pvd) o << "  VTK series            " << sr.trajectory_pvd->string() << " (" << sr.vtk_frames << " frames)\n";
+    if (sr.plot_svg) o << "  picture               " << sr.plot_svg->string() << "\n";
   }
   for (const auto& w : rep.warnings) o << "\nwarning: " << w;
   if (!rep.warnings.empty()) o << "\n";

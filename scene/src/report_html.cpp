@@ -1,5 +1,6 @@
 // `run`'s report page (see report_html.hpp).
 #include "impactdeck/scene/report_html.hpp"
+#include "sequence_files.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -526,6 +527,31 @@ std::string report_html(const Scene& scene, const RunReport& rep, const std::vec
             plot::html_escape(newest.empty() ? std::string("(unknown)") : newest) +
             " (the newest input file's modification time)</p>");
   page.table({"input file", "modified", "SHA-256"}, hashes);
+
+  // Drop sequences: the picture of height and F_max against time, and every impact.
+  for (const auto& sr : rep.sequences) {
+    const auto& res = sr.result;
+    page.heading("Drop sequence '" + sr.spec->name + "'");
+    std::string summary = std::to_string(res.bounces.size()) + " impact(s) of '" + sr.spec->body + "' on '" +
+                          sr.spec->floor + "', stopped: " + sequence::to_string(res.stop);
+    if (res.worst_impact_index >= 0) {
+      summary += "; worst impact " + std::to_string(res.worst_impact_index) + " (" + res.worst_impact_reason + ")";
+    }
+    page.paragraph(summary);
+    page.figure(detail::sequence_svg(sr, rep.output_length_unit),
+                "Height of the lowest point above the floor and F_max of each impact against time");
+    std::vector<std::vector<std::string>> rows;
+    for (std::size_t i = 0; i < res.bounces.size(); ++i) {
+      const auto& b = res.bounces[i];
+      const double f = b.max_force_N();
+      rows.push_back({std::to_string(i), g(b.time_s, 6), g(b.approach_velocity_m_s, 5),
+                      std::isfinite(f) ? g(f, 5) : "not applicable", g(b.normal_impulse_Ns, 5), g(b.restitution, 4),
+                      vec3(b.point_own_m)});
+    }
+    page.table({"impact", "time (s)", "approach speed (m/s)", "F_max (N)", "normal impulse (N s)", "restitution",
+                "point, body frame (m)"},
+               rows);
+  }
 
   page.heading("Files written");
   std::filesystem::path page_dir;

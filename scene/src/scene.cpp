@@ -9,6 +9,7 @@
 #include <toml++/toml.h>
 
 #include "impactdeck/collision/contact_law.hpp"
+#include "impactdeck/sequence/sequence.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/common/suggest.hpp"
 #include "overrides_toml.hpp"
@@ -343,29 +344,9 @@ collision::RestitutionTable read_restitution_table(Reader& parent, const toml::t
   return tab;
 }
 
-ImpactSpec read_impact(std::size_t index, const toml::table& t, const Source& file,
-                       double to_m, const collision::RestitutionModel& defaults) {
-  Reader r(t, "impacts[" + std::to_string(index) + "]", file);
-  r.allow({"name", "target", "impactor", "point", "restitution", "contact_radius",
-           "approach_speed_m_s", "max_projection_distance", "contact_law", "limiting_pressure_Pa"});
-  ImpactSpec s;
-  s.place = r.self();
-  s.name = r.string("name").value_or("impact" + std::to_string(index + 1));
-  s.target = r.required_string("target");
-  s.impactor = r.required_string("impactor");
-  if (s.target == s.impactor) r.fail("impactor", "a body cannot hit itself");
-  if (const toml::node* n = r.get("point")) {
-    if (n->is_string()) {
-      if (n->value<std::string>().value() != "first-contact") {
-        r.fail("point", "must be [x, y, z] or \"first-contact\"");
-      }
-      s.first_contact = true;
-    } else {
-      s.point_m = *r.vec3("point") * to_m;
-    }
-  } else {
-    r.missing("point");
-  }
+// The keys of an impact's contact law (`restitution`, `contact_law`, `limiting_pressure_Pa`,
+// `contact_radius`): one reader for [[impacts]] and [[sequences]].
+void read_law_keys(Reader& r, ImpactSpec& s, const Source& file, const collision::RestitutionModel& defaults) {
   s.restitution = defaults;
   s.restitution_given = r.has("restitution");
   if (const std::optional<std::string> law = r.string("contact_law")) {
@@ -412,6 +393,32 @@ ImpactSpec read_impact(std::size_t index, const toml::table& t, const Source& fi
        {"mean", ContactRadiusRule::mean},
        {"paper", ContactRadiusRule::paper}},
       ContactRadiusRule::elliptical);
+}
+
+ImpactSpec read_impact(std::size_t index, const toml::table& t, const Source& file,
+                       double to_m, const collision::RestitutionModel& defaults) {
+  Reader r(t, "impacts[" + std::to_string(index) + "]", file);
+  r.allow({"name", "target", "impactor", "point", "restitution", "contact_radius",
+           "approach_speed_m_s", "max_projection_distance", "contact_law", "limiting_pressure_Pa"});
+  ImpactSpec s;
+  s.place = r.self();
+  s.name = r.string("name").value_or("impact" + std::to_string(index + 1));
+  s.target = r.required_string("target");
+  s.impactor = r.required_string("impactor");
+  if (s.target == s.impactor) r.fail("impactor", "a body cannot hit itself");
+  if (const toml::node* n = r.get("point")) {
+    if (n->is_string()) {
+      if (n->value<std::string>().value() != "first-contact") {
+        r.fail("point", "must be [x, y, z] or \"first-contact\"");
+      }
+      s.first_contact = true;
+    } else {
+      s.point_m = *r.vec3("point") * to_m;
+    }
+  } else {
+    r.missing("point");
+  }
+  read_law_keys(r, s, file, defaults);
   if (r.has("approach_speed_m_s")) {
     s.approach_speed_m_s = r.positive("approach_speed_m_s");
     if (s.first_contact) {
@@ -594,12 +601,83 @@ std::vector<std::string> material_names(const Scene& sc) {
   return names;
 }
 
+// One [[sequences]] entry (docs/sequences.md); its law keys are those of [[impacts]].
+SequenceSpec read_sequence(std::size_t index, const toml::table& t, const Source& file,
+                           const collision::RestitutionModel& defaults, const Scene& sc) {
+  const std::string self = "sequences[" + std::to_string(index) + "]";
+  Reader r(t, self, file);
+  r.allow({"name", "body", "floor", "max_impacts", "min_approach_speed_m_s", "friction_coefficient", "restitution",
+           "contact_radius", "contact_law", "limiting_pressure_Pa"});
+  SequenceSpec q;
+  q.place = r.self();
+  q.name = r.string("name").value_or("sequence" + std::to_string(index + 1));
+  if (q.name.find('/') != std::string::npos) r.fail("name", "is part of output file names: it must not contain '/'");
+  std::vector<std::string> names;
+  for (const auto& b : sc.bodies) names.push_back(b.name);
+  for (const char* key : {"body", "floor"}) {
+    const std::string who = r.required_string(key);
+    if (std::find(names.begin(), names.end(), who) == names.end()) {
+      r.fail(key, "no body named '" + who + "'" + did_you_mean(who, names));
+    }
+    (std::string(key) == "body" ? q.body : q.floor) = who;
+  }
+  if (q.body == q.floor) r.fail("floor", "the floor must be another body than the falling one");
+  const BodySpec& floor = sc.body(q.floor);
+  if (!floor.shape->half_space()) {
+    r.fail("floor", "'" + q.floor + "' is a " + floor.shape->kind() + ", not a plane: the floor of a sequence must be a "
+                    "body with shape = \"plane\"");
+  }
+  if (sc.body(q.body).fixed) r.fail("body", "'" + q.body + "' is fixed: the falling body must be free");
+  if (r.has("max_impacts")) {
+    const std::size_t n = r.count("max_impacts");
+    if (n > static_cast<std::size_t>(sequence::kMaxImpactsLimit)) {
+      r.fail("max_impacts", "must be at most " + std::to_string(sequence::kMaxImpactsLimit));
+    }
+    q.max_impacts = static_cast<int>(n);
+  }
+  if (const std::optional<double> v = r.number("min_approach_speed_m_s")) {
+    if (!(*v >= 0.0)) r.fail("min_approach_speed_m_s", "must be >= 0, got " + Reader::fmt(*v));
+    q.min_approach_speed_m_s = *v;
+  }
+  if (const std::optional<double> mu = r.number("friction_coefficient")) {
+    if (!(*mu >= 0.0)) r.fail("friction_coefficient", "must be >= 0, got " + Reader::fmt(*mu));
+    q.friction_coefficient = *mu;
+  }
+  q.friction_place = r.place("friction_coefficient");
+  // The impacts' law keys, read as on [[impacts]]: the body is the target, the floor the impactor.
+  q.impact.name = q.name;
+  q.impact.target = q.body;
+  q.impact.impactor = q.floor;
+  q.impact.first_contact = true;
+  q.impact.place = q.place;
+  read_law_keys(r, q.impact, file, defaults);
+  r.reject_unknown();
+  return q;
+}
+
+// A plastic law needs the yield strength of at least one of the impact's bodies (docs/plastic.md).
+void check_law_materials(const Scene& sc, const ImpactSpec& s, const Source& file) {
+  if (s.contact_law_given && s.contact_law != "auto" && s.contact_law != "hertz") {
+    // A plastic law needs the yield strength of at least one body (docs/plastic.md).
+    const Material& mt = sc.materials.at(sc.body(s.target).material);
+    const Material& mi = sc.materials.at(sc.body(s.impactor).material);
+    if (!mt.yield_strength_Pa && !mi.yield_strength_Pa) {
+      const std::string names = mt.name == mi.name ? "material '" + mt.name + "' has"
+                                                   : "materials '" + mt.name + "' and '" + mi.name + "' have";
+      throw file.error(s.contact_law_place, "contact_law = \"" + s.contact_law + "\" is a plastic law, but " + names +
+                                                " no yield_strength_Pa: give " +
+                                                (mt.name == mi.name ? "it" : "one of them") +
+                                                " yield_strength_Pa or set contact_law = \"hertz\"");
+    }
+  }
+}
+
 Scene build(const toml::table& root, const Source& file, const fs::path& base_dir) {
   Scene sc;
   sc.file = file.name();
   Reader r(root, "", file);
   r.allow({"length_unit", "modulus_convention", "energy_flux_unit", "restitution_range_policy",
-           "checks", "validity", "materials", "bodies", "impacts", "outputs"});
+           "checks", "validity", "materials", "bodies", "impacts", "outputs", "gravity_m_s2", "sequences"});
   const std::string unit_text = r.required_string("length_unit");
   auto unit = parse_length_unit(unit_text);
   if (!unit)
@@ -678,7 +756,32 @@ Scene build(const toml::table& root, const Source& file, const fs::path& base_di
     sc.bodies.push_back(std::move(b));
   }
 
+  // [[sequences]] first: a scene with sequences may leave [[impacts]] out.
+  if (const toml::node* n = r.get("sequences")) {
+    const toml::array& sa = table_array(n, "sequences", file);
+    for (std::size_t i = 0; i < sa.size(); ++i) {
+      SequenceSpec q = read_sequence(i, *sa.get(i)->as_table(), file, rdefaults, sc);
+      check_law_materials(sc, q.impact, file);
+      for (const auto& other : sc.sequences) {
+        if (other.name == q.name) {
+          throw file.error(Place{q.place.line, "sequences[" + std::to_string(i) + "].name"},
+                           "duplicate sequence name '" + q.name + "'");
+        }
+      }
+      sc.sequences.push_back(std::move(q));
+    }
+  }
+  if (const std::optional<Eigen::Vector3d> g = r.vec3("gravity_m_s2")) {
+    sc.gravity_m_s2 = *g;
+  } else if (!sc.sequences.empty()) {
+    r.fail("gravity_m_s2", "missing: a scene with [[sequences]] needs gravity_m_s2 = [gx, gy, gz] (m/s^2)");
+  }
   const toml::node* impacts = r.get("impacts");
+  if (!impacts && !sc.sequences.empty()) {
+    if (const toml::node* n = r.get("outputs")) sc.outputs = read_outputs(sub_table(n, "outputs", file), file, to_m);
+    r.reject_unknown();
+    return sc;
+  }
   if (!impacts) r.missing("impacts");
   const toml::array& ia = table_array(impacts, "impacts", file);
   for (std::size_t i = 0; i < ia.size(); ++i) {
@@ -694,19 +797,7 @@ Scene build(const toml::table& root, const Source& file, const fs::path& base_di
                          "no body named '" + *who + "'" + did_you_mean(*who, names));
       }
     }
-    if (s.contact_law_given && s.contact_law != "auto" && s.contact_law != "hertz") {
-      // A plastic law needs the yield strength of at least one body (docs/plastic.md).
-      const Material& mt = sc.materials.at(sc.body(s.target).material);
-      const Material& mi = sc.materials.at(sc.body(s.impactor).material);
-      if (!mt.yield_strength_Pa && !mi.yield_strength_Pa) {
-        const std::string names = mt.name == mi.name ? "material '" + mt.name + "' has"
-                                                     : "materials '" + mt.name + "' and '" + mi.name + "' have";
-        throw file.error(s.contact_law_place, "contact_law = \"" + s.contact_law + "\" is a plastic law, but " + names +
-                                                  " no yield_strength_Pa: give " +
-                                                  (mt.name == mi.name ? "it" : "one of them") +
-                                                  " yield_strength_Pa or set contact_law = \"hertz\"");
-      }
-    }
+    check_law_materials(sc, s, file);
     if (!s.first_contact) {
       const BodySpec& imp = sc.body(s.impactor);
       if (imp.placed && imp.position_m != Eigen::Vector3d::Zero()) {
@@ -723,7 +814,7 @@ Scene build(const toml::table& root, const Source& file, const fs::path& base_di
     }
     sc.impacts.push_back(std::move(s));
   }
-  if (sc.impacts.empty()) r.fail("impacts", "at least one impact is needed");
+  if (sc.impacts.empty() && sc.sequences.empty()) r.fail("impacts", "at least one impact (or a [[sequences]] entry) is needed");
 
   if (const toml::node* n = r.get("outputs")) sc.outputs = read_outputs(sub_table(n, "outputs", file), file, to_m);
   if (sc.outputs.fem && sc.outputs.fem->compare_contact) {

@@ -16,6 +16,7 @@
 #include "impactdeck/scene/compare_contact.hpp"
 #include "impactdeck/contact/impact.hpp"
 #include "impactdeck/scene/scene.hpp"
+#include "impactdeck/sequence/sequence.hpp"
 
 namespace impactdeck::scene {
 
@@ -41,6 +42,20 @@ struct ImpactReport : contact::Impact {
   std::optional<fem_export::CheckResult> fem_check;  ///< [outputs.fem] run = "calculix"
   /// [outputs.fem] compare_contact = true: the full-contact model against the analytic force
   std::optional<CompareReport> compare;
+  /// An impact of a sequence where no Hertz force exists (a sharp corner, a flat face): why. Its
+  /// jumps are the rigid impulse's; the force, the law's figures and the checks are not applicable
+  /// (null in JSON). Empty for every Hertzian impact.
+  std::string force_not_applicable;
+};
+
+/// One [[sequences]] entry as run (docs/sequences.md): the sequence and one ImpactReport per
+/// impact (the Hertzian ones as `run` solves a single impact; the others with their rigid jumps).
+struct SequenceReport {
+  std::shared_ptr<const SequenceSpec> spec;
+  sequence::SequenceResult result;
+  std::vector<ImpactReport> impacts;  ///< impacts[i] is result.bounces[i]
+  std::optional<std::filesystem::path> trajectory_csv, trajectory_pvd, plot_svg;  ///< where written
+  std::size_t vtk_frames = 0;
 };
 
 struct StageTiming {
@@ -50,6 +65,7 @@ struct StageTiming {
 
 struct RunReport {
   std::vector<ImpactReport> impacts;
+  std::vector<SequenceReport> sequences;
   std::vector<StageTiming> stages_run;
   std::vector<std::string> stages_skipped;
   std::vector<std::string> warnings;
@@ -110,6 +126,9 @@ collision::ForceTableOptions force_table_options(const Scene& scene, const Impac
 /// sampled): the body `body` alone in its own frame with the force on the target; its context
 /// names the scene's [outputs.fem] key and the impact. Throws InputError.
 fem_export::DeckRequest hybrid_deck_request(const Scene& scene, const ImpactReport& ir, const contact::PreparedBody& body);
+
+/// The stage of [[sequences]] (stages_run): every impact of every sequence.
+inline constexpr const char* kSequenceStage = "sequence";
 
 /// Every stage the tool knows, in pipeline order (for stages_run / stages_skipped).
 const std::vector<std::string>& all_stages();

@@ -84,6 +84,22 @@ struct ImpactSpec {
   Place place;
 };
 
+/// `[[sequences]]`: a free body dropped onto a plane, every bounce until it stops
+/// (docs/sequences.md).
+struct SequenceSpec {
+  std::string name;
+  std::string body;   ///< the free body that falls
+  std::string floor;  ///< a plane body
+  int max_impacts = 20;
+  double min_approach_speed_m_s = 0.05;  ///< sequence::kDefaultMinApproachSpeed
+  double friction_coefficient = 0;
+  Place friction_place;  ///< where friction_coefficient was given (the key alone when it was not)
+  /// The law keys (`restitution`, `contact_law`, `limiting_pressure_Pa`, `contact_radius`), read by
+  /// the reader of [[impacts]]: target = body, impactor = floor, name = the sequence's.
+  ImpactSpec impact;
+  Place place;
+};
+
 /// `[outputs.fem]`: FEM decks of the hybrid approach (docs/fem.md). Present = requested.
 struct FemOutputs {
   std::optional<double> mesh_size_m;       ///< default: smallest semi-axis / 2 (ellipsoid)
@@ -145,6 +161,9 @@ struct Scene {
   std::map<std::string, Material> materials;
   std::vector<BodySpec> bodies;
   std::vector<ImpactSpec> impacts;
+  std::vector<SequenceSpec> sequences;
+  /// `gravity_m_s2` (required with [[sequences]]).
+  std::optional<Eigen::Vector3d> gravity_m_s2;
   Outputs outputs;
 
   const BodySpec& body(const std::string& name) const;  ///< throws InputError if unknown

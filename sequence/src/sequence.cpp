@@ -1,0 +1,214 @@
+#include "impactdeck/sequence/sequence.hpp"
+
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "impactdeck/collision/eccentric.hpp"
+#include "impactdeck/collision/impact.hpp"
+#include "impactdeck/geometry/plane.hpp"
+
+namespace impactdeck::sequence {
+namespace {
+
+std::string fmt(double x) {
+  std::ostringstream s;
+  s.precision(6);
+  s << x + 0.0;
+  return s.str();
+}
+
+// Why no Hertz force exists at a flagged contact, in words.
+std::string flag_reason(const contact::ContactEvaluation& e) {
+  const collision::ContactFlag f = e.result.flag;
+  std::string r;
+  if (f == collision::ContactFlag::sharp) {
+    r = "the contact point is on a sharp edge or corner, where the part has no curvature (no edge_radius): no Hertz "
+        "force exists";
+  } else {
+    r = std::string("not a Hertz contact (flag ") + collision::flag_word(f) + ")";
+  }
+  if (!e.curvature_problem.empty()) r += " (" + e.curvature_problem + ")";
+  return r;
+}
+
+}  // namespace
+
+const char* to_string(StopReason r) {
+  switch (r) {
+    case StopReason::max_impacts: return "max_impacts";
+    case StopReason::min_approach_speed: return "min_approach_speed";
+    case StopReason::at_rest: return "at_rest";
+  }
+  return "?";
+}
+
+double Bounce::max_force_N() const {
+  return impact ? impact->result.history.compression.max_force_N : std::numeric_limits<double>::quiet_NaN();
+}
+
+Floor floor_of(const contact::PreparedBody& plane) {
+  const geometry::Plane* p = plane.shape ? plane.shape->half_space() : nullptr;
+  if (!p) throw InputError("", "floor", "'" + plane.name + "' is not a plane");
+  Floor f;
+  f.point_m = plane.pose.position_m;
+  f.normal = plane.pose.direction_to_world(p->normal()).normalized();
+  return f;
+}
+
+Bounce apply_bounce(const SequenceInput& in, std::size_t index, const BodyState& at,
+                    const geometry::SurfacePoint& support) {
+  const double mu = in.friction_coefficient;
+  if (!(mu >= 0.0) || !std::isfinite(mu)) {
+    throw in.ctx.error("friction_coefficient", "must be a finite number >= 0, got " + fmt(mu));
+  }
+  if (mu > 0.0) {
+    // The frictional impact (collision::solve_frictional_impact) takes this branch once merged.
+    throw in.ctx.error("friction_coefficient", "friction (" + fmt(mu) +
+                                                   ") is not available in this build: set friction_coefficient = 0");
+  }
+  Bounce b;
+  b.time_s = at.time_s;
+  b.before = at;
+  const contact::PreparedBody body = placed(in.body, at);
+  const contact::ContactModel model(body, in.floor, in.rule, in.effective_modulus_Pa, in.law, in.ctx);
+  b.contact = model.at_surface_point(support);
+  b.point_own_m = support.point_m;
+  if (b.contact.result.flag == collision::ContactFlag::none) {
+    if (in.complete) {
+      b.impact = in.complete(index, model, b.contact);
+    } else {
+      b.impact = contact::complete_impact(model, b.contact, contact::impact_input(model, b.contact));
+    }
+    const collision::ImpactResult& r = b.impact->result;
+    b.reduced_mass_kg = r.reduced_mass_kg;
+    b.approach_velocity_m_s = r.approach_velocity_m_s;
+    b.restitution = r.restitution.coefficient;
+    b.normal_impulse_Ns = r.kernel.impulse_total_Ns;
+    b.body_jump = r.target_jump;
+    b.floor_jump = r.impactor_jump;
+    const collision::LawResult& l = r.history.law_result;
+    b.dent_radius_m = l.residual_indentation_m > 0.0 ? std::sqrt(r.effective_radius_m * l.max_indentation_m) : 0.0;
+  } else {
+    const collision::ContactFlag f = b.contact.result.flag;
+    const bool geometric = f == collision::ContactFlag::sharp || f == collision::ContactFlag::no_curvature ||
+                           f == collision::ContactFlag::flat || f == collision::ContactFlag::line ||
+                           f == collision::ContactFlag::no_fit || f == collision::ContactFlag::saddle;
+    b.not_applicable = flag_reason(b.contact);
+    if (!geometric) throw in.ctx.error("", "at t = " + fmt(at.time_s) + " s: " + b.not_applicable);
+    if (!in.rigid_restitution) {
+      throw in.ctx.error("restitution", "at t = " + fmt(at.time_s) + " s " + b.not_applicable +
+                                            "; the rigid impulse needs a constant restitution: set restitution = "
+                                            "a number in [0, 1]");
+    }
+    // The rigid impulse still holds: Pi = (1 + e) m_w v_w along the normal (Eq. 13, 22-23).
+    const collision::RigidBody tb = body.rigid_body(), fb = in.floor.rigid_body();
+    const collision::Contact c{b.contact.point_m, b.contact.normal};
+    b.reduced_mass_kg = collision::reduced_mass_kg(tb, fb, c);
+    b.approach_velocity_m_s = collision::approach_velocity_m_s(tb, fb, c);
+    b.restitution = *in.rigid_restitution;
+    b.normal_impulse_Ns = (1.0 + b.restitution) * b.reduced_mass_kg * b.approach_velocity_m_s;
+    collision::velocity_jumps(tb, fb, c, b.normal_impulse_Ns, b.body_jump, b.floor_jump);
+  }
+  b.after = at;
+  b.after.velocity_m_s += b.body_jump.delta_velocity_m_s;
+  b.after.angular_velocity_rad_s += b.body_jump.delta_angular_velocity_rad_s;
+  return b;
+}
+
+SequenceResult run_sequence(const SequenceInput& in) {
+  const InputContext& ctx = in.ctx;
+  if (!in.floor.shape || !in.floor.shape->half_space()) {
+    throw ctx.error("floor", "'" + in.floor.name + "' is a " + (in.floor.shape ? in.floor.shape->kind() : "?") +
+                                 ", not a plane: the floor of a sequence must be a plane body");
+  }
+  if (in.body.fixed() || !in.body.shape || !in.body.shape->bounded()) {
+    throw ctx.error("body", "'" + in.body.name + "' must be a free, bounded body");
+  }
+  const double mu = in.friction_coefficient;
+  if (!(mu >= 0.0) || !std::isfinite(mu)) {
+    throw ctx.error("friction_coefficient", "must be a finite number >= 0, got " + fmt(mu));
+  }
+  if (in.max_impacts < 1 || in.max_impacts > kMaxImpactsLimit) {
+    throw ctx.error("max_impacts", "must lie in [1, " + std::to_string(kMaxImpactsLimit) + "]");
+  }
+  if (!(in.min_approach_speed_m_s >= 0.0) || !std::isfinite(in.min_approach_speed_m_s)) {
+    throw ctx.error("min_approach_speed_m_s", "must be a finite number >= 0");
+  }
+  const Floor floor = floor_of(in.floor);
+  const double gn = in.gravity_m_s2.dot(floor.normal);
+  if (!in.gravity_m_s2.allFinite() || !(gn < 0.0)) {
+    throw ctx.error("gravity_m_s2", "must point towards the floor '" + in.floor.name + "': g . n = " + fmt(gn) +
+                                        " m/s^2, n its outward normal; it must be < 0");
+  }
+  const double size = in.body.shape->size_m();
+  const double tol = kGapToleranceRelative * size;
+  BodyState s = state_of(in.body);
+  if (const double h0 = floor_gap_m(*in.body.shape, in.body.volume.centroid_m, s, floor); h0 < -tol) {
+    throw ctx.error("body", "'" + in.body.name + "' is already below the floor '" + in.floor.name +
+                                "': its lowest point is " + fmt(-h0) + " m under it");
+  }
+  const Flight flight(in.body.inertia_kg_m2, in.gravity_m_s2, ctx);
+  SequenceResult out;
+  out.trajectory.push_back({s, floor_gap_m(*in.body.shape, in.body.volume.centroid_m, s, floor)});
+  const double rest_energy = 0.5 * in.body.mass_kg * in.min_approach_speed_m_s * in.min_approach_speed_m_s;
+  for (;;) {
+    const NextContact nc = next_contact(in.body, flight, s, floor, tol, ctx);
+    const double span = nc.state.time_s - s.time_s;
+    for (int k = 1; k + 1 < kSamplesPerFlight; ++k) {
+      const BodyState t = flight.advance(s, span * k / (kSamplesPerFlight - 1));
+      out.trajectory.push_back({t, floor_gap_m(*in.body.shape, in.body.volume.centroid_m, t, floor)});
+    }
+    out.trajectory.push_back({nc.state, nc.gap_m});
+    double rate = 0.0;
+    floor_gap_m(*in.body.shape, in.body.volume.centroid_m, nc.state, floor, nullptr, &rate);
+    if (-rate < in.min_approach_speed_m_s) {
+      out.stop = StopReason::min_approach_speed;
+      break;
+    }
+    Bounce b = apply_bounce(in, out.bounces.size(), nc.state, nc.support);
+    for (std::size_t j = 0; j < out.bounces.size(); ++j) {
+      const Bounce& o = out.bounces[j];
+      if (o.dent_radius_m > 0.0 && (b.point_own_m - o.point_own_m).norm() <= o.dent_radius_m) {
+        b.in_dent_of = static_cast<int>(j);
+        break;
+      }
+    }
+    s = b.after;
+    out.trajectory.push_back({s, nc.gap_m});
+    out.bounces.push_back(std::move(b));
+    if (static_cast<int>(out.bounces.size()) >= in.max_impacts) {
+      out.stop = StopReason::max_impacts;
+      break;
+    }
+    const double kinetic = 0.5 * in.body.mass_kg * s.velocity_m_s.squaredNorm() +
+                           0.5 * s.angular_velocity_rad_s.dot(angular_momentum(in.body, s));
+    if (kinetic <= rest_energy) {
+      out.stop = StopReason::at_rest;
+      break;
+    }
+  }
+  // The worst impact: the largest Hertz force; where no force applies at any impact, the largest
+  // normal impulse.
+  double worst = -1.0;
+  for (std::size_t i = 0; i < out.bounces.size(); ++i) {
+    const double f = out.bounces[i].max_force_N();
+    if (std::isfinite(f) && f > worst) {
+      worst = f;
+      out.worst_impact_index = static_cast<int>(i);
+      out.worst_impact_reason = "largest max_force_N";
+    }
+  }
+  if (out.worst_impact_index < 0) {
+    for (std::size_t i = 0; i < out.bounces.size(); ++i) {
+      if (out.bounces[i].normal_impulse_Ns > worst) {
+        worst = out.bounces[i].normal_impulse_Ns;
+        out.worst_impact_index = static_cast<int>(i);
+        out.worst_impact_reason = "largest normal_impulse_Ns (no Hertz force applies at any impact)";
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace impactdeck::sequence
