@@ -169,6 +169,7 @@ collision::ImpactInput impact_input(const Scene& scene, const ImpactSpec& s, con
   in.thresholds = scene.thresholds;
   in.context = impact_context(scene, s);
   in.input_keys = detail::impact_input_keys(scene, s);
+  in.friction_coefficient = s.friction_coefficient;
   return in;
 }
 

@@ -347,7 +347,8 @@ ImpactSpec read_impact(std::size_t index, const toml::table& t, const Source& fi
                        double to_m, const collision::RestitutionModel& defaults) {
   Reader r(t, "impacts[" + std::to_string(index) + "]", file);
   r.allow({"name", "target", "impactor", "point", "restitution", "contact_radius",
-           "approach_speed_m_s", "max_projection_distance", "contact_law", "limiting_pressure_Pa"});
+           "approach_speed_m_s", "max_projection_distance", "contact_law", "limiting_pressure_Pa",
+           "friction_coefficient"});
   ImpactSpec s;
   s.place = r.self();
   s.name = r.string("name").value_or("impact" + std::to_string(index + 1));
@@ -386,6 +387,12 @@ ImpactSpec read_impact(std::size_t index, const toml::table& t, const Source& fi
     }
   }
   if (r.has("limiting_pressure_Pa")) s.limiting_pressure_Pa = r.positive("limiting_pressure_Pa");
+  if (r.has("friction_coefficient")) {  // finite (required_number checks it)
+    s.friction_coefficient = r.required_number("friction_coefficient");
+    if (!(s.friction_coefficient >= 0.0)) {
+      r.fail("friction_coefficient", "must be >= 0, got " + Reader::fmt(s.friction_coefficient));
+    }
+  }
   if (const toml::node* n = r.get("restitution")) {
     if (n->is_string()) {
       if (n->value<std::string>().value() != "energy-flux") {
