@@ -260,8 +260,6 @@ TEST(Sequence, RefusesBadInput) {
   in = input_with(ball, 0.5);
   in.friction_coefficient = -0.1;
   expect_place(in, "friction_coefficient");
-  in.friction_coefficient = 0.3;  // the frictional impact is not on this branch
-  expect_place(in, "friction_coefficient");
   in = input_with(ball, 0.5);
   in.floor = ellipsoid_body(1, 1, 1, std::numeric_limits<double>::infinity());
   expect_place(in, "floor");
@@ -431,7 +429,7 @@ TEST(SequenceScene, SequencesOnlySceneRunsAndWritesItsFiles) {
   EXPECT_EQ(i0["target"]["name"], "part");
   EXPECT_TRUE(i0["target"].contains("delta_velocity_m_s"));
   EXPECT_TRUE(i0["target"].contains("delta_angular_velocity_rad_s"));
-  EXPECT_EQ(i0["tangential_impulse_Ns"], 0.0);
+  EXPECT_EQ(i0["tangential_impulse_Ns"], nlohmann::json::array({0.0, 0.0, 0.0}));
   EXPECT_GT(i0["max_force_N"].get<double>(), 0.0);
   // The sequence's impact is the single impact's writer: a Hertz impact's own figures are there.
   EXPECT_DOUBLE_EQ(i0["impulse_total_Ns"].get<double>(), i0["normal_impulse_Ns"].get<double>());
@@ -510,4 +508,39 @@ TEST(SequenceScene, BadKeysAreRefusedNamingThem) {
   std::string no_gravity = scene_text(sphere, "");
   no_gravity.replace(no_gravity.find("gravity_m_s2"), std::string("gravity_m_s2 = [0, 0, -9.81]").size(), "");
   refused(no_gravity, "gravity_m_s2");
+}
+
+// --- friction (collision::solve_frictional_impact in apply_bounce) ----------------------------
+
+TEST(SequenceFriction, SphereSlidingOnARoughFloorSpinsAsTheClosedForm) {
+  // A solid sphere (R 20 mm) with a sideways drift lands on a rough floor (mu 0.1, e 0.6): in gross
+  // slip the first bounce gives it the spin 2.5 mu (1 + e) V_n / R about the axis n x drift
+  // (BEYOND_HERTZ.md), its drift drops by mu (1 + e) V_n, and no bounce gains energy.
+  const double R = 0.02, mu = 0.1, e = 0.6;
+  auto body = ellipsoid_body(R, R, R, 0.5);
+  body.pose.position_m = Vector3d(3.0, -2.0, 0.3);
+  body.velocity_m_s = Vector3d(2.0, 0.0, 0.0);
+  sequence::SequenceInput in = input_with(body, e);
+  in.friction_coefficient = mu;
+  in.max_impacts = 4;
+  const sequence::SequenceResult r = sequence::run_sequence(in);
+  ASSERT_GE(r.bounces.size(), 2u);
+  const sequence::Bounce& b = r.bounces[0];
+  ASSERT_TRUE(b.friction.has_value());
+  const double vn = b.approach_velocity_m_s;
+  // The closed forms hold to the frictional solver's closed-form (constant slip direction) rounding.
+  constexpr double kClosedFormRel = 1e-9;
+  EXPECT_NEAR(b.after.angular_velocity_rad_s.y(), 2.5 * mu * (1 + e) * vn / R, kClosedFormRel * vn / R);
+  EXPECT_NEAR(b.after.angular_velocity_rad_s.x(), 0.0, kClosedFormRel * vn / R);
+  EXPECT_NEAR(b.after.velocity_m_s.x(), 2.0 - mu * (1 + e) * vn, kClosedFormRel * vn);
+  EXPECT_NEAR(b.after.velocity_m_s.z(), e * vn, kClosedFormRel * vn);
+  EXPECT_NEAR(b.tangential_impulse_Ns.x(), mu * b.normal_impulse_Ns, kClosedFormRel * b.normal_impulse_Ns);
+  ASSERT_FALSE(b.friction->slip_history.empty());
+  EXPECT_EQ(b.friction->slip_history.front(), collision::SlipEvent::slides);
+  for (const auto& x : r.bounces) EXPECT_GE(x.energy_lost_J, 0.0);
+  // Frictionless, the same drop keeps its drift and gets no spin.
+  in.friction_coefficient = 0;
+  const sequence::SequenceResult f = sequence::run_sequence(in);
+  EXPECT_EQ(f.bounces[0].after.velocity_m_s.x(), 2.0);
+  EXPECT_EQ(f.bounces[0].after.angular_velocity_rad_s.norm(), 0.0);
 }

@@ -31,6 +31,18 @@ Impact complete_impact(const ContactModel& model, ContactEvaluation contact, con
   i.result = collision::complete_impact(input, contact.input, contact.result);
   i.validity = collision::assess_validity(contact.input, i.result.kernel, model.target().yield_strength_Pa,
                                           model.impactor().yield_strength_Pa, limits);
+  if (input.friction_coefficient > 0.0) {
+    collision::FrictionalImpactInput f;
+    f.a = input.impactor;
+    f.b = input.target;
+    f.r_a_m = input.contact.point_m - input.impactor.center_of_mass_m;
+    f.r_b_m = input.contact.point_m - input.target.center_of_mass_m;
+    f.normal = input.contact.normal;  // the target's outward normal: from b into a
+    f.friction_coefficient = input.friction_coefficient;
+    f.restitution = i.result.restitution.coefficient;
+    f.context = input.context;
+    i.friction = collision::solve_frictional_impact(f);
+  }
   i.contact = std::move(contact);
   return i;
 }

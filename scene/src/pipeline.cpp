@@ -175,6 +175,7 @@ collision::ImpactInput impact_input(const Scene& scene, const ImpactSpec& s, con
   in.thresholds = scene.thresholds;
   in.context = impact_context(scene, s);
   in.input_keys = detail::impact_input_keys(scene, s);
+  in.friction_coefficient = s.friction_coefficient;
   return in;
 }
 
@@ -413,6 +414,7 @@ SequenceReport run_sequence(const Scene& scene, const SequenceSpec& q, const std
     ir.result.restitution.coefficient = b.restitution;
     ir.result.target_jump = b.body_jump;
     ir.result.impactor_jump = b.floor_jump;
+    ir.friction = b.friction;  // the rigid impact's slip and jumps with friction
     ir.force_not_applicable = b.not_applicable;
     std::ostringstream w;
     w << "sequence '" << q.name << "' impact " << i << " at t = " << b.time_s << " s: " << b.not_applicable

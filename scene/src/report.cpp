@@ -27,6 +27,37 @@ nlohmann::json body_json(const std::string& name, const collision::VelocityJump&
           {"principal_curvatures_1_per_m", {json_number(k.curvature.k1_per_m), json_number(k.curvature.k2_per_m)}}};
 }
 
+// The jumps the reports give: the frictional impact's with friction (docs/friction.md), else the
+// kernel's (a = the impactor, b = the target).
+collision::VelocityJump target_jump(const ImpactReport& ir) {
+  if (!ir.friction) return ir.result.target_jump;
+  return {ir.friction->delta_velocity_b_m_s, ir.friction->delta_angular_velocity_b_rad_s};
+}
+collision::VelocityJump impactor_jump(const ImpactReport& ir) {
+  if (!ir.friction) return ir.result.impactor_jump;
+  return {ir.friction->delta_velocity_a_m_s, ir.friction->delta_angular_velocity_a_rad_s};
+}
+
+// The friction keys of an impact; without friction: the normal impulse of the law, no tangential
+// impulse, no slip events and Carnot's loss (Eq. 32).
+void friction_json(const ImpactReport& ir, nlohmann::json& i) {
+  i["friction_coefficient"] = json_number(ir.spec->friction_coefficient);
+  nlohmann::json slips = nlohmann::json::array();
+  if (!ir.friction) {
+    i["normal_impulse_Ns"] = json_number(ir.result.kernel.impulse_total_Ns);
+    i["tangential_impulse_Ns"] = json_vector(Eigen::Vector3d::Zero());
+    i["slip_history"] = slips;
+    i["energy_lost_J"] = json_number(ir.result.checks.carnot_loss_J);
+    return;
+  }
+  const collision::FrictionalImpactResult& f = *ir.friction;
+  for (collision::SlipEvent e : f.slip_history) slips.push_back(collision::to_string(e));
+  i["normal_impulse_Ns"] = json_number(f.normal_impulse_Ns);
+  i["tangential_impulse_Ns"] = json_vector(f.tangential_impulse_Ns);
+  i["slip_history"] = slips;
+  i["energy_lost_J"] = json_number(f.energy_lost_J);
+}
+
 // The built law gives Hertz's restitution (its model: energy flux, constant, table).
 bool hertz_law(const ImpactReport& ir) { return !ir.law.law || ir.law.name == "hertz"; }
 
@@ -61,8 +92,8 @@ nlohmann::json impact_json(const ImpactReport& ir) {
   i["name"] = ir.spec->name;
   const collision::KernelInput& kin = ir.contact.input;
   const collision::KernelResult& kr = r.kernel;
-  i["target"] = body_json(ir.spec->target, r.target_jump, kin.target);
-  i["impactor"] = body_json(ir.spec->impactor, r.impactor_jump, kin.impactor);
+  i["target"] = body_json(ir.spec->target, target_jump(ir), kin.target);
+  i["impactor"] = body_json(ir.spec->impactor, impactor_jump(ir), kin.impactor);
   i["contact_mode"] = ir.spec->first_contact ? "first-contact" : "point";
   i["contact_point_m"] = json_vector(ir.contact.point_m);
   i["contact_normal"] = json_vector(ir.contact.normal);
@@ -107,6 +138,7 @@ nlohmann::json impact_json(const ImpactReport& ir) {
   i["contact_time_s"] = json_number(r.history.contact_time_s());
   i["impulse_compression_Ns"] = json_number(r.history.impulse_compression_Ns());
   i["impulse_total_Ns"] = json_number(r.history.impulse_total_Ns());
+  friction_json(ir, i);
   i["residual_indentation_m"] = json_number(r.history.law_result.residual_indentation_m);
   i["dent_radius_m"] = json_number(ir.dent_radius_m);
   i["unloading_radius_m"] = json_number(ir.unloading_radius_m);
@@ -185,7 +217,8 @@ nlohmann::json sequence_json(const SequenceReport& sr) {
     i["contact_mode"] = "sequence";
     i["contact_point_own_m"] = json_vector(b.point_own_m);
     i["normal_impulse_Ns"] = json_number(b.normal_impulse_Ns);
-    i["tangential_impulse_Ns"] = json_number(b.tangential_impulse_Ns);
+    i["tangential_impulse_Ns"] = json_vector(b.tangential_impulse_Ns);
+    i["energy_lost_J"] = json_number(b.energy_lost_J);
     i["force_applicable"] = ir.force_not_applicable.empty();
     i["in_dent_of"] = b.in_dent_of >= 0 ? nlohmann::json(b.in_dent_of) : nlohmann::json(nullptr);
     if (!ir.force_not_applicable.empty()) {
@@ -305,10 +338,17 @@ std::string format_summary(const Scene& scene, const RunReport& rep) {
     if (v.peak_pressure_over_yield_onset) o << " (" << *v.peak_pressure_over_yield_onset << " x onset of yield)";
     const std::string model = ir.plastic() ? "the " + ir.contact_law + " law's" : "Hertz's";
     o << (v.ok ? " -> within " + model + " assumptions" : " -> OUTSIDE " + model + " assumptions (see warnings)") << "\n";
-    o << "  target   dv = " << text(r.target_jump.delta_velocity_m_s) << " m/s, dw = "
-      << text(r.target_jump.delta_angular_velocity_rad_s) << " rad/s\n";
-    o << "  impactor dv = " << text(r.impactor_jump.delta_velocity_m_s) << " m/s, dw = "
-      << text(r.impactor_jump.delta_angular_velocity_rad_s) << " rad/s\n";
+    if (const auto& f = ir.friction) {
+      o << "  friction              mu " << ir.spec->friction_coefficient << ": normal impulse " << f->normal_impulse_Ns
+        << " N s, tangential " << text(f->tangential_impulse_Ns) << " N s; slip:";
+      for (collision::SlipEvent e : f->slip_history) o << " " << collision::to_string(e);
+      o << "; energy lost " << f->energy_lost_J << " J\n";
+    }
+    const collision::VelocityJump tj = target_jump(ir), ij = impactor_jump(ir);
+    o << "  target   dv = " << text(tj.delta_velocity_m_s) << " m/s, dw = "
+      << text(tj.delta_angular_velocity_rad_s) << " rad/s\n";
+    o << "  impactor dv = " << text(ij.delta_velocity_m_s) << " m/s, dw = "
+      << text(ij.delta_angular_velocity_rad_s) << " rad/s\n";
     const auto& k = r.checks;
     o << "  check impulse (Eq. 31)  rel. error " << std::setprecision(2) << std::scientific
       << k.impulse_relative_error << " (limit " << k.thresholds.impulse_relative << ")\n";

@@ -345,7 +345,7 @@ collision::RestitutionTable read_restitution_table(Reader& parent, const toml::t
 }
 
 // The keys of an impact's contact law (`restitution`, `contact_law`, `limiting_pressure_Pa`,
-// `contact_radius`): one reader for [[impacts]] and [[sequences]].
+// `contact_radius`) and its `friction_coefficient`: one reader for [[impacts]] and [[sequences]].
 void read_law_keys(Reader& r, ImpactSpec& s, const Source& file, const collision::RestitutionModel& defaults) {
   s.restitution = defaults;
   s.restitution_given = r.has("restitution");
@@ -367,6 +367,12 @@ void read_law_keys(Reader& r, ImpactSpec& s, const Source& file, const collision
     }
   }
   if (r.has("limiting_pressure_Pa")) s.limiting_pressure_Pa = r.positive("limiting_pressure_Pa");
+  if (r.has("friction_coefficient")) {  // finite (required_number checks it)
+    s.friction_coefficient = r.required_number("friction_coefficient");
+    if (!(s.friction_coefficient >= 0.0)) {
+      r.fail("friction_coefficient", "must be >= 0, got " + Reader::fmt(s.friction_coefficient));
+    }
+  }
   if (const toml::node* n = r.get("restitution")) {
     if (n->is_string()) {
       if (n->value<std::string>().value() != "energy-flux") {
@@ -399,7 +405,8 @@ ImpactSpec read_impact(std::size_t index, const toml::table& t, const Source& fi
                        double to_m, const collision::RestitutionModel& defaults) {
   Reader r(t, "impacts[" + std::to_string(index) + "]", file);
   r.allow({"name", "target", "impactor", "point", "restitution", "contact_radius",
-           "approach_speed_m_s", "max_projection_distance", "contact_law", "limiting_pressure_Pa"});
+           "approach_speed_m_s", "max_projection_distance", "contact_law", "limiting_pressure_Pa",
+           "friction_coefficient"});
   ImpactSpec s;
   s.place = r.self();
   s.name = r.string("name").value_or("impact" + std::to_string(index + 1));
@@ -639,10 +646,6 @@ SequenceSpec read_sequence(std::size_t index, const toml::table& t, const Source
     if (!(*v >= 0.0)) r.fail("min_approach_speed_m_s", "must be >= 0, got " + Reader::fmt(*v));
     q.min_approach_speed_m_s = *v;
   }
-  if (const std::optional<double> mu = r.number("friction_coefficient")) {
-    if (!(*mu >= 0.0)) r.fail("friction_coefficient", "must be >= 0, got " + Reader::fmt(*mu));
-    q.friction_coefficient = *mu;
-  }
   q.friction_place = r.place("friction_coefficient");
   // The impacts' law keys, read as on [[impacts]]: the body is the target, the floor the impactor.
   q.impact.name = q.name;
@@ -650,7 +653,8 @@ SequenceSpec read_sequence(std::size_t index, const toml::table& t, const Source
   q.impact.impactor = q.floor;
   q.impact.first_contact = true;
   q.impact.place = q.place;
-  read_law_keys(r, q.impact, file, defaults);
+  read_law_keys(r, q.impact, file, defaults);  // friction_coefficient too
+  q.friction_coefficient = q.impact.friction_coefficient;
   r.reject_unknown();
   return q;
 }

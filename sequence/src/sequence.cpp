@@ -7,6 +7,7 @@
 #include "impactdeck/collision/eccentric.hpp"
 #include "impactdeck/collision/impact.hpp"
 #include "impactdeck/geometry/plane.hpp"
+#include "impactdeck/sequence/flight.hpp"
 
 namespace impactdeck::sequence {
 namespace {
@@ -62,11 +63,6 @@ Bounce apply_bounce(const SequenceInput& in, std::size_t index, const BodyState&
   if (!(mu >= 0.0) || !std::isfinite(mu)) {
     throw in.ctx.error("friction_coefficient", "must be a finite number >= 0, got " + fmt(mu));
   }
-  if (mu > 0.0) {
-    // The frictional impact (collision::solve_frictional_impact) takes this branch once merged.
-    throw in.ctx.error("friction_coefficient", "friction (" + fmt(mu) +
-                                                   ") is not available in this build: set friction_coefficient = 0");
-  }
   Bounce b;
   b.time_s = at.time_s;
   b.before = at;
@@ -76,9 +72,11 @@ Bounce apply_bounce(const SequenceInput& in, std::size_t index, const BodyState&
   b.point_own_m = support.point_m;
   if (b.contact.result.flag == collision::ContactFlag::none) {
     if (in.complete) {
-      b.impact = in.complete(index, model, b.contact);
+      b.impact = in.complete(index, model, b.contact);  // its input carries the friction coefficient
     } else {
-      b.impact = contact::complete_impact(model, b.contact, contact::impact_input(model, b.contact));
+      collision::ImpactInput input = contact::impact_input(model, b.contact);
+      input.friction_coefficient = mu;
+      b.impact = contact::complete_impact(model, b.contact, input);
     }
     const collision::ImpactResult& r = b.impact->result;
     b.reduced_mass_kg = r.reduced_mass_kg;
@@ -87,6 +85,7 @@ Bounce apply_bounce(const SequenceInput& in, std::size_t index, const BodyState&
     b.normal_impulse_Ns = r.kernel.impulse_total_Ns;
     b.body_jump = r.target_jump;
     b.floor_jump = r.impactor_jump;
+    b.friction = b.impact->friction;
     const collision::LawResult& l = r.history.law_result;
     b.dent_radius_m = l.residual_indentation_m > 0.0 ? std::sqrt(r.effective_radius_m * l.max_indentation_m) : 0.0;
   } else {
@@ -109,10 +108,31 @@ Bounce apply_bounce(const SequenceInput& in, std::size_t index, const BodyState&
     b.restitution = *in.rigid_restitution;
     b.normal_impulse_Ns = (1.0 + b.restitution) * b.reduced_mass_kg * b.approach_velocity_m_s;
     collision::velocity_jumps(tb, fb, c, b.normal_impulse_Ns, b.body_jump, b.floor_jump);
+    if (mu > 0.0) {  // the same rigid impact with Coulomb friction (docs/friction.md)
+      collision::FrictionalImpactInput f;
+      f.a = fb;
+      f.b = tb;
+      f.r_a_m = c.point_m - fb.center_of_mass_m;
+      f.r_b_m = c.point_m - tb.center_of_mass_m;
+      f.normal = c.normal;  // the body's outward normal: from b into a
+      f.friction_coefficient = mu;
+      f.restitution = b.restitution;
+      f.context = in.ctx;
+      b.friction = collision::solve_frictional_impact(f);
+    }
+  }
+  if (b.friction) {  // friction's jumps replace the frictionless ones (the body is b, the floor a)
+    const collision::FrictionalImpactResult& f = *b.friction;
+    b.normal_impulse_Ns = f.normal_impulse_Ns;
+    b.tangential_impulse_Ns = f.tangential_impulse_Ns;  // on a, the floor (impacts[]' impactor), as in impacts[]
+    b.body_jump = {f.delta_velocity_b_m_s, f.delta_angular_velocity_b_rad_s};
+    b.floor_jump = {f.delta_velocity_a_m_s, f.delta_angular_velocity_a_rad_s};
   }
   b.after = at;
   b.after.velocity_m_s += b.body_jump.delta_velocity_m_s;
   b.after.angular_velocity_rad_s += b.body_jump.delta_angular_velocity_rad_s;
+  // The body's kinetic energy lost (the same place before and after: the potential cancels).
+  b.energy_lost_J = mechanical_energy_J(in.body, b.before, in.gravity_m_s2) - mechanical_energy_J(in.body, b.after, in.gravity_m_s2);
   return b;
 }
 

@@ -32,6 +32,10 @@ struct ImpactInput {
   /// The contact law; null: Hertz with `restitution` (HertzLaw, built by solve_impact).
   std::shared_ptr<const ContactLaw> law;
   RestitutionModel restitution;     ///< Hertz's restitution when `law` is null
+  /// Coulomb friction at the point (>= 0). 0: the frictionless jumps of the kernel. > 0:
+  /// contact::complete_impact adds collision::solve_frictional_impact's jumps with the law's
+  /// restitution as Stronge's e (docs/friction.md); solve_impact and complete_impact ignore it.
+  double friction_coefficient = 0;
   CheckThresholds thresholds;
   /// Where the input comes from (e.g. the scene file and "line 19, key 'impacts[0]': impact
   /// 'fig4'"): named by every error solve_impact throws. Empty: the errors name no file.

@@ -78,6 +78,9 @@ struct ImpactSpec {
   bool contact_law_given = false;  ///< `contact_law` set in the scene
   Place contact_law_place;         ///< where (errors about the law name it)
   std::optional<double> limiting_pressure_Pa;  ///< `limiting_pressure_Pa`: p_y of a plastic law
+  /// `friction_coefficient`: Coulomb's mu at the point (>= 0, default 0: frictionless); > 0 gives
+  /// the jumps of collision::solve_frictional_impact (docs/friction.md).
+  double friction_coefficient = 0;
   ContactRadiusRule contact_radius = ContactRadiusRule::elliptical;
   std::optional<double> approach_speed_m_s;  ///< if set: impactor velocity = -speed * n
   std::optional<double> max_projection_distance_m;  ///< default: 1 % of the target's size

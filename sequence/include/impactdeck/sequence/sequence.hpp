@@ -12,6 +12,7 @@
 
 #include "impactdeck/collision/contact_law.hpp"
 #include "impactdeck/collision/kernel.hpp"
+#include "impactdeck/collision/friction.hpp"
 #include "impactdeck/contact/body.hpp"
 #include "impactdeck/contact/contact_model.hpp"
 #include "impactdeck/contact/impact.hpp"
@@ -73,7 +74,13 @@ struct Bounce {
   double approach_velocity_m_s = 0;
   double restitution = 0;
   double normal_impulse_Ns = 0;
-  double tangential_impulse_Ns = 0;   ///< 0: frictionless
+  /// The friction impulse on the floor (the impact's impactor, as impacts[]' tangential_impulse_Ns);
+  /// the body gets its opposite. 0: frictionless.
+  Eigen::Vector3d tangential_impulse_Ns = Eigen::Vector3d::Zero();
+  /// With friction_coefficient > 0: the frictional impact (collision::solve_frictional_impact, the
+  /// body is its b, the floor its a) whose jumps the bounce applies.
+  std::optional<collision::FrictionalImpactResult> friction;
+  double energy_lost_J = 0;  ///< the body's kinetic energy before minus after (the floor is fixed)
   collision::VelocityJump body_jump, floor_jump;
   Eigen::Vector3d point_own_m = Eigen::Vector3d::Zero();  ///< the contact point, body frame
   double dent_radius_m = 0;  ///< sqrt(R* d*) when the law left a dent, else 0
