@@ -92,6 +92,20 @@ nlohmann::json to_json(const Scene& scene, const RunReport& rep) {
     const bool hertz_restitution = hertz_law(ir);
     i["contact_law"] = ir.contact_law;
     i["contact_law_requested"] = ir.spec->contact_law;
+    {  // the sharp edge or corner at the point, sharp or rounded by edge_radius (docs/sharp-contacts.md)
+      const bool on_target = kin.target.curvature.feature != collision::SharpKind::none;
+      const collision::ContactCurvature& sc = on_target ? kin.target.curvature : kin.impactor.curvature;
+      if (sc.feature == collision::SharpKind::none) {
+        i["sharp_feature"] = nullptr;
+      } else {
+        const bool edge = sc.feature == collision::SharpKind::edge;
+        i["sharp_feature"] = {{"body", on_target ? ir.spec->target : ir.spec->impactor},
+                              {"kind", edge ? "edge" : "corner"},
+                              {edge ? "dihedral_angle_deg" : "apex_half_angle_deg", json_number(sc.feature_angle_rad * 180.0 / M_PI)},
+                              {"edge_length_m", edge ? json_number(sc.feature_length_m) : nlohmann::json(nullptr)},
+                              {"rounded_by_edge_radius", !sc.sharp}};
+      }
+    }
     i["limiting_pressure_Pa"] = optional_number(ir.law.limiting_pressure_Pa);
     i["yield_velocity_m_s"] = optional_number(ir.yield_velocity_m_s);
     i["validity"]["contact_law"] = ir.contact_law;
