@@ -304,19 +304,23 @@ approach_speed_m_s = 3.0
 )" + impact_keys + "\n";
 }
 
-// The 200 x 100 x 60 mm steel box (0.5 kg) falling at 3 m/s on a steel floor, turned by `angle_deg`
-// about `axis`: [1, 1, 0] by 35 deg puts a corner lowest, [1, 0, 0] by 45 deg the long edge.
-std::string box_drop(const std::string& axis, double angle_deg, const std::string& box_keys, const std::string& impact_keys,
-                     const std::string& material_keys = "yield_strength_Pa = 2.5e8") {
-  return steel_floor(material_keys) + R"(
-[[bodies]]
+// The 200 x 100 x 60 mm steel box of 0.5 kg, turned by `angle_deg` about `axis`, with `keys`.
+std::string box_body(const std::string& axis, double angle_deg, const std::string& keys) {
+  return R"([[bodies]]
 name = "box"
 shape = "mesh"
 mesh = ")" + data("box_200x100x60mm.stl").string() + R"("
 material = "steel"
 mass_kg = 0.5
 orientation_axis = )" + axis + R"(
-orientation_angle_deg = )" + exact(angle_deg) + "\n" + box_keys + drop_impact("box", impact_keys);
+orientation_angle_deg = )" + exact(angle_deg) + "\n" + keys + "\n";
+}
+
+// The 200 x 100 x 60 mm steel box (0.5 kg) falling at 3 m/s on a steel floor, turned by `angle_deg`
+// about `axis`: [1, 1, 0] by 35 deg puts a corner lowest, [1, 0, 0] by 45 deg the long edge.
+std::string box_drop(const std::string& axis, double angle_deg, const std::string& box_keys, const std::string& impact_keys,
+                     const std::string& material_keys = "yield_strength_Pa = 2.5e8") {
+  return steel_floor(material_keys) + "\n" + box_body(axis, angle_deg, box_keys) + drop_impact("box", impact_keys);
 }
 
 const std::string kCorner = "[1, 1, 0]";
@@ -425,4 +429,41 @@ TEST(SharpScene, BoxOnEdgeWedgeAndRoundedLineContact) {
 TEST(SharpScene, WedgeOrConeAtASmoothPointIsRefused) {
   const std::string e = error_of(sphere_drop(5.0, 1.0, "contact_law = \"cone\""));
   EXPECT_NE(e.find("law of a sharp edge or corner"), std::string::npos) << e;
+}
+
+// A rounded edge on a body curved along it: elliptical Hertz while the contact's length 2a along
+// the edge is shorter than the edge, the line contact once it reaches it. The box's long edge
+// (200 mm, rounded to 0.5 mm) falls on the top of a fixed steel sphere of radius R: R = 10 m gives
+// a contact some 10 mm long (a/b of a few hundred), R = 1000 km one longer than the edge.
+TEST(SharpScene, RoundedEdgeOnACurvedBodyTurnsLineWhenTheContactSpansTheEdge) {
+  auto on_sphere = [](double radius_mm) {
+    return R"(length_unit = "mm"
+[materials.steel]
+youngs_modulus_Pa = 2.1e11
+poisson_ratio = 0.3
+[[bodies]]
+name = "dome"
+shape = "sphere"
+radius = )" + exact(radius_mm) + R"(
+material = "steel"
+fixed = true
+)" + box_body("[1, 0, 0]", 45, "edge_radius = 0.5") + R"(
+[[impacts]]
+name = "drop"
+target = "dome"
+impactor = "box"
+point = [0, 0, )" + exact(radius_mm) + R"(]
+approach_speed_m_s = 3.0
+)";
+  };
+  const nlohmann::json short_contact = impact_json(on_sphere(1e4));
+  EXPECT_EQ(short_contact["contact_law"], "hertz");
+  EXPECT_EQ(short_contact["sharp_feature"]["rounded_by_edge_radius"], true);
+  const double a = short_contact["validity"]["contact_semi_axis_a_m"].get<double>();
+  EXPECT_GT(a, 1e-3);
+  EXPECT_LT(2.0 * a, 0.2);
+  const nlohmann::json spanning = impact_json(on_sphere(1e9));
+  EXPECT_EQ(spanning["contact_law"], "line");
+  EXPECT_NEAR(spanning["effective_radius_m"].get<double>(), 5e-4, 1e-12);  // across the edge: rho (and 1/R of the dome)
+  EXPECT_NEAR(spanning["validity"]["contact_semi_axis_a_m"].get<double>(), 0.1, 1e-12);
 }

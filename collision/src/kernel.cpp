@@ -124,10 +124,12 @@ namespace {
 struct CallInvariants {
   bool valid;                          // E* finite and positive, a contact law
   bool target_spins, impactor_spins;  // a non-zero angular velocity (else w x r is left out: 0)
+  bool line_law;                       // the law of a rounded edge's line contact: R* across the edge
   explicit CallInvariants(const KernelInput& in)
       : valid(finite_positive(in.effective_modulus_Pa) && in.law != nullptr),
         target_spins(!in.target.angular_velocity_rad_s.isZero(0)),
-        impactor_spins(!in.impactor.angular_velocity_rad_s.isZero(0)) {}
+        impactor_spins(!in.impactor.angular_velocity_rad_s.isZero(0)),
+        line_law(in.law != nullptr && in.law->takes_line_contacts()) {}
 };
 
 // The input's validity (the invariants' in `ci`), the reduced mass at the contact point (tensor form
@@ -164,8 +166,8 @@ inline bool step_motion(const KernelInput& in, const CallInvariants& ci, const K
 }
 
 // The contact curvature: relative curvatures A <= B and the effective radius by the rule.
-inline bool step_radius(const KernelInput& in, const KernelPoint& p, KernelResult& r, RelativeCurvatures& rc,
-                        EllipticalContact& ec) {
+inline bool step_radius(const KernelInput& in, const CallInvariants& ci, const KernelPoint& p, KernelResult& r,
+                        RelativeCurvatures& rc, EllipticalContact& ec) {
   const ContactCurvature& t_curv = *p.target_curvature;
   const ContactCurvature& i_curv = *p.impactor_curvature;
   if (t_curv.sharp || i_curv.sharp) {
@@ -194,7 +196,7 @@ inline bool step_radius(const KernelInput& in, const KernelPoint& p, KernelResul
   if (!(rc.A_per_m > 0.0)) {
     // A rounded edge on a surface flat along it: the line contact's law takes it, R* across the edge.
     const bool rounded_edge = (t_curv.feature == SharpKind::edge) != (i_curv.feature == SharpKind::edge);
-    if (rounded_edge && in.law->takes_line_contacts() && rc.B_per_m > 0.0 && !(rc.A_per_m < 0.0)) {
+    if (rounded_edge && ci.line_law && rc.B_per_m > 0.0 && !(rc.A_per_m < 0.0)) {
       r.effective_radius_m = 0.5 / rc.B_per_m;
       if (!(r.approach_velocity_m_s > 0.0)) {
         r.flag = ContactFlag::no_approach;
@@ -225,6 +227,7 @@ inline bool step_radius(const KernelInput& in, const KernelPoint& p, KernelResul
       break;
     }
   }
+  if (ci.line_law) r.effective_radius_m = 0.5 / rc.B_per_m;  // the line contact's: across the edge
   if (!finite_positive(r.effective_radius_m)) {
     r.flag = ContactFlag::degenerate;
     return false;
@@ -338,7 +341,7 @@ void solve_kernel(const KernelInput& in, const KernelPoint* points, KernelResult
     RelativeCurvatures rc[kKernelLanes];
     EllipticalContact ec[kKernelLanes];
     for (std::size_t k = 0; k < n; ++k) live[k] = step_motion(in, ci, p[k], *r[k]);
-    for (std::size_t k = 0; k < n; ++k) live[k] = live[k] && step_radius(in, p[k], *r[k], rc[k], ec[k]);
+    for (std::size_t k = 0; k < n; ++k) live[k] = live[k] && step_radius(in, ci, p[k], *r[k], rc[k], ec[k]);
     if (hertz != nullptr) {
       // Hertz's fast path: the law's two steps inline, straight into the results, each over the
       // group before the next (as the kernel's own steps).

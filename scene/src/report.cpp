@@ -229,6 +229,15 @@ std::string format_summary(const Scene& scene, const RunReport& rep) {
     if (ir.yield_velocity_m_s) o << ", V_y = " << *ir.yield_velocity_m_s << " m/s";
     if (ir.law.limiting_pressure_Pa) o << ")";
     o << "\n";
+    for (const auto* side : {&ir.contact.input.target.curvature, &ir.contact.input.impactor.curvature}) {
+      if (side->feature == collision::SharpKind::none) continue;  // docs/sharp-contacts.md
+      const bool edge = side->feature == collision::SharpKind::edge;
+      o << "  sharp feature         " << (edge ? "edge" : "corner") << " of '"
+        << (side == &ir.contact.input.target.curvature ? ir.spec->target : ir.spec->impactor) << "' ("
+        << (edge ? "dihedral " : "apex half-angle ") << side->feature_angle_rad * 180.0 / M_PI << " deg";
+      if (edge) o << ", length " << side->feature_length_m << " m";
+      o << (side->sharp ? ", sharp" : ", rounded by edge_radius") << ")\n";
+    }
     if (hertz_law(ir) && r.restitution_kind == collision::RestitutionModel::Kind::energy_flux) {
       o << "  energy flux density   " << r.restitution.energy_flux_density << " "
         << collision::to_string(ir.spec->restitution.flux_unit) << " (ln = " << r.restitution.ln_energy_flux
