@@ -117,8 +117,8 @@ TEST(ContactLaw, RegistryNamesBuildsAndRefuses) {
     make_contact_law("no-such-law", o, {"scene.toml", "impacts[0]"});
     ADD_FAILURE() << "an unknown law was built";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("unknown contact law \"no-such-law\" (known: \"hertz\" \"jackson-green\" "
-                                         "\"linear-spring\" \"thornton\")"),
+    EXPECT_NE(std::string(e.what()).find("unknown contact law \"no-such-law\" (known: \"cone\" \"hertz\" "
+                                         "\"jackson-green\" \"line\" \"linear-spring\" \"thornton\" \"wedge\")"),
               std::string::npos)
         << e.what();
   }

@@ -38,6 +38,9 @@ struct Registry {
 std::shared_ptr<const ContactLaw> make_hertz_law(const LawOptions& options);
 std::shared_ptr<const ContactLaw> make_thornton_law(const LawOptions& options);
 std::shared_ptr<const ContactLaw> make_jackson_green_law(const LawOptions& options);
+std::shared_ptr<const ContactLaw> make_wedge_law(const LawOptions& options);
+std::shared_ptr<const ContactLaw> make_cone_law(const LawOptions& options);
+std::shared_ptr<const ContactLaw> make_line_law(const LawOptions& options);
 
 namespace {
 
@@ -48,6 +51,9 @@ Registry& registry() {
                         {"hertz", make_hertz_law},
                         {"thornton", make_thornton_law},
                         {"jackson-green", make_jackson_green_law},
+                        {"wedge", make_wedge_law},
+                        {"cone", make_cone_law},
+                        {"line", make_line_law},
                     }};
   return r;
 }

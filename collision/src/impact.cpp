@@ -15,7 +15,7 @@ namespace {
 // input (deterministic: the kernel's numbers; a kernel result keeps no law-specific state).
 LawResult law_result_of(const ContactLaw& law, const KernelInput& k, const KernelResult& kr) {
   LawInput in;
-  detail::law_input(k, kr, in);
+  detail::law_input(k, k.target.curvature, k.impactor.curvature, kr, in);
   LawResult l;
   law.solve(&in, &l, 1);
   return l;
@@ -53,7 +53,8 @@ std::string explain_flag(const KernelInput& in, const KernelResult& r, const std
     case ContactFlag::sharp:
       s << "the contact point lies on a sharp edge or corner of "
         << (in.target.curvature.sharp ? target_name : impactor_name)
-        << ", where no local radius exists (not a Hertz contact)";
+        << ", where no local radius exists (not a Hertz contact): give the body edge_radius (its edge break) "
+           "or a yield strength for a plastic contact_law (the wedge and cone laws run there)";
       break;
     case ContactFlag::no_fit:
       s << impactor_name << " does not fit: a concave surface is tighter than the other body (" << curv

@@ -124,10 +124,12 @@ namespace {
 struct CallInvariants {
   bool valid;                          // E* finite and positive, a contact law
   bool target_spins, impactor_spins;  // a non-zero angular velocity (else w x r is left out: 0)
+  bool line_law;                       // the law of a rounded edge's line contact: R* across the edge
   explicit CallInvariants(const KernelInput& in)
       : valid(finite_positive(in.effective_modulus_Pa) && in.law != nullptr),
         target_spins(!in.target.angular_velocity_rad_s.isZero(0)),
-        impactor_spins(!in.impactor.angular_velocity_rad_s.isZero(0)) {}
+        impactor_spins(!in.impactor.angular_velocity_rad_s.isZero(0)),
+        line_law(in.law != nullptr && in.law->takes_line_contacts()) {}
 };
 
 // The input's validity (the invariants' in `ci`), the reduced mass at the contact point (tensor form
@@ -164,13 +166,23 @@ inline bool step_motion(const KernelInput& in, const CallInvariants& ci, const K
 }
 
 // The contact curvature: relative curvatures A <= B and the effective radius by the rule.
-inline bool step_radius(const KernelInput& in, const KernelPoint& p, KernelResult& r, RelativeCurvatures& rc,
-                        EllipticalContact& ec) {
+inline bool step_radius(const KernelInput& in, const CallInvariants& ci, const KernelPoint& p, KernelResult& r,
+                        RelativeCurvatures& rc, EllipticalContact& ec) {
   const ContactCurvature& t_curv = *p.target_curvature;
   const ContactCurvature& i_curv = *p.impactor_curvature;
   if (t_curv.sharp || i_curv.sharp) {
-    r.flag = ContactFlag::sharp;
-    return false;
+    // A law of sharp points ("wedge", "cone") takes a point where exactly one body is sharp, with
+    // its feature; it needs no radius (R* stays 0). Otherwise no Hertz contact exists there.
+    const ContactCurvature& s = t_curv.sharp ? t_curv : i_curv;
+    if (!in.law->takes_sharp_points() || (t_curv.sharp && i_curv.sharp) || s.feature == SharpKind::none) {
+      r.flag = ContactFlag::sharp;
+      return false;
+    }
+    if (!(r.approach_velocity_m_s > 0.0)) {
+      r.flag = ContactFlag::no_approach;
+      return false;
+    }
+    return true;
   }
   rc = relative_curvatures(t_curv.k1_per_m, t_curv.k2_per_m, t_curv.d1, t_curv.d2, i_curv.k1_per_m,
                            i_curv.k2_per_m, i_curv.d1, i_curv.d2, *p.normal);
@@ -182,6 +194,16 @@ inline bool step_radius(const KernelInput& in, const KernelPoint& p, KernelResul
     return false;
   }
   if (!(rc.A_per_m > 0.0)) {
+    // A rounded edge on a surface flat along it: the line contact's law takes it, R* across the edge.
+    const bool rounded_edge = (t_curv.feature == SharpKind::edge) != (i_curv.feature == SharpKind::edge);
+    if (rounded_edge && ci.line_law && rc.B_per_m > 0.0 && !(rc.A_per_m < 0.0)) {
+      r.effective_radius_m = 0.5 / rc.B_per_m;
+      if (!(r.approach_velocity_m_s > 0.0)) {
+        r.flag = ContactFlag::no_approach;
+        return false;
+      }
+      return true;
+    }
     r.flag = classify_non_hertzian(t_curv, i_curv, rc.B_per_m);
     return false;
   }
@@ -205,6 +227,7 @@ inline bool step_radius(const KernelInput& in, const KernelPoint& p, KernelResul
       break;
     }
   }
+  if (ci.line_law) r.effective_radius_m = 0.5 / rc.B_per_m;  // the line contact's: across the edge
   if (!finite_positive(r.effective_radius_m)) {
     r.flag = ContactFlag::degenerate;
     return false;
@@ -274,20 +297,29 @@ inline void step_jumps(const KernelInput& in, const KernelPoint& p, KernelResult
 }
 
 // Any law but Hertz, once for the group's live points (one virtual call per group, not per point).
-inline void solve_law(const KernelInput& in, const RelativeCurvatures* rc, const EllipticalContact* ec, bool* live,
-                      KernelResult* const* r, std::size_t n) {
+inline void solve_law(const KernelInput& in, const KernelPoint* p, const RelativeCurvatures* rc,
+                      const EllipticalContact* ec, bool* live, KernelResult* const* r, std::size_t n) {
   LawInput law_in[kKernelLanes];
   LawResult law_out[kKernelLanes];
   std::size_t lane[kKernelLanes], m = 0;
   for (std::size_t k = 0; k < n; ++k) {
-    if (live[k]) detail::law_input(in, *r[k], law_in[m]), lane[m++] = k;
+    if (live[k]) {
+      detail::law_input(in, *p[k].target_curvature, *p[k].impactor_curvature, *r[k], law_in[m]);
+      lane[m++] = k;
+    }
   }
   if (m > 0) in.law->solve(law_in, law_out, m);
   for (std::size_t j = 0; j < m; ++j) {
     const std::size_t k = lane[j];
     live[k] = take_law(law_out[j], *r[k]);
     // The contact ellipse at F_max whenever the law gave its numbers (also for a refused restitution).
-    if (live[k] || law_out[j].status != LawStatus::degenerate) step_pressure(in, rc[k], ec[k], *r[k]);
+    if (law_out[j].contact_semi_axis_a_m > 0.0) {  // the law's own patch (a sharp edge or corner)
+      r[k]->contact_semi_axis_a_m = law_out[j].contact_semi_axis_a_m;
+      r[k]->contact_semi_axis_b_m = law_out[j].contact_semi_axis_b_m;
+      r[k]->peak_pressure_Pa = law_out[j].contact_pressure_Pa;
+    } else if (live[k] || law_out[j].status != LawStatus::degenerate) {
+      step_pressure(in, rc[k], ec[k], *r[k]);
+    }
   }
 }
 
@@ -309,14 +341,14 @@ void solve_kernel(const KernelInput& in, const KernelPoint* points, KernelResult
     RelativeCurvatures rc[kKernelLanes];
     EllipticalContact ec[kKernelLanes];
     for (std::size_t k = 0; k < n; ++k) live[k] = step_motion(in, ci, p[k], *r[k]);
-    for (std::size_t k = 0; k < n; ++k) live[k] = live[k] && step_radius(in, p[k], *r[k], rc[k], ec[k]);
+    for (std::size_t k = 0; k < n; ++k) live[k] = live[k] && step_radius(in, ci, p[k], *r[k], rc[k], ec[k]);
     if (hertz != nullptr) {
       // Hertz's fast path: the law's two steps inline, straight into the results, each over the
       // group before the next (as the kernel's own steps).
       LawInput law_in[kKernelLanes];
       for (std::size_t k = 0; k < n; ++k) {
         if (!live[k]) continue;
-        detail::law_input(in, *r[k], law_in[k]);
+        detail::law_input(in, *p[k].target_curvature, *p[k].impactor_curvature, *r[k], law_in[k]);
         live[k] = take_status(hertz_compression(law_in[k], *r[k], r[k]->hertz_constant), *r[k]);
       }
       for (std::size_t k = 0; k < n; ++k) {
@@ -326,7 +358,7 @@ void solve_kernel(const KernelInput& in, const KernelPoint* points, KernelResult
         if (live[k]) live[k] = take_status(hertz_restitution(hertz->restitution(), law_in[k], *r[k]), *r[k]);
       }
     } else {
-      solve_law(in, rc, ec, live, r, n);
+      solve_law(in, p, rc, ec, live, r, n);
     }
     for (std::size_t k = 0; k < n; ++k) {
       if (live[k]) step_jumps(in, p[k], *r[k]);

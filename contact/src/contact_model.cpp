@@ -43,11 +43,45 @@ ContactModel::ContactModel(const PreparedBody& target, const PreparedBody& impac
   }
 }
 
+namespace {
+
+// A sharp point's feature into the kernel's surface c (sharp, no curvature); with an edge radius
+// rho, rounded: a corner a sphere of radius rho, an edge a cylinder of radius rho along it
+// (k = 1/rho across, 0 along), `outward` the body's outward contact normal (world).
+void sharp_surface(const geometry::SharpFeature& f, const geometry::PoseMap& frame, std::optional<double> edge_radius_m,
+                   const Eigen::Vector3d& outward, collision::ContactCurvature& c) {
+  const bool corner = f.kind == geometry::SharpFeature::Kind::corner;
+  c.feature = corner ? collision::SharpKind::corner : collision::SharpKind::edge;
+  c.feature_angle_rad = corner ? f.apex_half_angle_rad : f.dihedral_angle_rad;
+  c.feature_length_m = f.length_m;
+  if (!edge_radius_m) return;
+  const double k = 1.0 / *edge_radius_m;
+  // Along the edge in the tangent plane (any tangent direction at a corner).
+  Eigen::Vector3d along = corner ? outward.unitOrthogonal() : frame.direction_to_world(f.direction);
+  along -= along.dot(outward) * outward;
+  if (!(along.norm() > 1e-6)) return;  // an edge along the normal: no rounding of it touches, stays sharp
+  along.normalize();
+  c.sharp = false;
+  c.d2 = along;
+  c.d1 = outward.cross(along).normalized();
+  c.k1_per_m = k;
+  c.k2_per_m = corner ? k : 0.0;
+  c.paper_curvature_per_m = 0.5 * (c.k1_per_m + c.k2_per_m);
+}
+
+}  // namespace
+
 void ContactModel::surface(const PreparedBody& b, const geometry::PoseMap& frame, const geometry::SurfacePoint& own,
-                           const geometry::Curvature& k, collision::ContactCurvature& c) const {
-  if (k.sharp_feature) {  // no curvature exists there: the defaults, flagged sharp
+                           const geometry::Curvature& k, const Eigen::Vector3d& outward,
+                           collision::ContactCurvature& c) const {
+  if (k.sharp_feature) {  // no curvature exists there: the defaults, flagged sharp, with the feature
     c = collision::ContactCurvature{};
     c.sharp = true;
+    geometry::SurfacePoint at = own;
+    at.normal = frame.direction_to_own(outward);
+    if (const std::optional<geometry::SharpFeature> f = b.shape->sharp_feature(at)) {
+      sharp_surface(*f, frame, b.edge_radius_m, outward, c);
+    }
     return;
   }
   c.sharp = false;
@@ -113,8 +147,8 @@ void ContactModel::evaluate(PointWork* w, std::size_t n) const {
     PointWork& x = w[k];
     x.target_lever_arm_m = x.point_m - target_centroid_;
     x.impactor_lever_arm_m = x.point_m - x.impactor_centroid_m;
-    surface(target_, target_frame_, *x.target_point, x.target_curvature, *x.target_surface);
-    surface(impactor_, impactor_frame_, x.impactor_point, x.impactor_curvature, *x.impactor_surface);
+    surface(target_, target_frame_, *x.target_point, x.target_curvature, x.normal, *x.target_surface);
+    surface(impactor_, impactor_frame_, x.impactor_point, x.impactor_curvature, -x.normal, *x.impactor_surface);
     points[m] = {&x.normal,
                  &x.target_lever_arm_m,
                  &x.impactor_lever_arm_m,

@@ -212,6 +212,13 @@ struct MeshShape::Index {
   std::vector<std::array<char, 3>> face_edge_sharp;  // edge k of face f is sharp
   std::size_t sharp_edge_count = 0;
   std::vector<char> vertex_sharp;
+  // The sharp edges (ends v0 < v1, faces f0 and f1; f1 = -1 unless exactly two faces) and, per
+  // vertex, the indices of those it ends (CSR: sharp_at[sharp_begin[v] .. sharp_begin[v + 1])).
+  struct SharpEdge {
+    int v0, v1, f0, f1;
+  };
+  std::vector<SharpEdge> sharp_edges;
+  std::vector<int> sharp_begin, sharp_at;
   std::vector<double> cumulative_area;
   std::vector<int> surface_vertices;  // corners of some triangle, ascending
   double mean_edge = 0;
@@ -303,6 +310,7 @@ MeshShape::MeshShape(TriangleMesh mesh, const MeshMassProperties& mass, const Me
     const int f0 = records.face[i];
     if (run_is_sharp(records, i, j, cos_sharp, [&](int f) -> const Eigen::Vector3d& { return ix.face_normal[f]; })) {
       ++ix.sharp_edge_count;
+      ix.sharp_edges.push_back({EdgeTable::lo(key), EdgeTable::hi(key), f0, j - i == 2 ? records.face[i + 1] : -1});
       ix.vertex_sharp[EdgeTable::lo(key)] = 1;
       ix.vertex_sharp[EdgeTable::hi(key)] = 1;
       for (std::size_t q = i; q < j; ++q) ix.face_edge_sharp[records.face[q]][records.corner[q]] = 1;
@@ -312,6 +320,17 @@ MeshShape::MeshShape(TriangleMesh mesh, const MeshMassProperties& mass, const Me
       ix.face_across[f1][records.corner[i + 1]] = f0;
     }
     i = j;
+  }
+  ix.sharp_begin.assign(nv + 1, 0);
+  for (const auto& e : ix.sharp_edges) ++ix.sharp_begin[e.v0 + 1], ++ix.sharp_begin[e.v1 + 1];
+  for (std::size_t v = 0; v < nv; ++v) ix.sharp_begin[v + 1] += ix.sharp_begin[v];
+  ix.sharp_at.resize(2 * ix.sharp_edges.size());
+  {
+    std::vector<int> fill(ix.sharp_begin.begin(), ix.sharp_begin.end() - 1);
+    for (std::size_t e = 0; e < ix.sharp_edges.size(); ++e) {
+      ix.sharp_at[fill[ix.sharp_edges[e].v0]++] = static_cast<int>(e);
+      ix.sharp_at[fill[ix.sharp_edges[e].v1]++] = static_cast<int>(e);
+    }
   }
   ix.lo = ix.hi = V[0];
   for (const auto& v : V) {
@@ -437,6 +456,113 @@ bool MeshShape::on_sharp_feature(const SurfacePoint& at) const {
   const auto hit = ix.tree.closest_point_and_primitive(cp(at.point_m));
   const int f = static_cast<int>(hit.second - ix.triangles.begin());
   return near_sharp_feature(f, ev(hit.first));
+}
+
+namespace {
+
+// The interior dihedral angle of a sharp edge, through the solid: pi - (angle between the outward
+// face normals) where the edge is convex (the far corner of f1 lies below f0's plane), pi + it
+// where it is concave; nullopt unless exactly two faces meet there.
+template <class Edge>
+std::optional<double> interior_dihedral_rad(const TriangleMesh& m, const std::vector<Eigen::Vector3d>& face_normal,
+                                            const Edge& e) {
+  if (e.f1 < 0 || face_normal[e.f0].isZero() || face_normal[e.f1].isZero()) return std::nullopt;
+  const double theta = std::acos(std::clamp(face_normal[e.f0].dot(face_normal[e.f1]), -1.0, 1.0));
+  int far = -1;
+  for (int v : m.triangles[e.f1])
+    if (v != e.v0 && v != e.v1) far = v;
+  if (far < 0) return std::nullopt;
+  const bool convex = face_normal[e.f0].dot(m.vertices_m[far] - m.vertices_m[e.v0]) < 0.0;
+  return convex ? M_PI - theta : M_PI + theta;
+}
+
+}  // namespace
+
+std::optional<SharpFeature> MeshShape::sharp_feature(const SurfacePoint& at) const {
+  const Index& ix = *index_;
+  const auto& V = mesh_.vertices_m;
+  const auto hit = ix.tree.closest_point_and_primitive(cp(at.point_m));
+  const int f = static_cast<int>(hit.second - ix.triangles.begin());
+  const Eigen::Vector3d p = ev(hit.first);
+  const auto& t = mesh_.triangles[f];
+  const double tol = 1e-6 * ix.mean_edge;
+  const double cos_run = std::cos(kSharpRunDeg * M_PI / 180.0), sin_plane = std::sin(kSharpRunDeg * M_PI / 180.0);
+  const Eigen::Vector3d n = at.normal.norm() > 0.0 ? Eigen::Vector3d(at.normal.normalized()) : Eigen::Vector3d::Zero();
+  auto other_end = [&](int e, int v) { return ix.sharp_edges[e].v0 == v ? ix.sharp_edges[e].v1 : ix.sharp_edges[e].v0; };
+  auto away = [&](int e, int v) { return Eigen::Vector3d((V[other_end(e, v)] - V[v]).normalized()); };
+
+  // The straight edge through sharp mesh edge `e0`: its run both ways (each step a sharp edge
+  // within kSharpRunDeg of e0; at most every sharp edge once: bounded), its faces' dihedral angle.
+  auto edge_feature = [&](int e0) -> std::optional<SharpFeature> {
+    const auto dihedral = interior_dihedral_rad(mesh_, ix.face_normal, ix.sharp_edges[e0]);
+    if (!dihedral) return std::nullopt;
+    const Eigen::Vector3d d0 = away(e0, ix.sharp_edges[e0].v0);
+    Eigen::Vector3d ends[2];
+    for (int side = 0; side < 2; ++side) {
+      const Eigen::Vector3d dir = side == 0 ? d0 : Eigen::Vector3d(-d0);
+      int v = side == 0 ? ix.sharp_edges[e0].v1 : ix.sharp_edges[e0].v0, from = e0;
+      for (std::size_t step = 0; step < ix.sharp_edges.size(); ++step) {
+        int next = -1;
+        for (int q = ix.sharp_begin[v]; q < ix.sharp_begin[v + 1]; ++q) {
+          const int e = ix.sharp_at[q];
+          if (e != from && away(e, v).dot(dir) >= cos_run) next = e;
+        }
+        if (next < 0) break;
+        v = other_end(next, v);
+        from = next;
+      }
+      ends[side] = V[v];
+    }
+    SharpFeature sf;
+    sf.kind = SharpFeature::Kind::edge;
+    sf.point_m = p;
+    sf.direction = (ends[0] - ends[1]).normalized();
+    sf.length_m = (ends[0] - ends[1]).norm();
+    sf.dihedral_angle_rad = *dihedral;
+    return sf;
+  };
+
+  // Near a vertex on a sharp edge: an edge lying in the contact's tangent plane is the contact;
+  // else a corner where sharp edges meet that are not one straight edge.
+  for (int k = 0; k < 3; ++k) {
+    const int v = t[k];
+    if (!ix.vertex_sharp[v] || (p - V[v]).norm() > tol) continue;
+    const int b = ix.sharp_begin[v], c = ix.sharp_begin[v + 1];
+    int in_plane = -1, in_plane_count = 0;
+    if (!n.isZero()) {
+      for (int q = b; q < c; ++q) {
+        if (std::abs(away(ix.sharp_at[q], v).dot(n)) <= sin_plane) {
+          if (in_plane < 0 || away(ix.sharp_at[q], v).dot(away(in_plane, v)) > -cos_run) ++in_plane_count;
+          in_plane = ix.sharp_at[q];
+        }
+      }
+    }
+    if (in_plane_count > 1) return std::nullopt;  // two edges of a face on the other body: a flat contact
+    if (in_plane >= 0) return edge_feature(in_plane);
+    const bool one_edge = c - b == 1 || (c - b == 2 && away(ix.sharp_at[b], v).dot(away(ix.sharp_at[b + 1], v)) <= -cos_run);
+    if (one_edge) return edge_feature(ix.sharp_at[b]);
+    double omega = 2.0 * M_PI;
+    for (int q = b; q < c; ++q) {
+      const auto d = interior_dihedral_rad(mesh_, ix.face_normal, ix.sharp_edges[ix.sharp_at[q]]);
+      if (!d) return std::nullopt;
+      omega += *d - M_PI;
+    }
+    SharpFeature sf;
+    sf.kind = SharpFeature::Kind::corner;
+    sf.point_m = V[v];
+    sf.solid_angle_sr = omega;
+    sf.apex_half_angle_rad = std::acos(std::clamp(1.0 - omega / (2.0 * M_PI), -1.0, 1.0));
+    return sf;
+  }
+  // On a sharp edge of the face, away from its ends.
+  for (int k = 0; k < 3; ++k) {
+    const int a = t[k], b = t[(k + 1) % 3];
+    if (!ix.face_edge_sharp[f][k] || point_segment_distance(p, V[a], V[b]) > tol) continue;
+    for (int q = ix.sharp_begin[a]; q < ix.sharp_begin[a + 1]; ++q) {
+      if (other_end(ix.sharp_at[q], a) == b) return edge_feature(ix.sharp_at[q]);
+    }
+  }
+  return std::nullopt;
 }
 
 // curvature() and paper_radius_m() skip the condition number: it is a diagnostic, and its 10×10

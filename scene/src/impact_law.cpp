@@ -58,4 +58,34 @@ ImpactLaw impact_law(const Scene& scene, const ImpactSpec& s, const InputContext
   return l;
 }
 
+std::optional<ImpactLaw> sharp_impact_law(const ImpactSpec& s, const ImpactLaw& law, const collision::KernelInput& in,
+                                          const InputContext& ctx) {
+  const collision::ContactCurvature& t = in.target.curvature;
+  const collision::ContactCurvature& i = in.impactor.curvature;
+  const collision::ContactCurvature& c = t.sharp ? t : i;
+  // One sharp body with its feature known, and a plastic law chosen ("auto": one with a yield
+  // strength and no restitution; compare_contact's elastic model keeps Hertz): else Hertz refuses.
+  if (t.sharp == i.sharp || c.feature == collision::SharpKind::none || law.name == "hertz") return std::nullopt;
+  ImpactLaw l = law;
+  l.name = c.feature == collision::SharpKind::edge ? "wedge" : "cone";
+  collision::LawOptions o;
+  o.hardness_Pa = s.limiting_pressure_Pa.value_or(0.0);
+  // The hardness the law runs at: limiting_pressure_Pa, else Tabor's 3 Y (l.limiting_pressure_Pa is
+  // p_y = 1.6 Y here, from impact_law).
+  if (s.limiting_pressure_Pa) {
+    l.limiting_pressure_Pa = s.limiting_pressure_Pa;
+  } else if (law.limiting_pressure_Pa) {
+    l.limiting_pressure_Pa = *law.limiting_pressure_Pa / collision::kThorntonYieldFactor * collision::kTaborHardnessFactor;
+  }
+  l.law = collision::make_contact_law(l.name, o, ctx);
+  return l;
+}
+
+ImpactLaw line_impact_law(const ImpactLaw& law, const InputContext& ctx) {
+  ImpactLaw l = law;
+  l.name = "line";
+  l.law = collision::make_contact_law(l.name, collision::LawOptions{}, ctx);
+  return l;
+}
+
 }  // namespace impactdeck::scene

@@ -87,7 +87,9 @@ void check_impact_magnitudes(const Scene& scene, const ImpactSpec& s, const coll
     refuse(scene, modulus_key(scene, t.material), who + "effective modulus E*", in.effective_modulus_Pa, "Pa",
            list({modulus_key(scene, t.material), modulus_key(scene, i.material)}));
   }
-  if (!in_range(effective_radius_m)) {
+  // R* = 0: a sharp edge or corner under the wedge or cone law, which has no radius (the kernel
+  // flags any other R* that is not finite and positive).
+  if (effective_radius_m != 0.0 && !in_range(effective_radius_m)) {
     refuse(scene, key_of(s.place, "point"), who + "effective radius R*", effective_radius_m, "m",
            list({size_key(t), size_key(i), key_of(s.place, "contact_radius")}));
   }
@@ -107,7 +109,7 @@ void check_impact_magnitudes(const Scene& scene, const ImpactSpec& s, const coll
 
 std::string indentation_warning(const Scene& scene, const ImpactSpec& s, const collision::ImpactResult& r) {
   const double x = r.history.compression.max_indentation_m, R = r.effective_radius_m;
-  if (!(x >= R)) return "";
+  if (!(x >= R) || R == 0.0) return "";  // R* = 0: a sharp edge or corner's law, no radius
   std::ostringstream m;
   m << "the maximal indentation " << x << " m reaches the effective radius " << R
     << " m: Hertz contact does not hold at all (the bodies would pass through each other), whatever the numbers "

@@ -125,6 +125,7 @@ PreparedBody prepare_body(const BodySpec& b, const Scene& scene, RunReport* repo
   const Material& m = scene.materials.at(b.material);
   p.material = m.elastic;
   p.yield_strength_Pa = m.yield_strength_Pa;
+  p.edge_radius_m = b.edge_radius_m;
   if (b.fixed) {
     p.mass_kg = std::numeric_limits<double>::infinity();
     p.inertia_kg_m2 = Eigen::Matrix3d::Identity() * std::numeric_limits<double>::infinity();
@@ -284,6 +285,24 @@ void describe_law(const Scene& scene, const ImpactSpec& s, const ImpactLaw& law,
   const double k = 3.0 * l.max_force_N / (4.0 * r.effective_modulus_Pa * unloading * std::sqrt(unloading));
   ir.unloading_radius_m = k * k;
   ir.dent_radius_m = l.residual_indentation_m > 0.0 ? std::sqrt(r.effective_radius_m * l.max_indentation_m) : 0.0;
+  if (law.law && (law.law->takes_sharp_points() || law.law->takes_line_contacts())) {
+    // A sharp edge or corner, or a rounded edge's line contact (docs/sharp-contacts.md): no V_y; the
+    // law's patch at F* (the cone's circle, the wedge's or the line's strip) under its pressure.
+    // Unloading is a flat punch or linear, not a Hertz curve: no unloading radius.
+    ir.yield_velocity_m_s.reset();
+    ir.contact_law = law.name;
+    ir.unloading_radius_m = 0.0;
+    ir.dent_radius_m = r.kernel.contact_semi_axis_b_m;
+    collision::ValidityReport v;
+    v.limits = scene.validity;
+    v.contact_semi_axis_a_m = r.kernel.contact_semi_axis_a_m;
+    v.contact_semi_axis_b_m = r.kernel.contact_semi_axis_b_m;
+    v.peak_pressure_Pa = r.kernel.peak_pressure_Pa;
+    v.yielding_body = ir.validity.yielding_body;
+    v.ok = true;
+    ir.validity = std::move(v);
+    return;
+  }
   if (ir.plastic()) {
     collision::ValidityLimits limits = scene.validity;
     limits.max_indentation_over_radius = kPlasticMaxIndentationOverRadius;
@@ -548,15 +567,50 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
     const PreparedBody& target = bodies.at(s.target);
     const PreparedBody& impactor = bodies.at(s.impactor);
     const InputContext ctx = impact_context(scene, s);
-    const ImpactLaw law = impact_law(scene, s, ctx);
-    const ContactModel model(
-        target, impactor, s.contact_radius,
-        collision::effective_modulus_Pa(target.material, impactor.material, scene.modulus_convention, ctx), law.law,
-        ctx);
-    ContactEvaluation located = clock.run(Stage::contact_geometry, [&] { return locate_contact(scene, s, model); });
+    ImpactLaw law = impact_law(scene, s, ctx);
+    const double e_star =
+        collision::effective_modulus_Pa(target.material, impactor.material, scene.modulus_convention, ctx);
+    std::optional<ContactModel> model;
+    model.emplace(target, impactor, s.contact_radius, e_star, law.law, ctx);
+    ContactEvaluation located = clock.run(Stage::contact_geometry, [&] { return locate_contact(scene, s, *model); });
+    const Place point_place{s.place.line, s.place.key + ".point"};
+    const bool fitted = located.result.flag != collision::ContactFlag::no_curvature;
+    const collision::ContactCurvature& tc = located.input.target.curvature;
+    const collision::ContactCurvature& ic = located.input.impactor.curvature;
+    auto solve_again_with = [&](ImpactLaw other) {  // the same point, solved again with another law
+      law = std::move(other);
+      model.emplace(target, impactor, s.contact_radius, e_star, law.law, ctx);
+      located.input.law = law.law.get();
+      located.result = collision::solve_kernel(located.input);
+    };
+    const bool sharp_point = fitted && (tc.sharp || ic.sharp);
+    const bool rounded_edge = fitted && !sharp_point && ((tc.feature == collision::SharpKind::edge) !=
+                                                         (ic.feature == collision::SharpKind::edge));
+    if (sharp_point) {
+      // A sharp edge or corner without edge_radius: the wedge or cone law where a plastic law runs
+      // (docs/sharp-contacts.md).
+      if (std::optional<ImpactLaw> sharp = sharp_impact_law(s, law, located.input, ctx)) solve_again_with(*sharp);
+    } else if (law.law->takes_sharp_points() && fitted) {
+      throw InputError(where(scene), s.contact_law_place.describe(),
+                       "impact '" + s.name + "': contact_law = \"" + law.name + "\" is the law of a sharp edge or corner, "
+                       "but the contact point at " + text(located.point_m) + " m is smooth (or rounded by edge_radius)");
+    }
+    if (rounded_edge && !law.law->takes_line_contacts()) {
+      // An edge rounded by edge_radius: a line contact over the edge's length where the rounding
+      // lies on a surface flat along the edge, or where the contact's length reaches the edge's.
+      const double length = (tc.feature == collision::SharpKind::edge ? tc : ic).feature_length_m;
+      const collision::KernelResult& kr = located.result;
+      if (kr.flag == collision::ContactFlag::line ||
+          (kr.flag == collision::ContactFlag::none && 2.0 * kr.contact_semi_axis_a_m >= length)) {
+        solve_again_with(line_impact_law(law, ctx));
+      }
+    } else if (law.law->takes_line_contacts() && fitted && !rounded_edge) {
+      throw InputError(where(scene), s.contact_law_place.describe(),
+                       "impact '" + s.name + "': contact_law = \"line\" is the law of an edge rounded by edge_radius, "
+                       "but the contact point at " + text(located.point_m) + " m is not on one");
+    }
     if (located.result.flag != collision::ContactFlag::none) {
-      const Place place{s.place.line, s.place.key + ".point"};
-      throw InputError(where(scene), place.describe(),
+      throw InputError(where(scene), point_place.describe(),
                        "impact '" + s.name + "': at " + text(located.point_m) + " m (normal " + text(located.normal) +
                            "): " +
                            collision::explain_flag(located.input, located.result, "'" + s.target + "'",
@@ -564,7 +618,7 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
                            (located.curvature_problem.empty() ? "" : " (" + located.curvature_problem + ")"));
     }
     ImpactReport ir = clock.run(
-        Stage::impact, [&] { return solve_located_impact(scene, s, law, model, std::move(located), report.warnings); });
+        Stage::impact, [&] { return solve_located_impact(scene, s, law, *model, std::move(located), report.warnings); });
     report.impacts.push_back(std::move(ir));
   }
   for (const auto& q : scene.sequences) {

@@ -114,6 +114,20 @@ nlohmann::json impact_json(const ImpactReport& ir) {
   const bool hertz_restitution = hertz_law(ir);
   i["contact_law"] = ir.contact_law;
   i["contact_law_requested"] = ir.spec->contact_law;
+  {  // the sharp edge or corner at the point, sharp or rounded by edge_radius (docs/sharp-contacts.md)
+    const bool on_target = kin.target.curvature.feature != collision::SharpKind::none;
+    const collision::ContactCurvature& sc = on_target ? kin.target.curvature : kin.impactor.curvature;
+    if (sc.feature == collision::SharpKind::none) {
+      i["sharp_feature"] = nullptr;
+    } else {
+      const bool edge = sc.feature == collision::SharpKind::edge;
+      i["sharp_feature"] = {{"body", on_target ? ir.spec->target : ir.spec->impactor},
+                            {"kind", edge ? "edge" : "corner"},
+                            {edge ? "dihedral_angle_deg" : "apex_half_angle_deg", json_number(sc.feature_angle_rad * 180.0 / M_PI)},
+                            {"edge_length_m", edge ? json_number(sc.feature_length_m) : nlohmann::json(nullptr)},
+                            {"rounded_by_edge_radius", !sc.sharp}};
+    }
+  }
   i["limiting_pressure_Pa"] = optional_number(ir.law.limiting_pressure_Pa);
   i["yield_velocity_m_s"] = optional_number(ir.yield_velocity_m_s);
   i["validity"]["contact_law"] = ir.contact_law;
@@ -315,6 +329,15 @@ std::string format_summary(const Scene& scene, const RunReport& rep) {
     if (ir.yield_velocity_m_s) o << ", V_y = " << *ir.yield_velocity_m_s << " m/s";
     if (ir.law.limiting_pressure_Pa) o << ")";
     o << "\n";
+    for (const auto* side : {&ir.contact.input.target.curvature, &ir.contact.input.impactor.curvature}) {
+      if (side->feature == collision::SharpKind::none) continue;  // docs/sharp-contacts.md
+      const bool edge = side->feature == collision::SharpKind::edge;
+      o << "  sharp feature         " << (edge ? "edge" : "corner") << " of '"
+        << (side == &ir.contact.input.target.curvature ? ir.spec->target : ir.spec->impactor) << "' ("
+        << (edge ? "dihedral " : "apex half-angle ") << side->feature_angle_rad * 180.0 / M_PI << " deg";
+      if (edge) o << ", length " << side->feature_length_m << " m";
+      o << (side->sharp ? ", sharp" : ", rounded by edge_radius") << ")\n";
+    }
     if (hertz_law(ir) && r.restitution_kind == collision::RestitutionModel::Kind::energy_flux) {
       o << "  energy flux density   " << r.restitution.energy_flux_density << " "
         << collision::to_string(ir.spec->restitution.flux_unit) << " (ln = " << r.restitution.ln_energy_flux

@@ -277,7 +277,7 @@ BodySpec read_body(std::size_t index, const toml::table& t, const Source& file,
                    double to_m, const fs::path& base_dir) {
   Reader r(t, "bodies[" + std::to_string(index) + "]", file);
   r.allow({"name", "shape", "material", "mass_kg", "fixed", "velocity_m_s", "angular_velocity_rad_s", "position",
-           "orientation_axis", "orientation_angle_deg"});
+           "orientation_axis", "orientation_angle_deg", "edge_radius"});
   for (const ShapeType& type : shape_types())  // every shape's keys (a key of another shape is ignored)
     for (const std::string& k : type.keys) r.allow({k.c_str()});
   BodySpec b;
@@ -286,6 +286,7 @@ BodySpec read_body(std::size_t index, const toml::table& t, const Source& file,
   b.shape = read_shape(r, to_m, base_dir);
   b.material = r.required_string("material");
   if (r.has("mass_kg")) b.mass_kg = r.positive("mass_kg");
+  if (r.has("edge_radius")) b.edge_radius_m = r.positive("edge_radius") * to_m;  // finite: number() checks it
   const std::optional<bool> fixed = r.boolean("fixed");
   b.fixed = fixed.value_or(false);
   if (b.fixed && b.mass_kg) r.fail("mass_kg", "a fixed body has infinite mass; remove mass_kg or fixed");

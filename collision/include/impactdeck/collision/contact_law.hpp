@@ -17,6 +17,13 @@
 
 namespace impactdeck::collision {
 
+/// The sharp feature of a mesh or CAD part at a contact point (docs/sharp-contacts.md).
+enum class SharpKind : std::uint8_t {
+  none,    ///< a smooth point (or a flat face)
+  edge,    ///< on a sharp edge: a dihedral angle and a length
+  corner,  ///< on a vertex where sharp edges meet: an apex half-angle
+};
+
 /// The normal direction of one impact as a law sees it (SI).
 struct LawInput {
   double reduced_mass_kg = 0;        ///< m_w at the contact point (Eq. 16-21)
@@ -24,6 +31,11 @@ struct LawInput {
   double effective_modulus_Pa = 0;   ///< E*
   double effective_radius_m = 0;     ///< R* (the Hertz-equivalent radius of an elliptical contact)
   double yield_strength_Pa = 0;      ///< of the weaker body; 0 when not known
+  /// The sharp feature of the body that has one at the point (the laws "wedge" and "cone"; the
+  /// line contact of a rounded edge reads its length).
+  SharpKind sharp_kind = SharpKind::none;
+  double sharp_angle_rad = 0;  ///< edge: the interior dihedral angle 2 beta; corner: the apex half-angle alpha
+  double sharp_length_m = 0;   ///< edge: the length L of the straight edge through the point
 };
 
 /// Why a law gives no result for an impact (the kernel maps it to its ContactFlag).
@@ -49,6 +61,9 @@ struct LawResult {
   double impulse_total_Ns = 0;        ///< (1 + R) m_w v_w
   double residual_indentation_m = 0;  ///< the dent left behind (0 for an elastic law)
   std::array<double, 4> state{};      ///< the law's own numbers for its F(t); opaque to callers
+  /// The law's own contact patch at F_max (semi-axes a >= b) and its pressure there; 0: the kernel
+  /// takes the Hertz ellipse of F_max (every law but "wedge" and "cone").
+  double contact_semi_axis_a_m = 0, contact_semi_axis_b_m = 0, contact_pressure_Pa = 0;
 };
 
 /// The interface. solve() is the kernel's hot path: noexcept and allocation-free; the kernel calls
@@ -70,11 +85,24 @@ class ContactLaw {
   /// One line on a restitution outside its range or invalid (for warnings and errors); empty when
   /// `r` is inside the range. The default: the coefficient, when it lies outside [0, 1].
   virtual std::string describe_restitution(const LawResult& r, double approach_velocity_m_s) const;
+  /// True for a law of a sharp edge or corner (LawInput::sharp_kind): the kernel passes it the
+  /// points where one body is sharp instead of flagging them (ContactFlag::sharp).
+  virtual bool takes_sharp_points() const noexcept { return false; }
+  /// True for the line contact of a rounded edge ("line"): the kernel passes it the points where
+  /// one body's surface is an edge rounded by its edge radius (ContactCurvature::feature edge, not
+  /// sharp) and the relative curvature along the edge is 0 (else flagged ContactFlag::line), with
+  /// R* the radius across the edge.
+  virtual bool takes_line_contacts() const noexcept { return false; }
 };
 
 /// Thornton's default limiting pressure p_y over the weaker body's yield strength: the onset of
 /// yield under a circular Hertz contact, p0 = 1.60 Y for nu = 0.3 (Johnson 1985, Sect. 6.2).
 inline constexpr double kThorntonYieldFactor = 1.6;
+
+/// The default indentation hardness of the laws "wedge" and "cone" over the weaker body's yield
+/// strength: a fully plastic indentation by a sharp indenter, H = 3 Y (Tabor 1951; Johnson 1985,
+/// Sect. 6.5). A sharp edge or corner is fully plastic at once.
+inline constexpr double kTaborHardnessFactor = 3.0;
 
 /// What a scene says about the law of an impact (each law reads what it needs).
 struct LawOptions {
@@ -86,6 +114,8 @@ struct LawOptions {
   double poisson_ratio = 0.3;
   double tangent_modulus_Pa = 0;
   double youngs_modulus_Pa = 0;
+  /// "wedge" and "cone": the indentation pressure p; 0: kTaborHardnessFactor x the yield strength.
+  double hardness_Pa = 0;
 };
 
 using ContactLawFactory = std::function<std::shared_ptr<const ContactLaw>(const LawOptions&)>;

@@ -45,6 +45,11 @@ struct ContactCurvature {
   /// 1/R of the paper's rule (Eq. 26; 1/r on a sphere, 0 on a plane); used by ContactRule::paper.
   double paper_curvature_per_m = 0;
   bool sharp = false;  ///< on a sharp edge or corner: no curvature exists
+  /// The sharp feature at the point (geometry::SharpFeature): set where `sharp` is, and kept where
+  /// a body's edge_radius rounds it (then `sharp` is false and k1, k2 are the rounding's).
+  SharpKind feature = SharpKind::none;
+  double feature_angle_rad = 0;  ///< edge: the interior dihedral angle; corner: the apex half-angle
+  double feature_length_m = 0;   ///< edge: its straight length
 
   static ContactCurvature sphere(double radius_m);  ///< k1 = k2 = paper = 1/r
   static ContactCurvature flat();                   ///< a plane

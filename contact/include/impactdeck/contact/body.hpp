@@ -25,6 +25,9 @@ struct PreparedBody {
   Eigen::Matrix3d inertia_kg_m2 = Eigen::Matrix3d::Zero();  ///< own frame, about the centroid
   collision::ElasticMaterial material;
   std::optional<double> yield_strength_Pa;
+  /// The part's edge break (m): a sharp corner is a sphere of this radius, a sharp edge a cylinder
+  /// (ContactModel; docs/sharp-contacts.md). Unset: sharp points stay sharp.
+  std::optional<double> edge_radius_m;
   Eigen::Vector3d velocity_m_s = Eigen::Vector3d::Zero();            ///< world
   Eigen::Vector3d angular_velocity_rad_s = Eigen::Vector3d::Zero();  ///< world
 

@@ -112,9 +112,11 @@ class ContactModel {
   void evaluate(ContactEvaluation& e, const Eigen::Vector3d& impactor_centroid_world_m,
                 std::optional<double> approach_speed_m_s) const;
   /// The kernel's view of a body's surface at `own` (world directions, the rule's Eq. 26
-  /// curvature), written into `c` (every field).
+  /// curvature), written into `c` (every field); `outward` is the body's outward contact normal
+  /// (world). A sharp point carries its feature (Shape::sharp_feature), rounded by the body's
+  /// edge_radius_m when it has one.
   void surface(const PreparedBody& b, const geometry::PoseMap& frame, const geometry::SurfacePoint& own,
-               const geometry::Curvature& k, collision::ContactCurvature& c) const;
+               const geometry::Curvature& k, const Eigen::Vector3d& outward, collision::ContactCurvature& c) const;
 
   const PreparedBody& target_;
   const PreparedBody& impactor_;

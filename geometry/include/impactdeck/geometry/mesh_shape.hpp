@@ -49,6 +49,9 @@ class MeshShape final : public Shape {
   /// Within 1e-6 mean edge lengths of a sharp edge or of a vertex on one (the test curvature_fit
   /// applies before fitting).
   bool on_sharp_feature(const SurfacePoint& at) const override;
+  /// The edge or corner there (Shape::sharp_feature): O(sharp edges at the vertex + the edge's
+  /// run of mesh edges).
+  std::optional<SharpFeature> sharp_feature(const SurfacePoint& at) const override;
   /// Eq. 26 on the mesh: the three axis-normal planes through the point cut the surface; each
   /// section's radius at the point follows from the jet-fitted curvature tensor by Euler's and
   /// Meusnier's theorems (κ = κ_n(t)/|n×e|, t = n×e/|n×e|); tangent cuts (|n×e| ≤ 1e-3) are left

@@ -42,6 +42,32 @@ struct Curvature {
   double mean_per_m() const { return 0.5 * (k1_per_m + k2_per_m); }
 };
 
+/// A sharp edge or corner of a part at a contact point (docs/sharp-contacts.md), own frame.
+struct SharpFeature {
+  enum class Kind { edge, corner };
+  Kind kind = Kind::edge;
+  Eigen::Vector3d point_m = Eigen::Vector3d::Zero();  ///< the corner's vertex, or the point on the edge
+  /// edge: the unit direction of its straight run (from its first end to its last)
+  Eigen::Vector3d direction = Eigen::Vector3d::UnitX();
+  /// edge: the interior dihedral angle between its two faces, measured through the solid (pi: no
+  /// edge; below pi: convex, a box's 90 deg)
+  double dihedral_angle_rad = 0;
+  /// edge: the length of the straight edge through the point (the run of sharp mesh edges that
+  /// stay within kSharpRunDeg of its first one)
+  double length_m = 0;
+  /// corner: the solid's interior solid angle at the vertex, 2 pi + sum over its sharp edges of
+  /// (dihedral - pi) (the spherical polygon the faces cut from a small sphere about the vertex)
+  double solid_angle_sr = 0;
+  /// corner: the half-angle of the circular cone of the same solid angle,
+  /// alpha = acos(1 - solid_angle / (2 pi)) (a box corner: acos(3/4) = 41.4 deg)
+  double apex_half_angle_rad = 0;
+};
+
+/// A run of sharp mesh edges is one straight edge while each stays within this angle of the run's
+/// first edge; an edge through a corner vertex is the contact (an edge contact, not a corner) when
+/// it lies within this angle of the contact's tangent plane.
+inline constexpr double kSharpRunDeg = 1.0;
+
 class Shape {
  public:
   virtual ~Shape() = default;
@@ -52,6 +78,11 @@ class Shape {
   /// True when the point lies on a sharp edge or corner, where curvature() reports
   /// sharp_feature and no local radius exists. Cheap (no curvature fit). Smooth shapes: false.
   virtual bool on_sharp_feature(const SurfacePoint& /*at*/) const { return false; }
+  /// The sharp edge or corner at a point where on_sharp_feature holds; `at.normal` is the contact's
+  /// outward normal of this body there (it tells an edge lying on the other body from a corner;
+  /// zero: by the mesh alone). nullopt: no sharp feature, or one this query does not classify (a
+  /// boundary or non-manifold edge, a flat face lying on the other body, a smooth or CAD shape).
+  virtual std::optional<SharpFeature> sharp_feature(const SurfacePoint& /*at*/) const { return std::nullopt; }
   /// The paper's local radius (Eq. 26): mean radius of the sections by the three axis-normal
   /// planes through the point, degenerate (tangent) sections left out; a sphere's radius on a
   /// sphere (axis-normal sections are not normal sections: docs/table1.md), infinity on a plane.

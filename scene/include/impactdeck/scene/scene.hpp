@@ -55,6 +55,9 @@ struct BodySpec {
   bool placed = false;  ///< position or orientation given
   Eigen::Vector3d velocity_m_s = Eigen::Vector3d::Zero();            ///< world frame
   Eigen::Vector3d angular_velocity_rad_s = Eigen::Vector3d::Zero();  ///< world frame
+  /// `edge_radius` (length unit, > 0): the part's edge break. A contact on a sharp corner is a
+  /// sphere of this radius, on a sharp edge a cylinder along the edge (docs/sharp-contacts.md).
+  std::optional<double> edge_radius_m;
   Place place;
 };
 
@@ -211,6 +214,19 @@ struct ImpactLaw {
 
 /// The law of impact `s`. Throws InputError (ctx) for a law the registry refuses.
 ImpactLaw impact_law(const Scene& scene, const ImpactSpec& s, const InputContext& ctx);
+
+/// The law at a point where one body is sharp (in.target/impactor.curvature.sharp with its feature;
+/// no edge_radius rounded it): "wedge" on an edge, "cone" on a corner, at the hardness
+/// limiting_pressure_Pa or collision::kTaborHardnessFactor x the yield strength, where `law` (of
+/// impact_law) is a plastic one; nullopt where it is Hertz, which refuses the point
+/// (docs/sharp-contacts.md).
+std::optional<ImpactLaw> sharp_impact_law(const ImpactSpec& s, const ImpactLaw& law, const collision::KernelInput& in,
+                                          const InputContext& ctx);
+
+/// `law` with the line contact of an edge rounded by edge_radius ("line", elastic) in its place:
+/// where the rounding lies on a surface flat along the edge, or where the elliptical contact's
+/// length reaches the edge's length (docs/sharp-contacts.md).
+ImpactLaw line_impact_law(const ImpactLaw& law, const InputContext& ctx);
 
 /// Johnson's yield velocity (BEYOND_HERTZ.md; Johnson 1985, Sect. 11.4): the approach speed at which
 /// a Hertz impact first reaches the limiting pressure p_y,

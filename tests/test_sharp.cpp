@@ -1,0 +1,469 @@
+// Sharp edges and corners of machined parts (issue 30 item 8, docs/sharp-contacts.md): the mesh's
+// sharp-feature query, the laws "wedge", "cone" and "line" against closed forms computed here and
+// an independent integration of m x'' = -F(x), and a box mesh dropped on a corner and on an edge,
+// with and without edge_radius.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <regex>
+#include <sstream>
+#include <string>
+
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_integration.h>
+#include <gsl/gsl_odeiv2.h>
+#include <gsl/gsl_sf_ellint.h>
+#include <gtest/gtest.h>
+
+#include "impactdeck/collision/contact_law.hpp"
+#include "impactdeck/common/error.hpp"
+#include "impactdeck/geometry/mass_properties.hpp"
+#include "impactdeck/geometry/mesh_io.hpp"
+#include "impactdeck/geometry/mesh_shape.hpp"
+#include "impactdeck/scene/pipeline.hpp"
+#include "impactdeck/scene/report.hpp"
+#include "impactdeck/scene/scene.hpp"
+
+using namespace impactdeck;
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path data(const std::string& name) { return fs::path(IMPACTDECK_SOURCE_DIR) / "tests" / "data" / name; }
+
+/// The box's geometry after a rotation and a 1 km translation: face normals come from vertex
+/// differences of ~1e3 m coordinates, whose rounding (~1e-13 m) over 60 mm edges is ~2e-12
+/// relative; 1e-9 leaves a wide margin.
+constexpr double kFarBoxRel = 1e-9;
+/// A law's closed form against an rk8pd integration of m x'' = -F(x) at rtol 1e-12 and against
+/// quadrature of its F(t) at 1e-12: 1e-8 (the suite's ODE figure, tolerances.hpp kOdeCurveRel).
+constexpr double kLawOdeRel = 1e-8;
+/// The same impact through the scene (a box corner rounded to rho) and as a sphere of radius rho
+/// with the box's reduced mass: the same formulas on the same numbers, but the reduced mass goes
+/// through the tensor form of Eq. 21 with lever arms, so a few ulps apart.
+constexpr double kSameImpactRel = 1e-12;
+
+geometry::SharpFeature feature_at(const geometry::MeshShape& s, const Eigen::Vector3d& p, const Eigen::Vector3d& n) {
+  geometry::SurfacePoint at = s.closest_point(p);
+  EXPECT_TRUE(s.on_sharp_feature(at)) << p.transpose();
+  at.normal = n;
+  const std::optional<geometry::SharpFeature> f = s.sharp_feature(at);
+  EXPECT_TRUE(f.has_value()) << p.transpose();
+  return f.value_or(geometry::SharpFeature{});
+}
+
+}  // namespace
+
+TEST(SharpFeature, BoxRotatedFarFromOriginCornersAndEdges) {
+  geometry::TriangleMesh m = geometry::load_mesh(data("box_200x100x60mm.stl"), LengthUnit::mm).mesh;
+  Eigen::Vector3d lo = m.vertices_m[0], hi = lo;
+  for (const auto& v : m.vertices_m) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+  ASSERT_NEAR((hi - lo).x(), 0.2, 1e-12);
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  const Eigen::Vector3d T(1000.0, -2000.0, 500.0);
+  for (auto& v : m.vertices_m) v = R * v + T;
+  const geometry::MeshShape s(m, geometry::compute_mass_properties(m, geometry::label_shells(m)));
+  auto world = [&](const Eigen::Vector3d& own) { return Eigen::Vector3d(R * own + T); };
+  const Eigen::Vector3d none = Eigen::Vector3d::Zero();
+
+  // The corner at lo: three 90 deg edges, an octant (pi/2 sr), the cone of acos(3/4).
+  const geometry::SharpFeature c = feature_at(s, world(lo), none);
+  EXPECT_EQ(c.kind, geometry::SharpFeature::Kind::corner);
+  EXPECT_NEAR(c.solid_angle_sr, 0.5 * M_PI, kFarBoxRel * M_PI);
+  EXPECT_NEAR(c.apex_half_angle_rad, std::acos(0.75), kFarBoxRel);
+  // Touching with its diagonal down: still the corner.
+  const geometry::SharpFeature c2 = feature_at(s, world(lo), R * Eigen::Vector3d(-1, -1, -1).normalized());
+  EXPECT_EQ(c2.kind, geometry::SharpFeature::Kind::corner);
+
+  // The middle of each of the three edges through lo: direction, 90 deg, the box's edge lengths.
+  const Eigen::Vector3d size = hi - lo;
+  for (int axis = 0; axis < 3; ++axis) {
+    Eigen::Vector3d mid = lo;
+    mid[axis] += 0.5 * size[axis];
+    const geometry::SharpFeature e = feature_at(s, world(mid), none);
+    EXPECT_EQ(e.kind, geometry::SharpFeature::Kind::edge) << axis;
+    EXPECT_NEAR(std::abs(e.direction.dot(R.col(axis))), 1.0, kFarBoxRel) << axis;
+    EXPECT_NEAR(e.dihedral_angle_rad, 0.5 * M_PI, kFarBoxRel) << axis;
+    EXPECT_NEAR(e.length_m, size[axis], kFarBoxRel * size[axis]) << axis;
+    // At the corner vertex, an outward contact normal across this edge (the edge lies on the
+    // other body): the edge, not the corner.
+    Eigen::Vector3d n_own = -Eigen::Vector3d::Ones();
+    n_own[axis] = 0.0;
+    const geometry::SharpFeature ev = feature_at(s, world(lo), R * n_own.normalized());
+    EXPECT_EQ(ev.kind, geometry::SharpFeature::Kind::edge) << axis;
+    EXPECT_NEAR(ev.length_m, size[axis], kFarBoxRel * size[axis]) << axis;
+  }
+  // A face lying on the other body at the corner: a flat contact, not classified.
+  Eigen::Vector3d face_n = Eigen::Vector3d::Zero();
+  face_n.z() = -1.0;
+  geometry::SurfacePoint at = s.closest_point(world(lo));
+  at.normal = R * face_n;
+  EXPECT_FALSE(s.sharp_feature(at).has_value());
+  // A point inside a face: no feature.
+  const Eigen::Vector3d face_mid = world(Eigen::Vector3d(lo.x() + 0.3 * size.x(), lo.y() + 0.4 * size.y(), lo.z()));
+  EXPECT_FALSE(s.sharp_feature(s.closest_point(face_mid)).has_value());
+}
+
+namespace {
+
+// An impact of the laws' tests: 1 kg, steel on steel (E* = 115.4 GPa), Y = 250 MPa.
+collision::LawInput sharp_input(collision::SharpKind kind, double V) {
+  collision::LawInput in;
+  in.reduced_mass_kg = 1.0;
+  in.approach_velocity_m_s = V;
+  in.effective_modulus_Pa = 2.1e11 / (2.0 * (1.0 - 0.09));
+  in.yield_strength_Pa = 2.5e8;
+  in.sharp_kind = kind;
+  in.sharp_angle_rad = kind == collision::SharpKind::edge ? 0.5 * M_PI : std::acos(0.75);
+  in.sharp_length_m = kind == collision::SharpKind::edge ? 0.1 : 0.0;
+  return in;
+}
+
+collision::LawResult solve(const collision::ContactLaw& law, const collision::LawInput& in) {
+  collision::LawResult r;
+  law.solve(&in, &r, 1);
+  return r;
+}
+
+// The force of the indent at depth x, written here from the geometry: the hardness p times the
+// projected area (wedge: 2 L x tan(beta); cone: pi (x tan(alpha))^2).
+struct Indent {
+  collision::LawInput in;
+  double p;
+  double area(double x) const {
+    if (in.sharp_kind == collision::SharpKind::edge) return 2.0 * in.sharp_length_m * x * std::tan(0.5 * in.sharp_angle_rad);
+    const double a = x * std::tan(in.sharp_angle_rad);
+    return M_PI * a * a;
+  }
+  double force(double x) const { return x > 0.0 ? p * area(x) : 0.0; }
+};
+
+int indent_rhs(double, const double y[], double dydt[], void* params) {
+  const auto* ind = static_cast<const Indent*>(params);
+  dydt[0] = y[1];
+  dydt[1] = -ind->force(y[0]) / ind->in.reduced_mass_kg;
+  return GSL_SUCCESS;
+}
+
+// x and x' at time t of m x'' = -F(x) from x = 0, x' = V (rk8pd, rtol 1e-12).
+std::pair<double, double> integrate_loading(const Indent& ind, double t) {
+  gsl_odeiv2_system sys{indent_rhs, nullptr, 2, const_cast<Indent*>(&ind)};
+  gsl_odeiv2_driver* d = gsl_odeiv2_driver_alloc_y_new(&sys, gsl_odeiv2_step_rk8pd, 1e-9 * t, 1e-12, 1e-12);
+  double y[2] = {0.0, ind.in.approach_velocity_m_s}, t0 = 0.0;
+  EXPECT_EQ(gsl_odeiv2_driver_apply(d, &t0, t, y), GSL_SUCCESS);
+  gsl_odeiv2_driver_free(d);
+  return {y[0], y[1]};
+}
+
+struct ForceOf {
+  const collision::ContactLaw* law;
+  const collision::LawResult* r;
+};
+double force_of(double t, void* p) {
+  const auto* f = static_cast<const ForceOf*>(p);
+  return f->law->force_N(*f->r, t);
+}
+
+// Quadrature of the law's F(t) over [a, b] (QAGS, rtol 1e-12).
+double impulse(const collision::ContactLaw& law, const collision::LawResult& r, double a, double b) {
+  ForceOf f{&law, &r};
+  gsl_function fn{force_of, &f};
+  gsl_integration_workspace* w = gsl_integration_workspace_alloc(1000);
+  double result = 0, err = 0;
+  gsl_integration_qags(&fn, a, b, 0.0, 1e-12, 1000, w, &result, &err);
+  gsl_integration_workspace_free(w);
+  return result;
+}
+
+}  // namespace
+
+TEST(SharpLaws, WedgeAndConeAgainstEnergyBalanceIntegrationAndUnloading) {
+  for (const auto kind : {collision::SharpKind::edge, collision::SharpKind::corner}) {
+    const bool edge = kind == collision::SharpKind::edge;
+    const auto law = collision::make_contact_law(edge ? "wedge" : "cone", collision::LawOptions{});
+    ASSERT_TRUE(law->takes_sharp_points());
+    const collision::LawInput in = sharp_input(kind, 3.0);
+    const collision::LawResult r = solve(*law, in);
+    ASSERT_EQ(r.status, collision::LawStatus::ok) << law->name();
+    const Indent ind{in, collision::kTaborHardnessFactor * in.yield_strength_Pa};
+    const double m = in.reduced_mass_kg, V = in.approach_velocity_m_s, E = in.effective_modulus_Pa;
+    // Energy balance: 1/2 m V^2 = int_0^x* F dx (wedge: k x*^2 / 2; cone: c x*^3 / 3).
+    const double x = r.max_indentation_m;
+    const double work = edge ? 0.5 * ind.force(x) * x : ind.force(x) * x / 3.0;
+    EXPECT_NEAR(work, 0.5 * m * V * V, kLawOdeRel * 0.5 * m * V * V) << law->name();
+    EXPECT_NEAR(r.max_force_N, ind.force(x), kLawOdeRel * r.max_force_N) << law->name();
+    if (edge) {  // harmonic: t_m = (pi/2) sqrt(m/k), k = F(x)/x
+      EXPECT_NEAR(r.compression_time_s, 0.5 * M_PI * std::sqrt(m * x / ind.force(x)), kLawOdeRel * r.compression_time_s);
+    }
+    // The ODE reaches x* with x' = 0 at t_m: |x'(t_m)| against F*/m t_m is the relative time error.
+    const auto [x_tm, v_tm] = integrate_loading(ind, r.compression_time_s);
+    EXPECT_NEAR(x_tm, x, kLawOdeRel * x) << law->name();
+    EXPECT_LT(std::abs(v_tm) / (r.max_force_N / m * r.compression_time_s), kLawOdeRel) << law->name();
+    // F(t): the loading impulse is m V, the unloading's e m V (quadrature of the law's curve).
+    EXPECT_NEAR(impulse(*law, r, 0.0, r.compression_time_s), m * V, kLawOdeRel * m * V) << law->name();
+    EXPECT_NEAR(impulse(*law, r, r.compression_time_s, r.contact_time_s), r.restitution.coefficient * m * V,
+                kLawOdeRel * m * V)
+        << law->name();
+    // Elastic unloading as a rigid flat elliptical punch of the indent's semi-axes (a >= b):
+    // S = pi E* a / K(e) (a circle: 2 E* a), recovery F*/S, released energy F*^2/(2 S) = 1/2 m (e V)^2.
+    const double half_width = edge ? x * std::tan(0.5 * in.sharp_angle_rad) : x * std::tan(in.sharp_angle_rad);
+    const double a = edge ? std::max(0.5 * in.sharp_length_m, half_width) : half_width;
+    const double b = edge ? std::min(0.5 * in.sharp_length_m, half_width) : half_width;
+    const double S = M_PI * E * a / gsl_sf_ellint_Kcomp(std::sqrt(1.0 - (b / a) * (b / a)), GSL_PREC_DOUBLE);
+    if (!edge) EXPECT_NEAR(S, 2.0 * E * a, kLawOdeRel * S);  // Sneddon's circle
+    const double e = std::sqrt(r.max_force_N * r.max_force_N / S / m) / V;
+    EXPECT_NEAR(r.restitution.coefficient, e, kLawOdeRel * e) << law->name();
+    EXPECT_NEAR(r.residual_indentation_m, x - r.max_force_N / S, kLawOdeRel * x) << law->name();
+    EXPECT_GT(r.residual_indentation_m, 0.0);
+    EXPECT_GT(r.restitution.coefficient, 0.0);
+    EXPECT_LT(r.restitution.coefficient, 0.5);  // a sharp indent in steel is nearly fully plastic
+    EXPECT_DOUBLE_EQ(r.contact_semi_axis_a_m, a);
+    EXPECT_DOUBLE_EQ(r.contact_semi_axis_b_m, b);
+    EXPECT_NEAR(r.contact_pressure_Pa, ind.p, kLawOdeRel * ind.p);
+    RecordProperty(std::string(law->name()) + "_restitution", std::to_string(r.restitution.coefficient));
+    RecordProperty(std::string(law->name()) + "_dent_um", std::to_string(r.residual_indentation_m * 1e6));
+  }
+}
+
+// The limits that do not depend on V: the wedge's loading time (harmonic), the cone's restitution
+// (e^2 = 3 pi p tan(alpha) / (4 E*): F*^2 / (m V^2 S) with x* cancelling).
+TEST(SharpLaws, SpeedIndependentLimits) {
+  const auto wedge = collision::make_contact_law("wedge", collision::LawOptions{});
+  const auto cone = collision::make_contact_law("cone", collision::LawOptions{});
+  const collision::LawResult w1 = solve(*wedge, sharp_input(collision::SharpKind::edge, 0.5));
+  const collision::LawResult w2 = solve(*wedge, sharp_input(collision::SharpKind::edge, 5.0));
+  EXPECT_NEAR(w1.compression_time_s, w2.compression_time_s, kLawOdeRel * w1.compression_time_s);
+  EXPECT_NEAR(w2.max_indentation_m / w1.max_indentation_m, 10.0, 10.0 * kLawOdeRel);
+  const collision::LawInput in = sharp_input(collision::SharpKind::corner, 0.5);
+  const collision::LawResult c1 = solve(*cone, in);
+  const collision::LawResult c2 = solve(*cone, sharp_input(collision::SharpKind::corner, 5.0));
+  const double p = collision::kTaborHardnessFactor * in.yield_strength_Pa;
+  const double e = std::sqrt(3.0 * M_PI * p * std::tan(in.sharp_angle_rad) / (4.0 * in.effective_modulus_Pa));
+  EXPECT_NEAR(c1.restitution.coefficient, e, kLawOdeRel * e);
+  EXPECT_NEAR(c2.restitution.coefficient, e, kLawOdeRel * e);
+  // An explicit hardness replaces Tabor's 3 Y.
+  collision::LawOptions o;
+  o.hardness_Pa = 2.0 * p;
+  const collision::LawResult c3 = solve(*collision::make_contact_law("cone", o), in);
+  EXPECT_NEAR(c3.restitution.coefficient, e * std::sqrt(2.0), kLawOdeRel * e);
+  // Not the law's feature, or no hardness: no result (the scene refuses such input first).
+  EXPECT_NE(solve(*wedge, sharp_input(collision::SharpKind::corner, 1.0)).status, collision::LawStatus::ok);
+  collision::LawInput no_yield = in;
+  no_yield.yield_strength_Pa = 0.0;
+  EXPECT_NE(solve(*cone, no_yield).status, collision::LawStatus::ok);
+}
+
+TEST(SharpLaws, LineContactIsHarmonicAndElastic) {
+  const auto law = collision::make_contact_law("line", collision::LawOptions{});
+  collision::LawInput in = sharp_input(collision::SharpKind::edge, 2.0);
+  in.effective_radius_m = 5e-4;
+  const collision::LawResult r = solve(*law, in);
+  ASSERT_EQ(r.status, collision::LawStatus::ok);
+  const double k = 0.25 * M_PI * in.effective_modulus_Pa * in.sharp_length_m;
+  EXPECT_NEAR(r.max_force_N, in.approach_velocity_m_s * std::sqrt(in.reduced_mass_kg * k), kLawOdeRel * r.max_force_N);
+  EXPECT_NEAR(r.compression_time_s, 0.5 * M_PI * std::sqrt(in.reduced_mass_kg / k), kLawOdeRel * r.compression_time_s);
+  EXPECT_EQ(r.restitution.coefficient, 1.0);
+  EXPECT_EQ(r.residual_indentation_m, 0.0);
+  EXPECT_NEAR(impulse(*law, r, 0.0, r.contact_time_s), 2.0 * in.approach_velocity_m_s, kLawOdeRel * 2.0);
+}
+
+// ---- The acceptance's held-out check: a box mesh dropped on a corner and on an edge. ----
+
+namespace {
+
+std::string exact(double x) {
+  std::ostringstream s;
+  s << std::setprecision(17) << x;
+  return s.str();
+}
+
+// A scene's steel (with `material_keys`) and its floor, the plane z = 0.
+std::string steel_floor(const std::string& material_keys) {
+  return R"(length_unit = "mm"
+[materials.steel]
+youngs_modulus_Pa = 2.1e11
+poisson_ratio = 0.3
+)" + material_keys + R"(
+[[bodies]]
+name = "floor"
+shape = "plane"
+normal = [0, 0, 1]
+material = "steel")";
+}
+
+// The impact of `impactor` falling at 3 m/s on the floor, with `impact_keys`.
+std::string drop_impact(const std::string& impactor, const std::string& impact_keys) {
+  return R"(
+[[impacts]]
+name = "drop"
+target = "floor"
+impactor = ")" + impactor + R"("
+point = [0, 0, 0]
+approach_speed_m_s = 3.0
+)" + impact_keys + "\n";
+}
+
+// The 200 x 100 x 60 mm steel box of 0.5 kg, turned by `angle_deg` about `axis`, with `keys`.
+std::string box_body(const std::string& axis, double angle_deg, const std::string& keys) {
+  return R"([[bodies]]
+name = "box"
+shape = "mesh"
+mesh = ")" + data("box_200x100x60mm.stl").string() + R"("
+material = "steel"
+mass_kg = 0.5
+orientation_axis = )" + axis + R"(
+orientation_angle_deg = )" + exact(angle_deg) + "\n" + keys + "\n";
+}
+
+// The 200 x 100 x 60 mm steel box (0.5 kg) falling at 3 m/s on a steel floor, turned by `angle_deg`
+// about `axis`: [1, 1, 0] by 35 deg puts a corner lowest, [1, 0, 0] by 45 deg the long edge.
+std::string box_drop(const std::string& axis, double angle_deg, const std::string& box_keys, const std::string& impact_keys,
+                     const std::string& material_keys = "yield_strength_Pa = 2.5e8") {
+  return steel_floor(material_keys) + "\n" + box_body(axis, angle_deg, box_keys) + drop_impact("box", impact_keys);
+}
+
+const std::string kCorner = "[1, 1, 0]";
+const std::string kEdge = "[1, 0, 0]";
+
+nlohmann::json impact_json(const std::string& text) {
+  const scene::Scene s = scene::parse_scene(text, "sharp.toml");
+  return scene::to_json(s, scene::run_scene(s, scene::RunOptions{fs::temp_directory_path()}))["impacts"][0];
+}
+
+std::string error_of(const std::string& text) {
+  try {
+    impact_json(text);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// The same impact as a sphere of radius rho_mm and mass m_kg dropped straight (reduced mass m).
+std::string sphere_drop(double rho_mm, double m_kg, const std::string& impact_keys) {
+  return steel_floor("yield_strength_Pa = 2.5e8") + R"(
+[[bodies]]
+name = "ball"
+shape = "sphere"
+radius = )" + exact(rho_mm) + R"(
+material = "steel"
+mass_kg = )" + exact(m_kg) + "\n" + drop_impact("ball", impact_keys);
+}
+
+void expect_same_impact(const nlohmann::json& a, const nlohmann::json& b) {
+  for (const char* key : {"max_force_N", "contact_time_s", "restitution", "residual_indentation_m"}) {
+    const double x = a[key].get<double>(), y = b[key].get<double>();
+    EXPECT_NEAR(x, y, kSameImpactRel * std::max(std::abs(y), 1e-300)) << key;
+  }
+  EXPECT_EQ(a["contact_law"], b["contact_law"]);
+}
+
+}  // namespace
+
+TEST(SharpScene, BoxOnCornerWithAndWithoutEdgeRadius) {
+  // Without edge_radius: "hertz" refuses, naming edge_radius and the plastic laws.
+  const std::string refused = error_of(box_drop(kCorner, 35, "", "contact_law = \"hertz\""));
+  EXPECT_TRUE(std::regex_search(refused, std::regex("sharp edge or corner of 'box'.*edge_radius.*plastic contact_law")))
+      << refused;
+  EXPECT_EQ(refused.find('\n'), std::string::npos);
+  // ... and so does "auto" without a yield strength.
+  EXPECT_NE(error_of(box_drop(kCorner, 35, "", "", "")).find("edge_radius"), std::string::npos);
+  // "auto" with a yield strength: the cone law at the corner, never a refusal.
+  const nlohmann::json cone = impact_json(box_drop(kCorner, 35, "", ""));
+  EXPECT_EQ(cone["contact_law"], "cone");
+  EXPECT_EQ(cone["validity"]["contact_law"], "cone");
+  EXPECT_EQ(cone["sharp_feature"]["kind"], "corner");
+  EXPECT_NEAR(cone["sharp_feature"]["apex_half_angle_deg"].get<double>(), std::acos(0.75) * 180.0 / M_PI, 1e-9);
+  EXPECT_GT(cone["residual_indentation_m"].get<double>(), 0.0);
+  EXPECT_GT(cone["restitution"].get<double>(), 0.0);
+  EXPECT_LT(cone["restitution"].get<double>(), 1.0);
+  EXPECT_TRUE(cone["checks"]["passed"].get<bool>());
+  // The point stays the corner as meshed: the lever arm of the sharp part (the box's centre is
+  // half its 233 mm diagonal from the corner).
+  const double m_w = cone["reduced_mass_kg"].get<double>();
+  EXPECT_LT(m_w, 0.5);
+  // The cone law's numbers at that reduced mass, from the law itself.
+  collision::LawInput in = sharp_input(collision::SharpKind::corner, 3.0);
+  in.reduced_mass_kg = m_w;
+  in.effective_modulus_Pa = cone["effective_modulus_Pa"].get<double>();
+  const collision::LawResult r = solve(*collision::make_contact_law("cone", collision::LawOptions{}), in);
+  EXPECT_NEAR(cone["max_force_N"].get<double>(), r.max_force_N, 1e-9 * r.max_force_N);
+
+  // With edge_radius = 0.5 mm: a sphere of that radius at the corner, as a sphere scene with the
+  // same reduced mass; with Hertz and with the plastic default (Thornton).
+  for (const std::string law : {"contact_law = \"hertz\"", ""}) {
+    const nlohmann::json rounded = impact_json(box_drop(kCorner, 35, "edge_radius = 0.5", law));
+    EXPECT_NEAR(rounded["effective_radius_m"].get<double>(), 5e-4, 1e-15);
+    EXPECT_EQ(rounded["sharp_feature"]["rounded_by_edge_radius"], true);
+    EXPECT_NEAR(rounded["reduced_mass_kg"].get<double>(), m_w, kSameImpactRel * m_w);  // the same lever arm
+    const nlohmann::json sphere = impact_json(sphere_drop(0.5, rounded["reduced_mass_kg"].get<double>(), law));
+    expect_same_impact(rounded, sphere);
+    EXPECT_EQ(rounded["contact_law"], law.empty() ? "thornton" : "hertz");
+  }
+}
+
+TEST(SharpScene, BoxOnEdgeWedgeAndRoundedLineContact) {
+  // Without edge_radius, "auto" with a yield strength: the wedge along the 200 mm edge, 90 deg.
+  const nlohmann::json wedge = impact_json(box_drop(kEdge, 45, "", ""));
+  EXPECT_EQ(wedge["contact_law"], "wedge");
+  EXPECT_EQ(wedge["sharp_feature"]["kind"], "edge");
+  EXPECT_NEAR(wedge["sharp_feature"]["dihedral_angle_deg"].get<double>(), 90.0, 1e-9);
+  EXPECT_NEAR(wedge["sharp_feature"]["edge_length_m"].get<double>(), 0.2, 1e-12);
+  EXPECT_GT(wedge["residual_indentation_m"].get<double>(), 0.0);
+  EXPECT_TRUE(wedge["checks"]["passed"].get<bool>());
+  // With edge_radius: a cylinder along the edge on the flat floor, whose contact length is at once
+  // the whole edge: the line contact over L = 200 mm, F = (pi/4) E* L d.
+  const nlohmann::json line = impact_json(box_drop(kEdge, 45, "edge_radius = 0.5", ""));
+  EXPECT_EQ(line["contact_law"], "line");
+  const double m = line["reduced_mass_kg"].get<double>(), E = line["effective_modulus_Pa"].get<double>();
+  const double k = 0.25 * M_PI * E * 0.2;
+  EXPECT_NEAR(line["max_force_N"].get<double>(), 3.0 * std::sqrt(m * k), 1e-9 * 3.0 * std::sqrt(m * k));
+  EXPECT_NEAR(line["effective_radius_m"].get<double>(), 5e-4, 1e-15);
+  EXPECT_EQ(line["restitution"].get<double>(), 1.0);
+  EXPECT_TRUE(line["checks"]["passed"].get<bool>());
+  // Hertz alone on the sharp edge refuses.
+  EXPECT_NE(error_of(box_drop(kEdge, 45, "", "contact_law = \"hertz\"")).find("edge_radius"), std::string::npos);
+}
+
+TEST(SharpScene, WedgeOrConeAtASmoothPointIsRefused) {
+  const std::string e = error_of(sphere_drop(5.0, 1.0, "contact_law = \"cone\""));
+  EXPECT_NE(e.find("law of a sharp edge or corner"), std::string::npos) << e;
+}
+
+// A rounded edge on a body curved along it: elliptical Hertz while the contact's length 2a along
+// the edge is shorter than the edge, the line contact once it reaches it. The box's long edge
+// (200 mm, rounded to 0.5 mm) falls on the top of a fixed steel sphere of radius R: R = 10 m gives
+// a contact some 10 mm long (a/b of a few hundred), R = 1000 km one longer than the edge.
+TEST(SharpScene, RoundedEdgeOnACurvedBodyTurnsLineWhenTheContactSpansTheEdge) {
+  auto on_sphere = [](double radius_mm) {
+    return R"(length_unit = "mm"
+[materials.steel]
+youngs_modulus_Pa = 2.1e11
+poisson_ratio = 0.3
+[[bodies]]
+name = "dome"
+shape = "sphere"
+radius = )" + exact(radius_mm) + R"(
+material = "steel"
+fixed = true
+)" + box_body("[1, 0, 0]", 45, "edge_radius = 0.5") + R"(
+[[impacts]]
+name = "drop"
+target = "dome"
+impactor = "box"
+point = [0, 0, )" + exact(radius_mm) + R"(]
+approach_speed_m_s = 3.0
+)";
+  };
+  const nlohmann::json short_contact = impact_json(on_sphere(1e4));
+  EXPECT_EQ(short_contact["contact_law"], "hertz");
+  EXPECT_EQ(short_contact["sharp_feature"]["rounded_by_edge_radius"], true);
+  const double a = short_contact["validity"]["contact_semi_axis_a_m"].get<double>();
+  EXPECT_GT(a, 1e-3);
+  EXPECT_LT(2.0 * a, 0.2);
+  const nlohmann::json spanning = impact_json(on_sphere(1e9));
+  EXPECT_EQ(spanning["contact_law"], "line");
+  EXPECT_NEAR(spanning["effective_radius_m"].get<double>(), 5e-4, 1e-12);  // across the edge: rho (and 1/R of the dome)
+  EXPECT_NEAR(spanning["validity"]["contact_semi_axis_a_m"].get<double>(), 0.1, 1e-12);
+}
