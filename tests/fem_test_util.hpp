@@ -2,6 +2,7 @@
 // Helpers shared by the FEM test files: a fresh output folder under the build tree, a file's text,
 // a box as a CAD export writes it, a small ellipsoid deck request.
 #include <array>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -71,6 +72,26 @@ inline fem_export::DeckRequest ellipsoid_request() {
   r.options.mesh.load_mesh_size_m = 0.15;
   r.options.mesh.probes_m = {Eigen::Vector3d(0, 0.4, 0.25)};
   return r;
+}
+
+// One result block in ccx's fixed-width .frd layout (ccx 2.20 User's Manual, result format).
+inline void frd_block(std::ostream& o, double t, const char* name, const std::vector<std::vector<double>>& rows) {
+  char line[256];
+  std::snprintf(line, sizeof line, "  100CL  101%12.5E%12d                     1    1           1\n", t,
+                static_cast<int>(rows.size()));
+  o << line;
+  std::snprintf(line, sizeof line, " -4  %-8s%4d    1\n", name, static_cast<int>(rows[0].size()));
+  o << line;
+  for (std::size_t n = 0; n < rows.size(); ++n) {
+    std::snprintf(line, sizeof line, " -1%10d", static_cast<int>(n + 1));
+    o << line;
+    for (double v : rows[n]) {
+      std::snprintf(line, sizeof line, "%12.5E", v);
+      o << line;
+    }
+    o << "\n";
+  }
+  o << " -3\n";
 }
 
 }  // namespace impactdeck::test

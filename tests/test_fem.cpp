@@ -15,6 +15,7 @@
 #include "impactdeck/fem_export/mesh.hpp"
 #include "impactdeck/geometry/mesh_io.hpp"
 #include "fem_test_util.hpp"
+#include "comm_parse.hpp"
 #include "tolerances.hpp"
 
 namespace fs = std::filesystem;
@@ -143,79 +144,10 @@ TEST(FemMed, ReadsBackWithMdumpWithCountsAndGroups) {
 
 // ---- Code_Aster keyword table (its command catalogues, code_aster/Cata/Commands, 15.2) -----
 
-namespace {
-
-struct Call {
-  std::string command;
-  std::map<std::string, std::string> keys;  // top-level keyword -> raw value
-  std::set<std::string> nested;             // keywords inside _F(...)
-};
-
-std::vector<std::string> split_top(const std::string& s) {
-  std::vector<std::string> parts;
-  int depth = 0;
-  bool quote = false;
-  std::string cur;
-  for (char c : s) {
-    if (c == '\'') quote = !quote;
-    if (!quote && (c == '(')) ++depth;
-    if (!quote && (c == ')')) --depth;
-    if (!quote && depth == 0 && c == ',') {
-      parts.push_back(cur);
-      cur.clear();
-      continue;
-    }
-    cur += c;
-  }
-  if (cur.find_first_not_of(" \n") != std::string::npos) parts.push_back(cur);
-  return parts;
-}
-
-std::vector<Call> parse_comm(const std::string& text) {
-  std::string code;
-  std::istringstream in(text);
-  for (std::string l; std::getline(in, l);) code += l.substr(0, l.find('#')) + "\n";
-  std::vector<Call> calls;
-  const std::regex head(R"(^\s*(?:[A-Za-z_][A-Za-z0-9_]*\s*=\s*)?([A-Z_]+)\s*\()");
-  std::size_t pos = 0;
-  while (pos < code.size()) {
-    std::smatch m;
-    const std::string rest = code.substr(pos);
-    if (!std::regex_search(rest, m, head)) break;
-    const std::size_t open = pos + m.position(0) + m.length(0) - 1;
-    int depth = 0;
-    std::size_t close = open;
-    for (; close < code.size(); ++close) {
-      if (code[close] == '(') ++depth;
-      if (code[close] == ')' && --depth == 0) break;
-    }
-    Call c;
-    c.command = m[1];
-    for (const std::string& part : split_top(code.substr(open + 1, close - open - 1))) {
-      const auto eq = part.find('=');
-      if (eq == std::string::npos) continue;
-      std::string k = part.substr(0, eq);
-      k.erase(0, k.find_first_not_of(" \n"));
-      k.erase(k.find_last_not_of(" \n") + 1);
-      const std::string v = part.substr(eq + 1);
-      c.keys[k] = v;
-      const std::regex nested_key(R"(([A-Z_]+)\s*=)");
-      for (auto it = std::sregex_iterator(v.begin(), v.end(), nested_key); it != std::sregex_iterator(); ++it) {
-        c.nested.insert((*it)[1]);
-      }
-    }
-    calls.push_back(c);
-    pos = close + 1;
-  }
-  return calls;
-}
-
-std::string strip(std::string v) {
-  v.erase(std::remove_if(v.begin(), v.end(), [](char ch) { return ch == ' ' || ch == '\n'; }), v.end());
-  return v;
-}
-
-}  // namespace
+using test::Call;
+using test::parse_comm;
+using test::split_top;
+using test::strip;
 
 TEST(FemCodeAster, CommMatchesTheKeywordTableOfDecksMd) {
   const fs::path d = fresh_dir("comm");
@@ -229,7 +161,7 @@ TEST(FemCodeAster, CommMatchesTheKeywordTableOfDecksMd) {
   EXPECT_NE(comm.find("impactdeck "), std::string::npos);
 
   // command -> allowed top-level keywords, allowed keywords inside _F (Code_Aster's catalogues).
-  const std::map<std::string, std::pair<std::set<std::string>, std::set<std::string>>> table = {
+  const test::KeywordTable table = {
       {"DEBUT", {{}, {}}},
       {"LIRE_MAILLAGE", {{"FORMAT", "UNITE"}, {}}},
       {"AFFE_MODELE", {{"MAILLAGE", "AFFE"}, {"GROUP_MA", "TOUT", "PHENOMENE", "MODELISATION"}}},
@@ -253,17 +185,8 @@ TEST(FemCodeAster, CommMatchesTheKeywordTableOfDecksMd) {
   EXPECT_EQ(calls.front().command, "DEBUT");
   EXPECT_TRUE(calls.front().keys.empty()) << "DEBUT() must be bare (15.x rejects CODE=)";
   EXPECT_EQ(calls.back().command, "FIN");
-  std::map<std::string, const Call*> first;
-  for (const Call& c : calls) {
-    auto t = table.find(c.command);
-    ASSERT_NE(t, table.end()) << "command not in the keyword table: " << c.command;
-    for (const auto& [k, v] : c.keys) EXPECT_TRUE(t->second.first.count(k)) << c.command << " " << k;
-    for (const auto& k : c.nested) {
-      EXPECT_TRUE(t->second.first.count(k) || t->second.second.count(k)) << c.command << " _F " << k;
-    }
-    first.emplace(c.command, &c);
-  }
-  for (const auto& [cmd, spec] : table) EXPECT_TRUE(first.count(cmd)) << "missing " << cmd;
+  const auto first = test::check_keywords(calls, table);
+  ASSERT_FALSE(::testing::Test::HasFailure());
 
   const Call& dv = *first.at("DYNA_VIBRA");
   EXPECT_EQ(strip(dv.keys.at("TYPE_CALCUL")), "'TRAN'");

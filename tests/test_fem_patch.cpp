@@ -214,29 +214,7 @@ TEST(FemPatch, BadPatchesAreRefusedWithReasons) {
 
 // ---- Stresses read back from a .frd ----------------------------------------------------------
 
-namespace {
-
-// One result block in ccx's fixed-width .frd layout (ccx 2.20 User's Manual, result format).
-void frd_block(std::ostream& o, double t, const char* name, const std::vector<std::vector<double>>& rows) {
-  char line[256];
-  std::snprintf(line, sizeof line, "  100CL  101%12.5E%12d                     1    1           1\n", t,
-                static_cast<int>(rows.size()));
-  o << line;
-  std::snprintf(line, sizeof line, " -4  %-8s%4d    1\n", name, static_cast<int>(rows[0].size()));
-  o << line;
-  for (std::size_t n = 0; n < rows.size(); ++n) {
-    std::snprintf(line, sizeof line, " -1%10d", static_cast<int>(n + 1));
-    o << line;
-    for (double v : rows[n]) {
-      std::snprintf(line, sizeof line, "%12.5E", v);
-      o << line;
-    }
-    o << "\n";
-  }
-  o << " -3\n";
-}
-
-}  // namespace
+using test::frd_block;
 
 TEST(FemStress, VonMisesPeaksZonesAndVerdictFromAFrd) {
   const fs::path d = fresh_dir("frd");
@@ -308,7 +286,8 @@ TEST(FemStress, VonMisesPeaksZonesAndVerdictFromAFrd) {
 
   // Files: CSV with a column per series, VTU with every node and tetrahedron, MSH views, SVG.
   write_stress_files(d, m, r, "test");
-  ASSERT_EQ(r.files.size(), 5u);  // the CSV's JSON sidecar too
+  // The CSV's JSON sidecar too, and the time series: results.pvd and one .vtu per output time (2).
+  ASSERT_EQ(r.files.size(), 8u);
   const std::string csv = slurp(d / "von_mises_history.csv");
   EXPECT_EQ(csv.rfind("time_s,PROBE1_von_mises_Pa,LOAD_von_mises_Pa\n", 0), 0u) << "no comment lines: " << csv;
   const nlohmann::json side = nlohmann::json::parse(slurp(d / "von_mises_history.csv.json"));

@@ -46,6 +46,10 @@ struct Deck {
   bool patch_load = false;
   double contact_zone_radius_m = 0;
   std::optional<double> yield_strength_Pa;
+  // deck.json "plastic" (material_model = "plastic"): what the plastic verdict needs.
+  bool plastic = false;
+  double plastic_zone_radius_m = 0, residual_indentation_m = 0, dent_radius_m = 0;
+  std::string contact_law;
   std::string impact;
   DeckUnits units;  // deck.json length_unit (older decks: mm)
   const Solver* solver = nullptr;  // the solver that runs it (deck_from)
@@ -143,6 +147,18 @@ Deck deck_from(const json& j, const std::string& where) {
     d.contact_zone_radius_m = j.value("contact_zone_radius_m", 0.0);
     if (j.contains("yield_strength_Pa") && j.at("yield_strength_Pa").is_number()) {
       d.yield_strength_Pa = j.at("yield_strength_Pa").get<double>();
+    }
+    if (j.value("material_model", std::string("elastic")) == "plastic") {
+      const json& p = j.at("plastic");
+      d.plastic = true;
+      d.plastic_zone_radius_m = p.at("plastic_zone_radius_m").get<double>();
+      d.residual_indentation_m = p.at("residual_indentation_m").get<double>();
+      d.dent_radius_m = p.at("dent_radius_m").get<double>();
+      d.contact_law = p.at("contact_law").get<std::string>();
+      if (!(d.plastic_zone_radius_m > 0) || !(d.residual_indentation_m >= 0) || !(d.dent_radius_m >= 0) ||
+          !std::isfinite(d.plastic_zone_radius_m + d.residual_indentation_m + d.dent_radius_m)) {
+        throw InputError(where, "plastic", "plastic_zone_radius_m must be > 0, the dent and its radius >= 0");
+      }
     }
     // The first solver that runs here and whose files the deck has (the first one's key is required).
     const Solver* first = nullptr;
@@ -381,6 +397,11 @@ CheckResult check_deck(const fs::path& dir, const Deck& deck, const CheckOptions
     si.yield_strength_Pa = deck.yield_strength_Pa;
     si.end_time_s = deck.end_time_s;
     si.length_unit = deck.units.length;
+    si.plastic = deck.plastic;
+    si.plastic_zone_radius_m = deck.plastic_zone_radius_m;
+    si.contact_law = deck.contact_law;
+    si.residual_indentation_m = deck.residual_indentation_m;
+    si.dent_radius_m = deck.dent_radius_m;
     r.stress = deck.solver->stresses(job, si);
   }
   if (r.stress) {

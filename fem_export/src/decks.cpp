@@ -19,6 +19,7 @@
 #include "impactdeck/common/version.hpp"
 #include "impactdeck/fem_export/force_table.hpp"
 #include "impactdeck/fem_export/solver.hpp"
+#include "impactdeck/fem_export/stress.hpp"
 #include "deck_text.hpp"
 #include "impactdeck/common/json_number.hpp"
 #include "impactdeck/common/numeric.hpp"
@@ -75,6 +76,18 @@ void validate(const DeckRequest& r, const InputContext& where) {
   }
   if (!(t.min_gamma >= 0 && t.min_gamma < 1)) throw where.error("min_gamma", "must lie in [0, 1)");
   if (r.yield_strength_Pa && !(*r.yield_strength_Pa > 0)) throw where.error("yield_strength_Pa", "must be > 0");
+  if (r.material.model == MaterialModel::plastic) {
+    if (!r.yield_strength_Pa) {
+      throw where.error("material_model", "material_model = \"plastic\" needs the target material's yield_strength_Pa");
+    }
+    const auto& et = r.material.tangent_modulus_Pa;
+    if (et && !(*et >= 0 && *et < r.material.youngs_modulus_Pa)) {
+      throw where.error("tangent_modulus_Pa", "must lie in [0, E)");
+    }
+  }
+  if (!(r.residual_indentation_m >= 0) || !(r.dent_radius_m >= 0)) {
+    throw where.error("dent", "residual indentation and dent radius must be finite and >= 0");
+  }
   for (const std::string& name : o.solvers) {
     if (find_solver(name)) continue;
     std::string known;
@@ -123,6 +136,18 @@ bool DeckOptions::writes(const std::string& name) const {
 }
 
 const char* to_string(LoadKind k) { return k == LoadKind::hertz_patch ? "hertz-patch" : "point"; }
+
+const char* to_string(MaterialModel m) { return m == MaterialModel::plastic ? "plastic" : "elastic"; }
+
+std::vector<HardeningRow> hardening_table(const DeckMaterial& m, double yield_Pa) {
+  std::vector<HardeningRow> rows = {{yield_Pa, 0.0}};
+  const double et = m.tangent_modulus_Pa.value_or(0.0), e = m.youngs_modulus_Pa;
+  if (et > 0 && et < e) {
+    const double h = e * et / (e - et);  // plastic modulus: d(sigma) / d(plastic strain)
+    rows.push_back({yield_Pa + h * kHardeningTableMaxStrain, kHardeningTableMaxStrain});
+  }
+  return rows;
+}
 
 bool spin_is_significant(const RigidReference& part, const Eigen::Vector3d& p, const Eigen::Vector3d& d) {
   if (!(part.mass_kg > 0)) return false;
@@ -486,6 +511,8 @@ DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
     }
     const ScopedTimer decks_timer([&](double sec) { out.decks_seconds += sec; });  // to the end of the writing
     out.contact_zone_radius_m = std::max(r.options.contact_zone_factor * r.patch.a_max_m, 2.0 * q.load_mesh_size_m);
+    out.plastic_zone_radius_m = std::max(kLocalPlasticZoneFactor * std::max(r.patch.a_max_m, r.dent_radius_m),
+                                         2.0 * q.load_mesh_size_m);
     out.body_check = compare_body(m, r.material.density_kg_m3, r.model, r.options.tolerances,
                                   r.impulse_Ns * r.direction, r.load_point_m);
     const PatchLoad* pl = patch ? &*patch : nullptr;
@@ -592,6 +619,7 @@ DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
                  {"poisson_ratio", r.material.poisson_ratio},
                  {"density_kg_m3", r.material.density_kg_m3},
                  {"yield_strength_Pa", r.yield_strength_Pa ? json(*r.yield_strength_Pa) : json(nullptr)},
+                 {"material_model", to_string(r.material.model)},
                  {"probes", probes},
                  {"model", {{"mass_kg", r.model.mass_kg},
                             {"volume_m3", r.model.volume_m3},
@@ -609,6 +637,21 @@ DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
                                  {"min_gamma", t.min_gamma}}},
                  {"mesh", quality},
                  {"files", names}};
+    if (r.material.model == MaterialModel::plastic) {
+      json hardening = json::array();
+      for (const HardeningRow& h : hardening_table(r.material, *r.yield_strength_Pa)) {
+        hardening.push_back({{"stress_Pa", h.stress_Pa}, {"plastic_strain", h.plastic_strain}});
+      }
+      deck["plastic"] = {{"tangent_modulus_Pa", json_number(r.material.tangent_modulus_Pa)},
+                         {"hardening", hardening},
+                         {"nlgeom", true},
+                         {"plastic_strain_threshold", kPlasticStrainThreshold},
+                         {"plastic_zone_radius_m", out.plastic_zone_radius_m},
+                         {"plastic_zone_factor", kLocalPlasticZoneFactor},
+                         {"contact_law", r.contact_law},
+                         {"residual_indentation_m", r.residual_indentation_m},
+                         {"dent_radius_m", r.dent_radius_m}};
+    }
     for (const Solver* s : registered) s->describe(input, r.options.writes(s->name()), deck);  // "calculix": true, ...
     write_file_atomically(stage / "deck.json", deck.dump(2) + "\n");
     out.description = std::move(deck);

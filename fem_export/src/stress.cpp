@@ -2,6 +2,8 @@
 #include "impactdeck/fem_export/stress.hpp"
 
 #include <algorithm>
+#include <array>
+#include <cstdio>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -110,6 +112,47 @@ void record_values(const std::string& line, std::size_t lineno, const std::strin
   }
 }
 
+// A DISP record's three components (the deck's length unit).
+Eigen::Vector3d frd_displacement(const std::string& line, std::size_t lineno, const std::string& where) {
+  double u[3];
+  record_values(line, lineno, where, 3, u, "displacement");
+  return {u[0], u[1], u[2]};
+}
+
+// The result blocks the readers use (ccx 2.20 .frd names; PE only when asked for).
+enum class FrdBlock { none, disp, stress, pe };
+FrdBlock frd_block_kind(const std::string& line, bool with_pe) {
+  if (line.rfind(" -4  DISP", 0) == 0) return FrdBlock::disp;
+  if (line.rfind(" -4  STRESS", 0) == 0) return FrdBlock::stress;
+  if (with_pe && line.rfind(" -4  PE ", 0) == 0) return FrdBlock::pe;
+  return FrdBlock::none;
+}
+
+// The end of a VTK XML UnstructuredGrid piece (written by hand: we do not link VTK): the mesh's
+// points (times `per_m`, the deck's length unit), its tetrahedra (VTK type 10), the closing tags.
+void vtu_mesh_and_end(std::ostream& o, const TetMesh& m, double per_m) {
+  o << "<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
+  for (const auto& p : m.nodes_m) {
+    const Eigen::Vector3d x = p * per_m;
+    o << x.x() << " " << x.y() << " " << x.z() << "\n";
+  }
+  o << "</DataArray>\n</Points>\n<Cells>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
+  for (const auto& t : m.tets) o << t[0] << " " << t[1] << " " << t[2] << " " << t[3] << "\n";
+  o << "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
+  for (std::size_t e = 0; e < m.tets.size(); ++e) o << 4 * (e + 1) << "\n";
+  o << "</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
+  for (std::size_t e = 0; e < m.tets.size(); ++e) o << "10\n";
+  o << "</DataArray>\n</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
+}
+
+// The 0-based mesh node of a result line's node number (checked against the mesh's `n` nodes).
+std::size_t frd_node(long id, std::size_t n, const std::string& where, std::size_t lineno) {
+  if (id > static_cast<long>(n)) {
+    throw InputError(where, "line " + std::to_string(lineno), "a result line names a node the mesh does not have");
+  }
+  return static_cast<std::size_t>(id) - 1;
+}
+
 }  // namespace
 
 const char* to_string(VerdictKind k) {
@@ -117,6 +160,9 @@ const char* to_string(VerdictKind k) {
     case VerdictKind::survives: return "survives";
     case VerdictKind::yields: return "yields";
     case VerdictKind::no_yield_strength: return "no yield strength given";
+    case VerdictKind::survives_elastically: return "survives elastically";
+    case VerdictKind::local_plastic_strain: return "survives with local plastic strain";
+    case VerdictKind::yields_beyond_contact: return "yields beyond the contact zone";
   }
   return "?";
 }
@@ -131,6 +177,8 @@ StressResult read_stresses(const fs::path& frd, const TetMesh& mesh, const Stres
     throw InputError(where, "LOAD", "load node is not a node of the mesh");
   }
   StressResult r;
+  r.results_file = frd;
+  r.end_time_s = in.end_time_s;
   r.length_unit = in.length_unit;
   const DeckUnits units{in.length_unit};
   r.contact_zone_radius_m = in.contact_zone_radius_m;
@@ -150,8 +198,26 @@ StressResult read_stresses(const fs::path& frd, const TetMesh& mesh, const Stres
   std::vector<Eigen::Vector3d> disp(n, Eigen::Vector3d::Zero());
   std::vector<double> vm(n, 0.0);
   std::vector<char> seen(n, 0);
-  enum class Block { none, disp, stress } block = Block::none;
+  using Block = FrdBlock;
+  Block block = Block::none;
   double t = 0, governing_best = -1;
+  // Plastic decks: each output time's PE block (after its STRESS block) updates the peaks.
+  std::vector<double> pe(n, 0.0);
+  bool pe_seen = false;
+  PlasticResult plastic;
+  plastic.plastic_zone_radius_m = in.plastic_zone_radius_m;
+  if (in.plastic) r.node_peak_plastic_strain.assign(n, 0.0);
+  auto finish_pe = [&] {
+    pe_seen = true;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (pe[i] <= r.node_peak_plastic_strain[i]) continue;
+      r.node_peak_plastic_strain[i] = pe[i];
+      const double dist = (mesh.nodes_m[i] - c).norm();
+      PlasticStrainPeak now{pe[i], t, static_cast<int>(i), mesh.nodes_m[i], dist};
+      if (pe[i] > plastic.max.plastic_strain) plastic.max = now;
+      if (dist > in.plastic_zone_radius_m && pe[i] > plastic.beyond_zone.plastic_strain) plastic.beyond_zone = now;
+    }
+  };
   bool skip = false;
   auto finish_stress = [&] {
     for (std::size_t i = 0; i < n; ++i) {
@@ -194,22 +260,19 @@ StressResult read_stresses(const fs::path& frd, const TetMesh& mesh, const Stres
     skip = t > in.end_time_s * (1 + 1e-6);  // the momentum step's increment
   };
   visit.block = [&](const std::string& line) {
-    block = skip                                     ? Block::none
-            : line.rfind(" -4  DISP", 0) == 0   ? Block::disp
-            : line.rfind(" -4  STRESS", 0) == 0 ? Block::stress
-                                                     : Block::none;
+    block = skip ? Block::none : frd_block_kind(line, in.plastic);
     if (block == Block::stress) std::fill(seen.begin(), seen.end(), 0);
+    if (block == Block::pe) std::fill(pe.begin(), pe.end(), 0.0);
     return block != Block::none;
   };
   visit.record = [&](long id, const std::string& line, std::size_t lineno) {
-    if (id > static_cast<long>(n)) {
-      throw InputError(where, "line " + std::to_string(lineno), "a result line names a node the mesh does not have");
-    }
-    const std::size_t node = static_cast<std::size_t>(id) - 1;
+    const std::size_t node = frd_node(id, n, where, lineno);
     if (block == Block::disp) {
-      double u[3];
-      record_values(line, lineno, where, 3, u, "displacement");
-      disp[node] = Eigen::Vector3d(u[0], u[1], u[2]) / units.per_m();
+      disp[node] = frd_displacement(line, lineno, where) / units.per_m();
+    } else if (block == Block::pe) {
+      double e;
+      record_values(line, lineno, where, 1, &e, "equivalent plastic strain");
+      pe[node] = e;  // dimensionless
     } else {
       double sv[6];
       record_values(line, lineno, where, 6, sv, "stress");
@@ -219,6 +282,7 @@ StressResult read_stresses(const fs::path& frd, const TetMesh& mesh, const Stres
   };
   visit.end = [&] {
     if (block == Block::stress) finish_stress();
+    if (block == Block::pe) finish_pe();
     block = Block::none;
   };
   r.frd_bytes = scan_frd(f, where, visit);
@@ -242,6 +306,22 @@ StressResult read_stresses(const fs::path& frd, const TetMesh& mesh, const Stres
     v.safety_factor = v.governing.von_mises_Pa > 0 ? *in.yield_strength_Pa / v.governing.von_mises_Pa : 0.0;
     v.kind = v.governing.von_mises_Pa > *in.yield_strength_Pa ? VerdictKind::yields : VerdictKind::survives;
     if (v.kind == VerdictKind::survives) v.first_yield_time_s.reset();
+  }
+  if (in.plastic) {
+    if (!pe_seen) {
+      throw InputError(where, "PE", "no equivalent plastic strain output (a plastic deck requests *EL FILE PEEQ; did ccx finish?)");
+    }
+    plastic.contact_law = in.contact_law;
+    plastic.residual_indentation_m = in.residual_indentation_m;
+    plastic.dent_radius_m = in.dent_radius_m;
+    for (double e : r.node_peak_plastic_strain) plastic.yielded_nodes += e > plastic.threshold;
+    // The verdict rests on the plastic strain: the von Mises of a yielded body is capped by its
+    // hardening and says nothing more (its peaks stay reported above).
+    v.kind = plastic.beyond_zone.plastic_strain > plastic.threshold ? VerdictKind::yields_beyond_contact
+             : plastic.max.plastic_strain > plastic.threshold      ? VerdictKind::local_plastic_strain
+                                                                   : VerdictKind::survives_elastically;
+    v.first_yield_time_s.reset();
+    r.plastic = plastic;
   }
   return r;
 }
@@ -345,18 +425,8 @@ void write_stress_files(const fs::path& dir, const TetMesh& m, StressResult& r, 
     scalars("von_mises_at_peak_Pa", r.von_mises_at_peak_Pa);
     o << "<DataArray type=\"Float64\" Name=\"displacement_at_peak_m\" NumberOfComponents=\"3\" format=\"ascii\">\n";
     for (const auto& u : r.displacement_at_peak_m) o << u.x() << " " << u.y() << " " << u.z() << "\n";
-    o << "</DataArray>\n</PointData>\n<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-    for (const auto& p : m.nodes_m) {
-      const Eigen::Vector3d x = p * per_m;
-      o << x.x() << " " << x.y() << " " << x.z() << "\n";
-    }
-    o << "</DataArray>\n</Points>\n<Cells>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
-    for (const auto& t : m.tets) o << t[0] << " " << t[1] << " " << t[2] << " " << t[3] << "\n";
-    o << "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
-    for (std::size_t e = 0; e < m.tets.size(); ++e) o << 4 * (e + 1) << "\n";
-    o << "</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
-    for (std::size_t e = 0; e < m.tets.size(); ++e) o << "10\n";
-    o << "</DataArray>\n</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
+    o << "</DataArray>\n</PointData>\n";
+    vtu_mesh_and_end(o, m, per_m);
   });
 
   // 3. Gmsh MSH 2.2 with $NodeData views (open with gmsh; positions in the deck's unit like the .vtu,
@@ -429,6 +499,135 @@ void write_stress_files(const fs::path& dir, const TetMesh& m, StressResult& r, 
     r.files.push_back(svg);
   }
   r.files.insert(r.files.begin(), {csv, csv_sidecar_path(csv), vtu, msh});
+  // 5. The results as a VTK time series (ParaView animates the wave).
+  for (const auto& f : write_results_series(dir, m, r)) r.files.push_back(f);
+}
+
+// VTK's XML formats written by hand (we do not link VTK): ASCII UnstructuredGrid pieces and a
+// ParaView collection (.pvd) naming them with their times.
+std::vector<fs::path> write_results_series(const fs::path& dir, const TetMesh& m, const StressResult& r) {
+  if (r.results_file.empty() || r.time_s.empty()) return {};
+  const std::string where = r.results_file.string();
+  const std::size_t n = m.nodes_m.size(), times = r.time_s.size();
+  const double by_budget = std::floor(kSeriesNodeFileBudget / static_cast<double>(std::max<std::size_t>(n, 1)));
+  const std::size_t most = std::max<std::size_t>(2, std::min<std::size_t>(kMaxSeriesFiles, static_cast<std::size_t>(by_budget)));
+  const std::size_t stride = (times + most - 1) / most;
+  std::vector<char> keep(times, 0);
+  for (std::size_t k = 0; k < times; k += stride) keep[k] = 1;
+  keep[times - 1] = 1;
+  for (std::size_t k = 0; k < times; ++k) {
+    if (r.time_s[k] == r.peak_field_time_s) keep[k] = 1;
+  }
+  // Thinning the stride's picks next to the two forced ones keeps the count within `most`.
+  std::size_t kept = 0;
+  for (char c : keep) kept += c;
+  for (std::size_t k = times - 1; kept > most && k > 0; --k) {
+    if (keep[k] && k != times - 1 && r.time_s[k] != r.peak_field_time_s) keep[k] = 0, --kept;
+  }
+
+  const DeckUnits units{r.length_unit};
+  const std::string length = to_string(r.length_unit), stress_unit = units.stress_unit();
+  std::vector<Eigen::Vector3d> disp(n, Eigen::Vector3d::Zero());
+  std::vector<std::array<double, 6>> stress(n, std::array<double, 6>{});
+  std::vector<double> pe(n, 0.0);
+  bool has_pe = false, pending = false;
+  using Block = FrdBlock;
+  Block block = Block::none;
+  double t = 0, pending_t = 0;
+  std::size_t index = 0;  // stress blocks read: the index into r.time_s
+  std::vector<std::pair<double, std::string>> written;
+  std::vector<fs::path> files;
+  auto flush = [&] {
+    if (!pending) return;
+    pending = false;
+    char name[32];
+    std::snprintf(name, sizeof name, "results_%04zu.vtu", written.size());
+    const fs::path vtu = dir / name;
+    write_file_atomically(vtu, [&](std::ostream& o) {
+      o << std::setprecision(9);
+      o << "<?xml version=\"1.0\"?>\n<!-- impactdeck: CalculiX results at t = " << pending_t
+        << " s in the deck's units: positions and displacement in " << length << ", stresses in " << stress_unit
+        << " (" << units.name() << ") -->\n"
+        << "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n<FieldData>\n";
+      auto text = [&](const char* key, const std::string& value) {  // a string array: its bytes, 0-terminated
+        o << "<DataArray type=\"String\" Name=\"" << key << "\" NumberOfTuples=\"1\" format=\"ascii\">";
+        for (unsigned char ch : value) o << static_cast<int>(ch) << " ";
+        o << "0</DataArray>\n";
+      };
+      text("length_unit", length);
+      text("stress_unit", stress_unit);
+      o << "<DataArray type=\"Float64\" Name=\"metres_per_length_unit\" NumberOfTuples=\"1\" format=\"ascii\">"
+        << metres_per(r.length_unit) << "</DataArray>\n"
+        << "<DataArray type=\"Float64\" Name=\"pascals_per_stress_unit\" NumberOfTuples=\"1\" format=\"ascii\">"
+        << 1.0 / units.per_Pa() << "</DataArray>\n"
+        << "<DataArray type=\"Float64\" Name=\"TimeValue\" NumberOfTuples=\"1\" format=\"ascii\">" << pending_t
+        << "</DataArray>\n</FieldData>\n"
+        << "<Piece NumberOfPoints=\"" << n << "\" NumberOfCells=\"" << m.tets.size() << "\">\n"
+        << "<PointData Scalars=\"von_mises\" Vectors=\"displacement\" Tensors=\"stress\">\n"
+        << "<DataArray type=\"Float64\" Name=\"displacement\" NumberOfComponents=\"3\" format=\"ascii\">\n";
+      for (const auto& u : disp) o << u.x() << " " << u.y() << " " << u.z() << "\n";
+      o << "</DataArray>\n<DataArray type=\"Float64\" Name=\"stress\" NumberOfComponents=\"6\" format=\"ascii\">\n";
+      for (const auto& v : stress) o << v[0] << " " << v[1] << " " << v[2] << " " << v[3] << " " << v[4] << " " << v[5] << "\n";
+      o << "</DataArray>\n<DataArray type=\"Float64\" Name=\"von_mises\" format=\"ascii\">\n";
+      for (const auto& v : stress) o << von_mises(v.data()) << "\n";
+      o << "</DataArray>\n";
+      if (has_pe) {
+        o << "<DataArray type=\"Float64\" Name=\"equivalent_plastic_strain\" format=\"ascii\">\n";
+        for (double e : pe) o << e << "\n";
+        o << "</DataArray>\n";
+      }
+      o << "</PointData>\n";
+      vtu_mesh_and_end(o, m, units.per_m());
+    });
+    written.emplace_back(pending_t, name);
+    files.push_back(vtu);
+  };
+  std::ifstream f(r.results_file, std::ios::binary);
+  if (!f) throw InputError(where, "file", "CalculiX results (.frd) cannot be opened (missing or unreadable)");
+  bool skip = false;
+  FrdVisitor visit;
+  visit.time = [&](double time_s) {
+    if (time_s != t) flush();  // the blocks of one output time share its header's time
+    t = time_s;
+    skip = t > r.end_time_s * (1 + 1e-6);
+  };
+  visit.block = [&](const std::string& line) {
+    block = skip ? Block::none : frd_block_kind(line, true);
+    if (block == Block::pe) std::fill(pe.begin(), pe.end(), 0.0), has_pe = true;
+    return block != Block::none;
+  };
+  visit.record = [&](long id, const std::string& line, std::size_t lineno) {
+    const std::size_t node = frd_node(id, n, where, lineno);
+    if (block == Block::disp) {
+      disp[node] = frd_displacement(line, lineno, where);  // the deck's length unit, as the positions
+    } else if (block == Block::stress) {
+      record_values(line, lineno, where, 6, stress[node].data(), "stress");
+    } else {
+      record_values(line, lineno, where, 1, &pe[node], "equivalent plastic strain");
+    }
+  };
+  visit.end = [&] {
+    if (block == Block::stress) {
+      if (index < times && keep[index]) pending = true, pending_t = t;
+      ++index;
+    }
+    block = Block::none;
+  };
+  scan_frd(f, where, visit);
+  flush();
+  const fs::path pvd = dir / "results.pvd";
+  write_file_atomically(pvd, [&](std::ostream& o) {
+    o << std::setprecision(12);
+    o << "<?xml version=\"1.0\"?>\n<!-- impactdeck: the CalculiX results as a time series (" << written.size() << " of "
+      << times << " output times); lengths in " << length << ", stresses in " << stress_unit << " -->\n"
+      << "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n<Collection>\n";
+    for (const auto& [time, file] : written) {
+      o << "<DataSet timestep=\"" << time << "\" group=\"\" part=\"0\" file=\"" << file << "\"/>\n";
+    }
+    o << "</Collection>\n</VTKFile>\n";
+  });
+  files.insert(files.begin(), pvd);
+  return files;
 }
 
 std::string format_stress(const StressResult& r) {
@@ -453,6 +652,17 @@ std::string format_stress(const StressResult& r) {
   if (v.kind == VerdictKind::survives) {
     s << ", safety factor " << v.safety_factor << " against yield " << mpa(*v.yield_strength_Pa) << " MPa ("
       << v.governing_region << ")";
+  } else if (r.plastic) {
+    const PlasticResult& p = *r.plastic;
+    const PlasticStrainPeak& at = v.kind == VerdictKind::yields_beyond_contact ? p.beyond_zone : p.max;
+    if (at.node >= 0 && v.kind != VerdictKind::survives_elastically) {
+      s << ": equivalent plastic strain " << at.plastic_strain << " at " << mm_text(at.point_m) << ", "
+        << at.distance_m * 1e3 << " mm from the contact point, " << at.time_s << " s";
+    } else {
+      s << ": no equivalent plastic strain above " << p.threshold;
+    }
+    s << " (threshold " << p.threshold << "; local within " << p.plastic_zone_radius_m * 1e3 << " mm); dent "
+      << p.residual_indentation_m * 1e3 << " mm of radius " << p.dent_radius_m * 1e3 << " mm (" << p.contact_law << " law)";
   } else if (v.kind == VerdictKind::yields) {
     s << ": " << mpa(v.governing.von_mises_Pa) << " MPa > yield " << mpa(*v.yield_strength_Pa) << " MPa at "
       << mm_text(v.governing.point_m) << ", " << v.governing.time_s << " s (" << v.governing_region
@@ -493,9 +703,45 @@ json to_json(const StressResult& r) {
                   {"governing", peak(v.governing)},
                   {"safety_factor", v.yield_strength_Pa && v.governing.von_mises_Pa > 0 ? json(v.safety_factor) : json(nullptr)},
                   {"first_yield_time_s", v.first_yield_time_s ? json(*v.first_yield_time_s) : json(nullptr)}};
+  json extra = json::object();
+  if (r.plastic) {
+    const PlasticResult& p = *r.plastic;
+    const double per = DeckUnits{r.length_unit}.per_m();
+    auto pe_peak = [&](const PlasticStrainPeak& k) {
+      if (k.node < 0) return json(nullptr);
+      return json{{"value", k.plastic_strain},
+                  {"node", k.node + 1},
+                  {"point", json_vector(Eigen::Vector3d(k.point_m * per))},
+                  {"length_unit", to_string(r.length_unit)},
+                  {"point_m", json_vector(k.point_m)},
+                  {"distance_from_contact_m", k.distance_m},
+                  {"time_s", k.time_s}};
+    };
+    verdict["safety_factor"] = nullptr;  // a yielded body's von Mises is capped by its hardening
+    verdict["max_equivalent_plastic_strain"] = p.max.plastic_strain;
+    verdict["governing_plastic_strain"] =
+        pe_peak(v.kind == VerdictKind::yields_beyond_contact ? p.beyond_zone : p.max);
+    verdict["plastic_strain_threshold"] = p.threshold;
+    verdict["plastic_zone_radius_m"] = p.plastic_zone_radius_m;
+    verdict["contact_law"] = p.contact_law;
+    verdict["residual_indentation_m"] = p.residual_indentation_m;
+    verdict["dent_radius_m"] = p.dent_radius_m;
+    json out = pe_peak(p.max);
+    if (out.is_null()) out = {{"value", 0.0}, {"node", nullptr}, {"point", nullptr}, {"length_unit", to_string(r.length_unit)},
+                              {"point_m", nullptr}, {"distance_from_contact_m", nullptr}, {"time_s", nullptr}};
+    json plastic = {{"beyond_plastic_zone", pe_peak(p.beyond_zone)},
+                    {"plastic_strain_threshold", p.threshold},
+                    {"plastic_zone_radius_m", p.plastic_zone_radius_m},
+                    {"yielded_nodes", p.yielded_nodes},
+                    {"contact_law", p.contact_law},
+                    {"residual_indentation_m", p.residual_indentation_m},
+                    {"dent_radius_m", p.dent_radius_m}};
+    extra = {{"max_equivalent_plastic_strain", out}, {"plastic", plastic}};
+  }
   json files = json::array();
   for (const auto& f : r.files) files.push_back(f.string());
-  return {{"probes", probes},
+  json j = {{"material_model", r.plastic ? "plastic" : "elastic"},
+          {"probes", probes},
           {"load_node", load},
           {"contact_zone_radius_m", r.contact_zone_radius_m},
           {"outside_contact_zone", peak(r.outside_zone)},
@@ -505,6 +751,8 @@ json to_json(const StressResult& r) {
           {"peak_field_time_s", r.peak_field_time_s},
           {"frd_bytes", r.frd_bytes},
           {"files", files}};
+  j.update(extra);
+  return j;
 }
 
 }  // namespace impactdeck::fem_export

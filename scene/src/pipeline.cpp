@@ -193,6 +193,10 @@ fem_export::ContactPatch contact_patch(const ImpactReport& ir, const PreparedBod
   p.b_max_m = k.contact_semi_axis_b_m;
   p.axis_a = ir.spec->contact_radius == ContactRadiusRule::elliptical ? target.pose.direction_to_own(k.direction_A)
                                                                       : ir.contact.target_curvature.d1;
+  // A plastic law's contact at F_max is the dent's circle sqrt(R* d*) (docs/plastic.md), wider
+  // than the elastic ellipse of the same force: the patch load spreads the force over it, so its
+  // mean pressure is the law's (p_y for Thornton), and the contact zone is measured from it.
+  if (ir.dent_radius_m > std::max(p.a_max_m, p.b_max_m)) p.a_max_m = p.b_max_m = ir.dent_radius_m;
   return p;
 }
 
@@ -215,6 +219,13 @@ fem_export::DeckRequest fem_request(const Scene& scene, const ImpactReport& ir, 
   r.material.poisson_ratio = target.material.poisson_ratio;
   r.material.density_kg_m3 = target.mass_kg / target.volume.volume_m3;  // honours mass_kg
   r.yield_strength_Pa = scene.materials.at(b.material).yield_strength_Pa;
+  if (f.material_model == FemOutputs::MaterialModel::plastic) {
+    r.material.model = fem_export::MaterialModel::plastic;
+    r.material.tangent_modulus_Pa = scene.materials.at(b.material).tangent_modulus_Pa;
+  }
+  r.contact_law = ir.contact_law;
+  r.residual_indentation_m = ir.result.kernel.residual_indentation_m;
+  r.dent_radius_m = ir.dent_radius_m;
   r.force = *ir.table;
   r.impulse_Ns = ir.result.history.impulse_total_Ns();
   r.direction = -ir.contact.target_point.normal;

@@ -452,7 +452,8 @@ FemOutputs read_fem(const toml::table& t, const Source& file, double to_m) {
            "angular_momentum_tolerance", "model_linear_velocity_tolerance", "model_angular_velocity_tolerance",
            "volume_tolerance", "mass_tolerance", "inertia_tolerance", "min_gamma", "max_elements", "solver",
            "aster_cpus", "aster_mpi_processes", "compare_contact", "compare_contact_threshold", "compare_contact_refine",
-           "compare_contact_elements", "compare_contact_increments", "compare_contact_penalty_factor"});
+           "compare_contact_elements", "compare_contact_increments", "compare_contact_penalty_factor",
+           "material_model"});
   FemOutputs f;
   f.place = r.self();
   if (r.has("mesh_size")) f.mesh_size_m = r.positive("mesh_size") * to_m;
@@ -528,6 +529,10 @@ FemOutputs read_fem(const toml::table& t, const Source& file, double to_m) {
                                            {"iterative", FemOutputs::Solver::iterative}},
                                           FemOutputs::Solver::automatic);
   if (!f.code_aster && !f.calculix) r.fail("calculix", "code_aster and calculix are both false: no deck to write");
+  f.material_model = r.choice<FemOutputs::MaterialModel>(
+      "material_model", {{"elastic", FemOutputs::MaterialModel::elastic}, {"plastic", FemOutputs::MaterialModel::plastic}},
+      FemOutputs::MaterialModel::elastic);
+  f.material_model_place = r.has("material_model") ? r.place("material_model") : f.place;
   if (r.boolean("compare_contact").value_or(false)) {
     FemOutputs::CompareContact c;
     if (!f.calculix) r.fail("compare_contact", "compare_contact = true runs CalculiX: it needs calculix = true");
@@ -545,6 +550,9 @@ FemOutputs read_fem(const toml::table& t, const Source& file, double to_m) {
         r.fail(key, "must be a whole number in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
       }
       *into = static_cast<int>(n);
+    }
+    if (f.material_model == FemOutputs::MaterialModel::plastic) {
+      r.fail("material_model", "material_model = \"plastic\" with compare_contact = true: the full-contact model is elastic");
     }
     f.compare_contact = c;
   } else {
@@ -822,6 +830,17 @@ Scene build(const toml::table& root, const Source& file, const fs::path& base_di
   if (sc.impacts.empty() && sc.sequences.empty()) r.fail("impacts", "at least one impact (or a [[sequences]] entry) is needed");
 
   if (const toml::node* n = r.get("outputs")) sc.outputs = read_outputs(sub_table(n, "outputs", file), file, to_m);
+  if (sc.outputs.fem && sc.outputs.fem->material_model == FemOutputs::MaterialModel::plastic) {
+    // The plastic deck's hardening starts at the target material's yield strength (docs/fem.md).
+    for (const ImpactSpec& s : sc.impacts) {
+      const Material& mt = sc.materials.at(sc.body(s.target).material);
+      if (!mt.yield_strength_Pa) {
+        throw file.error(sc.outputs.fem->material_model_place,
+                         "material_model = \"plastic\" needs the target's yield strength: material '" + mt.name +
+                             "' (target '" + s.target + "' of impact '" + s.name + "') has no yield_strength_Pa");
+      }
+    }
+  }
   if (sc.outputs.fem && sc.outputs.fem->compare_contact) {
     for (const ImpactSpec& s : sc.impacts) {
       if (s.contact_law != "auto" && s.contact_law != "hertz") {

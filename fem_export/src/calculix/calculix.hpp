@@ -12,6 +12,12 @@
 
 namespace impactdeck::fem_export::calculix {
 
+/// Plastic decks, steps after the contact: ccx may cut an increment down to this fraction of the
+/// step (automatic incrementation; deck.cpp says why) ...
+inline constexpr double kPlasticMinIncrementFraction = 1e-4;
+/// ... and may take this many times the step's increments (its INC bound).
+inline constexpr std::size_t kPlasticIncrementHeadroom = 20;
+
 class CalculixSolver final : public Solver {
  public:
   std::string name() const override { return "calculix"; }

@@ -22,16 +22,29 @@ constexpr const char* kMedMesh = "BODYMESH";
 std::string code_aster_comm(const DeckRequest& r, const TetMesh& m, const PatchLoad* patch) {
   const DeckOptions& o = r.options;
   std::ostringstream s;
-  s << header_lines("#", r, "Code_Aster command file (DYNA_VIBRA, versions 15.x and later)");
+  const bool plastic = r.material.model == MaterialModel::plastic;
+  s << header_lines("#", r, std::string("Code_Aster command file (") + (plastic ? "DYNA_NON_LINE" : "DYNA_VIBRA") +
+                                ", versions 15.x and later)");
   s << "# Files (units): mesh.med (20), probe velocity tables (38), von Mises at the probes and LOAD (39),\n"
        "# results MED (80); see impact.export.\n";
   s << "DEBUT()\n\n";
   s << "MAIL = LIRE_MAILLAGE(FORMAT='MED', UNITE=20)\n\n";
   s << "MODELE = AFFE_MODELE(MAILLAGE=MAIL,\n"
        "                     AFFE=_F(GROUP_MA=('BODY',), PHENOMENE='MECANIQUE', MODELISATION='3D'))\n\n";
+  if (plastic) {
+    s << "# Elastic-plastic: von Mises with linear isotropic hardening (ECRO_LINE: D_SIGM_EPSI = the tangent\n"
+         "# modulus E_t, 0 = perfectly plastic; SY = the yield strength), run by DYNA_NON_LINE with VMIS_ISOT_LINE\n"
+         "# in large strains (GDEF_LOG); V1 of VARI_NOEU is the cumulated plastic strain.\n";
+  }
   s << "MATER = DEFI_MATERIAU(ELAS=_F(E=" << num(r.material.youngs_modulus_Pa * r.options.units.per_Pa())
     << ", NU=" << num(r.material.poisson_ratio) << ", RHO=" << num(r.material.density_kg_m3 * r.options.units.per_kg_m3())
-    << "))\n\n";
+    << ")";
+  if (plastic) {
+    s << ",\n                      ECRO_LINE=_F(D_SIGM_EPSI="
+      << num(r.material.tangent_modulus_Pa.value_or(0.0) * r.options.units.per_Pa())
+      << ", SY=" << num(r.yield_strength_Pa.value_or(0.0) * r.options.units.per_Pa()) << ")";
+  }
+  s << ")\n\n";
   s << "CHMAT = AFFE_MATERIAU(MAILLAGE=MAIL, AFFE=_F(GROUP_MA=('BODY',), MATER=MATER))\n\n";
   auto function = [&](const std::string& name, const std::vector<double>& t, const std::vector<double>& f) {
     s << name << " = DEFI_FONCTION(NOM_PARA='INST',\n                      VALE=(\n";
@@ -72,26 +85,38 @@ std::string code_aster_comm(const DeckRequest& r, const TetMesh& m, const PatchL
     s << "_F(JUSQU_A=" << num(g.end_s) << ", PAS=" << num(g.step_s) << "),\n                                   ";
   }
   s << "_F(JUSQU_A=" << num(o.end_time_s) << ", PAS=" << num(ts.main_step_s) << ")))\n\n";
-  s << "ASSEMBLAGE(MODELE=MODELE,\n"
-       "           CHAM_MATER=CHMAT,\n"
-       "           NUME_DDL=CO('NUMEDDL'),\n"
-       "           MATR_ASSE=(_F(MATRICE=CO('RIGI'), OPTION='RIGI_MECA'),\n"
-       "                      _F(MATRICE=CO('MASS'), OPTION='MASS_MECA')))\n\n";
-  s << "# Free body: K + a0 M is positive definite. SCHEMA written explicitly (15.x defaults to DIFF_CENTRE).\n";
-  s << "RESU = DYNA_VIBRA(TYPE_CALCUL='TRAN',\n"
-       "                  BASE_CALCUL='PHYS',\n"
-       "                  MODELE=MODELE,\n"
-       "                  CHAM_MATER=CHMAT,\n"
-       "                  MATR_MASS=MASS,\n"
-       "                  MATR_RIGI=RIGI,\n"
-       "                  SCHEMA_TEMPS=_F(SCHEMA='NEWMARK', BETA=0.25, GAMMA=0.5),\n"
-       "                  INCREMENT=_F(LIST_INST=LINST),\n"
-       "                  EXCIT=(" << excit << "))\n\n";
+  if (plastic) {
+    s << "# Implicit Newmark (average acceleration, as the elastic deck) with Newton on the tangent matrix.\n";
+    s << "RESU = DYNA_NON_LINE(MODELE=MODELE,\n"
+         "                     CHAM_MATER=CHMAT,\n"
+         "                     EXCIT=(" << excit << "),\n"
+         "                     COMPORTEMENT=_F(RELATION='VMIS_ISOT_LINE', DEFORMATION='GDEF_LOG', GROUP_MA=('BODY',)),\n"
+         "                     INCREMENT=_F(LIST_INST=LINST),\n"
+         "                     SCHEMA_TEMPS=_F(SCHEMA='NEWMARK', BETA=0.25, GAMMA=0.5, FORMULATION='DEPLACEMENT'),\n"
+         "                     NEWTON=_F(MATRICE='TANGENTE', REAC_INCR=1, REAC_ITER=1),\n"
+         "                     CONVERGENCE=_F(RESI_GLOB_RELA=1.0e-06, ITER_GLOB_MAXI=20))\n\n";
+  } else {
+    s << "ASSEMBLAGE(MODELE=MODELE,\n"
+         "           CHAM_MATER=CHMAT,\n"
+         "           NUME_DDL=CO('NUMEDDL'),\n"
+         "           MATR_ASSE=(_F(MATRICE=CO('RIGI'), OPTION='RIGI_MECA'),\n"
+         "                      _F(MATRICE=CO('MASS'), OPTION='MASS_MECA')))\n\n";
+    s << "# Free body: K + a0 M is positive definite. SCHEMA written explicitly (15.x defaults to DIFF_CENTRE).\n";
+    s << "RESU = DYNA_VIBRA(TYPE_CALCUL='TRAN',\n"
+         "                  BASE_CALCUL='PHYS',\n"
+         "                  MODELE=MODELE,\n"
+         "                  CHAM_MATER=CHMAT,\n"
+         "                  MATR_MASS=MASS,\n"
+         "                  MATR_RIGI=RIGI,\n"
+         "                  SCHEMA_TEMPS=_F(SCHEMA='NEWMARK', BETA=0.25, GAMMA=0.5),\n"
+         "                  INCREMENT=_F(LIST_INST=LINST),\n"
+         "                  EXCIT=(" << excit << "))\n\n";
+  }
   s << "# Von Mises stress (component VMIS)" << (patch ? "" : "; singular at the load node itself (point force)") << ".\n";
   s << "RESU = CALC_CHAMP(reuse=RESU,\n"
        "                  RESULTAT=RESU,\n"
        "                  CONTRAINTE=('SIGM_ELNO',),\n"
-       "                  CRITERES=('SIEQ_ELNO', 'SIEQ_NOEU'))\n\n";
+       "                  CRITERES=('SIEQ_ELNO', 'SIEQ_NOEU')" << (plastic ? ",\n                  VARI_INTERNE=('VARI_ELNO', 'VARI_NOEU')" : "") << ")\n\n";
   const auto probes = probe_groups(m);
   if (!probes.empty()) s << "# Velocity of each probe node, " << to_string(r.options.units.length) << "/s, one table per component (unit 38).\n";
   const char* comps[3] = {"DX", "DY", "DZ"};
@@ -120,7 +145,7 @@ std::string code_aster_comm(const DeckRequest& r, const TetMesh& m, const PatchL
   }
   s << "))\n\n";
   s << "IMPR_RESU(FORMAT='MED', UNITE=80,\n"
-       "          RESU=_F(RESULTAT=RESU, NOM_CHAM=('DEPL', 'VITE', 'SIEQ_NOEU')))\n\n";
+       "          RESU=_F(RESULTAT=RESU, NOM_CHAM=('DEPL', 'VITE', 'SIEQ_NOEU'" << (plastic ? ", 'VARI_NOEU'" : "") << ")))\n\n";
   s << "FIN()\n";
   return s.str();
 }

@@ -44,11 +44,41 @@ struct DeckUnits {
   std::string stress_unit() const;  ///< "MPa", "Pa", "N/cm2", "N/in2"
 };
 
+/// The target's constitutive model in the decks (`[outputs.fem] material_model`).
+enum class MaterialModel {
+  elastic,  ///< linear elastic (the paper's): *ELASTIC / ELAS, DYNA_VIBRA
+  /// elastic-plastic, von Mises with bilinear isotropic hardening from DeckRequest::yield_strength_Pa
+  /// and DeckMaterial::tangent_modulus_Pa: ccx *PLASTIC with NLGEOM, Code_Aster ECRO_LINE with
+  /// VMIS_ISOT_LINE in DYNA_NON_LINE; the equivalent plastic strain is read back (stress.hpp).
+  plastic,
+};
+const char* to_string(MaterialModel m);
+
 struct DeckMaterial {
   double youngs_modulus_Pa = 0;
   double poisson_ratio = 0;
   double density_kg_m3 = 0;
+  MaterialModel model = MaterialModel::elastic;
+  /// plastic: E_t in [0, E), the slope of the bilinear stress-strain curve past yield; unset:
+  /// perfectly plastic (E_t = 0).
+  std::optional<double> tangent_modulus_Pa;
 };
+
+/// The plastic strain up to which the hardening table is written (ccx's *PLASTIC holds the last
+/// stress beyond its last row): 1, far past the strains of a dent (d/a ~ 0.1, strains ~ 0.2 a/R).
+inline constexpr double kHardeningTableMaxStrain = 1.0;
+
+/// One row of a hardening table: the yield stress after `plastic_strain` of equivalent plastic strain.
+struct HardeningRow {
+  double stress_Pa = 0;
+  double plastic_strain = 0;
+};
+/// The bilinear (isotropic) hardening of `m` with yield strength `yield_Pa`: (Y, 0) and, when
+/// E_t > 0, (Y + H eps, eps) at eps = kHardeningTableMaxStrain with the plastic modulus
+/// H = E E_t / (E - E_t) (the slope against plastic strain of a line of slope E_t against total
+/// strain). Linear between the rows, so two rows are exact; E_t = 0: the single row (Y, 0),
+/// perfectly plastic.
+std::vector<HardeningRow> hardening_table(const DeckMaterial& m, double yield_Pa);
 
 /// part: a triangulated part from memory (mesh_part); cad: a STEP/IGES/BREP file meshed from its
 /// B-rep (mesh_cad).
@@ -193,6 +223,11 @@ struct DeckRequest {
   ContactPatch patch;
   RigidReference model;                     ///< the rigid model (FE-vs-model checks)
   std::optional<double> yield_strength_Pa;  ///< the target's material: the stress verdict
+  /// What the contact law says about the dent (the plastic verdict reports them): the law that
+  /// ran, the residual dent summed over both bodies and the dent radius sqrt(R* d*) (0: none).
+  std::string contact_law;
+  double residual_indentation_m = 0;
+  double dent_radius_m = 0;
   DeckOptions options;
   /// Where the request comes from (`run`: the scene file, its [outputs.fem] key and the impact):
   /// an error about the request or its meshing names it, then the deck folder or the file meshed
@@ -254,6 +289,9 @@ struct DeckResult {
   LoadKind load = LoadKind::point;
   PatchSummary patch;
   double contact_zone_radius_m = 0;
+  /// plastic: plastic strain within this distance of the contact point is local (stress.hpp,
+  /// kLocalPlasticZoneFactor): max(3 max(a_max, dent radius), 2 load element sizes).
+  double plastic_zone_radius_m = 0;
   BodyComparison body_check;
   nlohmann::json description;  ///< deck.json's contents, as written
   TetMesh mesh;               ///< the mesh of mesh.inp and mesh.med, in metres, as meshed

@@ -10,6 +10,9 @@
 //   - the verdict against the yield strength: survives (safety factor) or yields (place, time).
 // Under a point load the stress near the load node grows without bound as the mesh is refined,
 // so the zone's peak is reported as not meaningful and only the outside one is judged.
+// A plastic deck (material_model = "plastic") also writes ccx's equivalent plastic strain ("PE"
+// blocks of the .frd, *EL FILE PEEQ); its verdict rests on it (docs/fem.md, "Plastic decks"):
+// survives elastically, survives with local plastic strain, or yields beyond the contact zone.
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -22,6 +25,20 @@
 
 namespace impactdeck::fem_export {
 
+/// Equivalent plastic strain above which a node counts as yielded: a tenth of the yield strain of
+/// steel (Y/E ~ 1e-3), so yield is not missed, and far above the exact 0 ccx writes at nodes whose
+/// elements stayed elastic (a hand-check: a nodal PE is the average of its C3D4 elements' one
+/// integration point, so one yielded element leaves at least a quarter of its strain on each of
+/// its nodes).
+inline constexpr double kPlasticStrainThreshold = 1e-4;
+/// Plastic strain within this many contact radii (max of the contact semi-axis a_max and the law's
+/// dent radius sqrt(R* d*)) of the contact point is local: the plastic zone under a fully plastic
+/// indentation reaches a few contact radii (Johnson, Contact Mechanics, 1985, Sect. 6.3, the
+/// expanding-cavity model), the same reach as the stress verdict's contact zone
+/// (contact_zone_factor = 3). It is never less than 2 load element sizes: under a point load the
+/// elements around the load node yield whatever the contact size.
+inline constexpr double kLocalPlasticZoneFactor = 3.0;
+
 /// What the reader needs to know about the deck (deck.json) besides the mesh.
 struct StressInputs {
   int load_node = 0;                                  ///< 0-based mesh node of the contact point
@@ -33,6 +50,11 @@ struct StressInputs {
   /// The deck's length unit (DeckUnits): the .frd's displacements are in it and its stresses in
   /// N per its square; the .vtu / .msh positions are written in it.
   LengthUnit length_unit = LengthUnit::mm;
+  /// material_model = "plastic": the verdict rests on the equivalent plastic strain (PE).
+  bool plastic = false;
+  double plastic_zone_radius_m = 0;          ///< plastic: "local" within this of the contact point
+  std::string contact_law;                   ///< plastic: the law whose dent is reported
+  double residual_indentation_m = 0, dent_radius_m = 0;
 };
 
 /// The largest von Mises stress of a region over all output times.
@@ -52,7 +74,14 @@ struct ProbeStress {
   std::vector<double> von_mises_Pa;  ///< at StressResult::time_s
 };
 
-enum class VerdictKind { no_yield_strength, survives, yields };
+enum class VerdictKind {
+  no_yield_strength,
+  survives,  ///< elastic deck: governing von Mises below the yield strength
+  yields,    ///< elastic deck: above it
+  survives_elastically,    ///< plastic deck: no PE above kPlasticStrainThreshold
+  local_plastic_strain,    ///< plastic deck: PE above it only within the plastic zone radius
+  yields_beyond_contact,   ///< plastic deck: PE above it beyond the plastic zone radius
+};
 const char* to_string(VerdictKind k);
 
 struct Verdict {
@@ -62,6 +91,26 @@ struct Verdict {
   std::string governing_region;      ///< "outside the contact zone" / "inside the contact zone"
   double safety_factor = 0;          ///< yield strength / governing peak
   std::optional<double> first_yield_time_s;  ///< yields: first output time above the yield strength
+};
+
+/// The largest equivalent plastic strain of a region over all output times (plastic decks).
+struct PlasticStrainPeak {
+  double plastic_strain = 0;
+  double time_s = 0;
+  int node = -1;  ///< 0-based; -1 when no node of the region has plastic strain
+  Eigen::Vector3d point_m = Eigen::Vector3d::Zero();
+  double distance_m = 0;  ///< from the contact node
+};
+
+/// The plastic deck's result: PE read back and the dent of the law.
+struct PlasticResult {
+  PlasticStrainPeak max;                 ///< the whole body
+  PlasticStrainPeak beyond_zone;         ///< beyond plastic_zone_radius_m of the contact node
+  double threshold = kPlasticStrainThreshold;
+  double plastic_zone_radius_m = 0;
+  std::size_t yielded_nodes = 0;         ///< nodes whose PE exceeded the threshold at some time
+  std::string contact_law;
+  double residual_indentation_m = 0, dent_radius_m = 0;
 };
 
 struct StressResult {
@@ -75,6 +124,11 @@ struct StressResult {
   std::vector<double> outside_zone_history_Pa, inside_zone_history_Pa;
   bool inside_zone_meaningful = false;  ///< false under a point load
   Verdict verdict;
+  std::optional<PlasticResult> plastic;  ///< plastic decks only
+  /// Per node: the largest PE over time (plastic decks; empty otherwise).
+  std::vector<double> node_peak_plastic_strain;
+  std::filesystem::path results_file;    ///< the .frd read (the VTK time series is written from it)
+  double end_time_s = 0;                 ///< output after this is not the impact's (the momentum step)
   /// The fields of the .vtu / .msh: per node, the peak over time and its time; the von Mises and
   /// displacement at the time of the governing peak.
   std::vector<double> node_peak_Pa, node_peak_time_s, von_mises_at_peak_Pa;
@@ -104,6 +158,23 @@ std::vector<double> read_node_stresses(const std::filesystem::path& frd, std::ve
 /// paper's Fig. 15: von Mises against time at the probes and the load). Records them in `files`.
 void write_stress_files(const std::filesystem::path& dir, const TetMesh& mesh, StressResult& r,
                         const std::string& title);
+
+/// The VTK time series (write_results_series): at most this many .vtu files, ...
+inline constexpr std::size_t kMaxSeriesFiles = 100;
+/// ... and at most this many nodes x files (about 150 bytes of ASCII per node and file: ~300 MB);
+/// fewer files on a big mesh, never fewer than 2.
+inline constexpr double kSeriesNodeFileBudget = 2e6;
+
+/// Writes the ccx results of r.results_file as a VTK time series into `dir`: results.pvd and
+/// results_NNNN.vtu, one per kept output time up to r.end_time_s (every k-th, k the smallest that
+/// keeps within kMaxSeriesFiles and kSeriesNodeFileBudget; the last time and the governing peak's
+/// time always kept). Point data in the deck's unit system (the .frd's): displacement (same length
+/// unit as the positions), stress (6 components XX YY ZZ XY YZ XZ), von_mises, and
+/// equivalent_plastic_strain when the .frd has PE. Each .vtu states its units in FieldData
+/// (length_unit, stress_unit, metres_per_length_unit, pascals_per_stress_unit) and a comment, and
+/// its time in FieldData TimeValue. Returns the files written (the .pvd first).
+std::vector<std::filesystem::path> write_results_series(const std::filesystem::path& dir, const TetMesh& mesh,
+                                                        const StressResult& r);
 
 /// JSON of the result (keys in docs/fem.md).
 nlohmann::json to_json(const StressResult& r);

@@ -147,6 +147,10 @@ struct FemOutputs {
     double penalty_factor = 20;   ///< compare_contact_penalty_factor
   };
   std::optional<CompareContact> compare_contact;
+  /// `material_model`: "elastic" (the default) or "plastic" (bilinear from the target material's
+  /// yield_strength_Pa and tangent_modulus_Pa; docs/fem.md, "Plastic decks").
+  enum class MaterialModel { elastic, plastic } material_model = MaterialModel::elastic;
+  Place material_model_place;  ///< where the key is (errors about it name it)
   Place place;
 };
 
