@@ -226,6 +226,17 @@ plot::PartSurface boundary(const fem_export::TetMesh& m) {
 }
 
 // The von Mises field at the governing peak's time on the FE mesh's surface.
+// What the stress picture's caption says about plastic strain (the picture shows von Mises).
+std::string plastic_caption(const fem_export::StressResult& st) {
+  if (!st.plastic) return "Plastic strain: none (the deck's material is linear elastic).";
+  const fem_export::PlasticResult& p = *st.plastic;
+  if (p.yielded_nodes == 0)
+    return "Plastic strain: none above " + g(p.threshold, 3) + " (the deck's material is elastic-plastic).";
+  return "Plastic strain: up to " + g(p.max.plastic_strain, 3) + " at " + g(p.max.distance_m * 1e3, 3) +
+         " mm from the contact, " + std::to_string(p.yielded_nodes) + " node(s) above " + g(p.threshold, 3) +
+         " (the deck's material is elastic-plastic; results.pvd carries PE per increment).";
+}
+
 std::string stress_picture(const ImpactReport& ir, std::string& caption) {
   const fem_export::TetMesh& m = ir.fem_deck->mesh;
   const fem_export::StressResult& st = *ir.fem_check->stress;
@@ -261,7 +272,7 @@ std::string stress_picture(const ImpactReport& ir, std::string& caption) {
                           plot::format_number(cap * 1e-6, 3) +
                           " MPa, outside the contact zone): higher values (the point load's node and its neighbours) take the top colour"
                     : "") +
-            ". Plastic strain: none (the deck's material is linear elastic).";
+            ". " + plastic_caption(st);
   return plot::to_svg(plot::part_drawing(s, mk, o));
 }
 
@@ -281,11 +292,53 @@ std::string impact_part_svg(const Scene& scene, const std::string& impact, const
   return part_picture(*s, point_m, normal, Eigen::Vector3d::Zero(), bodies, scene.length_unit, caption);
 }
 
+namespace {
+
+// A plastic deck's verdict: the equivalent plastic strain read back (fem_export's three verdicts).
+ImpactVerdict plastic_verdict(const fem_export::Verdict& fv, const fem_export::PlasticResult& pr) {
+  ImpactVerdict v;
+  v.word = fem_export::to_string(fv.kind);
+  const std::string dent = "; dent " + g(pr.residual_indentation_m * 1e3, 3) + " mm deep, radius " +
+                           g(pr.dent_radius_m * 1e3, 3) + " mm (" + pr.contact_law + " law)";
+  const auto at = [](const fem_export::PlasticStrainPeak& p) {
+    return " at " + vec3(p.point_m, 1e3, 3) + " mm (the deck's frame), " + g(p.distance_m * 1e3, 3) +
+           " mm from the contact, t = " + g(p.time_s * 1e6, 3) + " \xC2\xB5s";
+  };
+  const std::string head = "FEM (CalculiX, elastic-plastic): ";
+  if (fv.kind == fem_export::VerdictKind::survives_elastically) {
+    v.kind = ImpactVerdict::Kind::survives;
+    if (fv.safety_factor > 0) v.safety_factor = fv.safety_factor;
+    v.basis = head + "no equivalent plastic strain above " + g(pr.threshold, 3) + "; peak von Mises " +
+              g(fv.governing.von_mises_Pa / 1e6, 3) + " MPa " + fv.governing_region + dent;
+    // The law dents the part where the FE model shows no plastic strain: the mesh does not
+    // resolve the dent (a point load, elements larger than it), which the reader must know.
+    if (pr.residual_indentation_m > 0)
+      v.basis += ": the law's contact is plastic where the FE mesh shows none (elements larger than the dent; refine "
+                 "the mesh at the contact to resolve it)";
+  } else if (fv.kind == fem_export::VerdictKind::local_plastic_strain) {
+    v.kind = ImpactVerdict::Kind::survives;
+    v.basis = head + "max equivalent plastic strain " + g(pr.max.plastic_strain, 3) + at(pr.max) + ", within the " +
+              g(pr.plastic_zone_radius_m * 1e3, 3) + " mm plastic zone; " + std::to_string(pr.yielded_nodes) +
+              " node(s) above " + g(pr.threshold, 3) + dent;
+  } else {
+    v.kind = ImpactVerdict::Kind::yields;
+    v.basis = head + "equivalent plastic strain " + g(pr.beyond_zone.plastic_strain, 3) + at(pr.beyond_zone) +
+              ", beyond the " + g(pr.plastic_zone_radius_m * 1e3, 3) + " mm plastic zone (max " +
+              g(pr.max.plastic_strain, 3) + ")" + dent;
+  }
+  return v;
+}
+
+}  // namespace
+
 ImpactVerdict impact_verdict(const ImpactReport& ir) {
   ImpactVerdict v;
   if (ir.fem_check && ir.fem_check->stress && ir.fem_check->stress->verdict.yield_strength_Pa) {
-    const fem_export::Verdict& fv = ir.fem_check->stress->verdict;
+    const fem_export::StressResult& st = *ir.fem_check->stress;
+    const fem_export::Verdict& fv = st.verdict;
+    if (st.plastic) return plastic_verdict(fv, *st.plastic);
     v.kind = fv.kind == fem_export::VerdictKind::yields ? ImpactVerdict::Kind::yields : ImpactVerdict::Kind::survives;
+    v.word = fem_export::to_string(fv.kind);
     v.safety_factor = fv.safety_factor;
     v.basis = "FEM (CalculiX): yield strength " + g(*fv.yield_strength_Pa / 1e6, 3) + " MPa over the peak von Mises " +
               g(fv.governing.von_mises_Pa / 1e6, 3) + " MPa " + fv.governing_region + ", at " +
@@ -297,6 +350,7 @@ ImpactVerdict impact_verdict(const ImpactReport& ir) {
   if (r.peak_pressure_over_yield_onset && *r.peak_pressure_over_yield_onset > 0) {
     const double ratio = *r.peak_pressure_over_yield_onset;
     v.kind = ratio > 1.0 ? ImpactVerdict::Kind::yields : ImpactVerdict::Kind::survives;
+    v.word = ratio > 1.0 ? "yields" : "survives";
     v.safety_factor = 1.0 / ratio;
     v.basis = "Hertz: yield onset 1.60 sigma_y = " + g(r.yield_onset_pressure_Pa.value_or(0) / 1e6, 3) +
               " MPa of the " + r.yielding_body + " over the peak contact pressure p0 = " + g(r.peak_pressure_Pa / 1e6, 3) +
@@ -325,34 +379,34 @@ std::string report_html(const Scene& scene, const RunReport& rep, const std::vec
     page.table({"impact", "failed check", "value", "limit", "reason"}, rows);
   }
 
-  // Then the verdict.
+  // Then the verdict: the worst impact's words (yielding before surviving, plastic strain before
+  // none), with the smallest safety factor where one exists.
   ImpactVerdict::Kind overall = ImpactVerdict::Kind::none;
-  double worst = 0;
+  std::string overall_word;
+  int overall_rank = -1;
+  std::optional<double> worst;
   std::vector<std::vector<std::string>> verdict_rows;
-  for (const auto& ir : rep.impacts) {
-    const ImpactVerdict v = impact_verdict(ir);
-    std::string word = v.kind == ImpactVerdict::Kind::yields     ? "yields"
-                       : v.kind == ImpactVerdict::Kind::survives ? "survives"
-                                                                 : "no verdict";
-    if (v.kind != ImpactVerdict::Kind::none) {
-      if (overall == ImpactVerdict::Kind::none || v.safety_factor < worst) worst = v.safety_factor;
-      if (v.kind == ImpactVerdict::Kind::yields) overall = ImpactVerdict::Kind::yields;
-      else if (overall == ImpactVerdict::Kind::none) overall = ImpactVerdict::Kind::survives;
-      word = outcome(v.kind == ImpactVerdict::Kind::survives, word);
-    }
-    verdict_rows.push_back({ir.spec->name, word, v.kind == ImpactVerdict::Kind::none ? "" : g(v.safety_factor, 4), v.basis});
-  }
-  std::string verdict = overall == ImpactVerdict::Kind::yields     ? "Verdict: yields"
-                        : overall == ImpactVerdict::Kind::survives ? "Verdict: survives"
-                                                                   : "Verdict: none (no yield strength given)";
-  if (overall != ImpactVerdict::Kind::none) verdict += " (smallest safety factor " + g(worst, 4) + ")";
-  // The governing number under it: the basis of the impact with the smallest safety factor.
   std::string governing;
   for (const auto& ir : rep.impacts) {
     const ImpactVerdict v = impact_verdict(ir);
-    if (v.kind != ImpactVerdict::Kind::none && v.safety_factor == worst && governing.empty())
-      governing = "impact '" + ir.spec->name + "': " + v.basis;
+    std::string word = v.word;
+    if (v.kind != ImpactVerdict::Kind::none) {
+      const int rank = (v.kind == ImpactVerdict::Kind::yields ? 2 : 0) + (v.safety_factor ? 0 : 1);
+      const bool smaller = v.safety_factor && (!worst || *v.safety_factor < *worst);
+      if (rank > overall_rank || (rank == overall_rank && smaller)) {
+        overall_rank = rank;
+        overall = v.kind;
+        overall_word = v.word;
+        governing = "impact '" + ir.spec->name + "': " + v.basis;
+      }
+      if (smaller) worst = v.safety_factor;
+      word = outcome(v.kind == ImpactVerdict::Kind::survives, word);
+    }
+    verdict_rows.push_back({ir.spec->name, word, v.safety_factor ? g(*v.safety_factor, 4) : "", v.basis});
   }
+  std::string verdict = overall == ImpactVerdict::Kind::none ? "Verdict: none (no yield strength given)"
+                                                              : "Verdict: " + overall_word;
+  if (worst) verdict += " (smallest safety factor " + g(*worst, 4) + ")";
   page.html("<p id=\"verdict\" class=\"verdict " +
             std::string(overall == ImpactVerdict::Kind::yields ? "fail" : overall == ImpactVerdict::Kind::survives ? "pass" : "") +
             "\">" + plot::html_escape(verdict) + "</p>");

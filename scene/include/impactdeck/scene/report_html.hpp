@@ -8,6 +8,7 @@
 // the version, the inputs' date and SHA-256 hashes, and links to every file written. Every text
 // from the scene is escaped.
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,13 +24,19 @@ struct ReportPicture {
   std::string png;  ///< PNG bytes (a data URI), or empty
 };
 
-/// The verdict of one impact: from the FEM stresses when ccx ran (yield strength / governing
-/// peak von Mises), else from the Hertz peak pressure against the yield onset 1.60 sigma_y
-/// (Johnson); none without a yield strength.
+/// The verdict of one impact: from the FEM stresses when ccx ran (an elastic deck: yield strength /
+/// governing peak von Mises; a plastic deck: the equivalent plastic strain read back, the three
+/// plastic verdicts of docs/fem.md), else from the Hertz peak pressure against the yield onset
+/// 1.60 sigma_y (Johnson); none without a yield strength.
 struct ImpactVerdict {
   enum class Kind { none, survives, yields } kind = Kind::none;
-  double safety_factor = 0;  ///< > 1 survives
-  std::string basis;         ///< what it was judged on
+  /// The verdict in words: "survives", "yields", and for a plastic deck "survives elastically",
+  /// "survives with local plastic strain", "yields beyond the contact zone"; "no verdict".
+  std::string word = "no verdict";
+  /// Yield strength over the governing peak (> 1 survives); none where plastic strain was found
+  /// (a plastic deck's von Mises is capped near the yield strength: the strain is the measure).
+  std::optional<double> safety_factor;
+  std::string basis;  ///< what it was judged on
 };
 ImpactVerdict impact_verdict(const ImpactReport& ir);
 
