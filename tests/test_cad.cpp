@@ -661,3 +661,138 @@ TEST(Cad, ChildProcessTurnsAbortsCrashesAndHangsIntoOneInputError) {
   expect_input_error([&] { run_in_child(where, "triangulation", "the mesher", 60, []() -> std::string { throw InputError("", "face 3", "no triangles"); }, last); },
                      "^part\\.step: face 3: no triangles$");
 }
+
+TEST(Cad, SharpEdgesAndCornersOfTheBrepAreClassified) {
+  // Issue 30 item 8 on CAD parts: a B-rep's sharp edge or corner gets the same SharpFeature as a
+  // mesh's (the wedge, cone and line laws and edge_radius need it); before, a CAD part landing on
+  // an edge was refused even with edge_radius or a yield strength. A 10 x 20 x 30 mm box, rotated
+  // and far from the origin: the figures are exact (planar faces), to the CAD tolerance.
+  const auto box = CadShape::load(gmsh_cad("sharp_box.step", "Box(1) = {0, 0, 0, 10, 20, 30};\n" + place_geo()),
+                                  LengthUnit::mm);
+  const auto at = [&](const Eigen::Vector3d& local_mm, const Eigen::Vector3d& normal_local) {
+    SurfacePoint p;
+    p.point_m = placed(local_mm);
+    p.normal = R() * normal_local.normalized();
+    return p;
+  };
+  const double tol = test::kCadExactRel;
+  // A generic landing on the corner at the origin: three 90 deg edges, solid angle pi/2 (an octant),
+  // the cone of the same solid angle has half-angle acos(3/4).
+  auto sf = box->sharp_feature(at({0, 0, 0}, {-1, -2, -3}));
+  ASSERT_TRUE(sf);
+  EXPECT_EQ(sf->kind, SharpFeature::Kind::corner);
+  EXPECT_NEAR(sf->solid_angle_sr, kPi / 2, tol * kPi);
+  EXPECT_NEAR(sf->apex_half_angle_rad, std::acos(0.75), tol);
+  EXPECT_LE((sf->point_m - placed({0, 0, 0})).norm(), tol * box->size_m());
+  // The support point along a generic direction is that corner, classified the same way.
+  const auto sp = box->support_point(R() * Eigen::Vector3d(-1, -2, -3));
+  ASSERT_TRUE(sp);
+  EXPECT_LE((sp->point_m - placed({0, 0, 0})).norm(), tol * box->size_m());
+  SurfacePoint contact = *sp;  // as first contact asks: with the contact's normal, the direction
+  contact.normal = (R() * Eigen::Vector3d(-1, -2, -3)).normalized();
+  sf = box->sharp_feature(contact);
+  ASSERT_TRUE(sf);
+  EXPECT_EQ(sf->kind, SharpFeature::Kind::corner);
+  // The middle of the 30 mm edge along z: an edge, interior dihedral 90 deg, its direction and length.
+  sf = box->sharp_feature(at({0, 0, 12}, {-1, -1, 0}));
+  ASSERT_TRUE(sf);
+  EXPECT_EQ(sf->kind, SharpFeature::Kind::edge);
+  EXPECT_NEAR(sf->dihedral_angle_rad, kPi / 2, tol);
+  EXPECT_NEAR(std::abs(sf->direction.dot(R() * Eigen::Vector3d::UnitZ())), 1.0, tol);
+  EXPECT_NEAR(sf->length_m, 0.030, tol * 0.030);
+  // At the corner with the z edge lying in the contact's tangent plane: that edge is the contact.
+  sf = box->sharp_feature(at({0, 0, 0}, {-1, -1, 0}));
+  ASSERT_TRUE(sf);
+  EXPECT_EQ(sf->kind, SharpFeature::Kind::edge);
+  EXPECT_NEAR(sf->length_m, 0.030, tol * 0.030);
+  // Two edges of the bottom face lie on the other body: a flat contact, no sharp feature.
+  EXPECT_FALSE(box->sharp_feature(at({0, 0, 0}, {0, 0, -1})));
+  // Away from every edge: none.
+  EXPECT_FALSE(box->sharp_feature(box->closest_point(placed({5, 10, 31}))));
+
+  // A concave edge: the inner edge of an L-shaped block, interior dihedral 270 deg.
+  const auto ell = CadShape::load(
+      gmsh_cad("sharp_ell.step",
+               "Box(1) = {0, 0, 0, 20, 20, 10};\nBox(2) = {10, 10, -1, 20, 20, 12};\n"
+               "BooleanDifference(3) = { Volume{1}; Delete; }{ Volume{2}; Delete; };\n"),
+      LengthUnit::mm);
+  SurfacePoint inner;
+  inner.point_m = Eigen::Vector3d(10, 10, 4) * 1e-3;
+  inner.normal = Eigen::Vector3d(1, 1, 0).normalized();
+  ASSERT_TRUE(ell->on_sharp_feature(inner));
+  sf = ell->sharp_feature(inner);
+  ASSERT_TRUE(sf);
+  EXPECT_EQ(sf->kind, SharpFeature::Kind::edge);
+  EXPECT_NEAR(sf->dihedral_angle_rad, 1.5 * kPi, tol);
+
+  // A curved edge: the cylinder's rim (r 10 mm), 90 deg, the exact tangent at the point and the
+  // whole rim's length (a curved edge is never laid flat on the other body).
+  const auto cyl = CadShape::load(solids().cylinder, LengthUnit::mm);
+  const double r = 10, h = 30, phi = 0.4;
+  SurfacePoint rim = cyl->closest_point(placed({(r + 1) * std::cos(phi), (r + 1) * std::sin(phi), h + 1}));
+  rim.normal = R() * Eigen::Vector3d(std::cos(phi), std::sin(phi), 1).normalized();
+  sf = cyl->sharp_feature(rim);
+  ASSERT_TRUE(sf);
+  EXPECT_EQ(sf->kind, SharpFeature::Kind::edge);
+  EXPECT_NEAR(sf->dihedral_angle_rad, kPi / 2, 1e-6);
+  EXPECT_NEAR(std::abs(sf->direction.dot(R() * Eigen::Vector3d(-std::sin(phi), std::cos(phi), 0))), 1.0, 1e-9);
+  // The 16-chord polyline is 0.64 % short of the circle.
+  EXPECT_NEAR(sf->length_m, 2 * kPi * r * 1e-3, 0.01 * 2 * kPi * r * 1e-3);
+}
+
+TEST(Cad, AStepBoxDroppedOnACornerRunsTheConeLawAsItsMeshDoes) {
+  // The same 10 x 20 x 30 mm steel box as a STEP B-rep and as a triangle mesh (OFF), dropped tilted
+  // onto a steel floor so that a corner lands first: both classify the corner the same way (solid
+  // angle pi/2), so the cone law gives the same force, to the CAD tolerance; with edge_radius the
+  // corner becomes a 1 mm sphere on both. Before, the STEP part was refused there.
+  const fs::path step = gmsh_cad("drop_box.step", "Box(1) = {0, 0, 0, 10, 20, 30};\n");
+  const fs::path off = temp_dir() / "drop_box.off";
+  std::ofstream(off) << "OFF\n8 12 0\n0 0 0\n10 0 0\n10 20 0\n0 20 0\n0 0 30\n10 0 30\n10 20 30\n0 20 30\n"
+                        "3 0 2 1\n3 0 3 2\n3 4 5 6\n3 4 6 7\n3 0 1 5\n3 0 5 4\n3 1 2 6\n3 1 6 5\n"
+                        "3 2 3 7\n3 2 7 6\n3 3 0 4\n3 3 4 7\n";
+  const auto scene_text = [](const fs::path& part, const std::string& extra) {
+    return R"(length_unit = "mm"
+[materials.steel]
+youngs_modulus_Pa = 2.05e11
+poisson_ratio = 0.3
+density_kg_m3 = 7850
+yield_strength_Pa = 3.5e8
+[[bodies]]
+name = "box"
+shape = "mesh"
+mesh = ")" + part.string() + R"("
+material = "steel"
+position = [12000, -7000, 5000]
+orientation_axis = [1, 2, 3]
+orientation_angle_deg = 40
+velocity_m_s = [0.3, 0, -3]
+)" + extra + R"(
+[[bodies]]
+name = "floor"
+shape = "plane"
+normal = [0, 0, 1]
+position = [0, 0, 4900]
+material = "steel"
+[[impacts]]
+name = "drop"
+target = "box"
+impactor = "floor"
+point = "first-contact"
+)";
+  };
+  for (const std::string extra : {"", "edge_radius = 1\n"}) {
+    const auto cad = scene::run_scene(scene::parse_scene(scene_text(step, extra), "cad.toml"));
+    const auto mesh = scene::run_scene(scene::parse_scene(scene_text(off, extra), "mesh.toml"));
+    ASSERT_EQ(cad.impacts.size(), 1u);
+    ASSERT_EQ(mesh.impacts.size(), 1u);
+    const auto& c = cad.impacts[0];
+    const auto& m = mesh.impacts[0];
+    EXPECT_EQ(c.contact_law, extra.empty() ? "cone" : "thornton") << extra;
+    EXPECT_EQ(c.contact_law, m.contact_law);
+    EXPECT_GT(c.result.kernel.max_force_N, 0.0);
+    EXPECT_LE(relative_difference(c.result.kernel.max_force_N, m.result.kernel.max_force_N), test::kCadExactRel)
+        << c.result.kernel.max_force_N << " vs " << m.result.kernel.max_force_N;
+    EXPECT_LE(relative_difference(c.result.kernel.restitution.coefficient, m.result.kernel.restitution.coefficient), test::kCadExactRel);
+    EXPECT_TRUE(cad.all_checks_passed());
+  }
+}

@@ -150,18 +150,21 @@ Hit plane_first(const Body& plane_body, const Body& other, bool plane_moves, con
   Eigen::Vector3d on_plane = plane_body.pose.to_own(x_plane);
   on_plane -= plane_body.plane->normal().dot(on_plane) * plane_body.plane->normal();
   const Eigen::Vector3d other_normal = sp->normal;  // exact where the body is analytic
+  // ... and smooth there: at a B-rep's sharp edge or vertex the body's normal is one of many (a
+  // face's, a bisector), and the contact's normal is the plane's.
+  const bool other_exact = other.analytic() && !other.shape->on_sharp_feature(*sp);
   if (plane_moves) {
     h.target_own = sp->point_m;
     h.mover_own = on_plane;
     h.mover_normal_own = plane_body.plane->normal();
-    if (other.analytic()) h.target_normal_own = other_normal;
+    if (other_exact) h.target_normal_own = other_normal;
     h.mover_feature = "smooth";
     h.target_feature = other.feature_name(feature);
   } else {
     h.target_own = on_plane;
     h.mover_own = sp->point_m;
     h.target_normal_own = plane_body.plane->normal();
-    if (other.analytic()) h.mover_normal_own = other_normal;
+    if (other_exact) h.mover_normal_own = other_normal;
     h.target_feature = "smooth";
     h.mover_feature = other.feature_name(feature);
   }

@@ -8,6 +8,9 @@
 #include <cmath>
 #include <limits>
 #include <mutex>
+#include <optional>
+#include <utility>
+#include <vector>
 
 #include "cad_plugin.hpp"
 #include "impactdeck/common/error.hpp"
@@ -63,6 +66,7 @@ struct CadShape::Impl {
   struct SharpEdge {
     int tag;
     Box box;
+    std::size_t index;  // into loaded.edges
   };
   std::vector<SharpEdge> sharp;
   std::vector<Box> edge_box;  // per loaded.edges entry: its polyline's box, padded by the chord sag
@@ -159,14 +163,48 @@ struct CadShape::Impl {
     return best;
   }
 
-  bool near_sharp_edge(const Eigen::Vector3d& p) const {
+  /// The sharp edges passing within the band of p (at most `limit`), with p's projection on each.
+  std::vector<std::pair<const SharpEdge*, detail::CadEdgePoint>> sharp_edges_near(const Eigen::Vector3d& p,
+                                                                                   std::size_t limit) const {
     const double band = options.sharp_band_relative * size;
+    std::vector<std::pair<const SharpEdge*, detail::CadEdgePoint>> out;
     for (const auto& e : sharp) {
+      if (out.size() >= limit) break;
       if (e.box.distance(p) > band) continue;
       detail::CadEdgePoint ep;
-      if (project_edge(e.tag, p, ep) && (ep.point_m - p).norm() <= band) return true;
+      if (project_edge(e.tag, p, ep) && (ep.point_m - p).norm() <= band) out.emplace_back(&e, ep);
     }
-    return false;
+    return out;
+  }
+  bool near_sharp_edge(const Eigen::Vector3d& p) const { return !sharp_edges_near(p, 1).empty(); }
+
+  /// The interior dihedral angle (through the solid) of B-rep edge `e` at its point p with unit
+  /// tangent `t`: pi - (angle between its two faces' outward normals) where the edge is convex,
+  /// pi + it where concave; nullopt unless exactly two faces meet there and both project.
+  std::optional<double> interior_dihedral_rad(const CadLoaded::Edge& e, const Eigen::Vector3d& p,
+                                              const Eigen::Vector3d& t) const {
+    if (e.faces.size() != 2 || e.faces[0] == e.faces[1]) return std::nullopt;
+    detail::CadFacePoint f0, f1;
+    if (!project_face(e.faces[0], p, f0) || !project_face(e.faces[1], p, f1)) return std::nullopt;
+    const double theta = std::acos(std::clamp(f0.normal.dot(f1.normal), -1.0, 1.0));
+    // Face 0's direction away from the edge, across it: its side is where face 0's triangles lie
+    // (the centroid of its triangle nearest to p). Convex when face 1's normal points against it.
+    Eigen::Vector3d w = f0.normal.cross(t);
+    if (!(w.norm() > 0)) return std::nullopt;
+    double best = std::numeric_limits<double>::infinity();
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+    for (std::size_t k = 0; k < loaded.triangles.size(); ++k) {
+      if (loaded.triangle_face[k] != e.faces[0]) continue;
+      const auto& tri = loaded.triangles[k];
+      const Eigen::Vector3d c = (loaded.nodes_m[tri[0]] + loaded.nodes_m[tri[1]] + loaded.nodes_m[tri[2]]) / 3.0;
+      if ((c - p).squaredNorm() < best) {
+        best = (c - p).squaredNorm();
+        centroid = c;
+      }
+    }
+    if (!std::isfinite(best)) return std::nullopt;
+    if (w.dot(centroid - p) < 0) w = -w;
+    return f1.normal.dot(w) < 0 ? M_PI - theta : M_PI + theta;
   }
 };
 
@@ -284,7 +322,7 @@ std::shared_ptr<const CadShape> CadShape::load(const fs::path& file, LengthUnit 
     box.lo.array() -= 0.5 * seg + 1e-9 * impl->size;
     box.hi.array() += 0.5 * seg + 1e-9 * impl->size;
     impl->edge_box.push_back(box);
-    if (e.dihedral_deg > o.sharp_angle_deg) impl->sharp.push_back(Impl::SharpEdge{e.tag, box});
+    if (e.dihedral_deg > o.sharp_angle_deg) impl->sharp.push_back(Impl::SharpEdge{e.tag, box, impl->edge_box.size() - 1});
   }
   impl->load_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return std::shared_ptr<const CadShape>(new CadShape(std::move(impl)));
@@ -300,6 +338,131 @@ CadLocation CadShape::locate(const Eigen::Vector3d& q) const { return impl_->loc
 SurfacePoint CadShape::closest_point(const Eigen::Vector3d& q) const { return impl_->locate(q).point; }
 
 bool CadShape::on_sharp_feature(const SurfacePoint& at) const { return impl_->near_sharp_edge(at.point_m); }
+
+namespace {
+
+// A B-rep edge's sampled polyline as seen from a point on it: the direction of the segment the
+// point lies on, the edge's length (from end to end when the polyline is straight within
+// kSharpRunDeg, else along it: a curved edge is never laid flat on the other body), and whether
+// the point is one of its ends.
+struct EdgeRun {
+  Eigen::Vector3d segment = Eigen::Vector3d::UnitX();
+  double length_m = 0;
+  bool straight = true;
+  bool at_start = false, at_end = false;
+};
+
+EdgeRun edge_run(const std::vector<Eigen::Vector3d>& poly, const Eigen::Vector3d& p, double band) {
+  EdgeRun r;
+  if (poly.size() < 2) return r;
+  double best = std::numeric_limits<double>::infinity();
+  const double cos_run = std::cos(kSharpRunDeg * M_PI / 180.0);
+  const Eigen::Vector3d chord = (poly.back() - poly.front()).normalized();
+  for (std::size_t i = 0; i + 1 < poly.size(); ++i) {
+    const Eigen::Vector3d d = poly[i + 1] - poly[i];
+    r.length_m += d.norm();
+    if (d.norm() > 0 && !(d.normalized().dot(chord) >= cos_run)) r.straight = false;
+    const double s = d.squaredNorm() > 0 ? std::clamp((p - poly[i]).dot(d) / d.squaredNorm(), 0.0, 1.0) : 0.0;
+    const double dist = (poly[i] + s * d - p).norm();
+    if (dist < best && d.norm() > 0) {
+      best = dist;
+      r.segment = d.normalized();
+    }
+  }
+  if (r.straight) {
+    r.length_m = (poly.back() - poly.front()).norm();
+    r.segment = chord;
+  }
+  r.at_start = (p - poly.front()).norm() <= band;
+  r.at_end = (p - poly.back()).norm() <= band;
+  return r;
+}
+
+}  // namespace
+
+std::optional<SharpFeature> CadShape::sharp_feature(const SurfacePoint& at) const {
+  const Impl& I = *impl_;
+  const double band = I.options.sharp_band_relative * I.size;
+  // A B-rep vertex has a handful of edges; more than this many sharp ones is not a corner we model.
+  constexpr std::size_t kMaxCornerEdges = 16;
+  const auto near = I.sharp_edges_near(at.point_m, kMaxCornerEdges + 1);
+  if (near.empty() || near.size() > kMaxCornerEdges) return std::nullopt;
+  const Eigen::Vector3d n = at.normal.norm() > 0.0 ? Eigen::Vector3d(at.normal.normalized()) : Eigen::Vector3d::Zero();
+  const double cos_run = std::cos(kSharpRunDeg * M_PI / 180.0), sin_plane = std::sin(kSharpRunDeg * M_PI / 180.0);
+
+  struct Near {
+    const CadLoaded::Edge* edge;
+    Eigen::Vector3d point;
+    EdgeRun run;
+    Eigen::Vector3d away;  // from the vertex into the edge (an end) or zero (an interior point)
+  };
+  std::vector<Near> edges;
+  for (const auto& [se, ep] : near) {
+    const CadLoaded::Edge& e = I.loaded.edges[se->index];
+    Near x{&e, ep.point_m, edge_run(e.polyline_m, ep.point_m, band), Eigen::Vector3d::Zero()};
+    if (x.run.at_start && e.polyline_m.size() > 1) x.away = (e.polyline_m[1] - e.polyline_m[0]).normalized();
+    else if (x.run.at_end && e.polyline_m.size() > 1)
+      x.away = (e.polyline_m[e.polyline_m.size() - 2] - e.polyline_m.back()).normalized();
+    // A curved edge leaves its end along its tangent, not along its first chord.
+    detail::CadEdgePoint a;
+    if (!x.away.isZero() && !x.run.straight && I.project_edge(e.tag, x.point + 1e-6 * I.size * x.away, a) &&
+        (a.point_m - x.point).norm() > 0)
+      x.away = (a.point_m - x.point).normalized();
+    edges.push_back(x);
+  }
+  auto edge_feature = [&](const Near& x) -> std::optional<SharpFeature> {
+    // The tangent at the point: a straight edge's chord; a curved edge's from the projections of
+    // two points 1e-6 of the part's size either side along its segment (error ~ 1e-6 size x the
+    // edge's curvature, against the segment's own up to half the angle between samples).
+    Eigen::Vector3d tangent = x.run.segment;
+    if (!x.run.straight) {
+      const double h = 1e-6 * I.size;
+      detail::CadEdgePoint a, b;
+      if (I.project_edge(x.edge->tag, x.point + h * tangent, a) && I.project_edge(x.edge->tag, x.point - h * tangent, b) &&
+          (a.point_m - b.point_m).norm() > 0)
+        tangent = (a.point_m - b.point_m).normalized();
+    }
+    const auto dihedral = I.interior_dihedral_rad(*x.edge, x.point, tangent);
+    if (!dihedral) return std::nullopt;
+    SharpFeature sf;
+    sf.kind = SharpFeature::Kind::edge;
+    sf.point_m = x.point;
+    sf.direction = tangent;
+    sf.length_m = x.run.length_m;
+    sf.dihedral_angle_rad = *dihedral;
+    return sf;
+  };
+  // On an edge away from its ends: that edge.
+  for (const auto& x : edges)
+    if (x.away.isZero()) return edge_feature(x);
+  // At a vertex: an edge lying in the contact's tangent plane is the contact (two: a face lies
+  // on the other body, a flat contact); one straight edge through it is an edge; else a corner.
+  const Near* in_plane = nullptr;
+  int in_plane_count = 0;
+  if (!n.isZero()) {
+    for (const auto& x : edges) {
+      if (std::abs(x.away.dot(n)) > sin_plane) continue;
+      if (!in_plane || x.away.dot(in_plane->away) > -cos_run) ++in_plane_count;
+      in_plane = &x;
+    }
+  }
+  if (in_plane_count > 1) return std::nullopt;
+  if (in_plane) return edge_feature(*in_plane);
+  if (edges.size() == 1 || (edges.size() == 2 && edges[0].away.dot(edges[1].away) <= -cos_run))
+    return edge_feature(edges[0]);
+  double omega = 2.0 * M_PI;
+  for (const auto& x : edges) {
+    const auto d = I.interior_dihedral_rad(*x.edge, x.point, x.away);
+    if (!d) return std::nullopt;
+    omega += *d - M_PI;
+  }
+  SharpFeature sf;
+  sf.kind = SharpFeature::Kind::corner;
+  sf.point_m = edges[0].point;
+  sf.solid_angle_sr = omega;
+  sf.apex_half_angle_rad = std::acos(std::clamp(1.0 - omega / (2.0 * M_PI), -1.0, 1.0));
+  return sf;
+}
 
 Curvature CadShape::curvature(const SurfacePoint& at) const {
   const CadLocation loc = impl_->locate(at.point_m);

@@ -81,6 +81,14 @@ class CadShape final : public Shape {
   /// (OpenCASCADE's), a check of the two. sharp_feature on a sharp B-rep edge.
   Curvature curvature(const SurfacePoint& at) const override;
   bool on_sharp_feature(const SurfacePoint& at) const override;
+  /// The sharp B-rep edge or vertex at a point where on_sharp_feature holds (docs/sharp-contacts.md):
+  /// an edge's interior dihedral angle from its two faces' exact normals there (convex or concave
+  /// by the side face 0's triangles lie on), its straight run along the edge's sampled polyline;
+  /// a vertex where sharp edges meet that are not one straight edge is a corner, 2 pi + the sum of
+  /// (dihedral - pi) over them; an edge through the vertex lying in the contact's tangent plane
+  /// (`at.normal`) is an edge contact. nullopt: no sharp feature, an edge without exactly two
+  /// faces, or two edges of a face lying on the other body (a flat contact).
+  std::optional<SharpFeature> sharp_feature(const SurfacePoint& at) const override;
   double paper_radius_m(const SurfacePoint& at) const override;
   std::optional<SurfacePoint> ray_exit(const Eigen::Vector3d& origin_m,
                                        const Eigen::Vector3d& direction) const override;
