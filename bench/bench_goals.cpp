@@ -15,7 +15,9 @@
 //   8. the 26-drop MIL-STD-810H campaign (`[drop_test]`) of samples/drop_sequence.toml (the
 //      aluminium handle mesh, each drop a sequence, no FEM): `campaign plan`, `campaign run
 //      --jobs 2`, `campaign collect`, wall time of the three (goal < 10 s on 2 cores).
-// `--drops-only` runs rows 7 and 8 alone.
+//   then, when built with Bullet (libbullet-dev), bench/bench_bullet's tables: the same drops in
+//      Bullet at 240 Hz and 10 kHz against ours and the closed forms.
+// `--drops-only` runs rows 7 and 8 (and Bullet's tables) alone.
 // The ccx row is bench/bench_ccx. Wall times are those of the whole process; CPU times (user +
 // system) are printed beside them, since a shared machine inflates wall times.
 //   bench_goals [--repeats N] [--subdivisions N] [--points N] [--drops-only]      (Markdown on stdout)
@@ -150,6 +152,13 @@ void drop_rows(const std::string& tool, const std::string& src, const fs::path& 
               "sequence, restitution 0.5), no FEM: plan + run --jobs 2 + collect | %.2f s wall (CPU of all its processes "
               "%.2f s: %.2f s of 2 cores) | | %s (< 10 s) |\n",
               b.wall.wall_s, b.cpu.cpu_s, b.cpu.cpu_s / 2, b.wall.wall_s < 10 ? "yes" : "NO");
+#ifdef BENCH_BULLET_EXE
+  const Run bullet = run({BENCH_BULLET_EXE}, out);
+  check(bullet, "bench_bullet");
+  std::printf("\n### The same drops in Bullet (bench/bench_bullet)\n\n%s", bullet.out.c_str());
+#else
+  std::printf("\n(bench_bullet not built: libbullet-dev was not found.)\n");
+#endif
 }
 
 }  // namespace
