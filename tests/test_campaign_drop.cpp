@@ -312,3 +312,19 @@ TEST(DropTest, BadProgrammesAreRefusedNamingTheKey) {
   EXPECT_NE(err("standard = \"ISTA-1A\"\nbody = \"part\"\nheight_m = -1\n").find("must be a number > 0"), std::string::npos);
   EXPECT_NE(err("standard = \"ISTA-1A\"\n").find("missing required key 'drop_test.body'"), std::string::npos);
 }
+
+TEST(DropTest, ASceneOfSequencesOnlyNeedsADropTestToBeCollected) {
+  // Planned before [drop_test] existed, such a campaign read past the end of the empty impact list.
+  TempDir t("sequences_only");
+  write(t.path / "part.toml", "gravity_m_s2 = [0, 0, -9.81]\n" + materials() + part_body("position = [0, 0, 500]\n") + kFloor +
+                                  "[[sequences]]\nname = \"fall\"\nbody = \"part\"\nfloor = \"floor\"\nrestitution = 0.5\n");
+  write(t.path / "c.toml", "scene = \"part.toml\"\n[product]\n\"sequences[0].restitution\" = [0.5, 0.6]\n");
+  EXPECT_NE(error_of([&] { campaign::read_campaign(t.path / "c.toml"); })
+                .find("c.toml: the scene has no [[impacts]] entry to collect (a scene of sequences only is collected by a "
+                      "[drop_test] of its body)"),
+            std::string::npos);
+  write(t.path / "c.toml", "scene = \"part.toml\"\n[orientations]\ncount = 3\n");
+  EXPECT_NE(error_of([&] { campaign::read_campaign(t.path / "c.toml"); })
+                .find("line 2, key 'orientations': the scene has no [[impacts]] entry: [orientations] varies an impact"),
+            std::string::npos);
+}
