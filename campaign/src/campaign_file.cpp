@@ -9,7 +9,9 @@
 #include <toml++/toml.h>
 
 #include "impactdeck/campaign/campaign.hpp"
+#include "impactdeck/campaign/drop_test.hpp"
 #include "impactdeck/campaign/orientations.hpp"
+#include "detail.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/common/input_file.hpp"
 #include "impactdeck/common/suggest.hpp"
@@ -33,6 +35,7 @@ struct Option {
   std::vector<scene::Override> overrides;
   std::optional<Eigen::Vector3d> point_m;
   std::optional<Eigen::Quaterniond> orientation;
+  std::string drop;  ///< [drop_test]: the drop's name
 };
 using Axis = std::vector<Option>;
 
@@ -46,9 +49,7 @@ std::string place(const toml::node* n, const std::string& key) {
 std::string number_text(double v) { return scene::detail::toml_float_text(v); }
 std::string value_text(const toml::node& n) { return scene::detail::toml_value_text(n); }
 
-std::string vec_text(const Eigen::Vector3d& v) {
-  return "[" + number_text(v.x() + 0.0) + ", " + number_text(v.y() + 0.0) + ", " + number_text(v.z() + 0.0) + "]";
-}
+std::string vec_text(const Eigen::Vector3d& v) { return detail::toml_vec_text(v); }
 
 // Entries of a table in file order (toml++ keeps them sorted by key).
 std::vector<std::pair<std::string, const toml::node*>> in_file_order(const toml::table& t) {
@@ -162,6 +163,12 @@ SlurmSettings read_slurm(const toml::table& t, const FileReader& fr) {
 
 }  // namespace
 
+namespace detail {
+std::string toml_vec_text(const Eigen::Vector3d& v) {
+  return "[" + number_text(v.x() + 0.0) + ", " + number_text(v.y() + 0.0) + ", " + number_text(v.z() + 0.0) + "]";
+}
+}  // namespace detail
+
 Campaign read_campaign(const fs::path& file, std::size_t max_cases) {
   FileReader fr(file);
   std::error_code ec;
@@ -174,7 +181,7 @@ Campaign read_campaign(const fs::path& file, std::size_t max_cases) {
     p << "line " << e.source().begin.line << ", column " << e.source().begin.column;
     throw InputError(fr.name(), p.str(), "TOML syntax error: " + std::string(e.description()));
   }
-  fr.only(root, "", {"scene", "impact", "cases", "product", "points", "orientations", "slurm"});
+  fr.only(root, "", {"scene", "impact", "cases", "product", "points", "orientations", "drop_test", "slurm"});
 
   Campaign c;
   c.file = file;
@@ -186,14 +193,20 @@ Campaign read_campaign(const fs::path& file, std::size_t max_cases) {
   if (!fs::is_regular_file(c.scene, ec)) fr.fail(sn, "scene", "no scene file " + c.scene.string());
   const scene::Scene base = scene::load_scene(c.scene);  // its own errors name the scene file
 
-  std::size_t impact = 0;
+  std::optional<std::size_t> impact;  // none: a scene of sequences only
   if (const toml::node* n = root.get("impact")) {
     if (!n->is_string()) fr.fail(n, "impact", "must be an impact name (string)");
     impact = impact_index(base, n->as_string()->get());
-    if (impact == base.impacts.size()) fr.fail(n, "impact", "the scene has no impact named '" + n->as_string()->get() + "'");
+    if (*impact == base.impacts.size()) fr.fail(n, "impact", "the scene has no impact named '" + n->as_string()->get() + "'");
+  } else if (!base.impacts.empty()) {
+    impact = 0;
   }
-  c.impact = base.impacts[impact].name;
-  const scene::ImpactSpec& spec = base.impacts[impact];
+  if (impact) c.impact = base.impacts[*impact].name;
+  // The collected impact, for the generators that need one.
+  auto impact_spec = [&](const toml::node* n, const char* generator) -> const scene::ImpactSpec& {
+    if (!impact) fr.fail(n, generator, "the scene has no [[impacts]] entry: [" + std::string(generator) + "] varies an impact");
+    return base.impacts[*impact];
+  };
 
   std::vector<Axis> axes;
   std::vector<std::string> axis_places;  // where each axis comes from: its line and key
@@ -222,7 +235,7 @@ Campaign read_campaign(const fs::path& file, std::size_t max_cases) {
       const toml::array* a = v->as_array();
       if (!a || a->empty()) fr.fail(v, "product.\"" + key + "\"", "must be a non-empty list of values");
       Axis axis;
-      for (const toml::node& e : *a) axis.push_back(Option{{{key, value_text(e)}}, {}, {}});
+      for (const toml::node& e : *a) axis.push_back(Option{{{key, value_text(e)}}, {}, {}, {}});
       axes.push_back(std::move(axis));
       axis_places.push_back(place(v, "product.\"" + key + "\""));
     }
@@ -232,6 +245,7 @@ Campaign read_campaign(const fs::path& file, std::size_t max_cases) {
     const toml::table* t = n->as_table();
     if (!t) fr.fail(n, "points", "must be a table");
     fr.only(*t, "points", {"count", "seed", "csv"});
+    const scene::ImpactSpec& spec = impact_spec(n, "points");
     if (spec.first_contact) {
       fr.fail(n, "points", "impact '" + spec.name + "' uses point = \"first-contact\": [points] sets the impact point");
     }
@@ -257,8 +271,8 @@ Campaign read_campaign(const fs::path& file, std::size_t max_cases) {
       cloud = study::area_uniform_cloud(*shape, count, seed);
     }
     Axis axis;
-    const std::string key = "impacts[" + std::to_string(impact) + "].point";
-    for (const auto& p : cloud) axis.push_back(Option{{{key, vec_text(p.point_m / unit)}}, p.point_m, {}});
+    const std::string key = "impacts[" + std::to_string(*impact) + "].point";
+    for (const auto& p : cloud) axis.push_back(Option{{{key, vec_text(p.point_m / unit)}}, p.point_m, {}, {}});
     axes.push_back(std::move(axis));
     axis_places.push_back(place(n, "points"));
     c.generators.push_back("points");
@@ -267,6 +281,7 @@ Campaign read_campaign(const fs::path& file, std::size_t max_cases) {
     const toml::table* t = n->as_table();
     if (!t) fr.fail(n, "orientations", "must be a table");
     fr.only(*t, "orientations", {"count", "body"});
+    const scene::ImpactSpec& spec = impact_spec(n, "orientations");
     if (!spec.first_contact) {
       fr.fail(n, "orientations", "impact '" + spec.name + "' has a fixed point: orientations need point = \"first-contact\"");
     }
@@ -280,22 +295,51 @@ Campaign read_campaign(const fs::path& file, std::size_t max_cases) {
     const std::size_t count = fr.count(*t, "orientations", "count", 100000);
     const std::string prefix = "bodies[" + std::to_string(bi) + "].";
     Axis axis;
-    for (const Eigen::Quaterniond& q : super_fibonacci_orientations(count)) {
-      const Eigen::AngleAxisd aa(q);
-      Eigen::Vector3d axis_v = aa.axis();
-      double angle_deg = aa.angle() * 180.0 / M_PI;
-      if (!(angle_deg > 1e-12) || !axis_v.allFinite()) {
-        axis_v = Eigen::Vector3d::UnitZ();
-        angle_deg = 0.0;
-      }
-      axis.push_back(Option{{{prefix + "orientation_axis", vec_text(axis_v)},
-                             {prefix + "orientation_angle_deg", number_text(angle_deg)}},
-                            {},
-                            q});
-    }
+    for (const Eigen::Quaterniond& q : super_fibonacci_orientations(count))
+      axis.push_back(Option{orientation_overrides(prefix, q), {}, q, {}});
     axes.push_back(std::move(axis));
     axis_places.push_back(place(n, "orientations"));
     c.generators.push_back("orientations");
+  }
+  if (const toml::node* n = root.get("drop_test")) {
+    const toml::table* t = n->as_table();
+    if (!t) fr.fail(n, "drop_test", "must be a table");
+    fr.only(*t, "drop_test", {"standard", "body", "height_m"});
+    if (root.contains("points") || root.contains("orientations")) {
+      fr.fail(n, "drop_test", "sets the body's orientation and placement: it does not combine with [points] or [orientations]");
+    }
+    DropTestSpec d;
+    d.table_place = place(n, "drop_test");
+    auto text = [&](const char* key, std::string& out, std::string& where) {
+      const toml::node* v = t->get(key);
+      if (!v) throw InputError(fr.name(), d.table_place, std::string("missing required key 'drop_test.") + key + "'");
+      where = place(v, std::string("drop_test.") + key);
+      if (!v->is_string() || v->as_string()->get().empty()) fr.fail(v, std::string("drop_test.") + key, "must be a name (string)");
+      out = v->as_string()->get();
+    };
+    text("standard", d.standard, d.standard_place);
+    text("body", d.body, d.body_place);
+    if (const toml::node* h = t->get("height_m")) {
+      d.height_place = place(h, "drop_test.height_m");
+      const auto v = h->value<double>();
+      if (!v || !(*v > 0) || !std::isfinite(*v)) fr.fail(h, "drop_test.height_m", "must be a number > 0 (m)");
+      d.height_m = *v;
+    }
+    const DropProgramme prog = plan_drops(base, d, impact, InputContext{fr.name(), ""});
+    c.sequence = prog.sequence;
+    if (!prog.sequence.empty()) c.impact.clear();  // the sequence's worst impact is collected
+    c.drop_test = DropTestInfo{d.standard, d.body, prog.sequence, prog.mass_kg, prog.gravity_m_s2, prog.height_m,
+                               prog.box.axes, prog.box.lengths_m()};
+    Axis axis;
+    for (const Drop& drop : prog.drops)
+      axis.push_back(Option{drop_overrides(base, prog.body_index, drop), {}, drop.orientation, drop.point.name});
+    axes.push_back(std::move(axis));
+    axis_places.push_back(d.table_place);
+    c.generators.push_back("drop_test");
+  }
+  if (!impact && c.sequence.empty()) {
+    throw InputError(fr.name(), "", "the scene has no [[impacts]] entry to collect (a scene of sequences only is "
+                                    "collected by a [drop_test] of its body)");
   }
   if (const toml::node* n = root.get("slurm")) {
     const toml::table* t = n->as_table();
@@ -303,7 +347,7 @@ Campaign read_campaign(const fs::path& file, std::size_t max_cases) {
     c.slurm = read_slurm(*t, fr);
   }
   if (axes.empty()) {
-    throw InputError(fr.name(), "", "no case generator: give [product], [[cases]], [points] or [orientations]");
+    throw InputError(fr.name(), "", "no case generator: give [product], [[cases]], [points], [orientations] or [drop_test]");
   }
 
   std::size_t total = 1;
@@ -328,6 +372,7 @@ Campaign read_campaign(const fs::path& file, std::size_t max_cases) {
       k.overrides.insert(k.overrides.end(), o.overrides.begin(), o.overrides.end());
       if (o.point_m) k.point_m = o.point_m;
       if (o.orientation) k.orientation = o.orientation;
+      if (!o.drop.empty()) k.drop = o.drop;
     }
     for (const auto& o : k.overrides)
       if (std::find(c.keys.begin(), c.keys.end(), o.key) == c.keys.end()) c.keys.push_back(o.key);
@@ -337,7 +382,14 @@ Campaign read_campaign(const fs::path& file, std::size_t max_cases) {
     const scene::Scene sc = scene::load_scene(c.scene, k.overrides, InputContext{fr.name(), case_place});
     // The collected impact must exist in every case: overrides that rename it would leave the
     // table empty.
-    if (impact_index(sc, c.impact) == sc.impacts.size()) {
+    if (!c.sequence.empty()) {
+      const bool kept = std::any_of(sc.sequences.begin(), sc.sequences.end(),
+                                    [&](const scene::SequenceSpec& q) { return q.name == c.sequence; });
+      if (!kept) {
+        throw InputError(fr.name(), case_place, "the case's overrides leave no sequence named '" + c.sequence +
+                                                    "', the sequence the drop test collects");
+      }
+    } else if (impact_index(sc, c.impact) == sc.impacts.size()) {
       std::vector<std::string> names;
       for (const auto& i : sc.impacts) names.push_back(i.name);
       throw InputError(fr.name(), case_place,

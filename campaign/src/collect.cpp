@@ -19,6 +19,8 @@
 #include "impactdeck/plot/drawing.hpp"
 #include "impactdeck/plot/html.hpp"
 #include "impactdeck/common/units.hpp"
+#include "impactdeck/geometry/plane.hpp"
+#include "impactdeck/scene/pipeline.hpp"
 #include "impactdeck/scene/report_html.hpp"
 #include "impactdeck/scene/scene.hpp"
 #include "detail.hpp"
@@ -84,6 +86,7 @@ const std::vector<std::pair<std::string, std::string>>& result_columns() {
 struct Row {
   std::size_t id = 0;
   CaseState state = CaseState::planned;
+  std::string drop;  ///< [drop_test]: the drop's name
   json inputs, impact, result, failure;
 };
 
@@ -100,6 +103,24 @@ Eigen::Vector3d drop_direction(const fs::path& scene_file, const std::string& im
     return t.rotation.transpose() * d.normalized();
   }
   return -Eigen::Vector3d::UnitZ();
+}
+
+// A drop test's case on the orientation sphere: the floor's inward normal (the drop direction) in
+// the body's own frame; the floor is the sequence's, or the collected impact's other body.
+Eigen::Vector3d drop_test_direction(const fs::path& scene_file, const std::string& body, const std::string& sequence,
+                                    const std::string& impact) {
+  const scene::Scene sc = scene::load_scene(scene_file);
+  std::string floor;
+  for (const auto& q : sc.sequences)
+    if (q.name == sequence) floor = q.floor;
+  for (const auto& i : sc.impacts)
+    if (sequence.empty() && i.name == impact) floor = i.target == body ? i.impactor : i.target;
+  const scene::BodySpec& b = sc.body(body);
+  const scene::BodySpec& f = sc.body(floor);
+  const auto shape = scene::make_shape(f, sc);
+  const geometry::Plane* plane = shape->half_space();
+  const Eigen::Vector3d down = plane ? Eigen::Vector3d(-(f.rotation * plane->normal())) : Eigen::Vector3d(-Eigen::Vector3d::UnitZ());
+  return b.rotation.transpose() * down.normalized();
 }
 
 // `unit`: the points' length unit (a point campaign: the scene's, so that the map overlays the
@@ -308,9 +329,12 @@ std::string report_page(const fs::path& dir, const std::string& impact, const st
   }
   page.html("<p id=\"verdict\" class=\"verdict " + std::string(judged == 0 ? "" : yields > 0 ? "fail" : "pass") + "\">" +
             plot::html_escape(verdict) + "</p>");
+  const bool named_drops = std::any_of(rows.begin(), rows.end(), [](const Row& r) { return !r.drop.empty(); });
+  auto drop_of = [&](std::size_t id) { return id < rows.size() && !rows[id].drop.empty() ? rows[id].drop + ", " : ""; };
   page.table({"campaign", "impact", "done", "failed", "pending", "worst case"},
              {{dir.string(), impact, std::to_string(out.done), std::to_string(out.failed), std::to_string(out.pending),
-               out.worst_id ? std::to_string(*out.worst_id) + (all_stress ? " (largest peak von Mises)" : " (largest max force)")
+               out.worst_id ? std::to_string(*out.worst_id) + " (" + drop_of(*out.worst_id) +
+                                  (all_stress ? "largest peak von Mises)" : "largest max force)")
                             : "-"}});
 
   // The five cases closest to yielding (smallest safety factor; by max force when none is judged).
@@ -330,7 +354,7 @@ std::string report_page(const fs::path& dir, const std::string& impact, const st
     std::vector<std::vector<std::string>> top;
     for (std::size_t n = 0; n < std::min<std::size_t>(5, order.size()); ++n) {
       const Row& r = rows[order[n]];
-      std::string inputs;
+      std::string inputs = r.drop;
       for (const auto& key : keys)
         if (r.inputs.contains(key)) inputs += (inputs.empty() ? "" : "; ") + key + " = " + compact_input(r.inputs[key]);
       top.push_back({std::to_string(r.id), verdicts[order[n]], factors[order[n]], number_text(at(r.impact, "/max_force_N")),
@@ -354,6 +378,7 @@ std::string report_page(const fs::path& dir, const std::string& impact, const st
 
   // One compact row per case; its warnings folded (they repeat from case to case).
   std::vector<std::string> header = {"case", "state"};
+  if (named_drops) header.push_back("drop");
   header.insert(header.end(), keys.begin(), keys.end());
   for (const char* h : {"max force (N)", "impulse error (Eq. 31)", "energy error (Eq. 32)", "FEM momentum error",
                         "checks", "verdict", "safety factor", "warnings / reason"})
@@ -370,6 +395,7 @@ std::string report_page(const fs::path& dir, const std::string& impact, const st
   for (std::size_t k = 0; k < rows.size(); ++k) {
     const Row& r = rows[k];
     t += "<tr>" + td(std::to_string(r.id)) + td(to_string(r.state));
+    if (named_drops) t += td(r.drop);
     for (const auto& key : keys) t += td(r.inputs.contains(key) ? compact_input(r.inputs[key]) : "");
     t += td(number_text(at(r.impact, "/max_force_N"), 4));
     t += td(number_text(at(r.impact, "/checks/impulse_relative_error"), 3));
@@ -399,6 +425,34 @@ std::string report_page(const fs::path& dir, const std::string& impact, const st
   page.heading("Cases");
   page.html("<div class=\"wide\">" + t + "</table></div>");
   return page.str();
+}
+
+// A drop test's sequence in a done case's result.json: its worst impact (null when the sequence has
+// no impact). Refused when the case has no sequence of that name.
+json sequence_worst_impact(const json& result, const std::string& sequence, const fs::path& file) {
+  std::vector<std::string> names;
+  const json seqs = result.value("sequences", json::array());
+  for (const json& q : seqs.is_array() ? seqs : json::array()) {
+    if (!q.is_object() || !q.value("name", json()).is_string()) continue;
+    if (q["name"] != sequence) {
+      names.push_back(q["name"].get<std::string>());
+      continue;
+    }
+    const json w = q.value("worst_impact_index", json());
+    const json impacts = q.value("impacts", json::array());
+    if (w.is_null()) return json(nullptr);
+    if (!w.is_number_unsigned() || !impacts.is_array() || w.get<std::size_t>() >= impacts.size() ||
+        !impacts[w.get<std::size_t>()].is_object()) {
+      throw InputError(file.string(), "key 'sequences." + sequence + ".worst_impact_index'",
+                       "must index the sequence's impacts");
+    }
+    json i = impacts[w.get<std::size_t>()];
+    i["sequence_impact_count"] = impacts.size();
+    return i;
+  }
+  throw InputError(file.string(), "key 'sequences'",
+                   "has no sequence named '" + sequence + "', the sequence the drop test collects" +
+                       did_you_mean(sequence, names));
 }
 
 // The collected impact of a done case's result.json: refused when the case has none of that name
@@ -438,7 +492,16 @@ CollectResult collect(const fs::path& dir_in) {
   const std::vector<std::string>& keys = plan.keys;
   const auto& generators = plan.generators;
   const bool points = std::find(generators.begin(), generators.end(), "points") != generators.end();
-  const bool drops = std::find(generators.begin(), generators.end(), "orientations") != generators.end();
+  const bool drop_test = std::find(generators.begin(), generators.end(), "drop_test") != generators.end();
+  const bool drops = drop_test || std::find(generators.begin(), generators.end(), "orientations") != generators.end();
+  std::string drop_body;
+  if (drop_test) {
+    const json d = plan.doc.value("drop_test", json::object());
+    if (!d.is_object() || !d.value("body", json()).is_string()) {
+      throw InputError(plan.file.string(), "key 'drop_test.body'", "must be a body name (string)");
+    }
+    drop_body = d["body"].get<std::string>();
+  }
 
   CollectResult out;
   std::vector<Row> rows;
@@ -446,11 +509,13 @@ CollectResult collect(const fs::path& dir_in) {
     Row r;
     r.id = c.id;
     r.inputs = c.overrides;
+    r.drop = c.drop;
     r.state = case_state(dir, r.id);
     const fs::path folder = case_folder(dir, r.id);
     if (r.state == CaseState::done) {
       r.result = detail::read_result(dir, r.id);
-      r.impact = collected_impact(r.result, impact, folder / "result.json");
+      r.impact = plan.sequence.empty() ? collected_impact(r.result, impact, folder / "result.json")
+                                       : sequence_worst_impact(r.result, plan.sequence, folder / "result.json");
       detail::check_inside(dir, fs::path("cases") / std::to_string(r.id) / "scene.toml", detail::Kind::file);
       ++out.done;
     } else if (r.state == CaseState::failed) {
@@ -465,13 +530,17 @@ CollectResult collect(const fs::path& dir_in) {
   // The table.
   std::ostringstream csv;
   csv << "id,state";
+  if (drop_test) csv << ",drop";
   for (const auto& k : keys) csv << "," << cell(k);
+  if (!plan.sequence.empty()) csv << ",sequence_impact_index,sequence_impact_count";
   for (const auto& [name, ptr] : result_columns()) csv << "," << name;
   csv << ",all_checks_passed,reason\n";
   json cases = json::array();
   for (const Row& r : rows) {
     csv << r.id << "," << to_string(r.state);
+    if (drop_test) csv << "," << cell(r.drop);
     for (const auto& k : keys) csv << "," << cell(r.inputs.contains(k) ? r.inputs[k] : json(nullptr));
+    if (!plan.sequence.empty()) csv << "," << cell(at(r.impact, "/index")) << "," << cell(at(r.impact, "/sequence_impact_count"));
     for (const auto& [name, ptr] : result_columns()) csv << "," << cell(at(r.impact, ptr.c_str()));
     csv << "," << cell(r.result.is_null() ? json(nullptr) : r.result.value("all_checks_passed", json(nullptr)));
     csv << "," << cell(r.failure.is_null() ? json(nullptr) : r.failure.value("reason", json("")));
@@ -481,6 +550,7 @@ CollectResult collect(const fs::path& dir_in) {
     j["id"] = r.id;
     j["state"] = to_string(r.state);
     j["inputs"] = r.inputs;
+    if (drop_test) j["drop"] = r.drop;
     if (!r.result.is_null()) {
       j["all_checks_passed"] = r.result.value("all_checks_passed", json(nullptr));
       j["warnings"] = r.result.value("warnings", json::array());
@@ -511,7 +581,7 @@ CollectResult collect(const fs::path& dir_in) {
   const fs::path cdir = dir / "collect";
   detail::check_inside(dir, "collect", detail::Kind::folder);
   if (out.worst_id) check_tree(case_folder(dir, *out.worst_id));
-  const json doc = {{"campaign", dir.string()},
+  json doc = {{"campaign", dir.string()},
                     {"impact", impact},
                     {"keys", keys},
                     {"done", out.done},
@@ -520,6 +590,11 @@ CollectResult collect(const fs::path& dir_in) {
                     {"worst_case_id", out.worst_id ? json(*out.worst_id) : json(nullptr)},
                     {"worst_case_by", out.worst_case_by},
                     {"cases", cases}};
+  if (!plan.sequence.empty()) doc["sequence"] = plan.sequence;
+  if (drop_test) {
+    doc["drop_test"] = plan.doc["drop_test"];
+    doc["worst_drop"] = out.worst_id ? json(rows[*out.worst_id].drop) : json(nullptr);
+  }
   // One transaction (common/run_transaction.hpp): every file and the worst case's copy appear
   // together, or nothing changes.
   RunTransaction txn(cdir, "collect");
@@ -549,7 +624,9 @@ CollectResult collect(const fs::path& dir_in) {
         const json f = at(r.impact, "/max_force_N");
         if (r.state != CaseState::done || !f.is_number()) continue;
         if (!drops && !unit) unit = scene::load_scene(case_folder(dir, r.id) / "scene.toml").length_unit;
-        if (drops) {
+        if (drop_test) {
+          pts.push_back(drop_test_direction(case_folder(dir, r.id) / "scene.toml", drop_body, plan.sequence, impact));
+        } else if (drops) {
           pts.push_back(drop_direction(case_folder(dir, r.id) / "scene.toml", impact));
         } else {
           pts.push_back(plan.cases[r.id].point_m.value_or(Eigen::Vector3d::Zero()));
@@ -566,7 +643,7 @@ CollectResult collect(const fs::path& dir_in) {
     }
     // The worst case of a drop campaign as it touches the floor (its orientation).
     std::string worst_svg, worst_caption;
-    if (drops && out.worst_id) {
+    if (drops && out.worst_id && plan.sequence.empty()) {
       for (const Row& r : rows) {
         const json p = at(r.impact, "/contact_point_m"), n = at(r.impact, "/contact_normal");
         auto vec3 = [](const json& v) {
@@ -579,7 +656,7 @@ CollectResult collect(const fs::path& dir_in) {
                                            normal, worst_caption);
       }
     }
-    out.report_html = add("report.html", report_page(dir, impact, keys, rows, out, all_stress, map_text, worst_svg,
+    out.report_html = add("report.html", report_page(dir, impact.empty() ? "sequence '" + plan.sequence + "' (its worst impact)" : impact, keys, rows, out, all_stress, map_text, worst_svg,
                                                      worst_caption));
     if (out.worst_id) {  // a copy of the worst case's folder (scene, decks, result), checked above
       const fs::path stage = txn.folder("worst_case", where, "collect");

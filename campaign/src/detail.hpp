@@ -60,12 +60,14 @@ struct PlanCase {
   nlohmann::json overrides;  ///< key -> TOML value text
   std::string scene_hash;
   std::optional<Eigen::Vector3d> point_m;
+  std::string drop;  ///< [drop_test]: the drop's name (empty otherwise)
 };
 struct Plan {
   std::filesystem::path dir, file;  ///< the campaign folder (absolute) and its campaign.json
   nlohmann::json doc;
   SlurmSettings slurm;  ///< its "slurm" object (defaults for a plan written without one)
   std::string impact;
+  std::string sequence;  ///< a drop_test's sequence (its worst impact is collected); empty: `impact`
   std::vector<std::string> keys, generators;
   std::vector<PlanCase> cases;
 };
@@ -102,6 +104,9 @@ void make_folder(const std::filesystem::path& p);
 /// A new file (O_EXCL | O_NOFOLLOW) with `text`, every write checked (a full disk: InputError naming
 /// the file and errno's reason).
 void write_new_file(const std::filesystem::path& p, const std::string& text);
+
+/// [x, y, z] as a TOML array of 17-significant-digit numbers (-0 written as 0).
+std::string toml_vec_text(const Eigen::Vector3d& v);
 
 /// `s` quoted for sh: '...' with every ' as '\'' (any byte, a newline included, stays literal).
 std::string sh_quote(const std::string& s);

@@ -134,6 +134,12 @@ Plan read_plan(const fs::path& dir_in) {
   const json* impact = member(p.doc, "impact");
   if (!impact || !impact->is_string()) bad("impact", "must be an impact name (string)");
   p.impact = impact->get<std::string>();
+  if (const json* sq = member(p.doc, "sequence")) {
+    if (!sq->is_string() || sq->get<std::string>().empty()) bad("sequence", "must be a sequence name (string)");
+    p.sequence = sq->get<std::string>();
+  } else if (p.impact.empty()) {
+    bad("impact", "must be an impact name (non-empty without 'sequence')");
+  }
   p.keys = string_list(p.doc, "keys", f);
   p.generators = string_list(p.doc, "generators", f);
   const json* cases = member(p.doc, "cases");
@@ -163,6 +169,10 @@ Plan read_plan(const fs::path& dir_in) {
       }
       pc.point_m = Eigen::Vector3d((*pt)[0].get<double>(), (*pt)[1].get<double>(), (*pt)[2].get<double>());
       if (!pc.point_m->allFinite()) bad(k + ".point_m", "must be finite");
+    }
+    if (const json* d = member(c, "drop")) {
+      if (!d->is_string()) bad(k + ".drop", "must be a drop name (string)");
+      pc.drop = d->get<std::string>();
     }
     p.cases.push_back(std::move(pc));
   }

@@ -95,22 +95,36 @@ PlanResult plan_campaign(const Campaign& c, const fs::path& dir_in) {
                           {"scene_hash", case_hashes[i]},
                           {"state", "planned"}};
       if (k.point_m) j["point_m"] = {k.point_m->x(), k.point_m->y(), k.point_m->z()};
+      if (!k.drop.empty()) j["drop"] = k.drop;
       if (k.orientation) {
         j["orientation_quaternion_wxyz"] = {k.orientation->w(), k.orientation->x(), k.orientation->y(),
                                             k.orientation->z()};
       }
       cases.push_back(std::move(j));
     }
-    const nlohmann::json doc = {{"format", "impactdeck-campaign 1"},
-                                {"campaign_file", fs::absolute(c.file).lexically_normal().string()},
-                                {"scene", c.scene.string()},
-                                {"impact", c.impact},
-                                {"generators", c.generators},
-                                {"keys", c.keys},
-                                {"input_hash", r.input_hash},
-                                {"case_count", c.cases.size()},
-                                {"slurm", detail::slurm_json(c.slurm)},
-                                {"cases", cases}};
+    nlohmann::json doc = {{"format", "impactdeck-campaign 1"},
+                          {"campaign_file", fs::absolute(c.file).lexically_normal().string()},
+                          {"scene", c.scene.string()},
+                          {"impact", c.impact},
+                          {"generators", c.generators},
+                          {"keys", c.keys},
+                          {"input_hash", r.input_hash},
+                          {"case_count", c.cases.size()},
+                          {"slurm", detail::slurm_json(c.slurm)},
+                          {"cases", cases}};
+    if (!c.sequence.empty()) doc["sequence"] = c.sequence;
+    if (const auto& d = c.drop_test) {
+      nlohmann::json axes = nlohmann::json::array();
+      for (int i = 0; i < 3; ++i) axes.push_back({d->principal_axes(0, i), d->principal_axes(1, i), d->principal_axes(2, i)});
+      doc["drop_test"] = {{"standard", d->standard},
+                          {"body", d->body},
+                          {"mode", d->sequence.empty() ? "impact" : "sequence"},
+                          {"mass_kg", d->mass_kg},
+                          {"gravity_m_s2", d->gravity_m_s2},
+                          {"height_m", d->height_m},
+                          {"principal_axes", axes},
+                          {"box_lengths_m", {d->box_lengths_m.x(), d->box_lengths_m.y(), d->box_lengths_m.z()}}};
+    }
     detail::write_new_file(txn.file("campaign.json", where, "campaign.json"), doc.dump(2) + "\n");
     txn.commit();
     r.warnings = txn.warnings();

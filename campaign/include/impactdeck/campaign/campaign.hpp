@@ -17,7 +17,16 @@ struct Case {
   std::size_t id = 0;
   std::vector<scene::Override> overrides;  ///< every `--set` this case applies, generator order
   std::optional<Eigen::Vector3d> point_m;             ///< [points]: target frame, metres
-  std::optional<Eigen::Quaterniond> orientation;      ///< [orientations]: the body's rotation
+  std::optional<Eigen::Quaterniond> orientation;      ///< [orientations], [drop_test]: the body's rotation
+  std::string drop;  ///< [drop_test]: the drop's name ("face +x", "edge +x-y", "corner +x+y+z")
+};
+
+/// A `[drop_test]`'s programme as campaign.json records it (drop_test.hpp plans it).
+struct DropTestInfo {
+  std::string standard, body, sequence;  ///< sequence: empty in impact mode
+  double mass_kg = 0, gravity_m_s2 = 0, height_m = 0;
+  Eigen::Matrix3d principal_axes = Eigen::Matrix3d::Identity();  ///< columns x, y, z (own frame)
+  Eigen::Vector3d box_lengths_m = Eigen::Vector3d::Zero();
 };
 
 /// The campaign file's `[slurm]` table (docs/campaign-format.md, "Slurm"), validated by
@@ -50,8 +59,12 @@ std::string slurm_time_text(double minutes);
 struct Campaign {
   std::filesystem::path file;   ///< the campaign file
   std::filesystem::path scene;  ///< the base scene (absolute)
-  std::string impact;           ///< the impact the table and map describe (default: the first)
-  std::vector<std::string> generators;  ///< in expansion order: cases, product, points, orientations
+  std::string impact;           ///< the impact the table and map describe (default: the first); empty with `sequence`
+  /// [drop_test] of a scene with a [[sequences]] of the body: the sequence whose worst impact the
+  /// table and map describe (empty otherwise)
+  std::string sequence;
+  std::optional<DropTestInfo> drop_test;
+  std::vector<std::string> generators;  ///< in expansion order: cases, product, points, orientations, drop_test
   std::vector<std::string> keys;        ///< every override key, in column order (no duplicates)
   std::vector<Case> cases;              ///< ids 0 ... N-1, row-major, last generator fastest
   bool runs_ccx = false;                ///< a case's scene runs ccx (outputs.fem.run = "calculix")
