@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <random>
 #include <regex>
@@ -416,6 +417,46 @@ TEST(Support, MeshExtremeVertexWithDeterministicTies) {
     EXPECT_GT(sp->normal.dot(d), 0.9);  // the smooth normal near the extreme vertex
   }
   expect_message(input_error_of([&] { ell->support_point({0, 0, 0}); }), "^direction: must be a non-zero finite");
+}
+
+TEST(Support, TheVertexTreeGivesTheFullScansVertexExactly) {
+  // MeshShape::support_point prunes a tree of vertex boxes; its answer must be the full scan's:
+  // the largest computed u . v, the lowest index among equal ones. A 10,242-vertex ellipsoid mesh
+  // with its top cut flat (hundreds of vertices tie exactly along +z, spread over many leaves),
+  // 1e3 sizes from the origin, as it is and rotated (rounding in the dot products), along random
+  // and axis directions.
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.7, Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  int ties = 0;
+  for (const bool rotated : {false, true}) {
+    TriangleMesh m = make_ellipsoid_mesh(3, 2, 1, 5);
+    for (auto& v : m.vertices_m) {
+      const Vector3d flat(v.x(), v.y(), std::min(v.z(), 0.5));
+      v = (rotated ? Vector3d(R * flat) : flat) + Vector3d(3000, -2000, 1000);
+    }
+    const auto shape = mesh_shape(m);
+    const auto& V = shape->mesh().vertices_m;
+    auto scan = [&](const Vector3d& u) {
+      int best = -1;
+      double best_dot = -std::numeric_limits<double>::infinity();
+      for (int i = 0; i < static_cast<int>(V.size()); ++i)
+        if (u.dot(V[i]) > best_dot) best_dot = u.dot(V[best = i]);
+      return best;
+    };
+    std::mt19937_64 rng(11);
+    std::vector<Vector3d> dirs = {Vector3d::UnitZ(), -Vector3d::UnitZ(), Vector3d::UnitX(), R * Vector3d::UnitZ()};
+    for (int i = 0; i < 300; ++i) dirs.push_back(random_unit(rng));
+    for (const auto& d : dirs) {
+      const auto sp = shape->support_point(d);
+      ASSERT_TRUE(sp.has_value());
+      const Vector3d u = d / d.cwiseAbs().maxCoeff();  // as support_point scales it
+      const int expected = scan(u);
+      EXPECT_EQ(sp->point_m, shape->closest_point(V[expected]).point_m) << d.transpose();
+      int equal = 0;
+      for (const auto& v : V) equal += u.dot(v) == u.dot(V[expected]);
+      ties += equal > 1;
+    }
+  }
+  EXPECT_GE(ties, 1);  // the flat top ties along +z: the lowest index must win there
 }
 
 TEST(Contains, MeshAgreesWithTheSolidItApproximates) {

@@ -202,6 +202,15 @@ double point_segment_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& a
 }
 }  // namespace
 
+namespace {
+// A node of the support query's tree: boxes split at the median of their longest side down to
+// kSupportLeaf vertices; order[first, last) are its vertices, left/right its children (-1: a leaf).
+struct SupportNode {
+  Eigen::Vector3d lo, hi;
+  int first = 0, last = 0, left = -1, right = -1;
+};
+}  // namespace
+
 struct MeshShape::Index {
   std::vector<CTriangle> triangles;
   Tree tree;
@@ -223,7 +232,45 @@ struct MeshShape::Index {
   std::vector<int> surface_vertices;  // corners of some triangle, ascending
   double mean_edge = 0;
   Eigen::Vector3d lo, hi;
+  // The support query's tree over the surface vertices (support_order: the vertices, each node's
+  // a contiguous range).
+  std::vector<SupportNode> support_nodes;
+  std::vector<int> support_order;
 };
+
+namespace {
+
+constexpr int kSupportLeaf = 16;
+
+// Builds node `n` over order[first, last) and its children; depth is log2 of the vertex count.
+void build_support_node(std::vector<SupportNode>& nodes, std::vector<int>& order,
+                        const std::vector<Eigen::Vector3d>& V, int first, int last) {
+  const int n = static_cast<int>(nodes.size());
+  nodes.emplace_back();
+  Eigen::Vector3d lo = V[order[first]], hi = lo;
+  for (int i = first; i < last; ++i) {
+    lo = lo.cwiseMin(V[order[i]]);
+    hi = hi.cwiseMax(V[order[i]]);
+  }
+  nodes[n].lo = lo;
+  nodes[n].hi = hi;
+  nodes[n].first = first;
+  nodes[n].last = last;
+  if (last - first <= kSupportLeaf) return;
+  int axis = 0;
+  (hi - lo).maxCoeff(&axis);
+  const int mid = first + (last - first) / 2;
+  std::nth_element(order.begin() + first, order.begin() + mid, order.begin() + last,
+                   [&](int a, int b) { return V[a][axis] < V[b][axis] || (V[a][axis] == V[b][axis] && a < b); });
+  const int left = static_cast<int>(nodes.size());
+  build_support_node(nodes, order, V, first, mid);
+  const int right = static_cast<int>(nodes.size());
+  build_support_node(nodes, order, V, mid, last);
+  nodes[n].left = left;
+  nodes[n].right = right;
+}
+
+}  // namespace
 
 MeshShape::MeshShape(TriangleMesh mesh, const MeshMassProperties& mass, const MeshShapeOptions& options)
     : mesh_(std::move(mesh)), mass_(mass), options_(options), index_(std::make_unique<Index>()) {
@@ -344,6 +391,8 @@ MeshShape::MeshShape(TriangleMesh mesh, const MeshMassProperties& mass, const Me
     for (std::size_t v = 0; v < nv; ++v)
       if (used[v]) ix.surface_vertices.push_back(static_cast<int>(v));
   }
+  ix.support_order = ix.surface_vertices;
+  build_support_node(ix.support_nodes, ix.support_order, V, 0, static_cast<int>(ix.support_order.size()));
   if (tree_thread.joinable()) {
     tree_thread.join();
     if (tree_error) std::rethrow_exception(tree_error);
@@ -783,14 +832,42 @@ std::optional<SurfacePoint> MeshShape::support_point(const Eigen::Vector3d& dire
   }
   const Eigen::Vector3d u = direction / largest;
   const auto& V = mesh_.vertices_m;
+  const Index& ix = *index_;
+  // Branch and bound over the vertex tree: a box's bound is its support u . corner, widened by a
+  // margin above the rounding of any dot product in it, so that no box holding a vertex whose
+  // computed u . v reaches the best is pruned. The answer is the full scan's exactly: the largest
+  // computed dot product, the lowest vertex index among equal ones. Why not a library: CGAL's
+  // search trees find nearest or farthest points, not the extreme along a direction, and its
+  // convex hull costs more to build (100k triangles) than the scans it would save; measured on a
+  // 20-impact sequence of an 81,920-triangle part (bench/bench_sequence), the scan was 83 % of it.
+  const double scale = u.cwiseAbs().dot(ix.lo.cwiseAbs().cwiseMax(ix.hi.cwiseAbs()));
+  const double margin = 8.0 * std::numeric_limits<double>::epsilon() * scale;
+  auto bound = [&](const SupportNode& n) {
+    return u.cwiseProduct(n.lo).cwiseMax(u.cwiseProduct(n.hi)).sum() + margin;
+  };
   int best = -1;
   double best_dot = -std::numeric_limits<double>::infinity();
-  for (int v : index_->surface_vertices) {  // ascending: the first of equal dot products stays
-    const double h = u.dot(V[v]);
-    if (h > best_dot) {
-      best_dot = h;
-      best = v;
+  // Depth first, the child with the larger bound first; the stack holds at most two nodes per level.
+  int stack[2 * 64];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const SupportNode& n = ix.support_nodes[stack[--top]];
+    if (bound(n) < best_dot) continue;
+    if (n.left < 0) {
+      for (int i = n.first; i < n.last; ++i) {
+        const int v = ix.support_order[i];
+        const double h = u.dot(V[v]);
+        if (h > best_dot || (h == best_dot && v < best)) {
+          best_dot = h;
+          best = v;
+        }
+      }
+      continue;
     }
+    const bool left_first = bound(ix.support_nodes[n.left]) >= bound(ix.support_nodes[n.right]);
+    stack[top++] = left_first ? n.right : n.left;
+    stack[top++] = left_first ? n.left : n.right;
   }
   return closest_point(V[best]);
 }
