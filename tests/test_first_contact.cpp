@@ -602,6 +602,125 @@ TEST(FirstContact, SpheresInClosedForm) {
 }
 
 // ---------------------------------------------------------------------------------------------
+// The generic convex route (a GJK ray cast of the support functions) against the exact routes: an
+// ellipsoid seen only through the Shape interface, convex, so that first contact cannot take its
+// ellipsoid methods.
+
+namespace {
+
+// An ellipsoid seen only through the Shape interface, under another kind name, convex or not.
+struct EllipsoidAsShape : Shape {
+  EllipsoidAsShape(const Ellipsoid& e, std::string name, bool convex) : e(e), name(std::move(name)), convex(convex) {}
+  Ellipsoid e;
+  std::string name;
+  bool convex;
+  std::string kind() const override { return name; }
+  VolumeProperties volume_properties() const override { return e.volume_properties(); }
+  SurfacePoint closest_point(const Vector3d& q) const override { return e.closest_point(q); }
+  Curvature curvature(const SurfacePoint& at) const override { return e.curvature(at); }
+  double paper_radius_m(const SurfacePoint& at) const override { return e.paper_radius_m(at); }
+  std::optional<SurfacePoint> ray_exit(const Vector3d& o, const Vector3d& dir) const override {
+    return e.ray_exit(o, dir);
+  }
+  double size_m() const override { return e.size_m(); }
+  std::vector<SurfacePoint> sample_surface(std::size_t n, std::uint64_t seed) const override {
+    return e.sample_surface(n, seed);
+  }
+  std::optional<SurfacePoint> support_point(const Vector3d& dir) const override { return e.support_point(dir); }
+  bool contains(const Vector3d& p) const override { return e.contains(p); }
+  bool is_convex() const override { return convex; }
+};
+
+struct HiddenEllipsoid final : EllipsoidAsShape {
+  explicit HiddenEllipsoid(const Ellipsoid& e) : EllipsoidAsShape(e, "hidden", true) {}
+};
+
+}  // namespace
+
+TEST(FirstContact, GenericRouteEqualsTheExactEllipsoidPair) {
+  std::mt19937_64 rng(808);
+  std::uniform_real_distribution<double> axis(0.3, 2.5), lateral(-0.6, 0.6);
+  double worst_travel = 0, worst_point = 0, worst_normal = 0;
+  for (int trial = 0; trial < 24; ++trial) {
+    // Spheres first (the brief's case), then ellipsoids.
+    const Vector3d eT = trial < 8 ? Vector3d::Constant(axis(rng)) : Vector3d(axis(rng), axis(rng), axis(rng));
+    const Vector3d eM = trial < 8 ? Vector3d::Constant(axis(rng)) : Vector3d(axis(rng), axis(rng), axis(rng));
+    const Ellipsoid T(eT.x(), eT.y(), eT.z()), M(eM.x(), eM.y(), eM.z());
+    const HiddenEllipsoid hT(T), hM(M);
+    const double size = std::max(T.size_m(), M.size_m());
+    Pose pt, pm;
+    pt.rotation = random_rotation(rng);
+    pm.rotation = random_rotation(rng);
+    pt.position_m = Vector3d(1.7e3, -4.1e3, 9.2e3) * size;
+    const Vector3d d = random_unit(rng);
+    const Vector3d side = d.unitOrthogonal(), side2 = d.cross(side);
+    const double reach = eT.minCoeff() + eM.minCoeff();
+    pm.position_m = pt.position_m - 3.0 * size * d + reach * (lateral(rng) * side + lateral(rng) * side2);
+    const FirstContact exact = first_contact({&T, pt}, {&M, pm}, d);
+    // The generic route for both, and for either one (the other keeps its support function).
+    for (const auto& [t, m] : {std::pair<const Shape*, const Shape*>{&hT, &hM}, {&hT, &M}, {&T, &hM}}) {
+      const FirstContact fc = first_contact({t, pt}, {m, pm}, d);
+      worst_travel = std::max(worst_travel, std::abs(fc.travel_m - exact.travel_m) / exact.travel_m);
+      worst_point = std::max(worst_point, (fc.point_m - exact.point_m).norm() / size);
+      worst_normal = std::max(worst_normal, (fc.normal - exact.normal).norm());
+      EXPECT_NEAR(fc.travel_m, exact.travel_m, test::kConvexCastRel * exact.travel_m) << "trial " << trial;
+      EXPECT_LE((fc.point_m - exact.point_m).norm(), test::kConvexCastRel * size) << "trial " << trial;
+      EXPECT_LE((fc.normal - exact.normal).norm(), test::kConvexCastRel) << "trial " << trial;
+      EXPECT_LE((fc.mover_point.point_m - exact.mover_point.point_m).norm(), test::kConvexCastRel * size);
+      EXPECT_EQ(fc.kind, "smooth");
+    }
+  }
+  RecordProperty("travel_rel_error", sci(worst_travel));
+  RecordProperty("point_rel_error", sci(worst_point));
+  RecordProperty("normal_error", sci(worst_normal));
+  std::printf("generic route vs the exact ellipsoid pair, 24 placements x 3: travel %.1e, point %.1e, normal %.1e\n",
+              worst_travel, worst_point, worst_normal);
+}
+
+TEST(FirstContact, GenericConvexShapeOntoAMeshEqualsTheExactSweptSphere) {
+  // The concave part u.off against a sphere or an ellipsoid, by the exact swept ellipsoid and by
+  // the generic route (the convex shape cast against each candidate triangle).
+  const auto part = mesh_shape(load_mesh(data("u.off"), LengthUnit::m).mesh);
+  std::mt19937_64 rng(31);
+  int hits = 0;
+  double worst_travel = 0, worst_point = 0;
+  for (int trial = 0; trial < 16; ++trial) {
+    const double r = 0.05 + 0.1 * trial / 16.0;
+    const Ellipsoid ball = trial % 2 == 0 ? Ellipsoid::sphere(r) : Ellipsoid(r, 0.7 * r, 1.3 * r);
+    const HiddenEllipsoid hidden(ball);
+    Pose pp, pb;
+    pp.rotation = random_rotation(rng);
+    pb.rotation = random_rotation(rng);
+    pp.position_m = {-300, 700, 120};
+    const Vector3d d = random_unit(rng);
+    pb.position_m = pp.position_m - 2.0 * d + 0.4 * random_unit(rng).cross(d);
+    FirstContact exact;
+    try {
+      exact = first_contact({part.get(), pp}, {&ball, pb}, d);
+    } catch (const InputError& e) {
+      expect_message(input_error_of([&] { first_contact({part.get(), pp}, {&hidden, pb}, d); }),
+                     "^moving along .* the bodies never touch$");
+      continue;
+    }
+    ++hits;
+    const double size = part->size_m();
+    const FirstContact fc = first_contact({part.get(), pp}, {&hidden, pb}, d);
+    worst_travel = std::max(worst_travel, std::abs(fc.travel_m - exact.travel_m) / size);
+    worst_point = std::max(worst_point, (fc.point_m - exact.point_m).norm() / size);
+    EXPECT_NEAR(fc.travel_m, exact.travel_m, test::kConvexCastRel * size) << "trial " << trial;
+    EXPECT_LE((fc.point_m - exact.point_m).norm(), test::kConvexCastRel * size) << "trial " << trial;
+    EXPECT_EQ(fc.kind, exact.kind) << "trial " << trial;
+    // The roles swapped: the part moves back onto the convex shape.
+    const FirstContact back = first_contact({&hidden, pb}, {part.get(), pp}, -d);
+    EXPECT_NEAR(back.travel_m, exact.travel_m, test::kConvexCastRel * size);
+    EXPECT_LE((back.point_m - (exact.point_m - exact.travel_m * d)).norm(), test::kConvexCastRel * size);
+  }
+  EXPECT_GE(hits, 8);
+  std::printf("generic convex shape onto u.off vs the swept ellipsoid, %d hits: travel %.1e, point %.1e (x size)\n",
+              hits, worst_travel, worst_point);
+}
+
+// ---------------------------------------------------------------------------------------------
 // Meshed ellipsoids converge to the analytic contact. Table printed for docs/geometry.md.
 
 TEST(FirstContact, MeshedEllipsoidConvergesToTheAnalyticContact) {
@@ -831,25 +950,29 @@ TEST(FirstContact, BadPlacementsAreOneLineErrors) {
   expect_message(input_error_of([] { Pose::from_axis_angle({0, 0, 0}, {0, 0, 0}, 0.5); }),
                  "^orientation_axis: must be a non-zero finite vector$");
   // A shape kind the search does not know (here a sphere seen only through the Shape interface).
-  struct Unknown final : Shape {
-    Ellipsoid e = Ellipsoid::sphere(0.3);
-    std::string kind() const override { return "unknown"; }
-    VolumeProperties volume_properties() const override { return e.volume_properties(); }
-    SurfacePoint closest_point(const Vector3d& q) const override { return e.closest_point(q); }
-    Curvature curvature(const SurfacePoint& at) const override { return e.curvature(at); }
-    double paper_radius_m(const SurfacePoint& at) const override { return e.paper_radius_m(at); }
-    std::optional<SurfacePoint> ray_exit(const Vector3d& o, const Vector3d& dir) const override {
-      return e.ray_exit(o, dir);
+  const EllipsoidAsShape unknown(Ellipsoid::sphere(0.3), "unknown", false);
+  // A convex one whose cast cannot converge (a broken support function, answering NaN): a
+  // one-line error after the bounded number of queries, not a hang or a NaN contact.
+  struct Erratic final : EllipsoidAsShape {
+    Erratic() : EllipsoidAsShape(Ellipsoid::sphere(0.3), "erratic", true) {}
+    std::optional<SurfacePoint> support_point(const Vector3d&) const override {
+      SurfacePoint sp;
+      sp.point_m = Vector3d::Constant(std::nan(""));
+      return sp;
     }
-    double size_m() const override { return e.size_m(); }
-    std::vector<SurfacePoint> sample_surface(std::size_t n, std::uint64_t seed) const override {
-      return e.sample_surface(n, seed);
-    }
-    std::optional<SurfacePoint> support_point(const Vector3d& dir) const override { return e.support_point(dir); }
-    bool contains(const Vector3d& p) const override { return e.contains(p); }
-  } unknown;
+  } erratic;
+  expect_message(input_error_of([&] { first_contact({&a, origin}, {&erratic, above}, {0, 0, -1}); }),
+                 "^first contact of the 'erratic' \\(moving\\) and the 'ellipsoid' did not converge in [0-9]+ "
+                 "support queries \\(distance left .* m\\): give the contact point \\(point = \\[x, y, z\\]\\)$");
+  // Not known to be convex: its support function describes only its hull; the message offers what
+  // works.
   expect_message(input_error_of([&] { first_contact({&a, origin}, {&unknown, above}, {0, 0, -1}); }),
-                 "^no first-contact method for the shape kinds 'unknown' \\(moving\\) and 'ellipsoid'$");
+                 "^no first-contact method for the shape kinds 'unknown' \\(moving\\) and 'ellipsoid': the "
+                 "'unknown' is not known to be convex; give the contact point \\(point = \\[x, y, z\\]\\) or the "
+                 "part as a mesh$");
+  expect_message(input_error_of([&] { first_contact({&unknown, origin}, {cube.get(), above}, {0, 0, -1}); }),
+                 "^no first-contact method for the shape kinds 'mesh' \\(moving\\) and 'unknown': the 'unknown' is "
+                 "not known");
   // Through its support point it still lands on a floor.
   EXPECT_NEAR(first_contact({&floor, origin}, {&unknown, above}, {0, 0, -1}).travel_m, 2.7, 1e-15);
   // Touching at travel 0 (within the 1e-9 allowance) is a contact, not an overlap.

@@ -61,6 +61,18 @@ inline constexpr double kSupportRel = 1e-12;
 /// against the independent last-separating-plane minimisation: both are refined to rounding
 /// (~1e-12 measured), 1e-9 is the acceptance figure.
 inline constexpr double kFirstContactRel = 1e-9;
+/// First contact by the generic convex route (a GJK ray cast of the support functions, converged
+/// to 1e-12 of the size: contact/src/convex_cast.hpp) against closed forms and the exact routes:
+/// travel and point relative to the size, the unit normal. The travel is a lower bound exact to
+/// second order in the normal's error; the brief's figure, 1e-10.
+inline constexpr double kConvexCastRel = 1e-10;
+/// The same where the difference has a flat direction at the contact (a capsule's straight side:
+/// contact/src/convex_cast.hpp, kConvexCastStallRel): rounding stops GJK on a sliver simplex at
+/// ~1e-8 of the size. Travel relative to the size (measured 2.2e-8; the stall allowance 1e-7
+/// bounds it), and the point relative to the size and the unit normal (measured 1.1e-6 and 9.5e-6,
+/// first order in the sliver's tilt along the flat direction), 1e-4.
+inline constexpr double kConvexCastFlatTravelRel = 1e-7;
+inline constexpr double kConvexCastFlatRel = 1e-4;
 /// Observed order of a meshed ellipsoid's contact error (least squares over 6 refinements) may fall
 /// this far below the expected 2 (gap) or 1 (point, normal): the extreme vertex jumps between
 /// neighbours as the mesh refines, so single steps scatter.

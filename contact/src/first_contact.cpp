@@ -17,6 +17,8 @@
 #include "impactdeck/geometry/mesh_shape.hpp"
 #include "impactdeck/geometry/plane.hpp"
 
+#include "convex_cast.hpp"
+
 namespace impactdeck::contact {
 
 using geometry::Ellipsoid;
@@ -545,6 +547,118 @@ Hit mesh_pair(const Body& target, const Body& mover, const Eigen::Vector3d& d, d
   return h;
 }
 
+// ---------------------------------------------------------------------------------------------
+// Shapes without an exact method, by their support functions (convex_cast.hpp): two convex
+// bounded shapes as one GJK ray cast of their Minkowski difference; a convex shape against a
+// mesh as the earliest cast against each triangle the shape's box sweeps over (each triangle is
+// convex; the first touch of a union is its earliest). Both to kConvexCastTolRel of the size.
+
+// A shape's support map in another body's frame, the shape mapped by x -> R x + t.
+detail::SupportMap placed_support(const Shape& shape, const Eigen::Matrix3d& R, const Eigen::Vector3d& t) {
+  return [&shape, R, t](const Eigen::Vector3d& dir) {
+    const auto sp = shape.support_point(R.transpose() * dir);
+    if (!sp) throw std::logic_error("first_contact: a bounded shape without a support point");
+    return Eigen::Vector3d(R * sp->point_m + t);
+  };
+}
+
+// The cast's end that is not a hit, as the one-line error first_contact promises.
+void check_cast(const detail::ConvexCast& c, const Body& target, const Body& mover, const Eigen::Vector3d& d,
+                const InputContext& ctx) {
+  using Status = detail::ConvexCast::Status;
+  if (c.status == Status::miss) never_touch(ctx, d);
+  if (c.status == Status::start_inside) already_overlap(ctx, "the two solids intersect at travel 0");
+  if (c.status == Status::no_convergence) {
+    std::ostringstream s;
+    s << "first contact of the '" << mover.shape->kind() << "' (moving) and the '" << target.shape->kind()
+      << "' did not converge in " << detail::kConvexCastMaxIterations << " support queries (distance left "
+      << c.residual << " m): give the contact point (point = [x, y, z])";
+    throw ctx.error("", s.str());
+  }
+}
+
+Hit convex_pair(const Body& target, const Body& mover, const Eigen::Vector3d& d, double tol,
+                const InputContext& ctx) {
+  const Eigen::Matrix3d R = target.pose.rotation.transpose() * mover.pose.rotation;  // mover -> target frame
+  const Eigen::Vector3d t = target.pose.to_own(mover.pose.position_m);
+  const double scale = std::max({target.shape->size_m(), mover.shape->size_m()});
+  const detail::ConvexCast c = detail::convex_cast(placed_support(*target.shape, Eigen::Matrix3d::Identity(),
+                                                                  Eigen::Vector3d::Zero()),
+                                                   placed_support(*mover.shape, R, t),
+                                                   target.pose.direction_to_own(d), -tol, scale);
+  check_cast(c, target, mover, d, ctx);
+  Hit h;
+  h.s = c.travel;
+  // The simplex's points lie within the tolerance's chord of a curved surface: onto it.
+  h.target_own = target.shape->closest_point(c.fixed_point).point_m;
+  h.mover_own = mover.shape->closest_point(R.transpose() * (c.mover_point - t)).point_m;
+  h.mover_feature = h.target_feature = "smooth";
+  return h;
+}
+
+// A convex shape (not a mesh) against a mesh, in the mesh's frame, the shape moving along d_rel.
+Hit mesh_convex(const Body& mesh_body, const Body& other, bool other_moves, const Eigen::Vector3d& d, double tol,
+                const InputContext& ctx) {
+  const MeshShape& mesh = *mesh_body.mesh;
+  const Eigen::Matrix3d R = mesh_body.pose.rotation.transpose() * other.pose.rotation;  // other -> mesh frame
+  const Eigen::Vector3d t = mesh_body.pose.to_own(other.pose.position_m);
+  const Eigen::Vector3d d_rel = mesh_body.pose.direction_to_own(other_moves ? d : Eigen::Vector3d(-d));
+  const detail::SupportMap shape = placed_support(*other.shape, R, t);
+  const auto& V = mesh.mesh().vertices_m;
+  const auto& F = mesh.mesh().triangles;
+  // The shape's bounding box in the mesh frame (its supports along the axes), padded.
+  Eigen::Vector3d lo, hi;
+  for (int k = 0; k < 3; ++k) {
+    hi[k] = shape(Eigen::Vector3d::Unit(k))[k];
+    lo[k] = shape(-Eigen::Vector3d::Unit(k))[k];
+  }
+  const Eigen::Vector3d pad = Eigen::Vector3d::Constant(tol + 1e-12 * (t.norm() + (hi - lo).norm()));
+  const Eigen::AlignedBox3d box(lo - pad, hi + pad);
+  // Overlap at travel -tol that no triangle shows: the shape inside the mesh (its centroid, inside
+  // a convex shape) or the mesh inside the shape (one of its vertices).
+  if (mesh.contains(R * other.shape->volume_properties().centroid_m + t - tol * d_rel)) {
+    already_overlap(ctx, "the " + other.shape->kind() + " lies inside the mesh");
+  }
+  if (other.shape->contains(R.transpose() * (V[F[0][0]] - t + tol * d_rel))) {
+    already_overlap(ctx, "the mesh lies inside the " + other.shape->kind());
+  }
+  const double scale = std::max(mesh.size_m(), other.shape->size_m());
+  const auto inside = [&](const Eigen::Vector3d& q) { return other.shape->contains(R.transpose() * (q - t)); };
+  detail::TriangleCast best;
+  mesh.sweep_faces(box, d_rel, -tol, kInf, [&](int f, double s_max) {
+    const std::array<Eigen::Vector3d, 3> P{V[F[f][0]], V[F[f][1]], V[F[f][2]]};
+    const detail::TriangleCast c = detail::triangle_cast(P, shape, inside, d_rel, -tol, scale, std::min(s_max, best.travel));
+    if (c.status == detail::TriangleCast::Status::overlap) {
+      already_overlap(ctx, "the mesh surface enters the " + other.shape->kind());
+    }
+    if (c.status == detail::TriangleCast::Status::no_convergence) {
+      detail::ConvexCast failed;
+      failed.status = detail::ConvexCast::Status::no_convergence;
+      failed.residual = c.residual;
+      check_cast(failed, other_moves ? mesh_body : other, other_moves ? other : mesh_body, d, ctx);
+    }
+    if (c.status == detail::TriangleCast::Status::hit && c.travel < best.travel) best = c;
+    return std::min(s_max, best.travel);
+  });
+  if (!(best.travel < kInf)) never_touch(ctx, d);
+  const char* feature = best.feature;
+  const Eigen::Vector3d on_other = other.shape->closest_point(R.transpose() * (best.on_shape - t)).point_m;
+  Hit h;
+  h.s = best.travel;
+  if (other_moves) {
+    h.target_own = best.on_triangle;
+    h.mover_own = on_other;
+    h.target_feature = feature;
+    h.mover_feature = "smooth";
+  } else {
+    h.target_own = on_other;
+    h.mover_own = best.on_triangle;
+    h.target_feature = "smooth";
+    h.mover_feature = feature;
+  }
+  return h;
+}
+
 }  // namespace
 
 FirstContact first_contact(const PlacedShape& target_in, const PlacedShape& mover_in,
@@ -573,9 +687,20 @@ FirstContact first_contact(const PlacedShape& target_in, const PlacedShape& move
     h = mesh_ellipsoid(mover, target, false, d, tol, ctx);
   } else if (target.mesh && mover.mesh) {
     h = mesh_pair(target, mover, d, tol, ctx);
+  } else if (target.mesh && mover.shape->is_convex()) {
+    h = mesh_convex(target, mover, true, d, tol, ctx);
+  } else if (mover.mesh && target.shape->is_convex()) {
+    h = mesh_convex(mover, target, false, d, tol, ctx);
+  } else if (target.shape->is_convex() && mover.shape->is_convex()) {
+    h = convex_pair(target, mover, d, tol, ctx);
   } else {
+    // A shape that is neither an ellipsoid, a plane nor a mesh and not known to be convex: its
+    // support function describes only its convex hull.
+    const Body& odd = mover.mesh || mover.shape->is_convex() ? target : mover;
     throw ctx.error("", "no first-contact method for the shape kinds '" + mover.shape->kind() + "' (moving) and '" +
-                                 target.shape->kind() + "'");
+                            target.shape->kind() + "': the '" + odd.shape->kind() +
+                            "' is not known to be convex; give the contact point (point = [x, y, z]) or the part "
+                            "as a mesh");
   }
   return dress(target, mover, d, h);
 }

@@ -1,7 +1,8 @@
 #pragma once
 // Where two placed bodies first touch when one of them translates along a line: the point, the
 // target's outward normal there, and how far the mover travelled. Exact (to rounding) for every
-// pair of ellipsoid / sphere / plane / mesh; see docs/geometry.md, "First contact".
+// pair of ellipsoid / sphere / plane / mesh; a convex shape of another kind by its support
+// function (to 1e-12 of the size); see docs/geometry.md, "First contact".
 #include <string>
 
 #include <Eigen/Dense>
@@ -50,12 +51,15 @@ struct FirstContact {
 /// the direction is zero or not finite, when the bodies never touch ("moving along (dx, dy, dz) the
 /// bodies never touch"), when they already overlap at travel 0 ("the bodies already overlap (...)"; a penetration up to
 /// 1e-9 of the bounded bodies' size counts as touching at travel 0), when both are unbounded (two
-/// planes) and for a pair of shape kinds it does not know.
-/// Methods: two convex analytic bodies by their support functions and affine maps (a convex
-/// one-dimensional root); a mesh against a plane by its support vertex; a mesh against an
-/// ellipsoid or sphere by an exact swept sphere against the triangles (after the affine map that
-/// makes the ellipsoid a unit sphere); two meshes by exact continuous collision of a translation
-/// (vertex-face both ways and edge-edge), candidates from the AABB trees.
+/// planes), for a shape of another kind that is not known to be convex (against anything but a
+/// plane), and when the generic cast does not converge.
+/// Methods: two ellipsoids by the affine map that makes the target a unit ball (a convex
+/// one-dimensional root); any bounded body against a plane by its support point; a mesh against an
+/// ellipsoid or sphere by an exact swept sphere against the triangles (after the same map); two
+/// meshes by exact continuous collision of a translation (vertex-face both ways and edge-edge),
+/// candidates from the AABB trees; two convex shapes without one of these by a GJK ray cast of
+/// their support functions, and a convex one against a mesh by casts against each candidate
+/// triangle's face, edges and vertices (contact/src/convex_cast.hpp).
 FirstContact first_contact(const PlacedShape& target, const PlacedShape& mover, const Eigen::Vector3d& direction_world,
                            const InputContext& ctx = {});
 
