@@ -53,10 +53,12 @@ std::string mm_text(const Eigen::Vector3d& p_m) {
   return s.str();
 }
 
-// The same, rounded to 3 significant digits for a picture's legend.
-std::string legend_mm(const Eigen::Vector3d& p_m) {
-  return "(" + plot::format_number(p_m.x() * 1e3, 3) + ", " + plot::format_number(p_m.y() * 1e3, 3) + ", " +
-         plot::format_number(p_m.z() * 1e3, 3) + ") mm";
+// A point in `unit` (the deck's length unit), rounded to 3 significant digits: a picture's legend,
+// the CSV sidecar's notes.
+std::string legend_point(const Eigen::Vector3d& p_m, LengthUnit unit) {
+  const Eigen::Vector3d p = p_m / metres_per(unit);
+  return "(" + plot::format_number(p.x(), 3) + ", " + plot::format_number(p.y(), 3) + ", " +
+         plot::format_number(p.z(), 3) + ") " + to_string(unit);
 }
 
 // One pass over a ccx .frd (both readers below): the result blocks of every output time, each
@@ -143,6 +145,25 @@ void vtu_mesh_and_end(std::ostream& o, const TetMesh& m, double per_m) {
   o << "</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
   for (std::size_t e = 0; e < m.tets.size(); ++e) o << "10\n";
   o << "</DataArray>\n</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
+}
+
+// The FieldData of every .vtu of the deck folder: its unit system (the deck's) as strings
+// unit_system, length_unit, stress_unit (VTK String arrays: each value's bytes, 0-terminated) and as
+// factors metres_per_length_unit, pascals_per_stress_unit. The caller closes the FieldData.
+void vtu_unit_fields(std::ostream& o, const DeckUnits& u) {
+  auto text = [&](const char* key, const std::string& value) {
+    o << "<DataArray type=\"String\" Name=\"" << key << "\" NumberOfTuples=\"1\" format=\"ascii\">";
+    for (unsigned char ch : value) o << static_cast<int>(ch) << " ";
+    o << "0</DataArray>\n";
+  };
+  o << "<FieldData>\n";
+  text("unit_system", u.name());
+  text("length_unit", to_string(u.length));
+  text("stress_unit", u.stress_unit());
+  o << "<DataArray type=\"Float64\" Name=\"metres_per_length_unit\" NumberOfTuples=\"1\" format=\"ascii\">"
+    << metres_per(u.length) << "</DataArray>\n"
+    << "<DataArray type=\"Float64\" Name=\"pascals_per_stress_unit\" NumberOfTuples=\"1\" format=\"ascii\">"
+    << 1.0 / u.per_Pa() << "</DataArray>\n";
 }
 
 // The 0-based mesh node of a result line's node number (checked against the mesh's `n` nodes).
@@ -379,52 +400,63 @@ void write_stress_files(const fs::path& dir, const TetMesh& m, StressResult& r, 
   for (const auto& p : r.probes) series.push_back(&p);
   series.push_back(&r.load);
 
-  // 1. History CSV, SI.
+  // Every file in the deck's unit system (DeckUnits): stresses in its stress unit, positions and
+  // displacements in its length unit; times in s.
+  const DeckUnits units{r.length_unit};
+  const double per_m = units.per_m(), per_Pa = units.per_Pa();
+  const std::string unit = to_string(r.length_unit), su = units.stress_unit();
+
+  // 1. History CSV.
   const fs::path csv = dir / "von_mises_history.csv";
   write_file_atomically(csv, [&](std::ostream& o) {
     o << "time_s";
-    for (const auto* p : series) o << "," << p->name << "_von_mises_Pa";
+    for (const auto* p : series) o << "," << p->name << "_von_mises_" << su;
     o << "\n" << std::setprecision(9);
     for (std::size_t k = 0; k < r.time_s.size(); ++k) {
       o << r.time_s[k];
-      for (const auto* p : series) o << "," << p->von_mises_Pa[k];
+      for (const auto* p : series) o << "," << p->von_mises_Pa[k] * per_Pa;
       o << "\n";
     }
   });
   {  // Its JSON sidecar: what used to be `#` lines (common/csv_sidecar.hpp).
     std::vector<std::string> columns = {"time_s"};
     std::vector<std::pair<std::string, std::string>> meta = {
-        {"title", "von Mises stress (Pa) against time (s) at each probe and at the contact node LOAD (impactdeck)"}};
+        {"title", "von Mises stress (" + su + ") against time (s) at each probe and at the contact node LOAD (impactdeck)"},
+        {"unit_system", units.name()}};
     for (const auto* p : series) {
-      columns.push_back(p->name + "_von_mises_Pa");
-      meta.push_back({p->name, "at " + mm_text(p->point_m)});
+      columns.push_back(p->name + "_von_mises_" + su);
+      meta.push_back({p->name, "at " + legend_point(p->point_m, r.length_unit)});
     }
     write_csv_sidecar(csv, columns, meta);
   }
 
   // 2. VTK XML unstructured grid (ASCII): positions in the deck's length unit, tetrahedra (VTK type 10).
-  const double per_m = DeckUnits{r.length_unit}.per_m();
-  const std::string unit = to_string(r.length_unit);
   const fs::path vtu = dir / "von_mises_peak.vtu";
+  const std::string peak_name = "von_mises_peak_" + su, at_peak_name = "von_mises_at_peak_" + su,
+                    disp_name = "displacement_at_peak_" + unit;
   write_file_atomically(vtu, [&](std::ostream& o) {
     o << std::setprecision(9);
-    o << "<?xml version=\"1.0\"?>\n<!-- impactdeck: peak von Mises over time (Pa) and the fields at the time of the "
-         "governing peak, t = " << r.peak_field_time_s << " s; positions in " << unit << " -->\n"
-      << "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n"
-      << "<FieldData>\n<DataArray type=\"Float64\" Name=\"metres_per_length_unit\" NumberOfTuples=\"1\" format=\"ascii\">"
-      << metres_per(r.length_unit) << "</DataArray>\n</FieldData>\n"
+    o << "<?xml version=\"1.0\"?>\n<!-- impactdeck: peak von Mises over time and the fields at the time of the "
+         "governing peak, t = " << r.peak_field_time_s << " s, in the deck's units (" << units.name() << "): positions and "
+         "displacement in " << unit << ", stresses in " << su << " -->\n"
+      << "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n";
+    vtu_unit_fields(o, units);
+    o << "</FieldData>\n"
       << "<Piece NumberOfPoints=\"" << m.nodes_m.size() << "\" NumberOfCells=\"" << m.tets.size() << "\">\n"
-      << "<PointData Scalars=\"von_mises_peak_Pa\" Vectors=\"displacement_at_peak_m\">\n";
-    auto scalars = [&](const char* name, const std::vector<double>& v) {
+      << "<PointData Scalars=\"" << peak_name << "\" Vectors=\"" << disp_name << "\">\n";
+    auto scalars = [&](const std::string& name, const std::vector<double>& v, double scale) {
       o << "<DataArray type=\"Float64\" Name=\"" << name << "\" format=\"ascii\">\n";
-      for (double x : v) o << x << "\n";
+      for (double x : v) o << x * scale << "\n";
       o << "</DataArray>\n";
     };
-    scalars("von_mises_peak_Pa", r.node_peak_Pa);
-    scalars("von_mises_peak_time_s", r.node_peak_time_s);
-    scalars("von_mises_at_peak_Pa", r.von_mises_at_peak_Pa);
-    o << "<DataArray type=\"Float64\" Name=\"displacement_at_peak_m\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-    for (const auto& u : r.displacement_at_peak_m) o << u.x() << " " << u.y() << " " << u.z() << "\n";
+    scalars(peak_name, r.node_peak_Pa, per_Pa);
+    scalars("von_mises_peak_time_s", r.node_peak_time_s, 1.0);
+    scalars(at_peak_name, r.von_mises_at_peak_Pa, per_Pa);
+    o << "<DataArray type=\"Float64\" Name=\"" << disp_name << "\" NumberOfComponents=\"3\" format=\"ascii\">\n";
+    for (const auto& u : r.displacement_at_peak_m) {
+      const Eigen::Vector3d x = u * per_m;
+      o << x.x() << " " << x.y() << " " << x.z() << "\n";
+    }
     o << "</DataArray>\n</PointData>\n";
     vtu_mesh_and_end(o, m, per_m);
   });
@@ -446,7 +478,7 @@ void write_stress_files(const fs::path& dir, const TetMesh& m, StressResult& r, 
     }
     o << "$EndElements\n";
     auto view = [&](const std::string& name, int comps, const auto& value) {
-      o << "$NodeData\n1\n\"" << name << ", positions in " << unit << "\"\n1\n" << r.peak_field_time_s << "\n3\n0\n" << comps << "\n"
+      o << "$NodeData\n1\n\"" << name << ", positions in " << unit << " (" << units.name() << ")\"\n1\n" << r.peak_field_time_s << "\n3\n0\n" << comps << "\n"
         << m.nodes_m.size() << "\n";
       for (std::size_t i = 0; i < m.nodes_m.size(); ++i) {
         o << i + 1;
@@ -455,12 +487,12 @@ void write_stress_files(const fs::path& dir, const TetMesh& m, StressResult& r, 
       }
       o << "$EndNodeData\n";
     };
-    view("peak von Mises over time (Pa)", 1, [&](std::ostream& s, std::size_t i) { s << " " << r.node_peak_Pa[i]; });
+    view("peak von Mises over time (" + su + ")", 1, [&](std::ostream& s, std::size_t i) { s << " " << r.node_peak_Pa[i] * per_Pa; });
     view("time of the peak von Mises (s)", 1, [&](std::ostream& s, std::size_t i) { s << " " << r.node_peak_time_s[i]; });
-    view("von Mises at the governing peak's time (Pa)", 1,
-         [&](std::ostream& s, std::size_t i) { s << " " << r.von_mises_at_peak_Pa[i]; });
-    view("displacement at the governing peak's time (m)", 3, [&](std::ostream& s, std::size_t i) {
-      const auto& u = r.displacement_at_peak_m[i];
+    view("von Mises at the governing peak's time (" + su + ")", 1,
+         [&](std::ostream& s, std::size_t i) { s << " " << r.von_mises_at_peak_Pa[i] * per_Pa; });
+    view("displacement at the governing peak's time (" + unit + ")", 3, [&](std::ostream& s, std::size_t i) {
+      const Eigen::Vector3d u = r.displacement_at_peak_m[i] * per_m;
       s << " " << u.x() << " " << u.y() << " " << u.z();
     });
   });
@@ -479,13 +511,13 @@ void write_stress_files(const fs::path& dir, const TetMesh& m, StressResult& r, 
     if (governing.size() == r.time_s.size()) {
       ps.push_back({std::string("verdict: max ") + (inside_governs ? "inside" : "outside") +
                         " the contact zone, peak " + plot::format_number(v.governing.von_mises_Pa * 1e-6, 3) +
-                        " MPa at " + legend_mm(v.governing.point_m),
+                        " MPa at " + legend_point(v.governing.point_m, r.length_unit),
                     r.time_s, governing, 0});
       lo = std::min(lo, v.governing.von_mises_Pa);
       hi = std::max(hi, v.governing.von_mises_Pa);
     }
     for (const auto* p : series) {
-      ps.push_back({p->name + " at " + legend_mm(p->point_m) + (p == &r.load ? " (contact node)" : ""), r.time_s,
+      ps.push_back({p->name + " at " + legend_point(p->point_m, r.length_unit) + (p == &r.load ? " (contact node)" : ""), r.time_s,
                     p->von_mises_Pa, p == &r.load ? plot::kVermilion : 1 + static_cast<int>(ps.size()) % 4});
       lo = std::min(lo, p->max_von_mises_Pa);
       hi = std::max(hi, p->max_von_mises_Pa);
@@ -548,19 +580,9 @@ std::vector<fs::path> write_results_series(const fs::path& dir, const TetMesh& m
       o << "<?xml version=\"1.0\"?>\n<!-- impactdeck: CalculiX results at t = " << pending_t
         << " s in the deck's units: positions and displacement in " << length << ", stresses in " << stress_unit
         << " (" << units.name() << ") -->\n"
-        << "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n<FieldData>\n";
-      auto text = [&](const char* key, const std::string& value) {  // a string array: its bytes, 0-terminated
-        o << "<DataArray type=\"String\" Name=\"" << key << "\" NumberOfTuples=\"1\" format=\"ascii\">";
-        for (unsigned char ch : value) o << static_cast<int>(ch) << " ";
-        o << "0</DataArray>\n";
-      };
-      text("length_unit", length);
-      text("stress_unit", stress_unit);
-      o << "<DataArray type=\"Float64\" Name=\"metres_per_length_unit\" NumberOfTuples=\"1\" format=\"ascii\">"
-        << metres_per(r.length_unit) << "</DataArray>\n"
-        << "<DataArray type=\"Float64\" Name=\"pascals_per_stress_unit\" NumberOfTuples=\"1\" format=\"ascii\">"
-        << 1.0 / units.per_Pa() << "</DataArray>\n"
-        << "<DataArray type=\"Float64\" Name=\"TimeValue\" NumberOfTuples=\"1\" format=\"ascii\">" << pending_t
+        << "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n";
+      vtu_unit_fields(o, units);
+      o << "<DataArray type=\"Float64\" Name=\"TimeValue\" NumberOfTuples=\"1\" format=\"ascii\">" << pending_t
         << "</DataArray>\n</FieldData>\n"
         << "<Piece NumberOfPoints=\"" << n << "\" NumberOfCells=\"" << m.tets.size() << "\">\n"
         << "<PointData Scalars=\"von_mises\" Vectors=\"displacement\" Tensors=\"stress\">\n"
@@ -619,7 +641,8 @@ std::vector<fs::path> write_results_series(const fs::path& dir, const TetMesh& m
   write_file_atomically(pvd, [&](std::ostream& o) {
     o << std::setprecision(12);
     o << "<?xml version=\"1.0\"?>\n<!-- impactdeck: the CalculiX results as a time series (" << written.size() << " of "
-      << times << " output times); lengths in " << length << ", stresses in " << stress_unit << " -->\n"
+      << times << " output times); unit system " << units.name() << ": lengths and displacements in " << length
+      << ", stresses in " << stress_unit << " -->\n"
       << "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n<Collection>\n";
     for (const auto& [time, file] : written) {
       o << "<DataSet timestep=\"" << time << "\" group=\"\" part=\"0\" file=\"" << file << "\"/>\n";
