@@ -4,9 +4,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <memory>
 #include <regex>
 #include <sstream>
 
@@ -365,6 +367,76 @@ TEST(FemStress, AnSIDecksResultFilesAreInSI) {
   EXPECT_EQ(slurp(d / "von_mises_history.csv").rfind("time_s,LOAD_von_mises_Pa\n1e-06,200000000\n", 0), 0u);
   const std::string msh = slurp(d / "von_mises_peak.msh");
   EXPECT_NE(msh.find("\"displacement at the governing peak's time (m), positions in m (SI)\""), std::string::npos) << msh;
+}
+
+// The stresses are read from solver-neutral nodal results (issue 28: the .frd's syntax lives in
+// src/calculix/): results held in memory, as another solver's reader would hand them over, give
+// the same peaks, verdict and files as the .frd reader does.
+class MemoryResults final : public NodalResults {
+ public:
+  struct Frame {
+    double time_s;
+    std::vector<std::array<double, 3>> displacement;
+    std::vector<std::array<double, 6>> stress;
+  };
+  MemoryResults(fs::path name, std::vector<Frame> frames) : name_(std::move(name)), frames_(std::move(frames)) {}
+  const fs::path& file() const override { return name_; }
+  std::size_t read(const NodalResultsVisitor& v, std::size_t node_count) const override {
+    ++passes;
+    auto field = [&](NodalField f, const auto& rows) {
+      if (!v.field(f)) return;
+      for (std::size_t i = 0; i < rows.size(); ++i) {
+        if (node_count > 0 && i >= node_count) throw InputError(name_.string(), "node", "not in the mesh");
+        if (!v.node_wanted || v.node_wanted(i)) v.value(i, rows[i].data());
+      }
+      v.end();
+    };
+    for (const Frame& f : frames_) {
+      v.time(f.time_s);
+      field(NodalField::displacement, f.displacement);
+      field(NodalField::stress, f.stress);
+    }
+    return 0;
+  }
+  mutable int passes = 0;
+
+ private:
+  fs::path name_;
+  std::vector<Frame> frames_;
+};
+
+TEST(FemStress, StressesComeFromSolverNeutralNodalResults) {
+  const fs::path d = fresh_dir("neutral");
+  TetMesh m;
+  m.nodes_m = {{0, 0, 0}, {0.01, 0, 0}, {0, 0.01, 0}, {0, 0, -0.01}};
+  m.tets = {{0, 1, 2, 3}};
+  using F = MemoryResults::Frame;
+  // mm-t-s: MPa and mm. Node 4 (outside a 5 mm zone) peaks at 2 us with 80 MPa uniaxial.
+  const std::vector<std::array<double, 3>> u0(4, {0, 0, 0}), u1 = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}, {0, 0, 0.5}};
+  const std::vector<std::array<double, 6>> s1 = {{10, 0, 0, 0, 0, 0}, {0, 0, 0, 0, 0, 0}, {0, 0, 0, 0, 0, 0}, {20, 0, 0, 0, 0, 0}},
+                                           s2 = {{10, 0, 0, 0, 0, 0}, {0, 0, 0, 0, 0, 0}, {0, 0, 0, 0, 0, 0}, {80, 0, 0, 0, 0, 0}};
+  auto results = std::make_shared<MemoryResults>(d / "memory", std::vector<F>{{1e-6, u0, s1}, {2e-6, u1, s2}});
+  StressInputs in;
+  in.load_node = 0;
+  in.contact_zone_radius_m = 0.005;
+  in.yield_strength_Pa = 100e6;
+  in.end_time_s = 1e-5;
+  StressResult r = read_stresses(results, m, in);
+  ASSERT_EQ(r.time_s.size(), 2u);
+  EXPECT_NEAR(r.outside_zone.von_mises_Pa, 80e6, 1e-6);
+  EXPECT_EQ(r.outside_zone.node, 3);
+  EXPECT_DOUBLE_EQ(r.peak_field_time_s, 2e-6);
+  EXPECT_NEAR(r.displacement_at_peak_m[3].z(), 0.5e-3, 1e-15);
+  EXPECT_EQ(r.verdict.kind, VerdictKind::survives);
+  EXPECT_NEAR(r.verdict.safety_factor, 1.25, 1e-12);
+  write_stress_files(d, m, r, "memory");
+  EXPECT_EQ(results->passes, 2);  // the verdict's pass, then the time series'
+  EXPECT_NE(slurp(d / "results_0001.vtu").find("\n0 0 0.5\n"), std::string::npos);
+  // The contact deck's probe reader takes them too (ProbeStress::node is 1-based).
+  std::vector<ProbeStress> probes = {{"P", 4, m.nodes_m[3], 0, 0, {}}};
+  const std::vector<double> times = read_node_stresses(*results, DeckUnits{LengthUnit::mm}, probes, 1e-5);
+  ASSERT_EQ(times.size(), 2u);
+  EXPECT_NEAR(probes[0].max_von_mises_Pa, 80e6, 1e-6);
 }
 
 // ---- Decks of a patch load -------------------------------------------------------------------
