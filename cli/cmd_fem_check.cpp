@@ -23,13 +23,14 @@ void register_fem_check(CLI::App& app, Context& ctx) {
     bool json = false;
     bool no_run = false;
     fem_export::CheckOptions options;
+    std::string ccx;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
       "fem-check", "Run ccx on a deck folder: momentum, the FE body and motion against the rigid model, stresses");
   cmd->add_option("dir", args->dir, "Deck folder (fem_<impact>/ written by 'impactdeck run')")->required();
   cmd->add_flag("--json", args->json, "Print one JSON document on stdout (keys: docs/fem.md)");
-  cmd->add_option("--ccx", args->options.ccx, "CalculiX executable (default: ccx from PATH)");
+  cmd->add_option("--ccx", args->ccx, "CalculiX executable (default: ccx from PATH)");
   cmd->add_flag("--no-run", args->no_run, "Do not run ccx; check the existing impact.dat");
   cmd->add_option("--linear-tolerance", args->options.linear_tolerance,
                   "Max relative error of the linear momentum (default: the deck's, 1e-3 unless the scene set it)")->check(positive_number());
@@ -46,10 +47,11 @@ void register_fem_check(CLI::App& app, Context& ctx) {
     check_threads(static_cast<unsigned>(std::min(args->options.threads, 1 << 30)));
     if (!std::isfinite(args->options.timeout_s)) throw UsageError("--solver-timeout-s must be a finite number of seconds");
     fem_export::CheckOptions o = args->options;
+    if (!args->ccx.empty()) o.executables["calculix"] = args->ccx;
     o.run_solver = !args->no_run;
     o.progress = ctx.progress();
     if (ctx.verbose) {
-      std::cerr << "impactdeck: fem-check: dir " << args->dir << ", ccx " << o.ccx << ", run " << o.run_solver
+      std::cerr << "impactdeck: fem-check: dir " << args->dir << ", ccx " << o.executable("calculix", "ccx") << ", run " << o.run_solver
                 << ", linear tolerance " << o.linear_tolerance << ", angular tolerance "
                 << o.angular_tolerance << ", threads " << o.threads << "\n";
     }

@@ -570,7 +570,7 @@ void define_analyses(py::module_& m) {
           if (!(std::isfinite(x) && x >= 0)) throw UsageError("tolerances and solver_timeout_s: finite numbers >= 0");
         }
         fem_export::CheckOptions o;
-        o.ccx = ccx;
+        o.executables["calculix"] = ccx;
         o.run_solver = run_solver;
         o.linear_tolerance = linear_tolerance;
         o.angular_tolerance = angular_tolerance;

@@ -52,7 +52,7 @@ assert [c["name"] for c in f] == ["impulse"], f
 c = f[0]
 assert c["impact"] == "impact1" and c["limit"] == 1e-99 and c["value"] > c["limit"], c
 assert "impulse check (Eq. 31)" in c["reason"] and "[checks] impulse_relative" in c["reason"], c
-assert sorted(p.rsplit("/", 1)[1] for p in d["files_written"]) == ["force_two_spheres.csv", "report.html"], d["files_written"]
+assert sorted(p.rsplit("/", 1)[1] for p in d["files_written"]) == ["force_two_spheres.csv", "force_two_spheres.csv.json", "report.html"], d["files_written"]  # the CSV's sidecar too
 PY
 "$bin" run "$src/samples/two_spheres.toml" --out "$tmp/ok" --json >"$tmp/ok.json" 2>/dev/null
 check "a passing run: exit 0" [ $? = 0 ]

@@ -4,8 +4,10 @@
 # and in the unit --output-length-unit asks for: checked in ParaView's terms (VTK's own readers:
 # every sweep point on the deck mesh's boundary surface, same bounding box), in Gmsh's (the gmsh
 # command merging the deck's .msh and the sweep's .pos, printing both bounding boxes) and in the
-# files' own words (header comments, FieldData, CSV column names, deck.json, JSON keys). Then the
-# solver's side: the same ccx result with the decks in cm and in m.
+# files' own words (header comments, FieldData, CSV column names, deck.json, JSON keys). The deck
+# follows the output unit when it is mm or m; an inch run's deck is mm-t-s (never an inch-based mass
+# unit, docs/fem.md "Units"), its mesh then scaled to inches to overlay the sweep. Then the
+# solver's side: the same ccx result with the decks in mm-t-s and in SI.
 # usage: output_unit_test.sh IMPACTDECK SOURCE_DIR
 set -u
 bin=$1; src=$2
@@ -25,6 +27,7 @@ check "sweep unknown unit: nothing written" test ! -e "$tmp/bad2"
 for unit in default m in; do
   flag=(); [ "$unit" != default ] && flag=(--output-length-unit "$unit")
   expect=$([ "$unit" = default ] && echo mm || echo "$unit")
+  deck_unit=$([ "$expect" = m ] && echo m || echo mm)
   o="$tmp/$unit"
   "$bin" run "$scene" --json --out "$o" "${flag[@]}" >"$o.run.json" 2>"$o.err"
   check "$unit: run exit 0" test $? -eq 0
@@ -36,16 +39,16 @@ for unit in default m in; do
   check "$unit: sweep (vertices) exit 0" test $? -eq 0
 
   # The files' own words.
-  python3 - "$o" "$expect" <<'PY' || { echo "FAILED: $unit: units stated"; fails=$((fails+1)); }
+  python3 - "$o" "$expect" "$deck_unit" <<'PY' || { echo "FAILED: $unit: units stated"; fails=$((fails+1)); }
 import json, sys, re
-o, u = sys.argv[1], sys.argv[2]
+o, su, u = sys.argv[1], sys.argv[2], sys.argv[3]
 metres = {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "in": 0.0254}[u]
 run = json.load(open(o + ".run.json")); sw = json.load(open(o + ".sweep.json"))
-assert run["output_length_unit"] == u and run["length_unit"] == "mm", run["output_length_unit"]
-assert sw["output_length_unit"] == u
+assert run["output_length_unit"] == su and run["length_unit"] == "mm", run["output_length_unit"]
+assert sw["output_length_unit"] == su
 deck = json.load(open(o + "/fem_hit/deck.json"))
 assert deck["length_unit"] == u, deck["length_unit"]
-assert deck["deck_units"].startswith(u + "-N-s-"), deck["deck_units"]
+assert deck["deck_units"] == {"mm": "mm-t-s", "m": "SI"}[u], deck["deck_units"]
 for f in ["impact.inp", "impact.comm"]:
     t = open(o + "/fem_hit/" + f).read()
     assert re.search(r"Units: %s, N, s, " % re.escape(u), t), f
@@ -54,26 +57,28 @@ geo = open(o + "/fem_hit/mesh.geo").read()
 m = re.search(r"^Mesh.ScalingFactor = ([^;]+);", geo, re.M)
 assert m and abs(float(m.group(1)) - 1e-3 / metres) <= 1e-15 * (1e-3 / metres), geo[:400]
 csv = [l for l in open(o + "/sweep_hit.csv") if not l.startswith("#")]
-assert csv[0].startswith("index,x_%s,y_%s,z_%s," % (u, u, u)), csv[0]
+assert csv[0].startswith("index,x_%s,y_%s,z_%s," % (su, su, su)), csv[0]
 head = "".join(l for l in open(o + "/sweep_hit.pos") if l.startswith("//"))
-assert ("coordinates in %s" % u) in head, head
+assert ("coordinates in %s" % su) in head, head
 PY
 
   # ParaView's side: VTK reads the sweep's .vtp and the deck's mesh (its nodes and tetrahedra
   # from mesh_v22.msh, its boundary surface by vtkDataSetSurfaceFilter); every sweep point lies on
   # that surface to round-off, and the corner sweep spans the mesh's bounding box.
-  /usr/bin/python3 - "$o" "$expect" <<'PY' || { echo "FAILED: $unit: VTK overlay"; fails=$((fails+1)); }
+  /usr/bin/python3 - "$o" "$expect" "$deck_unit" <<'PY' || { echo "FAILED: $unit: VTK overlay"; fails=$((fails+1)); }
 import sys, math
 import vtk
-o, u = sys.argv[1], sys.argv[2]
+o, u, du = sys.argv[1], sys.argv[2], sys.argv[3]
 metres = {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "in": 0.0254}[u]
+to_sweep = {"m": 1.0, "mm": 1e-3}[du] / metres  # deck unit -> the sweep's
 def read_msh22(path):
     lines = open(path).read().split("\n"); i = 0; nodes = {}; tets = []
     while i < len(lines):
         if lines[i] == "$Nodes":
             n = int(lines[i + 1])
             for k in range(n):
-                t, x, y, z = lines[i + 2 + k].split(); nodes[int(t)] = (float(x), float(y), float(z))
+                t, x, y, z = lines[i + 2 + k].split()
+                nodes[int(t)] = (float(x) * to_sweep, float(y) * to_sweep, float(z) * to_sweep)
             i += n + 2
         elif lines[i] == "$Elements":
             n = int(lines[i + 1])
@@ -122,7 +127,7 @@ blk = None
 for l in open(o + "/fem_hit/mesh.inp"):
     if l.startswith("*"): blk = l.split(",")[0].strip(); continue
     if blk == "*NODE":
-        f = [float(v) for v in l.split(",")]; inp[int(f[0])] = f[1:]
+        f = [float(v) for v in l.split(",")]; inp[int(f[0])] = [v * to_sweep for v in f[1:]]
 # (numbered apart: ccx's nodes follow the tetrahedra's index, Gmsh's its tags; each .inp node is
 # matched to its nearest .msh node, one to one: sorting the two lists pairs them wrongly when two
 # nodes mirror each other and their x differ only in digits the .inp's 12 do not keep)
@@ -153,17 +158,20 @@ Printf("view %.17g %.17g %.17g %.17g %.17g %.17g", View[0].MinX, View[0].MaxX, V
 GEO
   (cd "$o" && gmsh -nopopup -parse_and_exit overlay.geo) >"$o/gmsh.out" 2>&1
   check "$unit: gmsh merges both" test $? -eq 0
-  python3 - "$o/gmsh.out" <<'PY' || { echo "FAILED: $unit: Gmsh overlay"; cat "$o/gmsh.out"; fails=$((fails+1)); }
+  python3 - "$o/gmsh.out" "$expect" "$deck_unit" <<'PY' || { echo "FAILED: $unit: Gmsh overlay"; cat "$o/gmsh.out"; fails=$((fails+1)); }
 import re, sys
 t = open(sys.argv[1]).read()
-m = [float(v) for v in re.search(r"mesh (\S+) (\S+) (\S+) (\S+) (\S+) (\S+)", t).groups()]
+metres = {"m": 1.0, "mm": 1e-3, "in": 0.0254}
+to_sweep = metres[sys.argv[3]] / metres[sys.argv[2]]  # deck unit -> the sweep's
+m = [float(v) * to_sweep for v in re.search(r"mesh (\S+) (\S+) (\S+) (\S+) (\S+) (\S+)", t).groups()]
 v = [float(x) for x in re.search(r"view (\S+) (\S+) (\S+) (\S+) (\S+) (\S+)", t).groups()]
 size = max(m[1] - m[0], m[3] - m[2], m[5] - m[4])
 assert size > 0 and max(abs(a - b) for a, b in zip(m, v)) <= 1e-9 * size, (m, v)
 PY
 done
 
-# The same mesh in every unit: the nodes in m are the nodes in mm / 1000.
+# The same mesh in every unit: the nodes in m are the nodes in mm / 1000; the inch run's deck is
+# mm-t-s, the default's nodes.
 python3 - "$tmp" <<'PY' || { echo "FAILED: the units agree"; fails=$((fails+1)); }
 import sys
 def nodes(p):
@@ -171,12 +179,12 @@ def nodes(p):
     return [[float(v) for v in l.split()[1:]] for l in t if l.strip()]
 mm, m, inch = (nodes(sys.argv[1] + "/%s/fem_hit/mesh_v22.msh" % u) for u in ("default", "m", "in"))
 assert len(mm) == len(m) == len(inch)
-err = max(max(abs(a / 1000 - b), abs(a / 25.4 - c)) for p, q, r in zip(mm, m, inch) for a, b, c in zip(p, q, r))
+err = max(max(abs(a / 1000 - b), abs(a - c) / 1000) for p, q, r in zip(mm, m, inch) for a, b, c in zip(p, q, r))
 assert err <= 1e-12, err
 PY
 # The solver sees one consistent unit system whatever the length: the drop sample (a cm scene)
-# through ccx with its decks in cm (the default) and in m gives the same momentum and stresses
-# (ccx's .frd prints 6 significant digits: 1e-5).
+# through ccx with its decks in mm-t-s (the default for a cm scene) and in SI (output unit m)
+# gives the same momentum and stresses (ccx's .frd prints 6 significant digits: 1e-5).
 if command -v ccx >/dev/null; then
   for u in default m; do
     flag=(); [ "$u" != default ] && flag=(--output-length-unit "$u")
@@ -191,7 +199,8 @@ va, vb = (c["stress"]["verdict"]["governing"]["max_von_mises_Pa"] for c in (a, b
 assert a["passed"] and b["passed"]
 assert abs(va - vb) <= 1e-5 * va, (va, vb)
 assert abs(a["linear_momentum_relative_error"] - b["linear_momentum_relative_error"]) <= 1e-5, (a, b)
-print("drop sample: peak von Mises %.9g Pa (cm deck) and %.9g Pa (m deck)" % (va, vb))
+assert [json.load(open(p))["impacts"][0]["fem"]["check"]["stress"]["files"][0] for p in sys.argv[1:]]
+print("drop sample: peak von Mises %.9g Pa (mm-t-s deck) and %.9g Pa (SI deck)" % (va, vb))
 PY
 fi
 finish output_length_unit

@@ -362,7 +362,7 @@ TEST(FemCheck, MeshPartFromStlEccentricHitConservesLinearAndAngularMomentum) {
 #endif
   CheckOptions o;
 #ifdef IMPACTDECK_CCX
-  o.ccx = IMPACTDECK_CCX;
+  o.executables["calculix"] = IMPACTDECK_CCX;
 #endif
   const CheckResult c = run_check(d / "deck", o);
   ASSERT_TRUE(c.angular_momentum_relative_error.has_value());

@@ -4,9 +4,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <memory>
 #include <regex>
 #include <sstream>
 
@@ -288,18 +290,22 @@ TEST(FemStress, VonMisesPeaksZonesAndVerdictFromAFrd) {
   write_stress_files(d, m, r, "test");
   // The CSV's JSON sidecar too, and the time series: results.pvd and one .vtu per output time (2).
   ASSERT_EQ(r.files.size(), 8u);
+  // Every file in the deck's system (mm-t-s here): stresses in MPa, displacements in mm.
   const std::string csv = slurp(d / "von_mises_history.csv");
-  EXPECT_EQ(csv.rfind("time_s,PROBE1_von_mises_Pa,LOAD_von_mises_Pa\n", 0), 0u) << "no comment lines: " << csv;
+  EXPECT_EQ(csv.rfind("time_s,PROBE1_von_mises_MPa,LOAD_von_mises_MPa\n", 0), 0u) << "no comment lines: " << csv;
   const nlohmann::json side = nlohmann::json::parse(slurp(d / "von_mises_history.csv.json"));
-  EXPECT_EQ(side.at("columns").at(1).at("unit"), "Pa");
+  EXPECT_EQ(side.at("columns").at(1).at("unit"), "MPa");
   EXPECT_EQ(side.at("columns").at(0).at("unit"), "s");
+  EXPECT_EQ(side.at("metadata").at("unit_system"), "mm-t-s");
   EXPECT_NE(side.at("metadata").at("PROBE1").get<std::string>().find("mm"), std::string::npos);
-  EXPECT_NE(csv.find("\n2e-06,"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("\n2e-06,51.9615242,300\n"), std::string::npos) << csv;  // 30 sqrt 3 MPa, 300 MPa
   const std::string vtu = slurp(d / "von_mises_peak.vtu");
   EXPECT_NE(vtu.find("NumberOfPoints=\"5\" NumberOfCells=\"2\""), std::string::npos);
-  for (const char* f : {"von_mises_peak_Pa", "von_mises_peak_time_s", "von_mises_at_peak_Pa", "displacement_at_peak_m"}) {
+  for (const char* f : {"von_mises_peak_MPa", "von_mises_peak_time_s", "von_mises_at_peak_MPa", "displacement_at_peak_mm"}) {
     EXPECT_NE(vtu.find(f), std::string::npos) << f;
   }
+  // The displacement is the .frd's, in the positions' unit (mm): node 5's (1, 2, 3) mm, not 1e-3 m.
+  EXPECT_NE(vtu.find("\n1 2 3\n"), std::string::npos) << vtu;
   const std::string msh = slurp(d / "von_mises_peak.msh");
   EXPECT_EQ(msh.rfind("$MeshFormat\n2.2 0 8\n", 0), 0u);
   std::size_t views = 0;
@@ -321,6 +327,116 @@ TEST(FemStress, VonMisesPeaksZonesAndVerdictFromAFrd) {
   std::ofstream(d / "cut.frd") << cut;
   EXPECT_THROW(read_stresses(d / "cut.frd", m, in), InputError);
   EXPECT_THROW(read_stresses(d / "missing.frd", m, in), InputError);
+}
+
+// An SI deck's results (issue 32 item 2): the .frd in m and Pa; every file written from it says SI
+// and keeps its numbers in m and Pa, the displacements in the unit of the positions.
+TEST(FemStress, AnSIDecksResultFilesAreInSI) {
+  const fs::path d = fresh_dir("frd_si");
+  TetMesh m;
+  m.nodes_m = {{0, 0, 0}, {0.01, 0, 0}, {0, 0.01, 0}, {0, 0, -0.01}};
+  m.tets = {{0, 1, 2, 3}};
+  std::ostringstream frd;
+  frd << "    1C\n    2C                             4                                     1\n -3\n";
+  const std::vector<std::vector<double>> disp = {{0, 0, 0}, {2.5e-6, 0, 0}, {0, -1e-6, 0}, {0, 0, 4e-6}};  // m
+  const std::vector<std::vector<double>> s = {{2e8, 0, 0, 0, 0, 0}, {0, 0, 0, 0, 0, 0}, {0, 0, 0, 0, 0, 0},
+                                              {0, 0, 0, 0, 0, 0}};  // Pa
+  frd_block(frd, 1e-6, "DISP", disp);
+  frd_block(frd, 1e-6, "STRESS", s);
+  frd << "9999\n";
+  std::ofstream(d / "impact.frd") << frd.str();
+  StressInputs in;
+  in.load_node = 0;
+  in.contact_zone_radius_m = 1e-3;
+  in.end_time_s = 1e-5;
+  in.length_unit = LengthUnit::m;
+  StressResult r = read_stresses(d / "impact.frd", m, in);
+  EXPECT_NEAR(r.load.max_von_mises_Pa, 2e8, 1e-6);
+  EXPECT_NEAR(r.displacement_at_peak_m[3].z(), 4e-6, 1e-18);
+  write_stress_files(d, m, r, "si");
+  const std::string vtu = slurp(d / "von_mises_peak.vtu");
+  for (const char* f : {"von_mises_peak_Pa", "von_mises_at_peak_Pa", "displacement_at_peak_m\""}) {
+    EXPECT_NE(vtu.find(f), std::string::npos) << f;
+  }
+  EXPECT_NE(vtu.find("\n0 0 4e-06\n"), std::string::npos) << vtu;  // the .frd's metres
+  // FieldData unit_system "SI": a VTK String array holds the bytes, 0-terminated.
+  EXPECT_NE(vtu.find("Name=\"unit_system\" NumberOfTuples=\"1\" format=\"ascii\">83 73 0<"), std::string::npos) << vtu;
+  EXPECT_NE(slurp(d / "results_0000.vtu").find("Name=\"unit_system\" NumberOfTuples=\"1\" format=\"ascii\">83 73 0<"),
+            std::string::npos);
+  EXPECT_NE(slurp(d / "results.pvd").find("unit system SI: lengths and displacements in m, stresses in Pa"), std::string::npos);
+  EXPECT_EQ(slurp(d / "von_mises_history.csv").rfind("time_s,LOAD_von_mises_Pa\n1e-06,200000000\n", 0), 0u);
+  const std::string msh = slurp(d / "von_mises_peak.msh");
+  EXPECT_NE(msh.find("\"displacement at the governing peak's time (m), positions in m (SI)\""), std::string::npos) << msh;
+}
+
+// The stresses are read from solver-neutral nodal results (issue 28: the .frd's syntax lives in
+// src/calculix/): results held in memory, as another solver's reader would hand them over, give
+// the same peaks, verdict and files as the .frd reader does.
+class MemoryResults final : public NodalResults {
+ public:
+  struct Frame {
+    double time_s;
+    std::vector<std::array<double, 3>> displacement;
+    std::vector<std::array<double, 6>> stress;
+  };
+  MemoryResults(fs::path name, std::vector<Frame> frames) : name_(std::move(name)), frames_(std::move(frames)) {}
+  const fs::path& file() const override { return name_; }
+  std::size_t read(const NodalResultsVisitor& v, std::size_t node_count) const override {
+    ++passes;
+    auto field = [&](NodalField f, const auto& rows) {
+      if (!v.field(f)) return;
+      for (std::size_t i = 0; i < rows.size(); ++i) {
+        if (node_count > 0 && i >= node_count) throw InputError(name_.string(), "node", "not in the mesh");
+        if (!v.node_wanted || v.node_wanted(i)) v.value(i, rows[i].data());
+      }
+      v.end();
+    };
+    for (const Frame& f : frames_) {
+      v.time(f.time_s);
+      field(NodalField::displacement, f.displacement);
+      field(NodalField::stress, f.stress);
+    }
+    return 0;
+  }
+  mutable int passes = 0;
+
+ private:
+  fs::path name_;
+  std::vector<Frame> frames_;
+};
+
+TEST(FemStress, StressesComeFromSolverNeutralNodalResults) {
+  const fs::path d = fresh_dir("neutral");
+  TetMesh m;
+  m.nodes_m = {{0, 0, 0}, {0.01, 0, 0}, {0, 0.01, 0}, {0, 0, -0.01}};
+  m.tets = {{0, 1, 2, 3}};
+  using F = MemoryResults::Frame;
+  // mm-t-s: MPa and mm. Node 4 (outside a 5 mm zone) peaks at 2 us with 80 MPa uniaxial.
+  const std::vector<std::array<double, 3>> u0(4, {0, 0, 0}), u1 = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}, {0, 0, 0.5}};
+  const std::vector<std::array<double, 6>> s1 = {{10, 0, 0, 0, 0, 0}, {0, 0, 0, 0, 0, 0}, {0, 0, 0, 0, 0, 0}, {20, 0, 0, 0, 0, 0}},
+                                           s2 = {{10, 0, 0, 0, 0, 0}, {0, 0, 0, 0, 0, 0}, {0, 0, 0, 0, 0, 0}, {80, 0, 0, 0, 0, 0}};
+  auto results = std::make_shared<MemoryResults>(d / "memory", std::vector<F>{{1e-6, u0, s1}, {2e-6, u1, s2}});
+  StressInputs in;
+  in.load_node = 0;
+  in.contact_zone_radius_m = 0.005;
+  in.yield_strength_Pa = 100e6;
+  in.end_time_s = 1e-5;
+  StressResult r = read_stresses(results, m, in);
+  ASSERT_EQ(r.time_s.size(), 2u);
+  EXPECT_NEAR(r.outside_zone.von_mises_Pa, 80e6, 1e-6);
+  EXPECT_EQ(r.outside_zone.node, 3);
+  EXPECT_DOUBLE_EQ(r.peak_field_time_s, 2e-6);
+  EXPECT_NEAR(r.displacement_at_peak_m[3].z(), 0.5e-3, 1e-15);
+  EXPECT_EQ(r.verdict.kind, VerdictKind::survives);
+  EXPECT_NEAR(r.verdict.safety_factor, 1.25, 1e-12);
+  write_stress_files(d, m, r, "memory");
+  EXPECT_EQ(results->passes, 2);  // the verdict's pass, then the time series'
+  EXPECT_NE(slurp(d / "results_0001.vtu").find("\n0 0 0.5\n"), std::string::npos);
+  // The contact deck's probe reader takes them too (ProbeStress::node is 1-based).
+  std::vector<ProbeStress> probes = {{"P", 4, m.nodes_m[3], 0, 0, {}}};
+  const std::vector<double> times = read_node_stresses(*results, DeckUnits{LengthUnit::mm}, probes, 1e-5);
+  ASSERT_EQ(times.size(), 2u);
+  EXPECT_NEAR(probes[0].max_von_mises_Pa, 80e6, 1e-6);
 }
 
 // ---- Decks of a patch load -------------------------------------------------------------------

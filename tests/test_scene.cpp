@@ -103,7 +103,7 @@ TEST(Scene, PaperSampleReproducesHandCalculation) {
   EXPECT_LT(res.checks.energy_relative_error, impactdeck::test::kSelfCheckRel);
   // Pi/m of the ellipsoid: (1 + R) * m_w v / m1 = (1 + R) * 0.09998 m/s at 7850 kg/m^3 (paper Sect. 3.3).
   EXPECT_NEAR(-res.target_jump.delta_velocity_m_s.y(), (1 + res.restitution.coefficient) * 0.09998, 2e-5);
-  ASSERT_EQ(r.files_written.size(), 2u);  // the force table and the report page beside it
+  ASSERT_EQ(r.files_written.size(), 3u);  // the force table, its JSON sidecar and the report page beside them
   EXPECT_TRUE(fs::exists(out / "force_table2.csv"));
   EXPECT_EQ(r.files_written.back().filename(), "report.html");
   EXPECT_TRUE(fs::exists(out / "report.html"));

@@ -152,3 +152,31 @@ TEST(SolverRegistry, AnUnknownSolverNameIsRefusedBeforeMeshing) {
   }
   EXPECT_FALSE(fs::exists(d / "deck"));
 }
+
+// deck_units: a deck is written in mm-t-s or SI only (docs/fem.md, "Units"); a cm system (the
+// deck's units followed the scene's length unit before) is refused before meshing.
+TEST(DeckUnits, OnlyMmTSAndSIAreWritten) {
+  EXPECT_EQ(parse_deck_units("mm-t-s")->length, LengthUnit::mm);
+  EXPECT_EQ(parse_deck_units("SI")->length, LengthUnit::m);
+  for (const char* bad : {"si", "mm-N-s-tonne", "cm-N-s-(100 kg)", "", "SI "}) EXPECT_FALSE(parse_deck_units(bad)) << bad;
+  EXPECT_EQ(DeckUnits{LengthUnit::mm}.name(), "mm-t-s");
+  EXPECT_EQ(DeckUnits{LengthUnit::m}.name(), "SI");
+  EXPECT_EQ(DeckUnits{LengthUnit::mm}.stress_unit(), "MPa");
+  EXPECT_EQ(DeckUnits{LengthUnit::m}.mass_unit(), "kg");
+  // The default: SI for a m output, mm-t-s for every other one (cm and inch included).
+  EXPECT_EQ(default_deck_units(LengthUnit::m).length, LengthUnit::m);
+  for (LengthUnit u : {LengthUnit::mm, LengthUnit::cm, LengthUnit::in}) EXPECT_EQ(default_deck_units(u).length, LengthUnit::mm);
+
+  const fs::path d = fresh_dir("deck_units_cm");
+  DeckRequest r = request();
+  r.options.units.length = LengthUnit::cm;
+  try {
+    write_decks(r, d / "deck");
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("deck_units: a deck is written in \"mm-t-s\" or \"SI\", not cm-N-s-(100 kg)"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_FALSE(fs::exists(d / "deck"));
+}

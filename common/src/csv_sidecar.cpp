@@ -59,7 +59,7 @@ std::filesystem::path csv_sidecar_path(const std::filesystem::path& csv) {
 std::string csv_column_unit(std::string_view c) {
   // Longest suffixes first: "_m_s" before "_s", "_N_per_m1_5" before "_5".
   static const std::pair<const char*, const char*> units[] = {
-      {"_N_per_m1_5", "N/m^1.5"}, {"_rad_s", "rad/s"}, {"_m_s", "m/s"}, {"_Ns", "N s"}, {"_Pa", "Pa"},
+      {"_N_per_m1_5", "N/m^1.5"}, {"_rad_s", "rad/s"}, {"_m_s", "m/s"}, {"_Ns", "N s"}, {"_MPa", "MPa"}, {"_Pa", "Pa"},
       {"_kg", "kg"},              {"_N", "N"},         {"_mm", "mm"},   {"_cm", "cm"},  {"_in", "in"},
       {"_m", "m"},                {"_s", "s"},         {"_J", "J"}};
   for (const auto& [suffix, unit] : units)

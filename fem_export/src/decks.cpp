@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <fstream>
 #include <iomanip>
 #include <sstream>
 
@@ -88,6 +89,10 @@ void validate(const DeckRequest& r, const InputContext& where) {
   if (!(r.residual_indentation_m >= 0) || !(r.dent_radius_m >= 0)) {
     throw where.error("dent", "residual indentation and dent radius must be finite and >= 0");
   }
+  if (!o.units.writable()) {
+    throw where.error("deck_units", "a deck is written in \"" + std::string(kDeckUnitsMmTS) + "\" or \"" +
+                                        kDeckUnitsSI + "\", not " + o.units.name());
+  }
   for (const std::string& name : o.solvers) {
     if (find_solver(name)) continue;
     std::string known;
@@ -96,12 +101,22 @@ void validate(const DeckRequest& r, const InputContext& where) {
   }
 }
 
+// Gmsh's .msh has no unit field: a $Comments section (the MSH format ignores sections it does not
+// know; Gmsh, meshio and the tests' own reader skip it) states the deck's system at the file's end.
+void append_msh_units(const fs::path& msh, const DeckUnits& u) {
+  std::ofstream o(msh, std::ios::app | std::ios::binary);
+  o << "$Comments\nimpactdeck: node coordinates in " << to_string(u.length) << "; deck unit system " << u.name()
+    << ": " << u.description() << "\n$EndComments\n";
+  o.flush();
+  if (!o) throw InputError(msh.string(), "$Comments", "cannot append the unit statement");
+}
+
 }  // namespace
 
 std::string DeckUnits::name() const {
   switch (length) {
-    case LengthUnit::mm: return "mm-N-s-tonne";
-    case LengthUnit::m: return "m-N-s-kg";
+    case LengthUnit::mm: return kDeckUnitsMmTS;
+    case LengthUnit::m: return kDeckUnitsSI;
     case LengthUnit::cm: return "cm-N-s-(100 kg)";
     case LengthUnit::in: return "in-N-s-(N s^2/in)";
   }
@@ -118,17 +133,30 @@ std::string DeckUnits::stress_unit() const {
   return "?";
 }
 
-std::string DeckUnits::description() const {
-  const std::string l = to_string(length);
-  std::string mass;
+std::string DeckUnits::mass_unit() const {
   switch (length) {
-    case LengthUnit::mm: mass = "tonne"; break;
-    case LengthUnit::m: mass = "kg"; break;
-    case LengthUnit::cm: mass = "100 kg (N s^2/cm)"; break;
-    case LengthUnit::in: mass = "N s^2/in (39.37 kg)"; break;
+    case LengthUnit::mm: return "tonne";
+    case LengthUnit::m: return "kg";
+    case LengthUnit::cm: return "100 kg (N s^2/cm)";
+    case LengthUnit::in: return "N s^2/in (39.37 kg)";
   }
+  return "?";
+}
+
+std::string DeckUnits::description() const {
+  const std::string l = to_string(length), mass = mass_unit();
   return l + ", N, s, " + mass + " (E in " + stress_unit() + ", density in " + mass + "/" + l + "3, velocity in " +
-         l + "/s)";
+         l + "/s; system " + name() + ")";
+}
+
+std::optional<DeckUnits> parse_deck_units(std::string_view text) {
+  if (text == kDeckUnitsMmTS) return DeckUnits{LengthUnit::mm};
+  if (text == kDeckUnitsSI) return DeckUnits{LengthUnit::m};
+  return std::nullopt;
+}
+
+DeckUnits default_deck_units(LengthUnit output_length_unit) {
+  return DeckUnits{output_length_unit == LengthUnit::m ? LengthUnit::m : LengthUnit::mm};
 }
 
 bool DeckOptions::writes(const std::string& name) const {
@@ -518,6 +546,7 @@ DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
     const PatchLoad* pl = patch ? &*patch : nullptr;
 
     std::vector<std::string> names = {"mesh.geo", "mesh.msh", "mesh_v22.msh"};
+    for (const char* msh : {"mesh.msh", "mesh_v22.msh"}) append_msh_units(stage / msh, r.options.units);
     if (r.body.kind == BodyKind::part) names.push_back("mesh_part.stl");
     if (r.body.kind == BodyKind::cad) names.push_back("mesh_part" + r.body.cad.extension().string());
     // Each chosen solver's files, in the registry's order (solver.hpp).
@@ -598,6 +627,10 @@ DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
                  {"job", kJobName},
                  {"deck_units", r.options.units.name()},
                  {"length_unit", to_string(r.options.units.length)},
+                 {"stress_unit", r.options.units.stress_unit()},
+                 {"mass_unit", r.options.units.mass_unit()},
+                 // mesh_part.stl is mesh.geo's input: Gmsh's working unit, whatever the deck's.
+                 {"mesh_part_stl_length_unit", "mm"},
                  {"frame", "target"},
                  {"impulse_Ns", r.impulse_Ns},
                  {"direction", v3(r.direction)},
@@ -658,6 +691,7 @@ DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
 
     out.mesh = std::move(m);  // the check takes it from here (run_check(DeckResult))
     out.folder = folder;
+    out.units = r.options.units;
     for (const auto& n : names) out.files.push_back(folder / n);
     out.quality = q;
     out.node_count = q.node_count;

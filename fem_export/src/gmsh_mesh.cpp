@@ -482,11 +482,15 @@ namespace {
 constexpr int kLoadPointTag = 100000;
 constexpr int kFirstProbeTag = 100001;
 
-// The part surface as ASCII STL in mm with 17 significant digits: Gmsh reads it back exactly.
-std::string part_stl(const PartSurface& s) {
+// The part surface as ASCII STL in mm with 17 significant digits: Gmsh reads it back exactly. It is
+// the input of mesh.geo, whose working unit is mm; the solid's name line says so and names the
+// unit of the mesh saved (`saved`, the deck's length unit).
+std::string part_stl(const PartSurface& s, LengthUnit saved) {
   std::ostringstream o;
   o.precision(17);
-  o << "solid part\n";
+  const std::string name =
+      "part coordinates in mm (mesh.geo's working unit; the deck's mesh is in " + std::string(to_string(saved)) + ")";
+  o << "solid " << name << "\n";
   for (const auto& t : s.triangles) {
     const Eigen::Vector3d a = s.vertices_m[t[0]] * kMmPerM, b = s.vertices_m[t[1]] * kMmPerM,
                           c = s.vertices_m[t[2]] * kMmPerM;
@@ -496,7 +500,7 @@ std::string part_stl(const PartSurface& s) {
     for (const Eigen::Vector3d* v : {&a, &b, &c}) o << "  vertex " << v->x() << " " << v->y() << " " << v->z() << "\n";
     o << " endloop\nendfacet\n";
   }
-  o << "endsolid part\n";
+  o << "endsolid " << name << "\n";
   return o.str();
 }
 
@@ -899,7 +903,7 @@ MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& l
   const Try& t = tries[kept];
   const double h = h_first * t.size_factor, h0 = std::min(h0_first, h);
   // The kept try's surface, for the .geo to merge (the run itself meshed it from memory).
-  write_file_atomically(stl_copy, part_stl(surface_of(t.own_triangles)));
+  write_file_atomically(stl_copy, part_stl(surface_of(t.own_triangles), o.output_unit));
   std::ostringstream g;
   g << geo_header("mesh part (" + part + ") from memory, written as " + stl_copy.filename().string() +
                   " (mm)", o);

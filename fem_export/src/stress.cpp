@@ -1,14 +1,11 @@
-// Stresses of a CalculiX run read back from the .frd (see stress.hpp).
+// Stresses of a solver run, from its nodal results (see stress.hpp).
 #include "impactdeck/fem_export/stress.hpp"
 
 #include <algorithm>
 #include <array>
 #include <cstdio>
 #include <cmath>
-#include <cstdlib>
 #include <fstream>
-#include <limits>
-#include <functional>
 #include <map>
 #include <iomanip>
 #include <sstream>
@@ -16,7 +13,6 @@
 #include "impactdeck/common/atomic_file.hpp"
 #include "impactdeck/common/csv_sidecar.hpp"
 #include "impactdeck/common/error.hpp"
-#include "impactdeck/common/input_file.hpp"
 #include "impactdeck/fem_export/decks.hpp"
 #include "impactdeck/plot/stress_plot.hpp"
 #include "impactdeck/common/json_number.hpp"
@@ -33,19 +29,6 @@ double von_mises(const double s[6]) {
   return std::sqrt(0.5 * (a * a + b * b + c * c) + 3.0 * (s[3] * s[3] + s[4] * s[4] + s[5] * s[5]));
 }
 
-// Fixed-width field [pos, pos + width) of an .frd line as a number (frd writes 1.23456E-07 and
-// runs fields together when a sign fills the gap).
-bool field(const std::string& line, std::size_t pos, std::size_t width, double& v) {
-  if (line.size() < pos + width) return false;
-  char buf[32];
-  const std::size_t n = std::min<std::size_t>(width, sizeof buf - 1);
-  line.copy(buf, n, pos);
-  buf[n] = '\0';
-  char* end = nullptr;
-  v = std::strtod(buf, &end);
-  return end != buf && std::isfinite(v);
-}
-
 std::string mm_text(const Eigen::Vector3d& p_m) {
   std::ostringstream s;
   s << std::setprecision(4) << "(" << p_m.x() * 1e3 + 0.0 << ", " << p_m.y() * 1e3 + 0.0 << ", "
@@ -53,79 +36,12 @@ std::string mm_text(const Eigen::Vector3d& p_m) {
   return s.str();
 }
 
-// The same, rounded to 3 significant digits for a picture's legend.
-std::string legend_mm(const Eigen::Vector3d& p_m) {
-  return "(" + plot::format_number(p_m.x() * 1e3, 3) + ", " + plot::format_number(p_m.y() * 1e3, 3) + ", " +
-         plot::format_number(p_m.z() * 1e3, 3) + ") mm";
-}
-
-// One pass over a ccx .frd (both readers below): the result blocks of every output time, each
-// "  100C" header's time, each " -4  NAME" block start, its " -1" node records and its " -3" end.
-// `block` says whether a block's records are wanted (false: skipped); `record` gets the node number
-// and the line; `end` closes a wanted block. Returns the bytes read.
-struct FrdVisitor {
-  std::function<void(double time_s)> time;
-  std::function<bool(const std::string& line)> block;
-  std::function<void(long node, const std::string& line, std::size_t lineno)> record;
-  std::function<void()> end;
-};
-
-std::size_t scan_frd(std::istream& f, const std::string& where, const FrdVisitor& v) {
-  std::string line;
-  std::size_t lineno = 0, bytes = 0;
-  bool wanted = false;
-  while (std::getline(f, line)) {
-    ++lineno;
-    bytes += line.size() + 1;
-    if (line.rfind("  100C", 0) == 0) {
-      double t;
-      if (!field(line, 12, 12, t)) throw InputError(where, "line " + std::to_string(lineno), "bad time in a result header");
-      v.time(t);
-      continue;
-    }
-    if (line.rfind(" -4", 0) == 0) {
-      wanted = v.block(line);
-      continue;
-    }
-    if (line.rfind(" -3", 0) == 0) {
-      if (wanted) v.end();
-      wanted = false;
-      continue;
-    }
-    if (!wanted || line.rfind(" -1", 0) != 0) continue;
-    double id;
-    if (!field(line, 3, 10, id) || id < 1 || id != std::floor(id) || id > 1e15) {
-      throw InputError(where, "line " + std::to_string(lineno), "bad node number in a result line");
-    }
-    v.record(static_cast<long>(id), line, lineno);
-  }
-  return bytes;
-}
-
-// The `count` 12-wide values of a " -1" record (displacements, stress components).
-void record_values(const std::string& line, std::size_t lineno, const std::string& where, int count, double* out,
-                   const char* what) {
-  for (int k = 0; k < count; ++k) {
-    if (!field(line, 13 + 12 * static_cast<std::size_t>(k), 12, out[k])) {
-      throw InputError(where, "line " + std::to_string(lineno), std::string("bad ") + what);
-    }
-  }
-}
-
-// A DISP record's three components (the deck's length unit).
-Eigen::Vector3d frd_displacement(const std::string& line, std::size_t lineno, const std::string& where) {
-  double u[3];
-  record_values(line, lineno, where, 3, u, "displacement");
-  return {u[0], u[1], u[2]};
-}
-
-// The result blocks the readers use (ccx 2.20 .frd names; PE only when asked for).
-enum class FrdBlock { none, disp, stress, pe };
-FrdBlock frd_block_kind(const std::string& line, bool with_pe) {
-  if (line.rfind(" -4  DISP", 0) == 0) return FrdBlock::disp;
-  if (line.rfind(" -4  STRESS", 0) == 0) return FrdBlock::stress;
-  if (with_pe && line.rfind(" -4  PE ", 0) == 0) return FrdBlock::pe;
-  return FrdBlock::none;
+// A point in `unit` (the deck's length unit), rounded to 3 significant digits: a picture's legend,
+// the CSV sidecar's notes.
+std::string legend_point(const Eigen::Vector3d& p_m, LengthUnit unit) {
+  const Eigen::Vector3d p = p_m / metres_per(unit);
+  return "(" + plot::format_number(p.x(), 3) + ", " + plot::format_number(p.y(), 3) + ", " +
+         plot::format_number(p.z(), 3) + ") " + to_string(unit);
 }
 
 // The end of a VTK XML UnstructuredGrid piece (written by hand: we do not link VTK): the mesh's
@@ -145,12 +61,23 @@ void vtu_mesh_and_end(std::ostream& o, const TetMesh& m, double per_m) {
   o << "</DataArray>\n</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
 }
 
-// The 0-based mesh node of a result line's node number (checked against the mesh's `n` nodes).
-std::size_t frd_node(long id, std::size_t n, const std::string& where, std::size_t lineno) {
-  if (id > static_cast<long>(n)) {
-    throw InputError(where, "line " + std::to_string(lineno), "a result line names a node the mesh does not have");
-  }
-  return static_cast<std::size_t>(id) - 1;
+// The FieldData of every .vtu of the deck folder: its unit system (the deck's) as strings
+// unit_system, length_unit, stress_unit (VTK String arrays: each value's bytes, 0-terminated) and as
+// factors metres_per_length_unit, pascals_per_stress_unit. The caller closes the FieldData.
+void vtu_unit_fields(std::ostream& o, const DeckUnits& u) {
+  auto text = [&](const char* key, const std::string& value) {
+    o << "<DataArray type=\"String\" Name=\"" << key << "\" NumberOfTuples=\"1\" format=\"ascii\">";
+    for (unsigned char ch : value) o << static_cast<int>(ch) << " ";
+    o << "0</DataArray>\n";
+  };
+  o << "<FieldData>\n";
+  text("unit_system", u.name());
+  text("length_unit", to_string(u.length));
+  text("stress_unit", u.stress_unit());
+  o << "<DataArray type=\"Float64\" Name=\"metres_per_length_unit\" NumberOfTuples=\"1\" format=\"ascii\">"
+    << metres_per(u.length) << "</DataArray>\n"
+    << "<DataArray type=\"Float64\" Name=\"pascals_per_stress_unit\" NumberOfTuples=\"1\" format=\"ascii\">"
+    << 1.0 / u.per_Pa() << "</DataArray>\n";
 }
 
 }  // namespace
@@ -167,17 +94,14 @@ const char* to_string(VerdictKind k) {
   return "?";
 }
 
-StressResult read_stresses(const fs::path& frd, const TetMesh& mesh, const StressInputs& in) {
-  const std::string where = frd.string();
-  check_input_file(frd, "CalculiX results (.frd)", std::numeric_limits<std::uintmax_t>::max());  // not a FIFO
-  std::ifstream f(frd, std::ios::binary);
-  if (!f) throw InputError(where, "file", "CalculiX results (.frd) cannot be opened (missing or unreadable)");
+StressResult read_stresses(std::shared_ptr<const NodalResults> results, const TetMesh& mesh, const StressInputs& in) {
+  const std::string where = results->file().string();
   const std::size_t n = mesh.nodes_m.size();
   if (in.load_node < 0 || static_cast<std::size_t>(in.load_node) >= n) {
     throw InputError(where, "LOAD", "load node is not a node of the mesh");
   }
   StressResult r;
-  r.results_file = frd;
+  r.results = results;
   r.end_time_s = in.end_time_s;
   r.length_unit = in.length_unit;
   const DeckUnits units{in.length_unit};
@@ -198,8 +122,7 @@ StressResult read_stresses(const fs::path& frd, const TetMesh& mesh, const Stres
   std::vector<Eigen::Vector3d> disp(n, Eigen::Vector3d::Zero());
   std::vector<double> vm(n, 0.0);
   std::vector<char> seen(n, 0);
-  using Block = FrdBlock;
-  Block block = Block::none;
+  std::optional<NodalField> block;
   double t = 0, governing_best = -1;
   // Plastic decks: each output time's PE block (after its STRESS block) updates the peaks.
   std::vector<double> pe(n, 0.0);
@@ -254,38 +177,35 @@ StressResult read_stresses(const fs::path& frd, const TetMesh& mesh, const Stres
       r.displacement_at_peak_m = disp;
     }
   };
-  FrdVisitor visit;
+  NodalResultsVisitor visit;
   visit.time = [&](double time_s) {
     t = time_s;
     skip = t > in.end_time_s * (1 + 1e-6);  // the momentum step's increment
   };
-  visit.block = [&](const std::string& line) {
-    block = skip ? Block::none : frd_block_kind(line, in.plastic);
-    if (block == Block::stress) std::fill(seen.begin(), seen.end(), 0);
-    if (block == Block::pe) std::fill(pe.begin(), pe.end(), 0.0);
-    return block != Block::none;
+  visit.field = [&](NodalField f) {
+    block.reset();
+    if (skip || (f == NodalField::plastic_strain && !in.plastic)) return false;
+    block = f;
+    if (f == NodalField::stress) std::fill(seen.begin(), seen.end(), 0);
+    if (f == NodalField::plastic_strain) std::fill(pe.begin(), pe.end(), 0.0);
+    return true;
   };
-  visit.record = [&](long id, const std::string& line, std::size_t lineno) {
-    const std::size_t node = frd_node(id, n, where, lineno);
-    if (block == Block::disp) {
-      disp[node] = frd_displacement(line, lineno, where) / units.per_m();
-    } else if (block == Block::pe) {
-      double e;
-      record_values(line, lineno, where, 1, &e, "equivalent plastic strain");
-      pe[node] = e;  // dimensionless
+  visit.value = [&](std::size_t node, const double* v) {
+    if (block == NodalField::displacement) {
+      disp[node] = Eigen::Vector3d(v[0], v[1], v[2]) / units.per_m();
+    } else if (block == NodalField::plastic_strain) {
+      pe[node] = v[0];  // dimensionless
     } else {
-      double sv[6];
-      record_values(line, lineno, where, 6, sv, "stress");
-      vm[node] = von_mises(sv) / units.per_Pa();
+      vm[node] = von_mises(v) / units.per_Pa();
       seen[node] = 1;
     }
   };
   visit.end = [&] {
-    if (block == Block::stress) finish_stress();
-    if (block == Block::pe) finish_pe();
-    block = Block::none;
+    if (block == NodalField::stress) finish_stress();
+    if (block == NodalField::plastic_strain) finish_pe();
+    block.reset();
   };
-  r.frd_bytes = scan_frd(f, where, visit);
+  r.frd_bytes = results->read(visit, n);
   if (r.time_s.empty()) {
     throw InputError(where, "STRESS", "no stress output (the deck requests *EL FILE S; did ccx finish?)");
   }
@@ -326,14 +246,12 @@ StressResult read_stresses(const fs::path& frd, const TetMesh& mesh, const Stres
   return r;
 }
 
-std::vector<double> read_node_stresses(const fs::path& frd, std::vector<ProbeStress>& probes, double end_time_s) {
-  const std::string where = frd.string();
-  check_input_file(frd, "CalculiX results (.frd)", std::numeric_limits<std::uintmax_t>::max());  // not a FIFO
-  std::ifstream f(frd, std::ios::binary);
-  if (!f) throw InputError(where, "file", "CalculiX results (.frd) cannot be opened (missing or unreadable)");
-  std::map<long, std::size_t> wanted;  // ccx node id -> probe
+std::vector<double> read_node_stresses(const NodalResults& results, const DeckUnits& units,
+                                       std::vector<ProbeStress>& probes, double end_time_s) {
+  const std::string where = results.file().string();
+  std::map<std::size_t, std::size_t> wanted;  // 0-based node -> probe
   for (std::size_t k = 0; k < probes.size(); ++k) {
-    wanted[probes[k].node] = k;
+    wanted[static_cast<std::size_t>(probes[k].node) - 1] = k;  // ProbeStress::node is 1-based
     probes[k].von_mises_Pa.clear();
     probes[k].max_von_mises_Pa = probes[k].max_von_mises_time_s = 0;
   }
@@ -341,23 +259,21 @@ std::vector<double> read_node_stresses(const fs::path& frd, std::vector<ProbeStr
   std::vector<char> seen(probes.size(), 0);
   double t = 0;
   bool skip = false;
-  FrdVisitor visit;
+  NodalResultsVisitor visit;
   visit.time = [&](double time_s) {
     t = time_s;
     skip = t > end_time_s * (1 + 1e-6);
   };
-  visit.block = [&](const std::string& line) {
-    const bool stress = !skip && line.rfind(" -4  STRESS", 0) == 0;
+  visit.field = [&](NodalField f) {
+    const bool stress = !skip && f == NodalField::stress;
     if (stress) std::fill(seen.begin(), seen.end(), 0);
     return stress;
   };
-  visit.record = [&](long id, const std::string& line, std::size_t lineno) {
-    const auto it = wanted.find(id);
-    if (it == wanted.end()) return;
-    double sv[6];
-    record_values(line, lineno, where, 6, sv, "stress");
-    vm[it->second] = von_mises(sv) / DeckUnits{}.per_Pa();  // contact decks are in mm-N-s-tonne (MPa)
-    seen[it->second] = 1;
+  visit.node_wanted = [&](std::size_t node) { return wanted.count(node) > 0; };
+  visit.value = [&](std::size_t node, const double* sv) {
+    const std::size_t k = wanted.at(node);
+    vm[k] = von_mises(sv) / units.per_Pa();
+    seen[k] = 1;
   };
   visit.end = [&] {
     for (std::size_t k = 0; k < probes.size(); ++k) {
@@ -367,7 +283,7 @@ std::vector<double> read_node_stresses(const fs::path& frd, std::vector<ProbeStr
     }
     times.push_back(t);
   };
-  scan_frd(f, where, visit);
+  results.read(visit, 0);
   if (times.empty() && !probes.empty()) {
     throw InputError(where, "STRESS", "no stress output (the deck requests *EL FILE S; did ccx finish?)");
   }
@@ -379,52 +295,63 @@ void write_stress_files(const fs::path& dir, const TetMesh& m, StressResult& r, 
   for (const auto& p : r.probes) series.push_back(&p);
   series.push_back(&r.load);
 
-  // 1. History CSV, SI.
+  // Every file in the deck's unit system (DeckUnits): stresses in its stress unit, positions and
+  // displacements in its length unit; times in s.
+  const DeckUnits units{r.length_unit};
+  const double per_m = units.per_m(), per_Pa = units.per_Pa();
+  const std::string unit = to_string(r.length_unit), su = units.stress_unit();
+
+  // 1. History CSV.
   const fs::path csv = dir / "von_mises_history.csv";
   write_file_atomically(csv, [&](std::ostream& o) {
     o << "time_s";
-    for (const auto* p : series) o << "," << p->name << "_von_mises_Pa";
+    for (const auto* p : series) o << "," << p->name << "_von_mises_" << su;
     o << "\n" << std::setprecision(9);
     for (std::size_t k = 0; k < r.time_s.size(); ++k) {
       o << r.time_s[k];
-      for (const auto* p : series) o << "," << p->von_mises_Pa[k];
+      for (const auto* p : series) o << "," << p->von_mises_Pa[k] * per_Pa;
       o << "\n";
     }
   });
   {  // Its JSON sidecar: what used to be `#` lines (common/csv_sidecar.hpp).
     std::vector<std::string> columns = {"time_s"};
     std::vector<std::pair<std::string, std::string>> meta = {
-        {"title", "von Mises stress (Pa) against time (s) at each probe and at the contact node LOAD (impactdeck)"}};
+        {"title", "von Mises stress (" + su + ") against time (s) at each probe and at the contact node LOAD (impactdeck)"},
+        {"unit_system", units.name()}};
     for (const auto* p : series) {
-      columns.push_back(p->name + "_von_mises_Pa");
-      meta.push_back({p->name, "at " + mm_text(p->point_m)});
+      columns.push_back(p->name + "_von_mises_" + su);
+      meta.push_back({p->name, "at " + legend_point(p->point_m, r.length_unit)});
     }
     write_csv_sidecar(csv, columns, meta);
   }
 
   // 2. VTK XML unstructured grid (ASCII): positions in the deck's length unit, tetrahedra (VTK type 10).
-  const double per_m = DeckUnits{r.length_unit}.per_m();
-  const std::string unit = to_string(r.length_unit);
   const fs::path vtu = dir / "von_mises_peak.vtu";
+  const std::string peak_name = "von_mises_peak_" + su, at_peak_name = "von_mises_at_peak_" + su,
+                    disp_name = "displacement_at_peak_" + unit;
   write_file_atomically(vtu, [&](std::ostream& o) {
     o << std::setprecision(9);
-    o << "<?xml version=\"1.0\"?>\n<!-- impactdeck: peak von Mises over time (Pa) and the fields at the time of the "
-         "governing peak, t = " << r.peak_field_time_s << " s; positions in " << unit << " -->\n"
-      << "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n"
-      << "<FieldData>\n<DataArray type=\"Float64\" Name=\"metres_per_length_unit\" NumberOfTuples=\"1\" format=\"ascii\">"
-      << metres_per(r.length_unit) << "</DataArray>\n</FieldData>\n"
+    o << "<?xml version=\"1.0\"?>\n<!-- impactdeck: peak von Mises over time and the fields at the time of the "
+         "governing peak, t = " << r.peak_field_time_s << " s, in the deck's units (" << units.name() << "): positions and "
+         "displacement in " << unit << ", stresses in " << su << " -->\n"
+      << "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n";
+    vtu_unit_fields(o, units);
+    o << "</FieldData>\n"
       << "<Piece NumberOfPoints=\"" << m.nodes_m.size() << "\" NumberOfCells=\"" << m.tets.size() << "\">\n"
-      << "<PointData Scalars=\"von_mises_peak_Pa\" Vectors=\"displacement_at_peak_m\">\n";
-    auto scalars = [&](const char* name, const std::vector<double>& v) {
+      << "<PointData Scalars=\"" << peak_name << "\" Vectors=\"" << disp_name << "\">\n";
+    auto scalars = [&](const std::string& name, const std::vector<double>& v, double scale) {
       o << "<DataArray type=\"Float64\" Name=\"" << name << "\" format=\"ascii\">\n";
-      for (double x : v) o << x << "\n";
+      for (double x : v) o << x * scale << "\n";
       o << "</DataArray>\n";
     };
-    scalars("von_mises_peak_Pa", r.node_peak_Pa);
-    scalars("von_mises_peak_time_s", r.node_peak_time_s);
-    scalars("von_mises_at_peak_Pa", r.von_mises_at_peak_Pa);
-    o << "<DataArray type=\"Float64\" Name=\"displacement_at_peak_m\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-    for (const auto& u : r.displacement_at_peak_m) o << u.x() << " " << u.y() << " " << u.z() << "\n";
+    scalars(peak_name, r.node_peak_Pa, per_Pa);
+    scalars("von_mises_peak_time_s", r.node_peak_time_s, 1.0);
+    scalars(at_peak_name, r.von_mises_at_peak_Pa, per_Pa);
+    o << "<DataArray type=\"Float64\" Name=\"" << disp_name << "\" NumberOfComponents=\"3\" format=\"ascii\">\n";
+    for (const auto& u : r.displacement_at_peak_m) {
+      const Eigen::Vector3d x = u * per_m;
+      o << x.x() << " " << x.y() << " " << x.z() << "\n";
+    }
     o << "</DataArray>\n</PointData>\n";
     vtu_mesh_and_end(o, m, per_m);
   });
@@ -446,7 +373,7 @@ void write_stress_files(const fs::path& dir, const TetMesh& m, StressResult& r, 
     }
     o << "$EndElements\n";
     auto view = [&](const std::string& name, int comps, const auto& value) {
-      o << "$NodeData\n1\n\"" << name << ", positions in " << unit << "\"\n1\n" << r.peak_field_time_s << "\n3\n0\n" << comps << "\n"
+      o << "$NodeData\n1\n\"" << name << ", positions in " << unit << " (" << units.name() << ")\"\n1\n" << r.peak_field_time_s << "\n3\n0\n" << comps << "\n"
         << m.nodes_m.size() << "\n";
       for (std::size_t i = 0; i < m.nodes_m.size(); ++i) {
         o << i + 1;
@@ -455,12 +382,12 @@ void write_stress_files(const fs::path& dir, const TetMesh& m, StressResult& r, 
       }
       o << "$EndNodeData\n";
     };
-    view("peak von Mises over time (Pa)", 1, [&](std::ostream& s, std::size_t i) { s << " " << r.node_peak_Pa[i]; });
+    view("peak von Mises over time (" + su + ")", 1, [&](std::ostream& s, std::size_t i) { s << " " << r.node_peak_Pa[i] * per_Pa; });
     view("time of the peak von Mises (s)", 1, [&](std::ostream& s, std::size_t i) { s << " " << r.node_peak_time_s[i]; });
-    view("von Mises at the governing peak's time (Pa)", 1,
-         [&](std::ostream& s, std::size_t i) { s << " " << r.von_mises_at_peak_Pa[i]; });
-    view("displacement at the governing peak's time (m)", 3, [&](std::ostream& s, std::size_t i) {
-      const auto& u = r.displacement_at_peak_m[i];
+    view("von Mises at the governing peak's time (" + su + ")", 1,
+         [&](std::ostream& s, std::size_t i) { s << " " << r.von_mises_at_peak_Pa[i] * per_Pa; });
+    view("displacement at the governing peak's time (" + unit + ")", 3, [&](std::ostream& s, std::size_t i) {
+      const Eigen::Vector3d u = r.displacement_at_peak_m[i] * per_m;
       s << " " << u.x() << " " << u.y() << " " << u.z();
     });
   });
@@ -479,13 +406,13 @@ void write_stress_files(const fs::path& dir, const TetMesh& m, StressResult& r, 
     if (governing.size() == r.time_s.size()) {
       ps.push_back({std::string("verdict: max ") + (inside_governs ? "inside" : "outside") +
                         " the contact zone, peak " + plot::format_number(v.governing.von_mises_Pa * 1e-6, 3) +
-                        " MPa at " + legend_mm(v.governing.point_m),
+                        " MPa at " + legend_point(v.governing.point_m, r.length_unit),
                     r.time_s, governing, 0});
       lo = std::min(lo, v.governing.von_mises_Pa);
       hi = std::max(hi, v.governing.von_mises_Pa);
     }
     for (const auto* p : series) {
-      ps.push_back({p->name + " at " + legend_mm(p->point_m) + (p == &r.load ? " (contact node)" : ""), r.time_s,
+      ps.push_back({p->name + " at " + legend_point(p->point_m, r.length_unit) + (p == &r.load ? " (contact node)" : ""), r.time_s,
                     p->von_mises_Pa, p == &r.load ? plot::kVermilion : 1 + static_cast<int>(ps.size()) % 4});
       lo = std::min(lo, p->max_von_mises_Pa);
       hi = std::max(hi, p->max_von_mises_Pa);
@@ -506,8 +433,7 @@ void write_stress_files(const fs::path& dir, const TetMesh& m, StressResult& r, 
 // VTK's XML formats written by hand (we do not link VTK): ASCII UnstructuredGrid pieces and a
 // ParaView collection (.pvd) naming them with their times.
 std::vector<fs::path> write_results_series(const fs::path& dir, const TetMesh& m, const StressResult& r) {
-  if (r.results_file.empty() || r.time_s.empty()) return {};
-  const std::string where = r.results_file.string();
+  if (!r.results || r.time_s.empty()) return {};
   const std::size_t n = m.nodes_m.size(), times = r.time_s.size();
   const double by_budget = std::floor(kSeriesNodeFileBudget / static_cast<double>(std::max<std::size_t>(n, 1)));
   const std::size_t most = std::max<std::size_t>(2, std::min<std::size_t>(kMaxSeriesFiles, static_cast<std::size_t>(by_budget)));
@@ -531,8 +457,7 @@ std::vector<fs::path> write_results_series(const fs::path& dir, const TetMesh& m
   std::vector<std::array<double, 6>> stress(n, std::array<double, 6>{});
   std::vector<double> pe(n, 0.0);
   bool has_pe = false, pending = false;
-  using Block = FrdBlock;
-  Block block = Block::none;
+  std::optional<NodalField> block;
   double t = 0, pending_t = 0;
   std::size_t index = 0;  // stress blocks read: the index into r.time_s
   std::vector<std::pair<double, std::string>> written;
@@ -548,19 +473,9 @@ std::vector<fs::path> write_results_series(const fs::path& dir, const TetMesh& m
       o << "<?xml version=\"1.0\"?>\n<!-- impactdeck: CalculiX results at t = " << pending_t
         << " s in the deck's units: positions and displacement in " << length << ", stresses in " << stress_unit
         << " (" << units.name() << ") -->\n"
-        << "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n<FieldData>\n";
-      auto text = [&](const char* key, const std::string& value) {  // a string array: its bytes, 0-terminated
-        o << "<DataArray type=\"String\" Name=\"" << key << "\" NumberOfTuples=\"1\" format=\"ascii\">";
-        for (unsigned char ch : value) o << static_cast<int>(ch) << " ";
-        o << "0</DataArray>\n";
-      };
-      text("length_unit", length);
-      text("stress_unit", stress_unit);
-      o << "<DataArray type=\"Float64\" Name=\"metres_per_length_unit\" NumberOfTuples=\"1\" format=\"ascii\">"
-        << metres_per(r.length_unit) << "</DataArray>\n"
-        << "<DataArray type=\"Float64\" Name=\"pascals_per_stress_unit\" NumberOfTuples=\"1\" format=\"ascii\">"
-        << 1.0 / units.per_Pa() << "</DataArray>\n"
-        << "<DataArray type=\"Float64\" Name=\"TimeValue\" NumberOfTuples=\"1\" format=\"ascii\">" << pending_t
+        << "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n";
+      vtu_unit_fields(o, units);
+      o << "<DataArray type=\"Float64\" Name=\"TimeValue\" NumberOfTuples=\"1\" format=\"ascii\">" << pending_t
         << "</DataArray>\n</FieldData>\n"
         << "<Piece NumberOfPoints=\"" << n << "\" NumberOfCells=\"" << m.tets.size() << "\">\n"
         << "<PointData Scalars=\"von_mises\" Vectors=\"displacement\" Tensors=\"stress\">\n"
@@ -582,44 +497,44 @@ std::vector<fs::path> write_results_series(const fs::path& dir, const TetMesh& m
     written.emplace_back(pending_t, name);
     files.push_back(vtu);
   };
-  std::ifstream f(r.results_file, std::ios::binary);
-  if (!f) throw InputError(where, "file", "CalculiX results (.frd) cannot be opened (missing or unreadable)");
   bool skip = false;
-  FrdVisitor visit;
+  NodalResultsVisitor visit;
   visit.time = [&](double time_s) {
     if (time_s != t) flush();  // the blocks of one output time share its header's time
     t = time_s;
     skip = t > r.end_time_s * (1 + 1e-6);
   };
-  visit.block = [&](const std::string& line) {
-    block = skip ? Block::none : frd_block_kind(line, true);
-    if (block == Block::pe) std::fill(pe.begin(), pe.end(), 0.0), has_pe = true;
-    return block != Block::none;
+  visit.field = [&](NodalField f) {
+    block.reset();
+    if (skip) return false;
+    block = f;
+    if (f == NodalField::plastic_strain) std::fill(pe.begin(), pe.end(), 0.0), has_pe = true;
+    return true;
   };
-  visit.record = [&](long id, const std::string& line, std::size_t lineno) {
-    const std::size_t node = frd_node(id, n, where, lineno);
-    if (block == Block::disp) {
-      disp[node] = frd_displacement(line, lineno, where);  // the deck's length unit, as the positions
-    } else if (block == Block::stress) {
-      record_values(line, lineno, where, 6, stress[node].data(), "stress");
+  visit.value = [&](std::size_t node, const double* v) {
+    if (block == NodalField::displacement) {
+      disp[node] = Eigen::Vector3d(v[0], v[1], v[2]);  // the deck's length unit, as the positions
+    } else if (block == NodalField::stress) {
+      std::copy(v, v + 6, stress[node].begin());
     } else {
-      record_values(line, lineno, where, 1, &pe[node], "equivalent plastic strain");
+      pe[node] = v[0];
     }
   };
   visit.end = [&] {
-    if (block == Block::stress) {
+    if (block == NodalField::stress) {
       if (index < times && keep[index]) pending = true, pending_t = t;
       ++index;
     }
-    block = Block::none;
+    block.reset();
   };
-  scan_frd(f, where, visit);
+  r.results->read(visit, n);
   flush();
   const fs::path pvd = dir / "results.pvd";
   write_file_atomically(pvd, [&](std::ostream& o) {
     o << std::setprecision(12);
     o << "<?xml version=\"1.0\"?>\n<!-- impactdeck: the CalculiX results as a time series (" << written.size() << " of "
-      << times << " output times); lengths in " << length << ", stresses in " << stress_unit << " -->\n"
+      << times << " output times); unit system " << units.name() << ": lengths and displacements in " << length
+      << ", stresses in " << stress_unit << " -->\n"
       << "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n<Collection>\n";
     for (const auto& [time, file] : written) {
       o << "<DataSet timestep=\"" << time << "\" group=\"\" part=\"0\" file=\"" << file << "\"/>\n";

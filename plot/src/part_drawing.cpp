@@ -236,13 +236,12 @@ void draw_markers(Drawing& d, const Panel& p, const PartMarkers& m, double size,
   if (has_point && m.floor_normal && finite(*m.floor_normal)) draw_floor(d, p, *m.contact_point, *m.floor_normal, width_px);
   if (m.frame) {
     const Point2 o = p.project(m.frame_origin);
-    const char* names[3] = {"x'", "y'", "z'"};
     for (int i = 0; i < 3; ++i) {
       const V3 axis = m.frame->col(i);
       if (!finite(axis)) continue;
       const Point2 tip = p.project(m.frame_origin + axis.normalized() * 0.2 * size);
       arrow(d, o, tip, kAxes[i], 1.5);
-      d.text({tip.x + 3, tip.y - 3}, names[i], 11, Anchor::start, kAxes[i], true);
+      d.text({tip.x + 3, tip.y - 3}, m.frame_names[static_cast<std::size_t>(i)], 11, Anchor::start, kAxes[i], true);
     }
   }
   if (has_point) {
@@ -314,7 +313,7 @@ void draw_legend(Drawing& d, const PartMarkers& m, double ly, double x0, double 
   if (has_point && m.normal) entry("normal n", kNormal, 1);
   if (has_point && m.force) entry("force on the part", kForce, 2);
   if (has_point && m.floor_normal) entry("floor", kFloor, 1);
-  if (m.frame) entry("own axes x' y' z'", kAxes[0], 1);
+  if (m.frame) entry(m.frame_label, kAxes[0], 1);
   if (m.peak_point) entry(m.peak_label, kBlack, 3);
 }
 

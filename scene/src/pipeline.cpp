@@ -660,7 +660,9 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
     for (std::size_t k = 0; k < report.impacts.size(); ++k) {
       auto& ir = report.impacts[k];
       fem_export::DeckRequest req = fem_request(scene, ir, bodies.at(ir.spec->target));
-      req.options.units.length = report.output_length_unit;
+      const auto& deck_unit = scene.outputs.fem->deck_length_unit;
+      req.options.units = deck_unit ? fem_export::DeckUnits{*deck_unit}
+                                    : fem_export::default_deck_units(report.output_length_unit);
       ir.fem_deck = fem_export::write_deck_files(req, staged.fem[k]);  // errors: req.context
       const auto& patch = ir.fem_deck->patch;
       if (ir.fem_deck->load == fem_export::LoadKind::hertz_patch &&
@@ -768,7 +770,17 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
         sr.trajectory_pvd = txn.public_path(f.pvd);
         write_file_atomically(f.svg, detail::sequence_svg(sr, report.output_length_unit));
         sr.plot_svg = txn.public_path(f.svg);
-        for (const fs::path& p : {*sr.trajectory_csv, *sr.trajectory_pvd, *sr.plot_svg}) report.files_written.push_back(p);
+        report.files_written.insert(report.files_written.end(),
+                                    {*sr.trajectory_csv, txn.public_path(csv_sidecar_path(f.csv)), *sr.trajectory_pvd});
+        // The series' frames: every file of its folder, by name.
+        std::vector<fs::path> frames;
+        std::error_code ec;
+        for (fs::directory_iterator it(f.frames, ec), end; !ec && it != end; it.increment(ec)) {
+          frames.push_back(txn.public_path(it->path()));
+        }
+        std::sort(frames.begin(), frames.end());
+        report.files_written.insert(report.files_written.end(), frames.begin(), frames.end());
+        report.files_written.push_back(*sr.plot_svg);
       }
     });
   }
@@ -803,14 +815,21 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
       for (const auto& f : ir.compare->files) report.files_written.push_back(f);
     }
     if (ir.fem_check) {
-      for (auto& f : ir.fem_check->solver_files) f = txn.public_path(f);
+      // ccx's results and the files read from them, in the deck folder beside the deck's own.
+      auto written = [&](fs::path& f) {
+        f = txn.public_path(f);
+        if (std::find(report.files_written.begin(), report.files_written.end(), f) == report.files_written.end()) {
+          report.files_written.push_back(f);
+        }
+      };
+      for (auto& f : ir.fem_check->solver_files) written(f);
       if (ir.fem_check->stress) {
-        for (auto& f : ir.fem_check->stress->files) f = txn.public_path(f);
+        for (auto& f : ir.fem_check->stress->files) written(f);
       }
     }
   }
   for (const auto& ir : report.impacts) {
-    if (ir.table_path) report.files_written.push_back(*ir.table_path);
+    if (ir.table_path) report.files_written.insert(report.files_written.end(), {*ir.table_path, csv_sidecar_path(*ir.table_path)});
     if (ir.plot_path) report.files_written.push_back(*ir.plot_path);
   }
   if (staged.report) {

@@ -257,17 +257,26 @@ std::string stress_picture(const ImpactReport& ir, std::string& caption) {
     mk.peak_point = st.verdict.governing.point_m;
     mk.peak_label = "peak " + plot::format_number(st.verdict.governing.von_mises_Pa * 1e-6, 3) + " MPa";
   }
+  // The deck's axes (the target's own frame, the coordinates of mesh.inp and the .vtu files),
+  // drawn from the mesh's lowest corner, and the scale bar in the deck's length unit.
+  Eigen::Vector3d lo = m.nodes_m.front();
+  for (const auto& p : m.nodes_m) lo = lo.cwiseMin(p);
+  const LengthUnit unit = st.length_unit;
+  mk.frame = Eigen::Matrix3d::Identity();
+  mk.frame_origin = lo;
+  mk.frame_names = {"x", "y", "z"};
+  mk.frame_label = std::string("deck axes x y z (") + to_string(unit) + ")";
   plot::PartDrawingOptions o;
   o.title = "Von Mises stress at t = " + plot::format_number(st.peak_field_time_s * 1e6, 3) + " \xC2\xB5s, impact '" +
             ir.spec->name + "'";
   o.vertex_values = std::move(values);
   o.value_label = "MPa";
   o.value_scale = 1e-6;
-  const LengthUnit unit = st.length_unit;
   o.length_unit = to_string(unit);
   o.length_unit_size = metres_per(unit);
   caption = "Von Mises stress (MPa) on the FE mesh's surface at the time of the governing peak (t = " +
-            plot::format_number(st.peak_field_time_s, 4) + " s), the deck's own frame, from ccx's .frd" +
+            plot::format_number(st.peak_field_time_s, 4) + " s), in the deck's frame (the target's own axes x y z, " +
+            "as in mesh.inp, lengths in " + to_string(unit) + "), from ccx's .frd" +
             (capped ? "; the colour scale ends at the verdict's peak (" +
                           plot::format_number(cap * 1e-6, 3) +
                           " MPa, outside the contact zone): higher values (the point load's node and its neighbours) take the top colour"
@@ -541,7 +550,7 @@ std::string report_html(const Scene& scene, const RunReport& rep, const std::vec
     if (ir.fem_deck) {
       page.paragraph("FEM deck: " + ir.fem_deck->folder.string() + " (" + std::to_string(ir.fem_deck->quality.node_count) +
                      " nodes, " + std::to_string(ir.fem_deck->quality.tet_count) + " tetrahedra; units " +
-                     fem_export::DeckUnits{rep.output_length_unit}.description() + ")");
+                     ir.fem_deck->units.description() + ")");
     }
     if (ir.fem_check && ir.fem_check->stress) page.preformatted("FEM stresses", fem_export::format_stress(*ir.fem_check->stress));
     if (ir.compare) page.preformatted("Full-contact comparison (compare_contact)", format_compare(*ir.compare));

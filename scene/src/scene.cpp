@@ -9,6 +9,7 @@
 #include <toml++/toml.h>
 
 #include "impactdeck/collision/contact_law.hpp"
+#include "impactdeck/fem_export/decks.hpp"
 #include "impactdeck/sequence/sequence.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/common/suggest.hpp"
@@ -453,7 +454,7 @@ FemOutputs read_fem(const toml::table& t, const Source& file, double to_m) {
            "volume_tolerance", "mass_tolerance", "inertia_tolerance", "min_gamma", "max_elements", "solver",
            "aster_cpus", "aster_mpi_processes", "compare_contact", "compare_contact_threshold", "compare_contact_refine",
            "compare_contact_elements", "compare_contact_increments", "compare_contact_penalty_factor",
-           "material_model"});
+           "material_model", "deck_units"});
   FemOutputs f;
   f.place = r.self();
   if (r.has("mesh_size")) f.mesh_size_m = r.positive("mesh_size") * to_m;
@@ -533,6 +534,11 @@ FemOutputs read_fem(const toml::table& t, const Source& file, double to_m) {
       "material_model", {{"elastic", FemOutputs::MaterialModel::elastic}, {"plastic", FemOutputs::MaterialModel::plastic}},
       FemOutputs::MaterialModel::elastic);
   f.material_model_place = r.has("material_model") ? r.place("material_model") : f.place;
+  if (r.has("deck_units")) {  // the two unit systems a deck is written in
+    f.deck_length_unit = r.choice<LengthUnit>(
+        "deck_units", {{fem_export::kDeckUnitsMmTS, LengthUnit::mm}, {fem_export::kDeckUnitsSI, LengthUnit::m}},
+        std::nullopt);
+  }
   if (r.boolean("compare_contact").value_or(false)) {
     FemOutputs::CompareContact c;
     if (!f.calculix) r.fail("compare_contact", "compare_contact = true runs CalculiX: it needs calculix = true");

@@ -12,6 +12,9 @@
 
 namespace impactdeck::fem_export::calculix {
 
+/// ccx's executable when CheckOptions::executables does not name one (searched in PATH).
+inline constexpr const char* kCcx = "ccx";
+
 /// Plastic decks, steps after the contact: ccx may cut an increment down to this fraction of the
 /// step (automatic incrementation; deck.cpp says why) ...
 inline constexpr double kPlasticMinIncrementFraction = 1e-4;
@@ -29,6 +32,18 @@ class CalculixSolver final : public Solver {
   std::string mesh_file() const override { return "mesh.inp"; }
   SolverOutput run(const SolverJob& job) const override;
   std::optional<StressResult> stresses(const SolverJob& job, const StressInputs& in) const override;
+};
+
+/// ccx's .frd as solver-neutral nodal results (stress.hpp): DISP, STRESS and PE blocks (frd.cpp).
+/// The constructor checks the file (InputError when missing or unreadable).
+class FrdResults final : public NodalResults {
+ public:
+  explicit FrdResults(std::filesystem::path frd);
+  const std::filesystem::path& file() const override { return frd_; }
+  std::size_t read(const NodalResultsVisitor& visitor, std::size_t node_count) const override;
+
+ private:
+  std::filesystem::path frd_;
 };
 
 /// Text of the CalculiX main deck (`patch`: the hertz-patch nodal forces, nullptr: the point load

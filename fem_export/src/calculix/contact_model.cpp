@@ -351,7 +351,7 @@ ContactDeck write_contact_deck(const ContactModelRequest& r, const fs::path& fol
                {"source", r.source},
                {"impact", r.impact},
                {"job", kJobName},
-               {"deck_units", "mm-N-s-tonne"},
+               {"deck_units", kDeckUnitsMmTS},
                {"frame", "world, origin at the contact point"},
                {"contact_point_m", json_vector(r.contact_point_m)},
                {"normal", json_vector(r.normal)},

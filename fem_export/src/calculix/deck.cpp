@@ -46,7 +46,7 @@ void amplitude_rows(std::ostream& s, const std::vector<double>& t, const std::ve
 std::string calculix_mesh_inp(const TetMesh& m, const DeckUnits& u) {
   std::ostringstream s;
   s << "** impactdeck " << kVersion << ": mesh of the target body (" << to_string(u.length)
-    << "), included by impact.inp\n";
+    << "), included by impact.inp\n** Units: " << u.description() << ".\n";
   s << "*NODE, NSET=BODYN\n" << std::setprecision(15);
   for (std::size_t i = 0; i < m.nodes_m.size(); ++i) {
     const Eigen::Vector3d x = m.nodes_m[i] * u.per_m();

@@ -170,7 +170,7 @@ double run_ccx(const fs::path& work, const CheckOptions& o, double end_time_s, d
   const fs::path log = work / (job + ".log");
   detail::SolverRun run;
   try {
-    run = detail::run_solver({o.ccx, "-i", job}, work, log,
+    run = detail::run_solver({o.executable("calculix", kCcx), "-i", job}, work, log,
                              {"OMP_NUM_THREADS=" + threads, "CCX_NPROC_EQUATION_SOLVER=" + threads}, timeout_s, poll);
   } catch (const InputError& e) {
     if (e.reason().rfind("cannot run", 0) != 0) throw;
@@ -367,7 +367,7 @@ SolverOutput CalculixSolver::run(const SolverJob& job) const {
 std::optional<StressResult> CalculixSolver::stresses(const SolverJob& job, const StressInputs& in) const {
   const fs::path frd = job.work_dir / (std::string(kJobName) + ".frd");
   if (!fs::exists(frd)) return std::nullopt;
-  return read_stresses(frd, job.mesh, in);
+  return read_stresses(std::make_shared<FrdResults>(frd), job.mesh, in);
 }
 
 }  // namespace impactdeck::fem_export::calculix

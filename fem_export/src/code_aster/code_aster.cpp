@@ -132,7 +132,7 @@ std::string code_aster_comm(const DeckRequest& r, const TetMesh& m, const PatchL
     }
     s << "))\n\n";
   }
-  s << "# Von Mises (MPa) against time at each probe and at LOAD (unit 39).\n";
+  s << "# Von Mises (" << r.options.units.stress_unit() << ") against time at each probe and at LOAD (unit 39).\n";
   std::vector<std::string> at = probes;
   at.push_back("LOAD");
   for (std::size_t i = 0; i < at.size(); ++i) {

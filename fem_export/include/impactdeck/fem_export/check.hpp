@@ -22,6 +22,7 @@
 // compare_body). Then the stresses are read back from the solver's results (CalculiX: impact.frd,
 // stress.hpp). The solver runs and reads its results; the physics and the verdict are here.
 #include <filesystem>
+#include <map>
 #include <functional>
 #include <optional>
 #include <ostream>
@@ -37,7 +38,15 @@
 namespace impactdeck::fem_export {
 
 struct CheckOptions {
-  std::string ccx = "ccx";           ///< solver executable (searched in PATH)
+  /// Each solver's executable by its registry name (Solver::name(): "calculix"); a solver not
+  /// named here runs its own default (CalculiX: "ccx", searched in PATH). `fem-check --ccx PATH`
+  /// sets "calculix".
+  std::map<std::string, std::string> executables;
+  /// executables[solver], or `fallback` when not set.
+  std::string executable(const std::string& solver, const std::string& fallback) const {
+    const auto it = executables.find(solver);
+    return it == executables.end() || it->second.empty() ? fallback : it->second;
+  }
   bool run_solver = true;            ///< false: only parse an existing impact.dat
   /// Max relative error of the mean velocity; 0: the deck's (deck.json tolerances, default 1e-3).
   double linear_tolerance = 0;

@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -27,9 +28,11 @@ namespace impactdeck::fem_export {
 /// each solver's files (solver.hpp) are named after it.
 inline constexpr const char* kJobName = "impact";
 
-/// The solver's unit system of a deck: lengths in `length`, forces in N, times in s, so masses in
-/// N s^2 / length unit and stresses in N / length unit^2 (mm: mm-N-s-tonne with MPa, the default;
-/// m: SI). One consistent system whatever the length unit; every deck file states it.
+/// The solver's unit system of a deck (`[outputs.fem] deck_units`): lengths in `length`, forces in
+/// N, times in s, so masses in N s^2 / length unit and stresses in N / length unit^2. Two systems
+/// are written: "mm-t-s" (mm, N, s, tonne; MPa; length mm) and "SI" (m, N, s, kg; Pa; length m).
+/// Every file of the deck folder uses it and states it (docs/fem.md, "Units"). A cm or inch length
+/// is only read back from decks written before deck_units (fem-check): never written.
 struct DeckUnits {
   LengthUnit length = LengthUnit::mm;
   double per_m() const { return 1.0 / metres_per(length); }          ///< deck lengths per metre
@@ -37,12 +40,23 @@ struct DeckUnits {
   double per_Pa() const { return metres_per(length) * metres_per(length); }  ///< deck stresses per Pa
   double per_kg_m3() const { return per_Pa() * per_Pa(); }           ///< deck densities per kg/m^3
   double per_J() const { return per_m(); }                           ///< deck energies (N x length) per J
-  /// "mm-N-s-tonne", "m-N-s-kg", "cm-N-s-(100 kg)", "in-N-s-(N s^2/in)" (deck.json deck_units).
+  /// "mm-t-s", "SI" (the key's values; deck.json deck_units); older decks' cm and inch systems:
+  /// "cm-N-s-(100 kg)", "in-N-s-(N s^2/in)".
   std::string name() const;
   /// One line for the header comments: lengths, forces, times, masses, E, density, velocity.
   std::string description() const;
-  std::string stress_unit() const;  ///< "MPa", "Pa", "N/cm2", "N/in2"
+  std::string stress_unit() const;  ///< "MPa", "Pa" (older decks: "N/cm2", "N/in2")
+  std::string mass_unit() const;    ///< "tonne", "kg"
+  /// Whether a deck may be written in it (mm-t-s or SI).
+  bool writable() const { return length == LengthUnit::mm || length == LengthUnit::m; }
 };
+inline constexpr const char* kDeckUnitsMmTS = "mm-t-s";
+inline constexpr const char* kDeckUnitsSI = "SI";
+/// "mm-t-s" or "SI" (exact spelling); nullopt for anything else.
+std::optional<DeckUnits> parse_deck_units(std::string_view text);
+/// The system of a scene that does not set deck_units: SI when the run's output length unit is m,
+/// else mm-t-s (a mm, cm or inch scene: never a cm- or inch-based mass unit).
+DeckUnits default_deck_units(LengthUnit output_length_unit);
 
 /// The target's constitutive model in the decks (`[outputs.fem] material_model`).
 enum class MaterialModel {
@@ -186,8 +200,8 @@ struct DeckOptions {
   /// such a mesh takes hours (its own limit: --solver-timeout-s).
   std::size_t max_elements = 500000;
   CcxSolver solver = CcxSolver::automatic;  ///< impact.inp's equation solver
-  /// The decks' unit system (every file of the folder: .geo, .msh, MED, .inp, .comm, and the
-  /// stress files after a ccx run); `run --output-length-unit`, default the scene's unit.
+  /// The decks' unit system (every file of the folder: .geo, .msh, MED, .inp, .comm, the part
+  /// STL, and the result files after a ccx run): mm-t-s or SI (writable(); others are refused).
   DeckUnits units;
   MeshOptions mesh;
   /// The mesh size is a default, not the user's: while the FE body's volume or inertia (of the
@@ -282,6 +296,7 @@ struct PatchSummary {
 struct DeckResult {
   std::filesystem::path folder;
   std::vector<std::filesystem::path> files;  ///< every file of the folder, in writing order
+  DeckUnits units;                           ///< the unit system of every file of the folder
   MeshQuality quality;
   std::size_t node_count = 0, tet_count = 0;
   double mesh_seconds = 0;   ///< wall time of the meshing (Gmsh, every try and re-mesh)

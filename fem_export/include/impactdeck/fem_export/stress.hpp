@@ -1,7 +1,7 @@
 #pragma once
-// Stresses of a CalculiX run, read back from its .frd (ccx 2.20 User's Manual, *EL FILE): the nodal
-// stresses S (extrapolated from the elements and averaged at the nodes by ccx, MPa in the deck's
-// units) and displacements U of every output increment. Von Mises
+// Stresses of a solver run, from its nodal results (NodalResults below; CalculiX's .frd is read in
+// src/calculix/frd.cpp): the nodal stresses (for ccx: S of *EL FILE, extrapolated from the elements
+// and averaged at the nodes, in the deck's units) and displacements of every output time. Von Mises
 //     sigma_v = sqrt(1/2 [(sx - sy)^2 + (sy - sz)^2 + (sz - sx)^2] + 3 (txy^2 + tyz^2 + tzx^2))
 // at every node and time gives:
 //   - each probe's history and peak (the paper's Fig. 15), and the contact node's;
@@ -13,7 +13,10 @@
 // A plastic deck (material_model = "plastic") also writes ccx's equivalent plastic strain ("PE"
 // blocks of the .frd, *EL FILE PEEQ); its verdict rests on it (docs/fem.md, "Plastic decks"):
 // survives elastically, survives with local plastic strain, or yields beyond the contact zone.
+#include <cstddef>
 #include <filesystem>
+#include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -24,6 +27,35 @@
 #include "impactdeck/fem_export/mesh.hpp"
 
 namespace impactdeck::fem_export {
+
+struct DeckUnits;  // decks.hpp
+
+/// The nodal fields of a solver's results at each output time, in the deck's unit system
+/// (DeckUnits): displacement (3 components, its length unit), stress (6: XX YY ZZ XY YZ XZ, its
+/// stress unit), equivalent plastic strain (1, dimensionless; plastic decks).
+enum class NodalField { displacement, stress, plastic_strain };
+constexpr int components(NodalField f) { return f == NodalField::displacement ? 3 : f == NodalField::stress ? 6 : 1; }
+
+/// One pass over a solver's nodal results (NodalResults::read), in output order.
+struct NodalResultsVisitor {
+  std::function<void(double time_s)> time;      ///< the output time of the fields that follow
+  std::function<bool(NodalField field)> field;  ///< a field begins: whether its values are wanted
+  /// Optional: whether a node's values are wanted (unset: every node's); others are not parsed.
+  std::function<bool(std::size_t node)> node_wanted;
+  /// One node's values of a wanted field: its 0-based mesh node and components(field) numbers.
+  std::function<void(std::size_t node, const double* values)> value;
+  std::function<void()> end;                    ///< a wanted field ends
+};
+
+/// A solver's nodal results, read back (Solver::stresses makes them; CalculiX: calculix::FrdResults).
+class NodalResults {
+ public:
+  virtual ~NodalResults() = default;
+  virtual const std::filesystem::path& file() const = 0;  ///< the results file, named in errors
+  /// One pass over the results. `node_count` > 0: a value of a node at or past it is an error
+  /// (InputError naming the file and the place). Returns the bytes read.
+  virtual std::size_t read(const NodalResultsVisitor& visitor, std::size_t node_count) const = 0;
+};
 
 /// Equivalent plastic strain above which a node counts as yielded: a tenth of the yield strain of
 /// steel (Y/E ~ 1e-3), so yield is not missed, and far above the exact 0 ccx writes at nodes whose
@@ -47,7 +79,7 @@ struct StressInputs {
   bool patch_load = false;                            ///< hertz-patch: the zone's stresses mean something
   std::optional<double> yield_strength_Pa;
   double end_time_s = 0;                              ///< output after this (the momentum step) is ignored
-  /// The deck's length unit (DeckUnits): the .frd's displacements are in it and its stresses in
+  /// The deck's length unit (DeckUnits): the results' displacements are in it and their stresses in
   /// N per its square; the .vtu / .msh positions are written in it.
   LengthUnit length_unit = LengthUnit::mm;
   /// material_model = "plastic": the verdict rests on the equivalent plastic strain (PE).
@@ -127,7 +159,7 @@ struct StressResult {
   std::optional<PlasticResult> plastic;  ///< plastic decks only
   /// Per node: the largest PE over time (plastic decks; empty otherwise).
   std::vector<double> node_peak_plastic_strain;
-  std::filesystem::path results_file;    ///< the .frd read (the VTK time series is written from it)
+  std::shared_ptr<const NodalResults> results;  ///< the results read (the VTK time series is written from them)
   double end_time_s = 0;                 ///< output after this is not the impact's (the momentum step)
   /// The fields of the .vtu / .msh: per node, the peak over time and its time; the von Mises and
   /// displacement at the time of the governing peak.
@@ -140,15 +172,20 @@ struct StressResult {
   std::string von_mises_svg;                 ///< the text of von_mises.svg (empty: none written)
 };
 
-/// Reads `frd` (ccx's results) for `mesh` (node i = ccx node i + 1). Throws InputError when the
-/// file is missing, has no stress output, or names nodes the mesh does not have.
+/// Reads `results` for `mesh`. Throws InputError when they have no stress output or name nodes the
+/// mesh does not have.
+StressResult read_stresses(std::shared_ptr<const NodalResults> results, const TetMesh& mesh, const StressInputs& in);
+/// The same from ccx's .frd (node i = ccx node i + 1; src/calculix/frd.cpp). Throws InputError
+/// when the file is missing, too.
 StressResult read_stresses(const std::filesystem::path& frd, const TetMesh& mesh, const StressInputs& in);
 
-/// Reads the von Mises history of the named ccx nodes (1-based ids: `ProbeStress::node`) from an
-/// .frd in mm-N-s-tonne (a contact deck) whose stress output may be limited to those nodes
-/// (`*EL FILE, NSET=`), up to `end_time_s`;
-/// fills each probe's history, peak and time, and returns the output times. Throws InputError when
-/// the file is missing or a probe has no stress at some output time.
+/// Reads the von Mises history of the given nodes (1-based ids: `ProbeStress::node`) from results
+/// in `units` whose stress output may be limited to those nodes, up to `end_time_s`; fills each
+/// probe's history, peak and time, and returns the output times. Throws InputError when a probe
+/// has no stress at some output time.
+std::vector<double> read_node_stresses(const NodalResults& results, const DeckUnits& units,
+                                       std::vector<ProbeStress>& probes, double end_time_s);
+/// The same from the .frd of a contact deck (mm-t-s; `*EL FILE, NSET=`; src/calculix/frd.cpp).
 std::vector<double> read_node_stresses(const std::filesystem::path& frd, std::vector<ProbeStress>& probes,
                                        double end_time_s);
 
@@ -165,13 +202,13 @@ inline constexpr std::size_t kMaxSeriesFiles = 100;
 /// fewer files on a big mesh, never fewer than 2.
 inline constexpr double kSeriesNodeFileBudget = 2e6;
 
-/// Writes the ccx results of r.results_file as a VTK time series into `dir`: results.pvd and
+/// Writes the solver's results (r.results) as a VTK time series into `dir`: results.pvd and
 /// results_NNNN.vtu, one per kept output time up to r.end_time_s (every k-th, k the smallest that
 /// keeps within kMaxSeriesFiles and kSeriesNodeFileBudget; the last time and the governing peak's
-/// time always kept). Point data in the deck's unit system (the .frd's): displacement (same length
+/// time always kept). Point data in the deck's unit system (the results'): displacement (same length
 /// unit as the positions), stress (6 components XX YY ZZ XY YZ XZ), von_mises, and
-/// equivalent_plastic_strain when the .frd has PE. Each .vtu states its units in FieldData
-/// (length_unit, stress_unit, metres_per_length_unit, pascals_per_stress_unit) and a comment, and
+/// equivalent_plastic_strain when the results have it. Each .vtu states its units in FieldData
+/// (unit_system, length_unit, stress_unit, metres_per_length_unit, pascals_per_stress_unit) and a comment, and
 /// its time in FieldData TimeValue. Returns the files written (the .pvd first).
 std::vector<std::filesystem::path> write_results_series(const std::filesystem::path& dir, const TetMesh& mesh,
                                                         const StressResult& r);

@@ -26,6 +26,9 @@ struct PartMarkers {
   /// The part's own axes (columns: x, y, z) drawn at `frame_origin` (its orientation).
   std::optional<Eigen::Matrix3d> frame;
   Eigen::Vector3d frame_origin = Eigen::Vector3d::Zero();
+  /// The axes' names at their tips and the legend's entry for them.
+  std::array<std::string, 3> frame_names = {"x'", "y'", "z'"};
+  std::string frame_label = "own axes x' y' z'";
   /// A point ringed and labelled (e.g. where the governing stress peak is).
   std::optional<Eigen::Vector3d> peak_point;
   std::string peak_label = "peak";

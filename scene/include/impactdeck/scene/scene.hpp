@@ -151,6 +151,9 @@ struct FemOutputs {
   /// yield_strength_Pa and tangent_modulus_Pa; docs/fem.md, "Plastic decks").
   enum class MaterialModel { elastic, plastic } material_model = MaterialModel::elastic;
   Place material_model_place;  ///< where the key is (errors about it name it)
+  /// `deck_units`: the unit system of every file of the deck folder, "mm-t-s" or "SI"; unset:
+  /// fem_export::default_deck_units of the run's output length unit (docs/fem.md, "Units").
+  std::optional<LengthUnit> deck_length_unit;
   Place place;
 };
 
