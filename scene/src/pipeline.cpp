@@ -388,6 +388,54 @@ fem_export::DeckRequest hybrid_deck_request(const Scene& scene, const ImpactRepo
 
 namespace {
 
+// The contact law at a located point (docs/sharp-contacts.md, "Which law runs"): the one choice of
+// `run`'s impacts and of the sequences' bounces. At a sharp edge or corner without edge_radius, the
+// wedge or cone where the law is plastic (sharp_impact_law; Hertz keeps the flagged point); at an
+// edge rounded by edge_radius whose contact is a line, or spans the edge, the law "line". A sharp
+// or line law named for a point it does not fit is refused (contact_law's place). When the law
+// changes, `model` is rebuilt with it and `located` solved again at the same point.
+void choose_point_law(const Scene& scene, const ImpactSpec& s, ImpactLaw& law, std::optional<ContactModel>& model,
+                      ContactEvaluation& located, double e_star, const InputContext& ctx) {
+  const bool fitted = located.result.flag != collision::ContactFlag::no_curvature;
+  const collision::ContactCurvature& tc = located.input.target.curvature;
+  const collision::ContactCurvature& ic = located.input.impactor.curvature;
+  auto solve_again_with = [&](ImpactLaw other) {  // the same point, solved again with another law
+    law = std::move(other);
+    const PreparedBody& target = model->target();  // the bodies outlive the model
+    const PreparedBody& impactor = model->impactor();
+    const collision::ContactRule rule = model->rule();
+    model.emplace(target, impactor, rule, e_star, law.law, ctx);
+    located.input.law = law.law.get();
+    located.result = collision::solve_kernel(located.input);
+  };
+  const bool sharp_point = fitted && (tc.sharp || ic.sharp);
+  const bool rounded_edge = fitted && !sharp_point && ((tc.feature == collision::SharpKind::edge) !=
+                                                       (ic.feature == collision::SharpKind::edge));
+  if (sharp_point) {
+    // A sharp edge or corner without edge_radius: the wedge or cone law where a plastic law runs
+    // (docs/sharp-contacts.md).
+    if (std::optional<ImpactLaw> sharp = sharp_impact_law(s, law, located.input, ctx)) solve_again_with(*sharp);
+  } else if (law.law->takes_sharp_points() && fitted) {
+    throw InputError(where(scene), s.contact_law_place.describe(),
+                     "impact '" + s.name + "': contact_law = \"" + law.name + "\" is the law of a sharp edge or corner, "
+                     "but the contact point at " + text(located.point_m) + " m is smooth (or rounded by edge_radius)");
+  }
+  if (rounded_edge && !law.law->takes_line_contacts()) {
+    // An edge rounded by edge_radius: a line contact over the edge's length where the rounding
+    // lies on a surface flat along the edge, or where the contact's length reaches the edge's.
+    const double length = (tc.feature == collision::SharpKind::edge ? tc : ic).feature_length_m;
+    const collision::KernelResult& kr = located.result;
+    if (kr.flag == collision::ContactFlag::line ||
+        (kr.flag == collision::ContactFlag::none && 2.0 * kr.contact_semi_axis_a_m >= length)) {
+      solve_again_with(line_impact_law(law, ctx));
+    }
+  } else if (law.law->takes_line_contacts() && fitted && !rounded_edge) {
+    throw InputError(where(scene), s.contact_law_place.describe(),
+                     "impact '" + s.name + "': contact_law = \"line\" is the law of an edge rounded by edge_radius, "
+                     "but the contact point at " + text(located.point_m) + " m is not on one");
+  }
+}
+
 // One [[sequences]] entry (docs/sequences.md): the sequence library with `run`'s impact route for
 // every Hertzian impact (solve_located_impact: the same checks, law figures and warnings as a
 // single impact), and the rigid impulse's report where no Hertz force exists.
@@ -418,8 +466,16 @@ SequenceReport run_sequence(const Scene& scene, const SequenceSpec& q, const std
     return s;
   };
   std::map<std::size_t, ImpactReport> solved;
-  in.complete = [&](std::size_t index, const ContactModel& model, ContactEvaluation e) {
-    ImpactReport ir = solve_located_impact(scene, named(index), law, model, std::move(e), warnings);
+  // Each bounce's law is chosen at its point as a single impact's (choose_point_law); where a force
+  // then applies, `run`'s impact route completes it.
+  in.complete = [&](std::size_t index, const ContactModel& model,
+                    ContactEvaluation& e) -> std::optional<contact::Impact> {
+    const ImpactSpec s = named(index);
+    ImpactLaw point_law = law;
+    std::optional<ContactModel> m(model);
+    choose_point_law(scene, s, point_law, m, e, in.effective_modulus_Pa, ctx);
+    if (e.result.flag != collision::ContactFlag::none) return std::nullopt;  // the rigid impulse
+    ImpactReport ir = solve_located_impact(scene, s, point_law, *m, e, warnings);
     contact::Impact impact = ir;
     solved.emplace(index, std::move(ir));
     return impact;
@@ -449,8 +505,8 @@ SequenceReport run_sequence(const Scene& scene, const SequenceSpec& q, const std
     std::ostringstream w;
     w << "sequence '" << q.name << "' impact " << i << " at t = " << b.time_s << " s: " << b.not_applicable
       << "; the rigid impulse with restitution " << b.restitution
-      << " applies and the sequence goes on; max_force_N is not applicable (null): round the edge (an edge_radius "
-         "in the part) for a force";
+      << " applies and the sequence goes on; max_force_N is not applicable (null): for a force, round the edge (an "
+         "edge_radius on the part) or let a plastic contact law run (the wedge or cone at a sharp point)";
     warnings.push_back(w.str());
     sr.impacts.push_back(std::move(ir));
   }
@@ -585,41 +641,7 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
     model.emplace(target, impactor, s.contact_radius, e_star, law.law, ctx);
     ContactEvaluation located = clock.run(Stage::contact_geometry, [&] { return locate_contact(scene, s, *model); });
     const Place point_place{s.place.line, s.place.key + ".point"};
-    const bool fitted = located.result.flag != collision::ContactFlag::no_curvature;
-    const collision::ContactCurvature& tc = located.input.target.curvature;
-    const collision::ContactCurvature& ic = located.input.impactor.curvature;
-    auto solve_again_with = [&](ImpactLaw other) {  // the same point, solved again with another law
-      law = std::move(other);
-      model.emplace(target, impactor, s.contact_radius, e_star, law.law, ctx);
-      located.input.law = law.law.get();
-      located.result = collision::solve_kernel(located.input);
-    };
-    const bool sharp_point = fitted && (tc.sharp || ic.sharp);
-    const bool rounded_edge = fitted && !sharp_point && ((tc.feature == collision::SharpKind::edge) !=
-                                                         (ic.feature == collision::SharpKind::edge));
-    if (sharp_point) {
-      // A sharp edge or corner without edge_radius: the wedge or cone law where a plastic law runs
-      // (docs/sharp-contacts.md).
-      if (std::optional<ImpactLaw> sharp = sharp_impact_law(s, law, located.input, ctx)) solve_again_with(*sharp);
-    } else if (law.law->takes_sharp_points() && fitted) {
-      throw InputError(where(scene), s.contact_law_place.describe(),
-                       "impact '" + s.name + "': contact_law = \"" + law.name + "\" is the law of a sharp edge or corner, "
-                       "but the contact point at " + text(located.point_m) + " m is smooth (or rounded by edge_radius)");
-    }
-    if (rounded_edge && !law.law->takes_line_contacts()) {
-      // An edge rounded by edge_radius: a line contact over the edge's length where the rounding
-      // lies on a surface flat along the edge, or where the contact's length reaches the edge's.
-      const double length = (tc.feature == collision::SharpKind::edge ? tc : ic).feature_length_m;
-      const collision::KernelResult& kr = located.result;
-      if (kr.flag == collision::ContactFlag::line ||
-          (kr.flag == collision::ContactFlag::none && 2.0 * kr.contact_semi_axis_a_m >= length)) {
-        solve_again_with(line_impact_law(law, ctx));
-      }
-    } else if (law.law->takes_line_contacts() && fitted && !rounded_edge) {
-      throw InputError(where(scene), s.contact_law_place.describe(),
-                       "impact '" + s.name + "': contact_law = \"line\" is the law of an edge rounded by edge_radius, "
-                       "but the contact point at " + text(located.point_m) + " m is not on one");
-    }
+    choose_point_law(scene, s, law, model, located, e_star, ctx);
     if (located.result.flag != collision::ContactFlag::none) {
       throw InputError(where(scene), point_place.describe(),
                        "impact '" + s.name + "': at " + text(located.point_m) + " m (normal " + text(located.normal) +
