@@ -1,10 +1,12 @@
 // Drop sequences and the routes of a single impact (issue 31 item 4, docs/sequences.md): the law
 // chosen at a bounce's contact point is a single impact's (the wedge or cone at a sharp point, the
-// edge_radius sphere or line).
+// edge_radius sphere or line), and the FEM deck of a sequence's worst impact (fem = "worst") or of
+// each impact (fem = "all") is the single impact's deck, loaded from the bounce as it happened.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <iomanip>
 #include <sstream>
 #include <string>
@@ -27,6 +29,9 @@ using Eigen::Vector3d;
 /// the same numbers, except the state handed over as 17-digit text and the placement moved by a
 /// lift (the lever arm is a difference of coordinates ~0.3 m apart): a few ulps.
 constexpr double kSameImpactRel = 1e-12;
+/// A deck's vectors (own frame) against the bounce's rotated back by its orientation: a rotation
+/// of unit vectors and of impulses, a few ulps.
+constexpr double kSameDeckRel = 1e-12;
 
 std::string exact(double x) {
   std::ostringstream s;
@@ -39,6 +44,11 @@ fs::path fresh_dir(const std::string& name) {
   const fs::path d = fs::temp_directory_path() / name;
   fs::remove_all(d);
   return d;
+}
+
+nlohmann::json read_json(const fs::path& p) {
+  std::ifstream in(p);
+  return nlohmann::json::parse(in);
 }
 
 // Steel with a yield strength (the plastic laws by "auto" without restitution), a floor z = 0.
@@ -164,3 +174,159 @@ TEST_P(SequenceSharp, FirstBounceIsTheSingleImpact) {
 INSTANTIATE_TEST_SUITE_P(Laws, SequenceSharp, ::testing::ValuesIn(sharp_cases()),
                          [](const ::testing::TestParamInfo<SharpCase>& i) { return std::string(i.param.name); });
 
+namespace {
+
+// The slapdown of issue 31: a steel ellipsoid 250 x 30 x 30 mm tilted 12 deg dropped from 0.8 m hits
+// with its low end first and slaps its far end down harder; with `fem` and [outputs.fem] (Gmsh only:
+// run = "none").
+std::string slapdown(const std::string& sequence_keys, const std::string& fem = "mesh_size = 7.5\nrun = \"none\"\n",
+                     int max_impacts = 3) {
+  return steel_and_floor() + R"(
+[[bodies]]
+name = "rod"
+shape = "ellipsoid"
+semi_axes = [125, 15, 15]
+material = "steel"
+position = [0, 0, 840]
+orientation_axis = [0, 1, 0]
+orientation_angle_deg = 12
+angular_velocity_rad_s = [0.5, 0, 0]
+
+[[sequences]]
+name = "drop"
+body = "rod"
+floor = "floor"
+restitution = 0.6
+max_impacts = )" + std::to_string(max_impacts) + "\n" + sequence_keys + "\n" + (fem.empty() ? "" : "[outputs.fem]\n" + fem);
+}
+
+}  // namespace
+
+// fem = "worst" (the default): the worst impact, a later one than the first, gets the single
+// impact's deck in sequence_NAME_impact_I/, loaded as the bounce happened: the impulse, the load
+// point and direction and the rigid model's jumps in the body's frame at that impact (turned by
+// the flight's spin since the release).
+TEST(SequenceFem, WorstImpactGetsTheDeckOfItsBounce) {
+  const scene::Scene sc = scene::parse_scene(slapdown(""), "slap.toml");
+  ASSERT_EQ(sc.sequences[0].fem, scene::SequenceSpec::Fem::worst);
+  const fs::path out = fresh_dir("impactdeck_test_seqfem_worst");
+  const scene::RunReport r = scene::run_scene(sc, scene::RunOptions{out});
+  const auto& sr = r.sequences[0];
+  const int w = sr.result.worst_impact_index;
+  ASSERT_GE(w, 1) << "the slapdown's far end is the worst";
+  ASSERT_EQ(sr.fem_impacts, std::vector<std::size_t>{static_cast<std::size_t>(w)});
+  EXPECT_TRUE(sr.fem_not_meshed.empty());
+  for (std::size_t i = 0; i < sr.impacts.size(); ++i) EXPECT_EQ(sr.impacts[i].fem_deck.has_value(), int(i) == w) << i;
+
+  const nlohmann::json j = scene::to_json(sc, r);
+  const nlohmann::json& fem = j["sequences"][0]["fem"];
+  EXPECT_EQ(fem["mode"], "worst");
+  ASSERT_EQ(fem["decks"].size(), 1u);
+  EXPECT_EQ(fem["decks"][0]["index"], w);
+  EXPECT_EQ(fem["decks"][0]["worst"], true);
+  EXPECT_EQ(fem["decks"][0]["verdict"], nullptr);  // run = "none": no ccx, no verdict
+  const fs::path folder = out / ("sequence_drop_impact_" + std::to_string(w));
+  EXPECT_EQ(fem["decks"][0]["folder"], folder.string());
+  EXPECT_EQ(j["sequences"][0]["impacts"][w]["fem"]["folder"], folder.string());  // the single impact's writer
+  for (const char* stage : {"sequence", "force_table", "fem_mesh", "fem_decks"}) {
+    EXPECT_NE(std::find(j["stages_run"].begin(), j["stages_run"].end(), stage), j["stages_run"].end()) << stage;
+  }
+  for (const char* f : {"impact.inp", "impact.comm", "mesh.med", "force.csv", "deck.json"}) {
+    EXPECT_TRUE(fs::is_regular_file(folder / f)) << f;
+  }
+
+  // The deck against the bounce: the body's frame at the impact.
+  const auto& b = sr.result.bounces[w];
+  const Eigen::Quaterniond to_own = b.before.orientation.conjugate();
+  EXPECT_GT((to_own.toRotationMatrix() - sr.result.bounces[0].before.orientation.conjugate().toRotationMatrix()).norm(), 1e-3)
+      << "the rod turned between the first impact and the worst";
+  const nlohmann::json deck = read_json(folder / "deck.json");
+  auto expect_vector = [](const nlohmann::json& got, const Vector3d& want, double scale, const char* what) {
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(got[k].get<double>(), want[k], kSameDeckRel * scale) << what << " " << k;
+  };
+  EXPECT_NEAR(deck["impulse_Ns"].get<double>(), b.normal_impulse_Ns, kSameDeckRel * b.normal_impulse_Ns);
+  expect_vector(deck["direction"], to_own * Vector3d::UnitZ(), 1.0, "direction");  // the floor pushes up
+  expect_vector(deck["load_point_m"], b.point_own_m, 0.125, "load point");
+  const Vector3d dv = to_own * b.body_jump.delta_velocity_m_s;
+  const Vector3d dw = to_own * b.body_jump.delta_angular_velocity_rad_s;
+  expect_vector(deck["model"]["delta_velocity_m_s"], dv, dv.norm(), "delta v");
+  expect_vector(deck["model"]["delta_angular_velocity_rad_s"], dw, dw.norm(), "delta omega");
+}
+
+// fem = "all": one deck per impact with a force, each in its own folder.
+TEST(SequenceFem, AllImpactsGetADeckEach) {
+  const scene::Scene sc = scene::parse_scene(slapdown("fem = \"all\""), "slap.toml");
+  const fs::path out = fresh_dir("impactdeck_test_seqfem_all");
+  const scene::RunReport r = scene::run_scene(sc, scene::RunOptions{out});
+  const auto& sr = r.sequences[0];
+  ASSERT_EQ(sr.impacts.size(), 3u);
+  EXPECT_EQ(sr.fem_impacts, (std::vector<std::size_t>{0, 1, 2}));
+  const nlohmann::json fem = scene::to_json(sc, r)["sequences"][0]["fem"];
+  EXPECT_EQ(fem["mode"], "all");
+  ASSERT_EQ(fem["decks"].size(), 3u);
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(fem["decks"][i]["index"], i);
+    EXPECT_TRUE(fs::is_regular_file(out / ("sequence_drop_impact_" + std::to_string(i)) / "impact.inp")) << i;
+    const nlohmann::json deck = read_json(out / ("sequence_drop_impact_" + std::to_string(i)) / "deck.json");
+    EXPECT_EQ(deck["impact"], "drop impact " + std::to_string(i));
+  }
+}
+
+// fem = "none", or no [outputs.fem]: no deck, no FEM stage.
+TEST(SequenceFem, NoneWritesNoDeck) {
+  for (const auto& [keys, fem] : {std::pair<std::string, std::string>{"fem = \"none\"", "mesh_size = 7.5\nrun = \"none\"\n"},
+                                  std::pair<std::string, std::string>{"", ""}}) {
+    const scene::Scene sc = scene::parse_scene(slapdown(keys, fem), "slap.toml");
+    const fs::path out = fresh_dir("impactdeck_test_seqfem_none");
+    const scene::RunReport r = scene::run_scene(sc, scene::RunOptions{out});
+    const nlohmann::json j = scene::to_json(sc, r);
+    EXPECT_EQ(j["sequences"][0]["fem"]["mode"], "none");
+    EXPECT_TRUE(j["sequences"][0]["fem"]["decks"].empty());
+    EXPECT_EQ(std::find(j["stages_run"].begin(), j["stages_run"].end(), "fem_mesh"), j["stages_run"].end());
+    for (const auto& e : fs::directory_iterator(out)) EXPECT_EQ(e.path().filename().string().find("sequence_drop_impact"), std::string::npos);
+  }
+}
+
+// An impact without a force (elastic Hertz at a box's corners: the rigid impulse) cannot be meshed
+// with one: said in the JSON and as a warning, never skipped silently.
+TEST(SequenceFem, ImpactWithoutAForceIsSaidNotMeshed) {
+  const std::string text = steel_and_floor() + box(Vector3d(0, 0, 300), Vector3d(1, 1, 0), 35, Vector3d(0, 0, -2), "") +
+                           "\n[[sequences]]\nname = \"drop\"\nbody = \"box\"\nfloor = \"floor\"\nmax_impacts = 2\n"
+                           "restitution = 0.5\n\n[outputs.fem]\nmesh_size = 20\nrun = \"none\"\n";
+  const scene::Scene sc = scene::parse_scene(text, "box.toml");
+  const fs::path out = fresh_dir("impactdeck_test_seqfem_rigid");
+  const scene::RunReport r = scene::run_scene(sc, scene::RunOptions{out});
+  const auto& sr = r.sequences[0];
+  ASSERT_GE(sr.result.worst_impact_index, 0);
+  EXPECT_TRUE(sr.fem_impacts.empty());
+  ASSERT_EQ(sr.fem_not_meshed.size(), 1u);
+  EXPECT_EQ(int(sr.fem_not_meshed[0].index), sr.result.worst_impact_index);
+  const nlohmann::json fem = scene::to_json(sc, r)["sequences"][0]["fem"];
+  EXPECT_EQ(fem["mode"], "worst");
+  EXPECT_TRUE(fem["decks"].empty());
+  ASSERT_EQ(fem["not_meshed"].size(), 1u);
+  EXPECT_NE(fem["not_meshed"][0]["reason"].get<std::string>().find("no force applies"), std::string::npos);
+  bool warned = false;
+  for (const auto& w : r.warnings) warned = warned || w.find("no FEM deck") != std::string::npos;
+  EXPECT_TRUE(warned);
+}
+
+TEST(SequenceFem, BadFemValuesAreRefusedNamingTheKey) {
+  auto error = [](const std::string& text) -> std::string {
+    try {
+      scene::parse_scene(text, "slap.toml");
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  const std::string typo = error(slapdown("fem = \"wrost\""));
+  EXPECT_NE(typo.find("sequences[0].fem"), std::string::npos) << typo;
+  EXPECT_NE(typo.find("did you mean 'worst'"), std::string::npos) << typo;
+  const std::string many = error(slapdown("fem = \"all\"", "mesh_size = 7.5\n", 50));
+  EXPECT_NE(many.find("sequences[0].fem"), std::string::npos) << many;
+  EXPECT_NE(many.find("max_impacts <= 20"), std::string::npos) << many;
+  const std::string no_outputs = error(slapdown("fem = \"worst\"", ""));
+  EXPECT_NE(no_outputs.find("[outputs.fem]"), std::string::npos) << no_outputs;
+  EXPECT_EQ(error(slapdown("fem = \"none\"", "")), "");
+}
