@@ -129,12 +129,15 @@ std::vector<FailedCheck> failed_checks(const RunReport& report) {
     fem_checks(ir, c);
     compare_checks(ir, c);
   }
-  // Each Hertzian impact of a sequence runs the paper's checks as a single impact does.
+  // Each Hertzian impact of a sequence runs the paper's checks as a single impact does, and its
+  // FEM deck (fem = "worst" or "all") the deck's.
   for (const auto& sr : report.sequences) {
     for (const auto& ir : sr.impacts) {
       if (!ir.force_not_applicable.empty()) continue;
       Collector c(out, ir.spec->name);
       impact_checks(ir, c);
+      body_checks(ir, c);
+      fem_checks(ir, c);
     }
   }
   return out;

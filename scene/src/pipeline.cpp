@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <deque>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -49,9 +50,13 @@ bool RunReport::all_checks_passed() const {
     if (i.fem_check && !i.fem_check->passed) return false;
     if (i.compare && i.compare->verdict == CompareVerdict::disagree) return false;
   }
-  for (const auto& sr : sequences)
-    for (const auto& i : sr.impacts)
+  for (const auto& sr : sequences) {
+    for (const auto& i : sr.impacts) {
       if (i.force_not_applicable.empty() && !i.result.checks.passed) return false;
+      if (i.fem_deck && !i.fem_deck->body_check.passed) return false;
+      if (i.fem_check && !i.fem_check->passed) return false;
+    }
+  }
   return true;
 }
 
@@ -382,11 +387,63 @@ ImpactReport solve_located_impact(const Scene& scene, const ImpactSpec& s, const
   return ir;
 }
 
+std::string sequence_fem_folder(const std::string& name, std::size_t index) {
+  return "sequence_" + name + "_impact_" + std::to_string(index);
+}
+
 fem_export::DeckRequest hybrid_deck_request(const Scene& scene, const ImpactReport& ir, const PreparedBody& body) {
   return fem_request(scene, ir, body);
 }
 
 namespace {
+
+// The contact law at a located point (docs/sharp-contacts.md, "Which law runs"): the one choice of
+// `run`'s impacts and of the sequences' bounces. At a sharp edge or corner without edge_radius, the
+// wedge or cone where the law is plastic (sharp_impact_law; Hertz keeps the flagged point); at an
+// edge rounded by edge_radius whose contact is a line, or spans the edge, the law "line". A sharp
+// or line law named for a point it does not fit is refused (contact_law's place). When the law
+// changes, `model` is rebuilt with it and `located` solved again at the same point.
+void choose_point_law(const Scene& scene, const ImpactSpec& s, ImpactLaw& law, std::optional<ContactModel>& model,
+                      ContactEvaluation& located, double e_star, const InputContext& ctx) {
+  const bool fitted = located.result.flag != collision::ContactFlag::no_curvature;
+  const collision::ContactCurvature& tc = located.input.target.curvature;
+  const collision::ContactCurvature& ic = located.input.impactor.curvature;
+  auto solve_again_with = [&](ImpactLaw other) {  // the same point, solved again with another law
+    law = std::move(other);
+    const PreparedBody& target = model->target();  // the bodies outlive the model
+    const PreparedBody& impactor = model->impactor();
+    const collision::ContactRule rule = model->rule();
+    model.emplace(target, impactor, rule, e_star, law.law, ctx);
+    located.input.law = law.law.get();
+    located.result = collision::solve_kernel(located.input);
+  };
+  const bool sharp_point = fitted && (tc.sharp || ic.sharp);
+  const bool rounded_edge = fitted && !sharp_point && ((tc.feature == collision::SharpKind::edge) !=
+                                                       (ic.feature == collision::SharpKind::edge));
+  if (sharp_point) {
+    // A sharp edge or corner without edge_radius: the wedge or cone law where a plastic law runs
+    // (docs/sharp-contacts.md).
+    if (std::optional<ImpactLaw> sharp = sharp_impact_law(s, law, located.input, ctx)) solve_again_with(*sharp);
+  } else if (law.law->takes_sharp_points() && fitted) {
+    throw InputError(where(scene), s.contact_law_place.describe(),
+                     "impact '" + s.name + "': contact_law = \"" + law.name + "\" is the law of a sharp edge or corner, "
+                     "but the contact point at " + text(located.point_m) + " m is smooth (or rounded by edge_radius)");
+  }
+  if (rounded_edge && !law.law->takes_line_contacts()) {
+    // An edge rounded by edge_radius: a line contact over the edge's length where the rounding
+    // lies on a surface flat along the edge, or where the contact's length reaches the edge's.
+    const double length = (tc.feature == collision::SharpKind::edge ? tc : ic).feature_length_m;
+    const collision::KernelResult& kr = located.result;
+    if (kr.flag == collision::ContactFlag::line ||
+        (kr.flag == collision::ContactFlag::none && 2.0 * kr.contact_semi_axis_a_m >= length)) {
+      solve_again_with(line_impact_law(law, ctx));
+    }
+  } else if (law.law->takes_line_contacts() && fitted && !rounded_edge) {
+    throw InputError(where(scene), s.contact_law_place.describe(),
+                     "impact '" + s.name + "': contact_law = \"line\" is the law of an edge rounded by edge_radius, "
+                     "but the contact point at " + text(located.point_m) + " m is not on one");
+  }
+}
 
 // One [[sequences]] entry (docs/sequences.md): the sequence library with `run`'s impact route for
 // every Hertzian impact (solve_located_impact: the same checks, law figures and warnings as a
@@ -418,8 +475,16 @@ SequenceReport run_sequence(const Scene& scene, const SequenceSpec& q, const std
     return s;
   };
   std::map<std::size_t, ImpactReport> solved;
-  in.complete = [&](std::size_t index, const ContactModel& model, ContactEvaluation e) {
-    ImpactReport ir = solve_located_impact(scene, named(index), law, model, std::move(e), warnings);
+  // Each bounce's law is chosen at its point as a single impact's (choose_point_law); where a force
+  // then applies, `run`'s impact route completes it.
+  in.complete = [&](std::size_t index, const ContactModel& model,
+                    ContactEvaluation& e) -> std::optional<contact::Impact> {
+    const ImpactSpec s = named(index);
+    ImpactLaw point_law = law;
+    std::optional<ContactModel> m(model);
+    choose_point_law(scene, s, point_law, m, e, in.effective_modulus_Pa, ctx);
+    if (e.result.flag != collision::ContactFlag::none) return std::nullopt;  // the rigid impulse
+    ImpactReport ir = solve_located_impact(scene, s, point_law, *m, e, warnings);
     contact::Impact impact = ir;
     solved.emplace(index, std::move(ir));
     return impact;
@@ -449,8 +514,8 @@ SequenceReport run_sequence(const Scene& scene, const SequenceSpec& q, const std
     std::ostringstream w;
     w << "sequence '" << q.name << "' impact " << i << " at t = " << b.time_s << " s: " << b.not_applicable
       << "; the rigid impulse with restitution " << b.restitution
-      << " applies and the sequence goes on; max_force_N is not applicable (null): round the edge (an edge_radius "
-         "in the part) for a force";
+      << " applies and the sequence goes on; max_force_N is not applicable (null): for a force, round the edge (an "
+         "edge_radius on the part) or let a plastic contact law run (the wedge or cone at a sharp point)";
     warnings.push_back(w.str());
     sr.impacts.push_back(std::move(ir));
   }
@@ -472,6 +537,64 @@ struct StagedOutputs {
 
 constexpr const char* kReportHtml = "report.html";
 
+// Reserves one output of the run (RunTransaction::file or folder) under `name`; `place` says where
+// the scene gave it. No output may replace the run's own inputs (the scene, a part), however
+// named: checked on the final path before anything is staged.
+fs::path reserve_output(const Scene& scene, RunTransaction& txn, const std::string& name, const std::string& place,
+                        bool folder) {
+  const std::string file = where(scene);
+  std::vector<fs::path> inputs = {scene.file};
+  for (const auto& b : scene.bodies)
+    for (const fs::path& f : b.shape->input_files()) inputs.push_back(f);
+  const fs::path target_path = txn.out_dir() / RunTransaction::check_name(name, file, place);
+  std::error_code ec;
+  const fs::path target = fs::weakly_canonical(target_path, ec);
+  for (const fs::path& in : inputs) {
+    std::error_code ec2;
+    const fs::path c = fs::weakly_canonical(in, ec2);
+    const bool inside = c.string().rfind(target.string() + "/", 0) == 0;  // a part inside a deck folder
+    if (!ec && !ec2 && !in.empty() && (c == target || inside)) {
+      throw InputError(file, place, "the output '" + target_path.string() + "' would replace the run's own input '" +
+                                        in.string() + "'");
+    }
+  }
+  return folder ? txn.folder(name, file, place) : txn.file(name, file, place);
+}
+
+// One FEM deck of the run: the impact (of [[impacts]] or of a sequence), its target body as placed
+// at the impact, and the staged deck folder.
+struct FemJob {
+  ImpactReport* ir = nullptr;
+  const PreparedBody* target = nullptr;
+  fs::path folder;
+};
+
+// The impacts of sequence `sr` that get an FEM deck (SequenceSpec::fem; docs/sequences.md): the
+// worst one, or every one with a force. An impact asked for without a force (the rigid impulse at
+// a sharp point) gets none: said in the report (fem_not_meshed) and as a warning.
+void choose_sequence_decks(SequenceReport& sr, const Scene& scene, std::vector<std::string>& warnings) {
+  const SequenceSpec& q = *sr.spec;
+  sr.fem_requested = scene.outputs.fem && q.fem != SequenceSpec::Fem::none;
+  if (!sr.fem_requested) return;
+  std::vector<std::size_t> asked;
+  if (q.fem == SequenceSpec::Fem::all) {
+    for (std::size_t i = 0; i < sr.impacts.size(); ++i) asked.push_back(i);
+  } else if (sr.result.worst_impact_index >= 0) {
+    asked.push_back(static_cast<std::size_t>(sr.result.worst_impact_index));
+  }
+  for (std::size_t i : asked) {
+    const ImpactReport& ir = sr.impacts[i];
+    if (ir.force_not_applicable.empty()) {
+      sr.fem_impacts.push_back(i);
+      continue;
+    }
+    const std::string why = "no force applies (" + ir.force_not_applicable +
+                            "): the rigid impulse has no force history to load an FEM deck with";
+    sr.fem_not_meshed.push_back({i, why});
+    warnings.push_back("sequence '" + q.name + "' impact " + std::to_string(i) + ": no FEM deck: " + why);
+  }
+}
+
 StagedOutputs reserve_outputs(const Scene& scene, RunTransaction& txn) {
   StagedOutputs st;
   const std::string file = where(scene);
@@ -489,25 +612,8 @@ StagedOutputs reserve_outputs(const Scene& scene, RunTransaction& txn) {
                        "impact '" + s.name + "': the name is part of output file names, so it must not contain '/'");
     }
   };
-  // No output may replace the run's own inputs (the scene, a part), however named: checked on the
-  // final path before anything is staged.
-  std::vector<fs::path> inputs = {scene.file};
-  for (const auto& b : scene.bodies)
-    for (const fs::path& f : b.shape->input_files()) inputs.push_back(f);
   auto reserve = [&](const std::string& name, const std::string& place, bool folder) {
-    const fs::path target_path = txn.out_dir() / RunTransaction::check_name(name, file, place);
-    std::error_code ec;
-    const fs::path target = fs::weakly_canonical(target_path, ec);
-    for (const fs::path& in : inputs) {
-      std::error_code ec2;
-      const fs::path c = fs::weakly_canonical(in, ec2);
-      const bool inside = c.string().rfind(target.string() + "/", 0) == 0;  // a part inside a deck folder
-      if (!ec && !ec2 && !in.empty() && (c == target || inside)) {
-        throw InputError(file, place, "the output '" + target_path.string() + "' would replace the run's own input '" +
-                                          in.string() + "'");
-      }
-    }
-    return folder ? txn.folder(name, file, place) : txn.file(name, file, place);
+    return reserve_output(scene, txn, name, place, folder);
   };
   for (const auto& s : scene.impacts) {
     if (scene.outputs.fem || (n > 1 && (scene.outputs.force_table_csv || scene.outputs.force_plot_svg))) {
@@ -585,41 +691,7 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
     model.emplace(target, impactor, s.contact_radius, e_star, law.law, ctx);
     ContactEvaluation located = clock.run(Stage::contact_geometry, [&] { return locate_contact(scene, s, *model); });
     const Place point_place{s.place.line, s.place.key + ".point"};
-    const bool fitted = located.result.flag != collision::ContactFlag::no_curvature;
-    const collision::ContactCurvature& tc = located.input.target.curvature;
-    const collision::ContactCurvature& ic = located.input.impactor.curvature;
-    auto solve_again_with = [&](ImpactLaw other) {  // the same point, solved again with another law
-      law = std::move(other);
-      model.emplace(target, impactor, s.contact_radius, e_star, law.law, ctx);
-      located.input.law = law.law.get();
-      located.result = collision::solve_kernel(located.input);
-    };
-    const bool sharp_point = fitted && (tc.sharp || ic.sharp);
-    const bool rounded_edge = fitted && !sharp_point && ((tc.feature == collision::SharpKind::edge) !=
-                                                         (ic.feature == collision::SharpKind::edge));
-    if (sharp_point) {
-      // A sharp edge or corner without edge_radius: the wedge or cone law where a plastic law runs
-      // (docs/sharp-contacts.md).
-      if (std::optional<ImpactLaw> sharp = sharp_impact_law(s, law, located.input, ctx)) solve_again_with(*sharp);
-    } else if (law.law->takes_sharp_points() && fitted) {
-      throw InputError(where(scene), s.contact_law_place.describe(),
-                       "impact '" + s.name + "': contact_law = \"" + law.name + "\" is the law of a sharp edge or corner, "
-                       "but the contact point at " + text(located.point_m) + " m is smooth (or rounded by edge_radius)");
-    }
-    if (rounded_edge && !law.law->takes_line_contacts()) {
-      // An edge rounded by edge_radius: a line contact over the edge's length where the rounding
-      // lies on a surface flat along the edge, or where the contact's length reaches the edge's.
-      const double length = (tc.feature == collision::SharpKind::edge ? tc : ic).feature_length_m;
-      const collision::KernelResult& kr = located.result;
-      if (kr.flag == collision::ContactFlag::line ||
-          (kr.flag == collision::ContactFlag::none && 2.0 * kr.contact_semi_axis_a_m >= length)) {
-        solve_again_with(line_impact_law(law, ctx));
-      }
-    } else if (law.law->takes_line_contacts() && fitted && !rounded_edge) {
-      throw InputError(where(scene), s.contact_law_place.describe(),
-                       "impact '" + s.name + "': contact_law = \"line\" is the law of an edge rounded by edge_radius, "
-                       "but the contact point at " + text(located.point_m) + " m is not on one");
-    }
+    choose_point_law(scene, s, law, model, located, e_star, ctx);
     if (located.result.flag != collision::ContactFlag::none) {
       throw InputError(where(scene), point_place.describe(),
                        "impact '" + s.name + "': at " + text(located.point_m) + " m (normal " + text(located.normal) +
@@ -640,9 +712,29 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
   // A failed check does not stop the run: every output is still written and published, as the
   // evidence of what went wrong (the CLI exits 4 naming the check; failed_checks.hpp).
   const bool want_fem = scene.outputs.fem.has_value();
+  // Every deck of the run: one per impact, and the chosen impacts of each sequence (the body placed
+  // as it was at that impact). One route: the same request, deck writer and check.
+  std::vector<FemJob> fem_jobs;
+  std::deque<PreparedBody> placed_bodies;  // the sequences' bodies at their impacts (stable addresses)
+  if (want_fem) {
+    for (std::size_t k = 0; k < report.impacts.size(); ++k) {
+      fem_jobs.push_back({&report.impacts[k], &bodies.at(report.impacts[k].spec->target), staged.fem[k]});
+    }
+    for (auto& sr : report.sequences) {
+      choose_sequence_decks(sr, scene, report.warnings);
+      for (std::size_t i : sr.fem_impacts) {
+        placed_bodies.push_back(sequence::placed(bodies.at(sr.spec->body), sr.result.bounces[i].before));
+        fem_jobs.push_back({&sr.impacts[i], &placed_bodies.back(),
+                            reserve_output(scene, txn, sequence_fem_folder(sr.spec->name, i),
+                                           sr.spec->fem_place.describe() + " (deck folder of impact " +
+                                               std::to_string(i) + " of sequence '" + sr.spec->name + "')",
+                                           true)});
+      }
+    }
+  }
   if (scene.outputs.force_table_csv || want_fem) {
     clock.run(Stage::force_table, [&] {
-      for (auto& ir : report.impacts) {
+      auto sample = [&](ImpactReport& ir) {
         ir.table = collision::sample_force_table(ir.result.history, force_table_options(scene, *ir.spec));
         if (!ir.table->tolerance_met) {
           std::ostringstream m;
@@ -651,19 +743,22 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
             << ir.table->impulse_tolerance;
           report.warnings.push_back(m.str());
         }
-      }
+      };
+      for (auto& ir : report.impacts) sample(ir);
+      for (const FemJob& job : fem_jobs)
+        if (!job.ir->table) sample(*job.ir);  // a sequence's impact with a deck
     });
   }
   // FEM decks first (the slow part), written into the run's staging folder with the solver's
   // results: they appear in --out only with everything else, after every check passed.
   if (want_fem) {
-    for (std::size_t k = 0; k < report.impacts.size(); ++k) {
-      auto& ir = report.impacts[k];
-      fem_export::DeckRequest req = fem_request(scene, ir, bodies.at(ir.spec->target));
+    for (const FemJob& job : fem_jobs) {
+      ImpactReport& ir = *job.ir;
+      fem_export::DeckRequest req = fem_request(scene, ir, *job.target);
       const auto& deck_unit = scene.outputs.fem->deck_length_unit;
       req.options.units = deck_unit ? fem_export::DeckUnits{*deck_unit}
                                     : fem_export::default_deck_units(report.output_length_unit);
-      ir.fem_deck = fem_export::write_deck_files(req, staged.fem[k]);  // errors: req.context
+      ir.fem_deck = fem_export::write_deck_files(req, job.folder);  // errors: req.context
       const auto& patch = ir.fem_deck->patch;
       if (ir.fem_deck->load == fem_export::LoadKind::hertz_patch &&
           patch.largest_ellipse_elements < scene.outputs.fem->contact_elements) {
@@ -676,9 +771,10 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
       add_stage(report, Stage::fem_mesh, ir.fem_deck->mesh_seconds);
       add_stage(report, Stage::fem_decks, ir.fem_deck->decks_seconds);
     }
-    if (scene.outputs.fem->run == FemOutputs::Run::calculix) {
+    if (scene.outputs.fem->run == FemOutputs::Run::calculix && !fem_jobs.empty()) {
       clock.run(Stage::fem_run, [&] {
-        for (auto& ir : report.impacts) {
+        for (const FemJob& job : fem_jobs) {
+          ImpactReport& ir = *job.ir;
           // A mesh that misses the body checks still runs: its results are the evidence to look at.
           if (!ir.fem_deck->body_check.passed) {
             report.warnings.push_back("impact '" + ir.spec->name +
@@ -802,7 +898,12 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
     }
   }
   // Public paths (the report page names them; the commit below publishes them unchanged).
-  for (auto& ir : report.impacts) {
+  std::vector<ImpactReport*> published;
+  for (auto& ir : report.impacts) published.push_back(&ir);
+  for (auto& sr : report.sequences)
+    for (std::size_t i : sr.fem_impacts) published.push_back(&sr.impacts[i]);
+  for (ImpactReport* p : published) {
+    ImpactReport& ir = *p;
     if (ir.fem_deck) {
       ir.fem_deck->folder = txn.public_path(ir.fem_deck->folder);
       for (auto& f : ir.fem_deck->files) {

@@ -205,6 +205,29 @@ nlohmann::json impact_json(const ImpactReport& ir) {
   return i;
 }
 
+// A sequence's FEM decks (docs/sequences.md, "FEM"): which impacts got one, where, and the verdict;
+// which asked for got none, and why. Each deck's whole record is impacts[i].fem (impact_json).
+nlohmann::json sequence_fem_json(const SequenceReport& sr) {
+  const char* mode = !sr.fem_requested                           ? "none"
+                     : sr.spec->fem == SequenceSpec::Fem::all ? "all"
+                                                                 : "worst";
+  nlohmann::json decks = nlohmann::json::array(), none = nlohmann::json::array();
+  for (std::size_t i : sr.fem_impacts) {
+    const ImpactReport& ir = sr.impacts[i];
+    nlohmann::json d;
+    d["index"] = i;
+    d["folder"] = ir.fem_deck ? nlohmann::json(ir.fem_deck->folder.string()) : nlohmann::json(nullptr);
+    const fem_export::StressResult* st = ir.fem_check && ir.fem_check->stress ? &*ir.fem_check->stress : nullptr;
+    d["verdict"] = st ? nlohmann::json(fem_export::to_string(st->verdict.kind)) : nlohmann::json(nullptr);
+    d["safety_factor"] = st && st->verdict.yield_strength_Pa ? json_number(st->verdict.safety_factor) : nlohmann::json(nullptr);
+    d["checks_passed"] = (!ir.fem_deck || ir.fem_deck->body_check.passed) && (!ir.fem_check || ir.fem_check->passed);
+    d["worst"] = static_cast<int>(i) == sr.result.worst_impact_index;
+    decks.push_back(std::move(d));
+  }
+  for (const auto& n : sr.fem_not_meshed) none.push_back({{"index", n.index}, {"reason", n.reason}});
+  return {{"mode", mode}, {"decks", std::move(decks)}, {"not_meshed", std::move(none)}};
+}
+
 // One sequence (docs/sequences.md): its impacts by impact_json plus time_s and the impulses; an
 // impact without a Hertz force (a sharp corner) has its force and the law's figures null.
 nlohmann::json sequence_json(const SequenceReport& sr) {
@@ -251,6 +274,7 @@ nlohmann::json sequence_json(const SequenceReport& sr) {
     impacts.push_back(std::move(i));
   }
   q["impacts"] = std::move(impacts);
+  q["fem"] = sequence_fem_json(sr);
   nlohmann::json files = nlohmann::json::object();
   if (sr.trajectory_csv) files["trajectory_csv"] = sr.trajectory_csv->string();
   if (sr.trajectory_pvd) files["trajectory_pvd"] = sr.trajectory_pvd->string();
@@ -430,6 +454,15 @@ std::string format_summary(const Scene& scene, const RunReport& rep) {
     if (res.worst_impact_index >= 0) {
       o << "  worst impact          " << res.worst_impact_index << " (" << res.worst_impact_reason << ")\n";
     }
+    for (std::size_t i : sr.fem_impacts) {  // each deck as a single impact's
+      const ImpactReport& ir = sr.impacts[i];
+      if (ir.fem_deck) o << "  impact " << i << " FEM deck   " << ir.fem_deck->folder.string() << "\n";
+      if (ir.fem_check) {
+        std::istringstream lines(fem_export::format_check(*ir.fem_check));
+        for (std::string l; std::getline(lines, l);) o << "  impact " << i << " FEM check: " << l << "\n";
+      }
+    }
+    for (const auto& n : sr.fem_not_meshed) o << "  impact " << n.index << " FEM deck   none: " << n.reason << "\n";
     if (sr.trajectory_csv) o << "  trajectory            " << sr.trajectory_csv->string() << "\n";
     if (sr.trajectory_pvd) o << "  VTK series            " << sr.trajectory_pvd->string() << " (" << sr.vtk_frames << " frames)\n";
     if (sr.plot_svg) o << "  picture               " << sr.plot_svg->string() << "\n";

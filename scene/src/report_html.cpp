@@ -388,15 +388,21 @@ std::string report_html(const Scene& scene, const RunReport& rep, const std::vec
     page.table({"impact", "failed check", "value", "limit", "reason"}, rows);
   }
 
-  // Then the verdict: the worst impact's words (yielding before surviving, plastic strain before
-  // none), with the smallest safety factor where one exists.
+  // Then the verdict, over the impacts and the sequences' impacts with an FEM deck: the worst
+  // impact's words (yielding before surviving, plastic strain before none), with the smallest
+  // safety factor where one exists.
+  std::vector<const ImpactReport*> judged;
+  for (const auto& ir : rep.impacts) judged.push_back(&ir);
+  for (const auto& sr : rep.sequences)
+    for (std::size_t i : sr.fem_impacts) judged.push_back(&sr.impacts[i]);
   ImpactVerdict::Kind overall = ImpactVerdict::Kind::none;
   std::string overall_word;
   int overall_rank = -1;
   std::optional<double> worst;
   std::vector<std::vector<std::string>> verdict_rows;
   std::string governing;
-  for (const auto& ir : rep.impacts) {
+  for (const ImpactReport* p : judged) {
+    const ImpactReport& ir = *p;
     const ImpactVerdict v = impact_verdict(ir);
     std::string word = v.word;
     if (v.kind != ImpactVerdict::Kind::none) {
@@ -614,6 +620,29 @@ std::string report_html(const Scene& scene, const RunReport& rep, const std::vec
     page.table({"impact", "time (s)", "approach speed (m/s)", "F_max (N)", "normal impulse (N s)", "restitution",
                 "point, body frame (m)"},
                rows);
+    // Its FEM decks (fem = "worst" or "all"): the worst impact's verdict first, as a single impact's.
+    if (sr.fem_requested) {
+      std::vector<std::vector<std::string>> fem_rows;
+      for (std::size_t i : sr.fem_impacts) {
+        const ImpactReport& ir = sr.impacts[i];
+        const ImpactVerdict v = impact_verdict(ir);
+        const bool worst = static_cast<int>(i) == res.worst_impact_index;
+        if (worst) {
+          page.html("<p class=\"sequence-verdict\" id=\"sequence-verdict-" + std::to_string(&sr - rep.sequences.data()) +
+                    "\">" + plot::html_escape("Worst impact " + std::to_string(i) + ": " + v.word +
+                                               (v.safety_factor ? " (safety factor " + g(*v.safety_factor, 4) + ")" : "") +
+                                               "; " + v.basis) +
+                    "</p>");
+        }
+        fem_rows.push_back({std::to_string(i) + (worst ? " (worst)" : ""),
+                            ir.fem_deck ? ir.fem_deck->folder.string() : "-",
+                            v.kind == ImpactVerdict::Kind::none ? v.word
+                                                                : outcome(v.kind == ImpactVerdict::Kind::survives, v.word),
+                            v.safety_factor ? g(*v.safety_factor, 4) : "", v.basis});
+      }
+      for (const auto& n : sr.fem_not_meshed) fem_rows.push_back({std::to_string(n.index), "none", "no deck", "", n.reason});
+      page.table({"impact", "FEM deck", "verdict", "safety factor", "basis"}, fem_rows);
+    }
   }
 
   page.heading("Files written");
@@ -623,7 +652,8 @@ std::string report_html(const Scene& scene, const RunReport& rep, const std::vec
   // Every file of the output folder: the run's list, the force tables' JSON sidecars, and the
   // solver's results in the deck folders.
   std::vector<std::filesystem::path> outputs = rep.files_written;
-  for (const auto& ir : rep.impacts) {
+  for (const ImpactReport* p : judged) {
+    const ImpactReport& ir = *p;
     if (ir.table_path && std::find(outputs.begin(), outputs.end(), csv_sidecar_path(*ir.table_path)) == outputs.end())
       outputs.push_back(csv_sidecar_path(*ir.table_path));
     if (!ir.fem_check) continue;
@@ -640,9 +670,14 @@ std::string report_html(const Scene& scene, const RunReport& rep, const std::vec
   // third version; docs/reliability.md): wall times stay in `run --json`.
   nlohmann::json doc = to_json(scene, rep);
   doc.erase("stage_times_s");
-  for (auto& i : doc["impacts"])
+  auto drop_wall_time = [](nlohmann::json& i) {
     if (i.contains("fem") && i["fem"].contains("check") && i["fem"]["check"].is_object())
       i["fem"]["check"].erase("solver_wall_time_s");
+  };
+  for (auto& i : doc["impacts"]) drop_wall_time(i);
+  if (doc.contains("sequences"))
+    for (auto& q : doc["sequences"])
+      for (auto& i : q["impacts"]) drop_wall_time(i);
   page.preformatted("The run's JSON document (run --json, without the wall times)", doc.dump(2));
   return page.str();
 }

@@ -629,7 +629,7 @@ SequenceSpec read_sequence(std::size_t index, const toml::table& t, const Source
   const std::string self = "sequences[" + std::to_string(index) + "]";
   Reader r(t, self, file);
   r.allow({"name", "body", "floor", "max_impacts", "min_approach_speed_m_s", "friction_coefficient", "restitution",
-           "contact_radius", "contact_law", "limiting_pressure_Pa"});
+           "contact_radius", "contact_law", "limiting_pressure_Pa", "fem"});
   SequenceSpec q;
   q.place = r.self();
   q.name = r.string("name").value_or("sequence" + std::to_string(index + 1));
@@ -661,6 +661,16 @@ SequenceSpec read_sequence(std::size_t index, const toml::table& t, const Source
     if (!(*v >= 0.0)) r.fail("min_approach_speed_m_s", "must be >= 0, got " + Reader::fmt(*v));
     q.min_approach_speed_m_s = *v;
   }
+  q.fem_given = r.has("fem");
+  q.fem_place = r.place("fem");
+  q.fem = r.choice<SequenceSpec::Fem>(
+      "fem", {{"worst", SequenceSpec::Fem::worst}, {"all", SequenceSpec::Fem::all}, {"none", SequenceSpec::Fem::none}},
+      SequenceSpec::Fem::worst);
+  if (q.fem == SequenceSpec::Fem::all && q.max_impacts > kMaxSequenceFemDecks) {
+    r.fail("fem", "fem = \"all\" meshes (and runs) one FEM deck per impact: it needs max_impacts <= " +
+                      std::to_string(kMaxSequenceFemDecks) + ", got " + std::to_string(q.max_impacts) +
+                      " (or use fem = \"worst\")");
+  }
   q.friction_place = r.place("friction_coefficient");
   // The impacts' law keys, read as on [[impacts]]: the body is the target, the floor the impactor.
   q.impact.name = q.name;
@@ -687,6 +697,32 @@ void check_law_materials(const Scene& sc, const ImpactSpec& s, const Source& fil
                                                 " no yield_strength_Pa: give " +
                                                 (mt.name == mi.name ? "it" : "one of them") +
                                                 " yield_strength_Pa or set contact_law = \"hertz\"");
+    }
+  }
+}
+
+// A sequence's `fem` against [outputs.fem] (docs/sequences.md): "worst" or "all" set without
+// [outputs.fem] has no deck settings to follow (refused); a plastic deck needs the falling body's
+// yield strength, as a single impact's target's.
+void check_sequence_fem(const Scene& sc, const Source& file) {
+  for (const SequenceSpec& q : sc.sequences) {
+    if (q.fem == SequenceSpec::Fem::none) continue;
+    if (!sc.outputs.fem) {
+      if (q.fem_given) {
+        throw file.error(q.fem_place, "sequence '" + q.name + "': fem = \"" +
+                                          (q.fem == SequenceSpec::Fem::all ? "all" : "worst") +
+                                          "\" needs the deck settings of [outputs.fem]: add [outputs.fem] or set "
+                                          "fem = \"none\"");
+      }
+      continue;
+    }
+    if (sc.outputs.fem->material_model == FemOutputs::MaterialModel::plastic) {
+      const Material& m = sc.materials.at(sc.body(q.body).material);
+      if (!m.yield_strength_Pa) {
+        throw file.error(sc.outputs.fem->material_model_place,
+                         "material_model = \"plastic\" needs the falling body's yield strength: material '" + m.name +
+                             "' (body '" + q.body + "' of sequence '" + q.name + "') has no yield_strength_Pa");
+      }
     }
   }
 }
@@ -798,6 +834,7 @@ Scene build(const toml::table& root, const Source& file, const fs::path& base_di
   const toml::node* impacts = r.get("impacts");
   if (!impacts && !sc.sequences.empty()) {
     if (const toml::node* n = r.get("outputs")) sc.outputs = read_outputs(sub_table(n, "outputs", file), file, to_m);
+    check_sequence_fem(sc, file);
     r.reject_unknown();
     return sc;
   }
@@ -847,6 +884,7 @@ Scene build(const toml::table& root, const Source& file, const fs::path& base_di
       }
     }
   }
+  check_sequence_fem(sc, file);
   if (sc.outputs.fem && sc.outputs.fem->compare_contact) {
     for (const ImpactSpec& s : sc.impacts) {
       if (s.contact_law != "auto" && s.contact_law != "hertz") {

@@ -70,14 +70,14 @@ Bounce apply_bounce(const SequenceInput& in, std::size_t index, const BodyState&
   const contact::ContactModel model(body, in.floor, in.rule, in.effective_modulus_Pa, in.law, in.ctx);
   b.contact = model.at_surface_point(support);
   b.point_own_m = support.point_m;
-  if (b.contact.result.flag == collision::ContactFlag::none) {
-    if (in.complete) {
-      b.impact = in.complete(index, model, b.contact);  // its input carries the friction coefficient
-    } else {
-      collision::ImpactInput input = contact::impact_input(model, b.contact);
-      input.friction_coefficient = mu;
-      b.impact = contact::complete_impact(model, b.contact, input);
-    }
+  if (in.complete) {
+    b.impact = in.complete(index, model, b.contact);  // its input carries the friction coefficient
+  } else if (b.contact.result.flag == collision::ContactFlag::none) {
+    collision::ImpactInput input = contact::impact_input(model, b.contact);
+    input.friction_coefficient = mu;
+    b.impact = contact::complete_impact(model, b.contact, input);
+  }
+  if (b.impact) {
     const collision::ImpactResult& r = b.impact->result;
     b.reduced_mass_kg = r.reduced_mass_kg;
     b.approach_velocity_m_s = r.approach_velocity_m_s;

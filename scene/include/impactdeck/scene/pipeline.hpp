@@ -56,7 +56,19 @@ struct SequenceReport {
   std::vector<ImpactReport> impacts;  ///< impacts[i] is result.bounces[i]
   std::optional<std::filesystem::path> trajectory_csv, trajectory_pvd, plot_svg;  ///< where written
   std::size_t vtk_frames = 0;
+  /// With [outputs.fem] and spec->fem not "none": the impacts that got an FEM deck (impacts[i].fem_deck,
+  /// fem_check), in order, and those asked for that got none, each with why (no force applies).
+  std::vector<std::size_t> fem_impacts;
+  struct NoDeck {
+    std::size_t index = 0;
+    std::string reason;
+  };
+  std::vector<NoDeck> fem_not_meshed;
+  bool fem_requested = false;  ///< the scene has [outputs.fem] and spec->fem is not "none"
 };
+
+/// The FEM deck folder of impact `index` of sequence `name` (docs/sequences.md).
+std::string sequence_fem_folder(const std::string& name, std::size_t index);
 
 struct StageTiming {
   std::string name;

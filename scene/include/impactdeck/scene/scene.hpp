@@ -103,8 +103,19 @@ struct SequenceSpec {
   /// The law keys (`restitution`, `contact_law`, `limiting_pressure_Pa`, `contact_radius`), read by
   /// the reader of [[impacts]]: target = body, impactor = floor, name = the sequence's.
   ImpactSpec impact;
+  /// `fem` (docs/sequences.md): which impacts get the FEM deck, the ccx check and the verdict of a
+  /// single impact when the scene has [outputs.fem]: the worst one (default), every one with a
+  /// force, or none.
+  enum class Fem { worst, all, none };
+  Fem fem = Fem::worst;
+  bool fem_given = false;
+  Place fem_place;  ///< where `fem` was given (the key alone when it was not)
   Place place;
 };
+
+/// `fem = "all"` on a sequence is refused beyond this many impacts (`max_impacts`): each deck is a
+/// Gmsh mesh and, with run = "calculix", a ccx run.
+inline constexpr int kMaxSequenceFemDecks = 20;
 
 /// `[outputs.fem]`: FEM decks of the hybrid approach (docs/fem.md). Present = requested.
 struct FemOutputs {

@@ -54,11 +54,17 @@ struct SequenceInput {
   double min_approach_speed_m_s = kDefaultMinApproachSpeed;
   double friction_coefficient = 0;
   InputContext ctx;  ///< names the sequence (its errors)
-  /// Completes a located, Hertzian impact (flag none). Default: contact::complete_impact with
-  /// contact::impact_input(model, e) (default thresholds). The scene passes its own (checks,
-  /// warnings, the report it keeps).
+  /// Completes a located impact, whatever its flag: the impact where a force applies, nullopt where
+  /// none does (the bounce then takes the rigid impulse, the reason read from `e`'s flag). It may
+  /// solve `e` again at the same point with another law (the scene's per-point law choice, the
+  /// same as a single impact's: a plastic law's wedge or cone at a sharp edge or corner, the line
+  /// law at a rounded edge) and leaves `e` as last solved. Unset: contact::complete_impact with
+  /// contact::impact_input(model, e) (default thresholds) where the flag is none. The scene passes
+  /// its own (law choice, checks, warnings, the report it keeps).
   /// `index`: the impact's index in the sequence.
-  std::function<contact::Impact(std::size_t index, const contact::ContactModel&, contact::ContactEvaluation)> complete;
+  std::function<std::optional<contact::Impact>(std::size_t index, const contact::ContactModel&,
+                                               contact::ContactEvaluation& e)>
+      complete;
 };
 
 /// One impact of a sequence.
