@@ -551,9 +551,6 @@ FemOutputs read_fem(const toml::table& t, const Source& file, double to_m) {
       }
       *into = static_cast<int>(n);
     }
-    if (f.material_model == FemOutputs::MaterialModel::plastic) {
-      r.fail("material_model", "material_model = \"plastic\" with compare_contact = true: the full-contact model is elastic");
-    }
     f.compare_contact = c;
   } else {
     for (const char* key : {"compare_contact_threshold", "compare_contact_refine", "compare_contact_elements",
