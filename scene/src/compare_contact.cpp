@@ -183,7 +183,7 @@ CompareInput compare_input(const Scene& scene, const ImpactReport& ir, const Pre
   const Material& im = scene.materials.at(ib.material);
   if (in.plastic && !tm.yield_strength_Pa && !im.yield_strength_Pa) {
     throw ctx.error("material_model", "material_model = \"plastic\" needs a yield_strength_Pa on material '" + tm.name +
-                                          "' or '" + im.name + "'");
+                                          (tm.name == im.name ? "'" : "' or '" + im.name + "'"));
   }
   // The hybrid deck's request of a free target (plastic where its material yields: fem_request
   // asks for plastic when [outputs.fem] does).

@@ -838,12 +838,13 @@ Scene build(const toml::table& root, const Source& file, const fs::path& base_di
       }
     }
   }
-  if (sc.outputs.fem && sc.outputs.fem->compare_contact) {
+  if (sc.outputs.fem && sc.outputs.fem->compare_contact &&
+      sc.outputs.fem->material_model != FemOutputs::MaterialModel::plastic) {
     for (const ImpactSpec& s : sc.impacts) {
       if (s.contact_law != "auto" && s.contact_law != "hertz") {
         throw file.error(s.contact_law_place, "[outputs.fem] compare_contact = true compares with an elastic "
                                               "full-contact model: it needs contact_law = \"hertz\" or \"auto\", got \"" +
-                                                  s.contact_law + "\"");
+                                                  s.contact_law + "\" (or material_model = \"plastic\")");
       }
     }
   }
