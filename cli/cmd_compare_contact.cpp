@@ -4,6 +4,7 @@
 // model's F_max differs from the analytic one by more than the threshold.
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <memory>
 
 #include "cli_limits.hpp"
@@ -50,6 +51,14 @@ void register_compare_contact(CLI::App& app, Context& ctx) {
   cmd->add_option("--solver-timeout-s", args->options.solver_timeout_s,
                   "Wall-time limit of each ccx run (default: from each deck's size)")
       ->check(positive_number());
+  cmd->add_option("--floor-block-factor", args->options.contact.floor_block_factor,
+                  "A plane floor is a block of half-width and depth this many contact radii (default 40)")
+      ->check(CLI::Range(4.0, 1000.0));
+  cmd->add_option("--material-model", args->options.material_model,
+                  "elastic (default) or plastic: both bodies elastic-plastic where their material has "
+                  "yield_strength_Pa, compared with each contact law")
+      ->transform(CLI::CheckedTransformer(std::map<std::string, fem_export::MaterialModel>{
+          {"elastic", fem_export::MaterialModel::elastic}, {"plastic", fem_export::MaterialModel::plastic}}));
   cmd->add_flag("--no-hybrid", [args](std::int64_t) { args->options.run_hybrid = false; },
                 "Run the full-contact model only");
   cmd->callback([args, &ctx] {

@@ -48,6 +48,10 @@ constexpr double kVibrationFractionMax = 0.10;
 // against the contact model's quadratic elements under the Hertz pressure (Saint-Venant: the same
 // far field). The coarse linear mesh's stress error dominates: measured hybrid/contact 0.84.
 constexpr double kProbeStressRel = 0.25;
+// A plastic ball on a floor at about 30 V_y, coarse (one element across the dent radius): Thornton's
+// F_max against the FE run. Thornton's p_y = 1.6 Y ignores the rise of the mean pressure toward the
+// hardness, and the coarse mesh spreads the dent; the ladder (docs/plastic.md) measured the spread.
+constexpr double kPlasticForceRel = 0.35;
 
 // Two bodies: the target rotated and far from the origin, the impactor placed to touch.
 std::string scene_text(const std::string& target_body, double speed_m_s) {
@@ -100,26 +104,130 @@ void expect_hertz(const scene::CompareReport& r, const std::string& what) {
 
 }  // namespace
 
-TEST(CompareContact, PlaneImpactorIsRefusedWithOneLine) {
-  const std::string text = scene_text(R"(
+TEST(CompareContact, TwoFixedBodiesAreRefusedWithOneLine) {
+  // A plane floor under a fixed ball: nothing moves, there is no impact to compare.
+  const std::string text = std::regex_replace(scene_text(R"(
 [[bodies]]
 name = "target"
 shape = "plane"
 normal = [0, 0, 1]
 material = "steel"
-)", 1.0) + "point = [0, 0, 10]\n";
-  // The plane is the impactor: an infinite floor falling on the ball.
-  const std::string swapped = std::regex_replace(
-      text, std::regex("target = \"target\"\nimpactor = \"ball\""), "target = \"ball\"\nimpactor = \"target\"");
-  ASSERT_NE(swapped, text);
-  const scene::Scene s = scene::parse_scene(swapped, "plane.toml");
+)", 1.0), std::regex("material = \"steel\"\n"), "material = \"steel\"\nfixed = true\n", std::regex_constants::format_first_only) +
+                           "point = [0, 0, 0]\n";
+  ASSERT_NE(text.find("fixed = true"), std::string::npos);
   try {
-    scene::compare_contact(s, fast(test::fresh_dir("test_compare_out", "plane")));
-    FAIL() << "a plane was accepted";
+    const scene::Scene s = scene::parse_scene(text, "fixed.toml");
+    scene::compare_contact(s, fast(test::fresh_dir("test_compare_out", "fixed")));
+    FAIL() << "two fixed bodies were accepted";
   } catch (const InputError& e) {
     EXPECT_EQ(e.code(), ExitCode::invalid_input);
-    EXPECT_NE(std::string(e.what()).find("infinite plane"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("fixed"), std::string::npos) << e.what();
     EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos);
+  }
+}
+
+// A floor (issue 29 item 6): a steel ball dropped on a steel plane, rotated and far from the
+// origin. The plane becomes a block of 40 contact radii under the contact, its bottom held
+// (docs/contact-vs-hybrid.md, "A floor"); in the impact its mass is infinite, so the reduced mass
+// is the ball's. The ball-on-ball tolerances hold: F_max within kContactForceRel of Hertz; the
+// contact time within two time steps of 2 t_m (the force is known at the increments only, so the
+// duration from the first to the last increment with a force is bracketed by one step at each end).
+TEST(CompareContact, BallOnFloorMatchesHertz) {
+  const std::string text = scene_text(R"(
+[[bodies]]
+name = "target"
+shape = "plane"
+normal = [0.48, 0.6, 0.64]
+position = [5000, -3000, 2000]
+material = "steel"
+)", 1.0) + "point = [0, 0, 0]\n";
+  const scene::Scene s = scene::parse_scene(text, "floor.toml");
+  const scene::CompareReport r = scene::compare_contact(s, fast(test::fresh_dir("test_compare_out", "floor")));
+  ASSERT_EQ(r.verdict, scene::CompareVerdict::agree) << r.explanation;
+  EXPECT_FALSE(r.hybrid_deck.has_value());  // the target is the floor: no hybrid deck of it
+  EXPECT_EQ(r.fixed_body, "target");
+  EXPECT_NEAR(r.floor_block_size_m, 40 * r.semi_axis_a_m, 1e-12);
+  // The reduced mass is the ball's: 1/2 m v^2 with m = rho 4/3 pi r^3.
+  const double ball_kg = 7850 * 4.0 / 3.0 * M_PI * 1e-6;
+  EXPECT_NEAR(r.impact_energy_J / (0.5 * ball_kg * 1.0), 1.0, 1e-3);  // the analytic sphere's mass
+  const auto& L = *r.finest();
+  RecordProperty("max_force_relative_difference", test::sci(L.max_force_relative_difference));
+  EXPECT_LT(std::abs(L.max_force_relative_difference), kContactForceRel);
+  EXPECT_NEAR(L.run.contact_duration_s, r.analytic_duration_s, 2 * L.deck.time_step_s);
+  EXPECT_GT(L.deck.target.fixed_nodes, 0u);
+  EXPECT_EQ(L.deck.impactor.fixed_nodes, 0u);
+  // The ball's momentum change is the contact impulse on it (the held block takes the rest). The
+  // impulse is the trapezoidal integral of the printed forces, so this check carries its quadrature
+  // error (kContactImpulseRel), not the solver's equation tolerance of two free bodies (measured
+  // 3.4e-4 at 12 increments).
+  EXPECT_LT(L.run.linear_momentum_relative_error, kContactImpulseRel);
+  EXPECT_NEAR(L.run.impulse_Ns / r.analytic_impulse_Ns, 1.0, kContactImpulseRel);
+  std::cout << "[ floor ] F_max " << L.run.max_force_N << " N (Hertz " << r.analytic_max_force_N << "), duration "
+            << L.run.contact_duration_s * 1e6 << " us (2 t_m " << r.analytic_duration_s * 1e6 << "), e "
+            << L.run.restitution << ", momentum " << L.run.linear_momentum_relative_error << "\n";
+  const auto j = scene::to_json(r);
+  EXPECT_EQ(j.at("floor").at("kind"), "plane as a block");
+  EXPECT_EQ(j.at("material_model"), "elastic");
+}
+
+// Plastic full contact (issue 30 item 5), the suite's one small case: a steel ball r 5 mm on a
+// steel floor at about 30 V_y, both bodies elastic-plastic (bilinear, E_t = 1 % of E: perfectly
+// plastic, ccx 2.20's incplas did not converge at the contact and ccx crashed),
+// coarse: one element across the dent radius, 10 increments across Thornton's contact time.
+// Thornton's F_max (the "auto" law) against the FE run: within kPlasticForceRel, the spread the
+// ladder measured at these speeds (docs/plastic.md, "The ladder").
+// Disabled: ccx 2.20 (Debian) does not run this deck. With SOLVER=ITERATIVE SCALING it prints
+// "no convergence in incplas" from the first increment and dies (SIGSEGV, reported as exit 3 with
+// that line); with SPOOLES it ended in the first increment without a message
+// (docs/contact-vs-hybrid.md, "Plastic full contact"). Enable it when a plastic contact deck runs
+// (node-to-surface contact is untried).
+TEST(CompareContact, DISABLED_PlasticBallOnFloorHasRestitutionAndDent) {
+  std::string text = std::regex_replace(scene_text(R"(
+[[bodies]]
+name = "target"
+shape = "plane"
+normal = [0, 0, 1]
+material = "steel"
+)", 0.12) + "point = [0, 0, 0]\n", std::regex("restitution = 1.0\n"), "");
+  text = std::regex_replace(text, std::regex("radius = 10"), "radius = 5");
+  text = std::regex_replace(text, std::regex("density_kg_m3 = 7850"), "density_kg_m3 = 7850\nyield_strength_Pa = 2.35e8\ntangent_modulus_Pa = 2.0e9");
+  const scene::Scene s = scene::parse_scene(text, "plastic.toml");
+  scene::CompareOptions o = fast(test::fresh_dir("test_compare_out", "plastic"));
+  o.contact.contact_increments = 10;
+  o.contact.end_time_factor = 1.3;  // past the separation, whatever the FE contact time
+  o.contact.floor_block_factor = 10;  // a small block: the force tolerance below is wider than its effect
+  o.threshold = 1.0;  // the verdict is not what is checked here
+  o.material_model = fem_export::MaterialModel::plastic;
+  const scene::CompareReport r = scene::compare_contact(s, o);
+  ASSERT_TRUE(r.plastic);
+  EXPECT_EQ(r.law, "thornton");
+  const auto& L = *r.finest();
+  std::cout << "[ plastic ] V/V_y " << r.approach_velocity_m_s / r.yield_velocity_m_s.value_or(1) << ", FE F_max "
+            << L.run.max_force_N << " N (thornton " << r.analytic_max_force_N << "), t_c " << L.run.contact_duration_s * 1e6
+            << " us (" << r.analytic_duration_s * 1e6 << "), e " << L.run.restitution << " (" << r.restitution
+            << "), dent " << L.run.residual_indentation_m * 1e6 << " um (" << r.analytic_residual_indentation_m * 1e6
+            << "), " << L.deck.node_count << " nodes, " << L.run.wall_time_s << " s\n";
+  EXPECT_TRUE(L.deck.target.plastic && L.deck.impactor.plastic);
+  EXPECT_LT(std::abs(L.max_force_relative_difference), kPlasticForceRel);
+  EXPECT_GT(L.run.restitution, 0.0);
+  EXPECT_LT(L.run.restitution, 1.0);
+  EXPECT_GT(L.run.residual_indentation_m, 0.0);
+  EXPECT_GT(L.run.impactor.dent_m, 0.0);  // the ball is dented too
+  // The keys of the plastic comparison (docs/cli.md).
+  const auto j = scene::to_json(r);
+  EXPECT_EQ(j.at("material_model"), "plastic");
+  for (const char* key : {"restitution", "residual_indentation_m", "dent_m"}) {
+    EXPECT_TRUE(j.at("contact_run").contains(key)) << key;
+  }
+  for (const char* key : {"contact_law", "yield_velocity_m_s", "speed_over_yield_velocity", "limiting_pressure_Pa"}) {
+    EXPECT_FALSE(j.at(key).is_null()) << key;
+  }
+  ASSERT_EQ(j.at("laws").size(), scene::kComparedLaws.size());
+  for (const auto& l : j.at("laws")) {
+    for (const char* key : {"max_force_N", "contact_time_s", "restitution", "residual_indentation_m",
+                            "max_force_relative_error", "restitution_relative_error"}) {
+      EXPECT_TRUE(l.contains(key)) << l.at("name") << "." << key;
+    }
   }
 }
 

@@ -69,26 +69,82 @@ fem_export::ContactBody contact_body(const fem_export::DeckRequest& own, const P
   b.angular_velocity_rad_s = k.angular_velocity_rad_s;
   b.centroid_own_m = p.volume.centroid_m;
   b.far_mesh_size_m = far_size_m;
+  b.yield_strength_Pa = own.yield_strength_Pa.value_or(0.0);
   return b;
 }
 
-// The full-contact model meshes both bodies and needs both masses: planes and fixed bodies are
-// refused, naming the body's place after `ctx`.
+// The full-contact model holds a fixed body (a plane as a block) and moves the other: two fixed
+// bodies have no impact to compare; refused naming the impact after `ctx`.
 void check_compare_bodies(const Scene& scene, const ImpactSpec& s, const InputContext& ctx) {
-  for (const std::string* name : {&s.target, &s.impactor}) {
-    const BodySpec& b = scene.body(*name);
-    if (b.shape->half_space()) {
-      throw ctx.error(b.place.describe(),
-                      "impact '" + s.name + "': body '" + b.name +
-                          "' is an infinite plane: the full-contact model meshes both bodies and a plane cannot be "
-                           "meshed (give the floor as a finite part)");
-    }
-    if (b.fixed) {
-      throw ctx.error(b.place.describe(),
-                      "impact '" + s.name + "': body '" + b.name +
-                          "' is fixed: the full-contact model needs both bodies free, with their masses");
-    }
+  const BodySpec& t = scene.body(s.target);
+  const BodySpec& i = scene.body(s.impactor);
+  if ((t.fixed || t.shape->half_space()) && (i.fixed || i.shape->half_space())) {
+    throw ctx.error(s.place.describe(), "impact '" + s.name + "': both bodies are fixed: nothing moves to compare");
   }
+}
+
+bool is_fixed(const BodySpec& b) { return b.fixed || b.shape->half_space(); }
+
+// The deck request of a fixed body: its body (none for a plane: a block is made under the contact)
+// and material. Its density is the material's, else the other body's (it only sets the block's
+// elastic waves: its bottom is held), said in a warning.
+fem_export::DeckRequest fixed_deck_request(const Scene& scene, const ImpactReport& ir, const PreparedBody& p,
+                                           const PreparedBody& other, std::vector<std::string>& warnings) {
+  const BodySpec& b = scene.body(p.name);
+  const Material& m = scene.materials.at(b.material);
+  fem_export::DeckRequest r;
+  r.source = scene.file.string();
+  r.impact = ir.spec->name;
+  if (!b.shape->half_space()) {
+    r.body = b.shape->fem_body(*p.shape, scene.length_unit);
+    r.options.mesh.mesh_size_m = default_mesh_size_m(*p.shape);
+  }
+  r.material.youngs_modulus_Pa = p.material.youngs_modulus_Pa;
+  r.material.poisson_ratio = p.material.poisson_ratio;
+  if (m.density_kg_m3) {
+    r.material.density_kg_m3 = *m.density_kg_m3;
+  } else {
+    r.material.density_kg_m3 = other.mass_kg / other.volume.volume_m3;
+    warnings.push_back("material '" + m.name + "' of the fixed body '" + p.name + "' has no density: its FE body takes '" +
+                       other.name + "''s (it only sets the elastic waves in a held body)");
+  }
+  return r;
+}
+
+// Each compared law's figures at the impact's point: the kernel solved again with that law (Hertz
+// with R = 1, the elastic reference).
+std::vector<LawFigures> law_figures(const Scene& scene, const ImpactReport& ir, const InputContext& ctx) {
+  std::vector<LawFigures> out;
+  for (const std::string& name : kComparedLaws) {
+    LawFigures f;
+    f.name = name;
+    ImpactSpec s = *ir.spec;
+    s.contact_law = name;
+    s.restitution_given = name == "hertz";
+    if (name == "hertz") {
+      s.restitution.kind = collision::RestitutionModel::Kind::constant;
+      s.restitution.constant = 1.0;
+    }
+    try {
+      const ImpactLaw law = impact_law(scene, s, ctx);
+      if (name != "hertz") f.limiting_pressure_Pa = law.limiting_pressure_Pa;
+      collision::KernelInput in = ir.contact.input;
+      in.law = law.law.get();
+      const collision::KernelResult k = collision::solve_kernel(in);
+      if (k.flag != collision::ContactFlag::none) {
+        f.problem = collision::flag_word(k.flag);
+      } else {
+        f.max_force_N = k.max_force_N;
+        f.contact_time_s = k.contact_time_s;
+        f.restitution = k.restitution.coefficient;
+        f.residual_indentation_m = k.residual_indentation_m;
+      }
+    } catch (const InputError& e) {
+      f.problem = e.reason();
+    }
+    out.push_back(f);
+  }
+  return out;
 }
 
 void check_compare_options(const CompareOptions& o, const InputContext& ctx) {
@@ -115,10 +171,42 @@ CompareInput compare_input(const Scene& scene, const ImpactReport& ir, const Pre
   in.impact = &ir;
   in.target = &target;
   in.impactor = &impactor;
-  in.target_deck = hybrid_deck_request(scene, ir, target);
-  in.impactor_deck = hybrid_deck_request(scene, ir, impactor);
-  in.impactor_mesh_size_m = default_mesh_size_m(*impactor.shape);
   in.warnings = compare_warnings(scene);
+  const BodySpec& tb = scene.body(target.name);
+  const BodySpec& ib = scene.body(impactor.name);
+  in.target_fixed = is_fixed(tb);
+  in.impactor_fixed = is_fixed(ib);
+  in.target_plane = tb.shape->half_space();
+  in.impactor_plane = ib.shape->half_space();
+  in.plastic = scene.outputs.fem && scene.outputs.fem->material_model == FemOutputs::MaterialModel::plastic;
+  const Material& tm = scene.materials.at(tb.material);
+  const Material& im = scene.materials.at(ib.material);
+  if (in.plastic && !tm.yield_strength_Pa && !im.yield_strength_Pa) {
+    throw ctx.error("material_model", "material_model = \"plastic\" needs a yield_strength_Pa on material '" + tm.name +
+                                          (tm.name == im.name ? "'" : "' or '" + im.name + "'"));
+  }
+  // The hybrid deck's request of a free target (plastic where its material yields: fem_request
+  // asks for plastic when [outputs.fem] does).
+  auto request = [&](const PreparedBody& p, const PreparedBody& other, bool fixed) {
+    fem_export::DeckRequest r = fixed ? fixed_deck_request(scene, ir, p, other, in.warnings)
+                                      : hybrid_deck_request(scene, ir, p);
+    const Material& m = scene.materials.at(scene.body(p.name).material);
+    r.yield_strength_Pa = m.yield_strength_Pa;
+    r.material.model = in.plastic && m.yield_strength_Pa ? fem_export::MaterialModel::plastic
+                                                         : fem_export::MaterialModel::elastic;
+    r.material.tangent_modulus_Pa = in.plastic ? m.tangent_modulus_Pa : std::nullopt;
+    return r;
+  };
+  in.target_deck = request(target, impactor, in.target_fixed);
+  in.impactor_deck = request(impactor, target, in.impactor_fixed);
+  in.impactor_mesh_size_m = in.impactor_plane ? 0.0 : default_mesh_size_m(*impactor.shape);
+  in.law = ir.contact_law.empty() ? ir.law.name : ir.contact_law;
+  in.law_automatic = ir.law.automatic;
+  in.limiting_pressure_Pa = ir.law.limiting_pressure_Pa;
+  if (in.plastic) {
+    in.laws = law_figures(scene, ir, ctx);
+    in.yield_velocity_m_s = ir.yield_velocity_m_s;
+  }
   return in;
 }
 
@@ -142,6 +230,10 @@ CompareReport compare_contact(const Scene& scene_in, const CompareOptions& o) {
   // The hybrid deck's settings: the scene's, or the defaults.
   Scene scene = scene_in;
   if (!scene.outputs.fem) scene.outputs.fem = FemOutputs{};
+  if (o.material_model == fem_export::MaterialModel::plastic) {
+    scene.outputs.fem->material_model = FemOutputs::MaterialModel::plastic;
+  }
+  const bool plastic = scene.outputs.fem->material_model == FemOutputs::MaterialModel::plastic;
   const ImpactSpec& s = *spec;
   check_compare_bodies(scene, s, ctx);
 
@@ -152,18 +244,20 @@ CompareReport compare_contact(const Scene& scene_in, const CompareOptions& o) {
   const InputContext impact_ctx = ctx.at(InputContext::joined(s.place.describe(), "impact '" + s.name + "'"));
   const double e_star =
       collision::effective_modulus_Pa(target.material, impactor.material, scene.modulus_convention, impact_ctx);
-  // The full-contact model is elastic: "auto" runs Hertz here (impact_law), a plastic law is refused.
+  // An elastic full-contact model: "auto" runs Hertz here (impact_law), a plastic law is refused.
+  // A plastic one compares with the impact's own law.
   ImpactLaw law = impact_law(scene, s, impact_ctx);
-  if (law.automatic && law.name != "hertz") {  // as `run` with compare_contact = true chooses
+  if (!plastic && law.automatic && law.name != "hertz") {  // as `run` with compare_contact = true chooses
     // (the scene may have no [outputs.fem] here: the impact asks for Hertz instead, still "auto")
     ImpactSpec elastic = s;
     elastic.contact_law = "hertz";
     law = impact_law(scene, elastic, impact_ctx);
     law.automatic = true;
   }
-  if (law.name != "hertz") {
+  if (!plastic && law.name != "hertz") {
     throw impact_ctx.error("contact_law", "compare-contact compares with an elastic full-contact model: it needs "
-                                          "contact_law = \"hertz\" or \"auto\", got \"" + law.name + "\"");
+                                          "contact_law = \"hertz\" or \"auto\", got \"" + law.name +
+                                          "\" (or material_model = \"plastic\")");
   }
   const ContactModel model(target, impactor, s.contact_radius, e_star, law.law, impact_ctx);
   ContactEvaluation ev = locate_impact_contact(scene, s, model);
@@ -215,20 +309,31 @@ CompareReport compare_contact(const CompareInput& in, const CompareOptions& o) {
   rep.assumed_loss_fraction = 1.0 - R * R;
   rep.analytic_max_force_N = k.max_force_N;
   rep.analytic_compression_time_s = k.compression_time_s;
-  rep.analytic_duration_s = 2.0 * k.compression_time_s;
-  rep.analytic_impulse_Ns = 2.0 * k.impulse_compression_Ns;
+  // Elastic: the Hertz impact with R = 1; plastic: the law's own figures.
+  rep.plastic = in.plastic;
+  rep.law = in.law;
+  rep.law_automatic = in.law_automatic;
+  rep.limiting_pressure_Pa = in.limiting_pressure_Pa;
+  rep.yield_velocity_m_s = in.yield_velocity_m_s;
+  rep.approach_velocity_m_s = k.approach_velocity_m_s;
+  rep.laws = in.laws;
+  rep.analytic_duration_s = in.plastic ? k.contact_time_s : 2.0 * k.compression_time_s;
+  rep.analytic_impulse_Ns = in.plastic ? k.impulse_total_Ns : 2.0 * k.impulse_compression_Ns;
+  rep.analytic_residual_indentation_m = in.plastic ? k.residual_indentation_m : 0.0;
   rep.impact_energy_J = 0.5 * k.reduced_mass_kg * k.approach_velocity_m_s * k.approach_velocity_m_s;
   rep.semi_axis_a_m = std::max(k.contact_semi_axis_a_m, k.contact_semi_axis_b_m);
   rep.semi_axis_b_m = std::min(k.contact_semi_axis_a_m, k.contact_semi_axis_b_m);
-  const double elastic = 2.0 / (1.0 + R);
+  const double elastic = in.plastic ? 1.0 : 2.0 / (1.0 + R);
   rep.analytic_target_dv = elastic * ir.result.target_jump.delta_velocity_m_s;
   rep.analytic_target_dw = elastic * ir.result.target_jump.delta_angular_velocity_rad_s;
   rep.analytic_impactor_dv = elastic * ir.result.impactor_jump.delta_velocity_m_s;
   rep.analytic_impactor_dw = elastic * ir.result.impactor_jump.delta_angular_velocity_rad_s;
   {
     collision::ForceHistory elastic = ir.result.history;  // the same pulse with R = 1
-    elastic.restitution = 1.0;
-    elastic.law = nullptr;  // Hertz's F(t) from the summary, not the law's result with its own R
+    if (!in.plastic) {
+      elastic.restitution = 1.0;
+      elastic.law = nullptr;  // Hertz's F(t) from the summary, not the law's result with its own R
+    }
     const int n = 200;
     for (int i = 0; i <= n; ++i) {
       const double t = elastic.contact_time_s() * i / n;
@@ -243,13 +348,26 @@ CompareReport compare_contact(const CompareInput& in, const CompareOptions& o) {
   const std::size_t increments = static_cast<std::size_t>(std::ceil(co.end_time_factor * co.contact_increments - 1e-9));
   const double end_time = increments * dt;
 
-  double target_far = in.target_deck.options.mesh.mesh_size_m;
+  // A plane floor: a block of half-width and depth floor_block_factor a (contact_model.hpp).
+  const double block_m = co.floor_block_factor * std::max(rep.semi_axis_a_m, rep.semi_axis_b_m);
+  if (in.target_fixed || in.impactor_fixed) {
+    const bool t = in.target_fixed;
+    rep.fixed_body = t ? target.name : impactor.name;
+    rep.fixed_kind = (t ? in.target_plane : in.impactor_plane) ? "plane as a block" : "fixed body";
+    rep.floor_block_size_m = (t ? in.target_plane : in.impactor_plane) ? block_m : 0.0;
+  }
+  double target_far = in.target_plane ? block_m / 4 : in.target_deck.options.mesh.mesh_size_m;
   fem_export::CheckOptions check_options;
   check_options.progress = o.progress;
   check_options.timeout_s = o.solver_timeout_s;
   check_options.threads = o.solver_threads;
   const fem_export::DeckRequest& target_req = in.target_deck;
-  if (o.run_hybrid) {
+  const bool run_hybrid = o.run_hybrid && !in.target_fixed;
+  if (o.run_hybrid && in.target_fixed) {
+    rep.warnings.push_back("the target '" + target.name + "' is fixed: no hybrid deck (it models a free target; make "
+                           "the free body the target to have one)");
+  }
+  if (run_hybrid) {
     fem_export::DeckRequest req = target_req;
     req.context = deck_context("hybrid deck");
     req.options.solvers = {"calculix"};
@@ -276,9 +394,32 @@ CompareReport compare_contact(const CompareInput& in, const CompareOptions& o) {
   cr.impact = in.impact_name;
   cr.context = deck_context("contact model");
   cr.target = contact_body(target_req, target, ev.target_point, ev.input.target, Eigen::Vector3d::Zero(), target_far);
-  cr.target.probes_own_m = target_req.options.mesh.probes_m;  // the hybrid deck's probes, target frame
+  if (!in.target_fixed) cr.target.probes_own_m = target_req.options.mesh.probes_m;  // the hybrid deck's, target frame
   cr.impactor = contact_body(impactor_req, impactor, ev.impactor_point, ev.input.impactor, ev.impactor_translation_m,
-                             in.impactor_mesh_size_m);
+                             in.impactor_plane ? block_m / 4 : in.impactor_mesh_size_m);
+  // A fixed body: held and at rest, so the free body takes the relative velocity (a fixed body
+  // moves only by approach_speed_m_s, which translates it). A plane: the block under the contact,
+  // in the world frame.
+  if (in.target_fixed) cr.impactor.velocity_m_s -= cr.target.velocity_m_s;
+  if (in.impactor_fixed) cr.target.velocity_m_s -= cr.impactor.velocity_m_s;
+  for (auto [body, fixed, plane, outward] : {std::tuple{&cr.target, in.target_fixed, in.target_plane, Eigen::Vector3d(ev.normal)},
+                                             std::tuple{&cr.impactor, in.impactor_fixed, in.impactor_plane, Eigen::Vector3d(-ev.normal)}}) {
+    if (!fixed) continue;
+    body->velocity_m_s.setZero();
+    body->angular_velocity_rad_s.setZero();
+    body->support_depth_m = block_m;
+    if (!plane) continue;
+    body->body = fem_export::DeckBody{};
+    body->body.kind = fem_export::BodyKind::part;
+    body->body.surface = fem_export::floor_block(ev.point_m, outward, block_m);
+    body->body.name = "the floor block of '" + body->name + "'";
+    body->body.volume_m3 = 4 * block_m * block_m * block_m;
+    body->rotation.setIdentity();
+    body->position_m.setZero();
+    body->contact_point_own_m = ev.point_m;
+    body->centroid_own_m = ev.point_m - 0.5 * block_m * outward.normalized();
+    body->support_depth_m = fem_export::kFloorSupportDepthFraction * block_m;
+  }
   cr.contact_point_m = ev.point_m;
   cr.normal = ev.normal;
   cr.effective_modulus_Pa = collision::effective_modulus_Pa(target.material, impactor.material,
@@ -286,6 +427,7 @@ CompareReport compare_contact(const CompareInput& in, const CompareOptions& o) {
   cr.semi_axis_a_m = rep.semi_axis_a_m;
   cr.semi_axis_b_m = rep.semi_axis_b_m;
   cr.compression_time_s = k.compression_time_s;
+  cr.contact_duration_s = rep.analytic_duration_s;
   for (int level = 0; level <= o.refine; ++level) {
     cr.options = co;
     cr.options.contact_elements = co.contact_elements * std::pow(std::sqrt(2.0), level);
@@ -344,7 +486,7 @@ CompareReport compare_contact(const CompareInput& in, const CompareOptions& o) {
     series.push_back({lab.str(), L.run.time_s, L.run.force_N, -1, false});
     series.back().colour = 1 + static_cast<int>(&L - &rep.ladder.front()) % 4;
   }
-  if (o.run_hybrid) series.push_back({"hybrid applied load", table.time_s, table.force_N, plot::kVermilion, false});
+  if (run_hybrid) series.push_back({"hybrid applied load", table.time_s, table.force_N, plot::kVermilion, false});
   plot::StressPlotOptions po;
   po.title = "Contact force, impact '" + in.impact_name + "': full contact against the hybrid load";
   po.quantity = "contact force";
@@ -388,6 +530,8 @@ json to_json(const CompareReport& r) {
                    {"impact_energy_J", r.impact_energy_J},
                    {"contact_semi_axes_m", {r.semi_axis_a_m, r.semi_axis_b_m}},
                    {"restitution", r.restitution},
+                   {"contact_law", r.law},
+                   {"residual_indentation_m", r.analytic_residual_indentation_m},
                    {"delta_velocity_m_s", {{"target", json_vector(r.analytic_target_dv)}, {"impactor", json_vector(r.analytic_impactor_dv)}}},
                    {"delta_angular_velocity_rad_s",
                     {{"target", json_vector(r.analytic_target_dw)}, {"impactor", json_vector(r.analytic_impactor_dw)}}}};
@@ -407,6 +551,10 @@ json to_json(const CompareReport& r) {
                 {"penalty_N_m3", L.deck.penalty_N_m3},
                 {"contact_duration_s", run.contact_duration_s},
                 {"impulse_Ns", run.impulse_Ns},
+                {"restitution", run.restitution},
+                {"residual_indentation_m", run.residual_indentation_m},
+                {"dent_m", {{"target", run.target.dent_m}, {"impactor", run.impactor.dent_m}}},
+                {"fixed_nodes", L.deck.target.fixed_nodes + L.deck.impactor.fixed_nodes},
                 {"delta_velocity_m_s", {{"target", json_vector(run.target.delta_velocity_m_s)}, {"impactor", json_vector(run.impactor.delta_velocity_m_s)}}},
                 {"delta_angular_velocity_rad_s",
                  {{"target", json_vector(run.target.delta_angular_velocity_rad_s)}, {"impactor", json_vector(run.impactor.delta_angular_velocity_rad_s)}}},
@@ -419,6 +567,39 @@ json to_json(const CompareReport& r) {
                 {"folder", L.deck.folder.string()}};
   };
   const ContactLevel& fine = r.ladder.back();
+  j["material_model"] = r.plastic ? "plastic" : "elastic";
+  j["contact_law"] = r.law;
+  j["contact_law_automatic"] = r.law_automatic;
+  j["limiting_pressure_Pa"] = r.limiting_pressure_Pa ? json(*r.limiting_pressure_Pa) : json(nullptr);
+  j["yield_velocity_m_s"] = r.yield_velocity_m_s ? json(*r.yield_velocity_m_s) : json(nullptr);
+  j["approach_velocity_m_s"] = r.approach_velocity_m_s;
+  j["speed_over_yield_velocity"] = r.yield_velocity_m_s && *r.yield_velocity_m_s > 0
+                                       ? json(r.approach_velocity_m_s / *r.yield_velocity_m_s)
+                                       : json(nullptr);
+  j["floor"] = r.fixed_body.empty() ? json(nullptr)
+                                    : json{{"body", r.fixed_body},
+                                           {"kind", r.fixed_kind},
+                                           {"block_size_m", r.floor_block_size_m}};
+  // Each law against the finest contact run: law / contact - 1 (plastic comparisons).
+  json laws = json::array();
+  for (const LawFigures& f : r.laws) {
+    json l = {{"name", f.name},
+              {"limiting_pressure_Pa", f.limiting_pressure_Pa ? json(*f.limiting_pressure_Pa) : json(nullptr)}};
+    if (!f.problem.empty()) {
+      l["problem"] = f.problem;
+    } else {
+      l["max_force_N"] = f.max_force_N;
+      l["contact_time_s"] = f.contact_time_s;
+      l["restitution"] = f.restitution;
+      l["residual_indentation_m"] = f.residual_indentation_m;
+      l["max_force_relative_error"] = rel(f.max_force_N, fine.run.max_force_N);
+      l["contact_time_relative_error"] = rel(f.contact_time_s, fine.run.contact_duration_s);
+      l["restitution_relative_error"] = rel(f.restitution, fine.run.restitution);
+      l["residual_indentation_relative_error"] = rel(f.residual_indentation_m, fine.run.residual_indentation_m);
+    }
+    laws.push_back(l);
+  }
+  j["laws"] = laws;
   j["contact_run"] = level_json(fine);
   json ladder = json::array();
   for (const auto& L : r.ladder) ladder.push_back(level_json(L));
@@ -475,7 +656,17 @@ std::string format_compare(const CompareReport& r) {
     o << "  not a Hertzian contact: " << r.non_hertzian_reason << "\n  " << r.explanation << "\n";
     return o.str();
   }
-  o << "  analytic (elastic Hertz): F_max " << r.analytic_max_force_N << " N, duration " << r.analytic_duration_s * 1e6
+  if (!r.fixed_body.empty()) {
+    o << "  fixed body '" << r.fixed_body << "': " << r.fixed_kind;
+    if (r.floor_block_size_m > 0) o << " of half-width and depth " << r.floor_block_size_m * 1e3 << " mm, bottom held";
+    o << "\n";
+  }
+  if (r.plastic) {
+    o << "  material model: plastic; the impact's law: " << r.law << (r.law_automatic ? " (auto)" : "");
+    if (r.yield_velocity_m_s) o << ", V/V_y " << r.approach_velocity_m_s / *r.yield_velocity_m_s;
+    o << "\n";
+  }
+  o << "  analytic (" << (r.plastic ? r.law + " law" : std::string("elastic Hertz")) << "): F_max " << r.analytic_max_force_N << " N, duration " << r.analytic_duration_s * 1e6
     << " us, impulse " << r.analytic_impulse_Ns << " N s\n";
   o << "  refinement (elements across the contact semi-axis b, F_max, difference, nodes, wall time):\n";
   for (const auto& L : r.ladder) {
@@ -487,6 +678,29 @@ std::string format_compare(const CompareReport& r) {
     << 100 * rel(f.run.contact_duration_s, r.analytic_duration_s) << " %), impulse " << f.run.impulse_Ns << " N s ("
     << 100 * rel(f.run.impulse_Ns, r.analytic_impulse_Ns) << " %), momentum error "
     << f.run.linear_momentum_relative_error << "\n";
+  if (r.plastic) {
+    o << "  full contact: restitution " << f.run.restitution << ", dent " << f.run.residual_indentation_m * 1e6
+      << " um (target " << f.run.target.dent_m * 1e6 << ", impactor " << f.run.impactor.dent_m * 1e6 << ")\n";
+    o << "  law            F_max (N)  vs FE   t_c (us)  vs FE   e        vs FE   dent (um)  vs FE\n";
+    for (const LawFigures& l : r.laws) {
+      o << "  " << l.name;
+      for (std::size_t k = l.name.size(); k < 14; ++k) o << ' ';
+      if (!l.problem.empty()) {
+        o << " n/a: " << l.problem << "\n";
+        continue;
+      }
+      auto pct = [](double v) {
+        std::ostringstream p;
+        p.precision(3);
+        p << 100 * v << " %";
+        return p.str();
+      };
+      o << " " << l.max_force_N << "  " << pct(rel(l.max_force_N, f.run.max_force_N)) << "  " << l.contact_time_s * 1e6
+        << "  " << pct(rel(l.contact_time_s, f.run.contact_duration_s)) << "  " << l.restitution << "  "
+        << pct(rel(l.restitution, f.run.restitution)) << "  " << l.residual_indentation_m * 1e6 << "  "
+        << pct(rel(l.residual_indentation_m, f.run.residual_indentation_m)) << "\n";
+    }
+  }
   o << "  vibration energy left: " << 100 * (r.impact_energy_J > 0 ? f.run.vibration_energy_J / r.impact_energy_J : 0)
     << " % of the impact energy; the restitution model assumes a loss of " << 100 * r.assumed_loss_fraction << " %\n";
   if (r.hybrid_check) {

@@ -39,7 +39,10 @@ ImpactLaw impact_law(const Scene& scene, const ImpactSpec& s, const InputContext
     l.limiting_pressure_Pa = collision::kThorntonYieldFactor * *yield;
   }
   if (yield) l.plastic_law = kDefaultPlasticLaw;
-  const bool compare = scene.outputs.fem && scene.outputs.fem->compare_contact;
+  // An elastic full-contact comparison needs Hertz; a plastic one ([outputs.fem] material_model)
+  // compares with the plastic law.
+  const bool compare = scene.outputs.fem && scene.outputs.fem->compare_contact &&
+                       scene.outputs.fem->material_model != FemOutputs::MaterialModel::plastic;
   if (s.contact_law == "auto") {
     l.automatic = true;
     l.name = (s.restitution_given || !yield || compare) ? "hertz" : kDefaultPlasticLaw;

@@ -46,6 +46,12 @@ class FrdResults final : public NodalResults {
   std::filesystem::path frd_;
 };
 
+/// The *MATERIAL card `name` of `m` with *ELASTIC, *DENSITY and, for MaterialModel::plastic, the
+/// *PLASTIC rows of hardening_table(m, yield_Pa); values times per_Pa (stresses) and per_kg_m3
+/// (density) into the deck's units. The one writer of both the hybrid deck and the contact model.
+std::string material_cards(const std::string& name, const DeckMaterial& m, double yield_Pa, double per_Pa,
+                           double per_kg_m3);
+
 /// Text of the CalculiX main deck (`patch`: the hertz-patch nodal forces, nullptr: the point load
 /// on LOAD) and of its included mesh (exposed for tests).
 std::string calculix_inp(const DeckRequest& request, const TetMesh& mesh, const PatchLoad* patch = nullptr);

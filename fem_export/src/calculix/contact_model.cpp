@@ -171,6 +171,27 @@ MeshResult mesh_body(const ContactBody& b, const MeshOptions& mo, const fs::path
 
 }  // namespace
 
+PartSurface floor_block(const Eigen::Vector3d& p, const Eigen::Vector3d& outward_normal, double size_m) {
+  const Eigen::Vector3d n = outward_normal.normalized();
+  // Two tangents completing n to a right-handed frame (t1, t2, n).
+  const Eigen::Vector3d t1 = n.unitOrthogonal(), t2 = n.cross(t1);
+  PartSurface s;
+  // Corners: bottom (depth size) 0..3, top 4..7, counter-clockwise about n seen from above.
+  for (double depth : {size_m, 0.0}) {
+    for (const auto& [u, v] : {std::pair{-1, -1}, {1, -1}, {1, 1}, {-1, 1}}) {
+      s.vertices_m.push_back(p + size_m * (u * t1 + v * t2) - depth * n);
+    }
+  }
+  // Outward triangles: top (+n), bottom (-n), and the four sides.
+  s.triangles = {{4, 5, 6}, {4, 6, 7}, {0, 2, 1}, {0, 3, 2}};
+  for (int k = 0; k < 4; ++k) {
+    const int a = k, b = (k + 1) % 4;
+    s.triangles.push_back({a, b, b + 4});
+    s.triangles.push_back({a, b + 4, a + 4});
+  }
+  return s;
+}
+
 ContactDeck write_contact_deck(const ContactModelRequest& r, const fs::path& folder) {
   const InputContext where = r.context.in_file(folder.string());
   const ContactModelOptions& o = r.options;
@@ -184,13 +205,19 @@ ContactDeck write_contact_deck(const ContactModelRequest& r, const fs::path& fol
     if (!(b->material.youngs_modulus_Pa > 0) || !(b->material.density_kg_m3 > 0) || !(b->far_mesh_size_m > 0)) {
       throw where.error("body '" + b->name + "'", "modulus, density and mesh size must be > 0");
     }
+    if (b->material.model == MaterialModel::plastic && !(b->yield_strength_Pa > 0)) {
+      throw where.error("body '" + b->name + "'", "a plastic material needs a yield strength > 0");
+    }
+    if (b->support_depth_m && !(*b->support_depth_m > 0)) {
+      throw where.error("body '" + b->name + "'", "a fixed body's support depth must be > 0");
+    }
   }
   ContactDeck out;
   const double hc = r.semi_axis_b_m / o.contact_elements;
   out.contact_mesh_size_m = hc;
   const double zone = std::max(o.refined_zone_factor * r.semi_axis_a_m, 2 * hc);
   const double surface_zone = std::max(o.surface_zone_factor * r.semi_axis_a_m, 4 * hc);
-  const double duration = 2.0 * r.compression_time_s;
+  const double duration = r.contact_duration_s > 0 ? r.contact_duration_s : 2.0 * r.compression_time_s;
   out.time_step_s = duration / o.contact_increments;
   out.increments = static_cast<std::size_t>(std::ceil(o.end_time_factor * o.contact_increments - 1e-9));
   out.end_time_s = out.increments * out.time_step_s;
@@ -207,6 +234,9 @@ ContactDeck write_contact_deck(const ContactModelRequest& r, const fs::path& fol
     std::array<QuadBody, 2> q;
     std::vector<std::pair<std::string, int>> probe_nodes;  // the target's, 0-based
     std::array<const ContactBody*, 2> bodies = {&r.target, &r.impactor};
+    // Each body's inward normal at the contact (deck frame): the target's is -n, the impactor's n.
+    const std::array<Eigen::Vector3d, 2> inward = {-r.normal.normalized(), r.normal.normalized()};
+    std::array<std::vector<int>, 2> fixed;  // body-local nodes held by *BOUNDARY
     std::array<ContactBodyMesh*, 2> meshes = {&out.target, &out.impactor};
     const char* names[2] = {"target", "impactor"};
     for (int i = 0; i < 2; ++i) {
@@ -223,6 +253,17 @@ ContactDeck write_contact_deck(const ContactModelRequest& r, const fs::path& fol
         throw where.error("body '" + bodies[i]->name + "'", "meshing failed: " + e.reason());
       }
       q[i] = quadratic(m.mesh, *bodies[i], r.contact_point_m);
+      meshes[i]->contact_node = static_cast<std::size_t>(m.mesh.node_of("LOAD"));  // corner nodes come first
+      if (bodies[i]->support_depth_m) {
+        // The held nodes: at least the support depth under the contact point, or past half the
+        // body's depth when it is shallower (a small fixed body).
+        double deepest = 0;
+        for (const auto& x : q[i].nodes) deepest = std::max(deepest, inward[i].dot(x));
+        const double depth = deepest >= *bodies[i]->support_depth_m ? *bodies[i]->support_depth_m : 0.5 * deepest;
+        for (std::size_t n = 0; n < q[i].nodes.size(); ++n)
+          if (inward[i].dot(q[i].nodes[n]) >= depth) fixed[i].push_back(static_cast<int>(n));
+        if (fixed[i].empty()) throw where.error("body '" + bodies[i]->name + "'", "no node to hold the fixed body by");
+      }
       // Probe nodes keep their numbers: the corner nodes come first in the quadratic mesh.
       if (i == 0) {
         for (const auto& [group, node] : m.mesh.node_groups)
@@ -248,7 +289,10 @@ ContactDeck write_contact_deck(const ContactModelRequest& r, const fs::path& fol
       bm.fe_mass_kg = q[i].mass_kg;
       bm.fe_centroid_m = q[i].centroid;
       bm.fe_inertia_kg_m2 = q[i].inertia;
+      bm.fixed_nodes = fixed[i].size();
+      bm.plastic = bodies[i]->material.model == MaterialModel::plastic;
     }
+    const bool plastic = out.target.plastic || out.impactor.plastic;
     out.impactor.first_node = out.target.node_count;
     out.node_count = out.target.node_count + out.impactor.node_count;
     out.mesh_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -287,11 +331,16 @@ ContactDeck write_contact_deck(const ContactModelRequest& r, const fs::path& fol
     }
     const char* mname[2] = {"MTGT", "MIMP"};
     for (int i = 0; i < 2; ++i) {
-      const DeckMaterial& m = bodies[i]->material;
-      d << "*MATERIAL, NAME=" << mname[i] << "\n*ELASTIC\n"
-        << deck_number(m.youngs_modulus_Pa * kMPa) << ", " << deck_number(m.poisson_ratio) << "\n*DENSITY\n"
-        << deck_number(m.density_kg_m3 * kTonnePerMm3) << "\n*SOLID SECTION, ELSET=" << eset[i] << ", MATERIAL=" << mname[i]
-        << "\n";
+      // The hybrid deck's material writer: elastic, or bilinear elastic-plastic (*PLASTIC).
+      d << calculix::material_cards(mname[i], bodies[i]->material, bodies[i]->yield_strength_Pa, kMPa, kTonnePerMm3)
+        << "*SOLID SECTION, ELSET=" << eset[i] << ", MATERIAL=" << mname[i] << "\n";
+    }
+    // A fixed body: its deep nodes held (the floor block's bottom face).
+    for (int i = 0; i < 2; ++i) {
+      if (fixed[i].empty()) continue;
+      d << "*NSET, NSET=NFIX" << i << "\n";
+      for (int n : fixed[i]) d << base[i] + n + 1 << "\n";
+      d << "*BOUNDARY\nNFIX" << i << ", 1, 3\n";
     }
     // Slave: the impactor's surface; master: the target's (both refined alike).
     d << "*SURFACE INTERACTION, NAME=SI1\n*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR\n"
@@ -301,6 +350,7 @@ ContactDeck write_contact_deck(const ContactModelRequest& r, const fs::path& fol
     d << "*INITIAL CONDITIONS, TYPE=VELOCITY\n";
     for (int i = 0; i < 2; ++i) {
       const ContactBody& b = *bodies[i];
+      if (b.support_depth_m) continue;  // a fixed body starts at rest
       const Eigen::Vector3d c = b.rotation * b.centroid_own_m + b.position_m - r.contact_point_m;
       for (std::size_t n = 0; n < q[i].nodes.size(); ++n) {
         const Eigen::Vector3d v = (b.velocity_m_s + b.angular_velocity_rad_s.cross(q[i].nodes[n] - c)) * kMm;
@@ -312,13 +362,15 @@ ContactDeck write_contact_deck(const ContactModelRequest& r, const fs::path& fol
     // increment back (seen on an eccentric sphere-on-ellipsoid hit: a fixed step diverged there).
     // The floor dt / 20 allows two cutbacks, and keeps the small steps ccx takes when the contact
     // opens ("impact rules") from costing many increments after the separation.
-    d << "*STEP, INC=" << 20 * out.increments + 200 << "\n*DYNAMIC" << solver << "\n"
+    // Plastic bodies: NLGEOM (a dent's strains are not small), as in the hybrid plastic deck.
+    const char* nlgeom = plastic ? ", NLGEOM" : "";
+    d << "*STEP" << nlgeom << ", INC=" << 20 * out.increments + 200 << "\n*DYNAMIC" << solver << "\n"
       << deck_number(out.time_step_s) << ", " << deck_number(out.end_time_s - out.time_step_s) << ", "
       << deck_number(0.05 * out.time_step_s) << ", " << deck_number(out.time_step_s) << "\n"
       << "*CONTACT PRINT, FREQUENCY=1, SLAVE=SIMP, MASTER=STGT\nCF\n"
       << (probe_nodes.empty() ? "" : "*EL FILE, FREQUENCY=1, NSET=NPROBES\nS\n") << "*END STEP\n";
     // One more increment that prints the final state of every node and the energies.
-    d << "*STEP, INC=100\n*DYNAMIC, DIRECT" << solver << "\n" << deck_number(out.time_step_s) << ", "
+    d << "*STEP" << nlgeom << ", INC=100\n*DYNAMIC, DIRECT" << solver << "\n" << deck_number(out.time_step_s) << ", "
       << deck_number(out.time_step_s) << "\n"
       << "*CONTACT PRINT, SLAVE=SIMP, MASTER=STGT\nCF\n*NODE PRINT, NSET=NALL\nU, V\n"
       << "*EL PRINT, ELSET=ETGT, TOTALS=ONLY\nELSE, ELKE\n*EL PRINT, ELSET=EIMP, TOTALS=ONLY\nELSE, ELKE\n*END STEP\n";
@@ -337,6 +389,11 @@ ContactDeck write_contact_deck(const ContactModelRequest& r, const fs::path& fol
                     {"role", names[i]},
                     {"first_node", base[i] + 1},
                     {"node_count", q[i].nodes.size()},
+                    {"contact_node", base[i] + meshes[i]->contact_node + 1},
+                    {"inward_normal", json_vector(inward[i])},
+                    {"fixed", !fixed[i].empty()},
+                    {"fixed_nodes", fixed[i].size()},
+                    {"plastic", meshes[i]->plastic},
                     {"element_count", q[i].elements.size()},
                     {"contact_faces", q[i].contact_faces.size()},
                     {"fe_mass_kg", q[i].mass_kg},
@@ -361,6 +418,7 @@ ContactDeck write_contact_deck(const ContactModelRequest& r, const fs::path& fol
                {"time_step_s", out.time_step_s},
                {"end_time_s", out.end_time_s},
                {"increments", out.increments},
+               {"plastic", plastic},
                {"bodies", bj}};
     json probes = json::array();
     for (const auto& [name, node] : probe_nodes) {
@@ -520,12 +578,24 @@ ContactRunResult run_contact(const fs::path& folder, const json& cj, const Check
     }
     r.contact_duration_s = first >= 0 ? last - first : 0;
   }
+  // The impulse on the impactor (the slave surface), a vector: a fixed body's support takes the
+  // rest of the momentum, so a free body's change is checked against it.
+  Eigen::Vector3d impulse_on_impactor = Eigen::Vector3d::Zero();
+  for (std::size_t i = 1; i < d.time_s.size(); ++i) {
+    if (d.time_s[i] <= d.time_s[i - 1]) continue;
+    impulse_on_impactor += 0.5 * (d.force_N[i] + d.force_N[i - 1]) * (d.time_s[i] - d.time_s[i - 1]);
+  }
+  if (!d.time_s.empty()) impulse_on_impactor += 0.5 * d.force_N.front() * d.time_s.front();
   // Final state of each body.
   Eigen::Vector3d p_before = Eigen::Vector3d::Zero(), p_after = Eigen::Vector3d::Zero();
   Eigen::Vector3d l_before = Eigen::Vector3d::Zero(), l_after = Eigen::Vector3d::Zero();  // about the origin
+  Eigen::Vector3d v_contact_before = Eigen::Vector3d::Zero(), v_contact_after = Eigen::Vector3d::Zero();
+  bool any_fixed = false;
+  double free_momentum_error = 0;
   for (int i = 0; i < 2; ++i) {
     const json& b = cj.at("bodies").at(i);
     const std::size_t first = b.at("first_node"), count = b.at("node_count");
+    const bool fixed = b.value("fixed", false);
     const double mass = b.at("fe_mass_kg");
     const Eigen::Vector3d c0 = vec3(b.at("fe_centroid_m"));
     const Eigen::Matrix3d inertia = mat3(b.at("fe_inertia_kg_m2"));
@@ -533,7 +603,8 @@ ContactRunResult run_contact(const fs::path& folder, const json& cj, const Check
     const json& nodes = b.at("nodes_m");
     const json& wn = b.at("node_mass_kg");
     Eigen::Vector3d P = Eigen::Vector3d::Zero(), first_moment = Eigen::Vector3d::Zero();
-    std::vector<Eigen::Vector3d> x(count), v(count);
+    Eigen::Vector3d U = Eigen::Vector3d::Zero();  // sum w u: the mean displacement's numerator
+    std::vector<Eigen::Vector3d> x0(count), u(count), v(count);
     std::vector<double> w(count);
     for (std::size_t k = 0; k < count; ++k) {
       const int id = static_cast<int>(first + k);
@@ -541,28 +612,53 @@ ContactRunResult run_contact(const fs::path& folder, const json& cj, const Check
       if (iu == d.u_m.end() || iv == d.v_m_s.end()) {
         throw InputError((folder / "impact.dat").string(), "final state", "node " + std::to_string(id) + " missing");
       }
-      x[k] = vec3(nodes.at(k)) + iu->second;
+      x0[k] = vec3(nodes.at(k));
+      u[k] = iu->second;
       v[k] = iv->second;
       w[k] = wn.at(k);
       P += w[k] * v[k];
-      first_moment += w[k] * x[k];
+      U += w[k] * u[k];
+      first_moment += w[k] * (x0[k] + u[k]);
+    }
+    ContactBodyMotion& m = i == 0 ? r.target : r.impactor;
+    m.fixed = fixed;
+    m.kinetic_energy_J = d.elke_J[i];
+    m.strain_energy_J = d.else_J[i];
+    // The contact node's displacement into the body, less the body's rigid displacement there.
+    const std::size_t cn = b.value("contact_node", first) - first;
+    const Eigen::Vector3d inward = b.contains("inward_normal") ? vec3(b.at("inward_normal"))
+                                                               : (i == 0 ? -n : n);
+    if (fixed) {
+      // Infinite mass: no rigid motion; everything left in it is vibration.
+      any_fixed = true;
+      m.vibration_energy_J = m.kinetic_energy_J + m.strain_energy_J;
+      if (cn < count) m.dent_m = u[cn].dot(inward);
+      r.vibration_energy_J += m.vibration_energy_J;
+      r.final_total_energy_J += m.kinetic_energy_J + m.strain_energy_J;
+      continue;
     }
     const Eigen::Vector3d c = first_moment / mass;
     // L about c and the node-weighted inertia J_w: exact omega for a rigid field (contact_model.hpp).
     Eigen::Vector3d L = Eigen::Vector3d::Zero();
-    Eigen::Matrix3d Jw = Eigen::Matrix3d::Zero();
+    Eigen::Matrix3d Jw = Eigen::Matrix3d::Zero(), J0 = Eigen::Matrix3d::Zero();
+    const Eigen::Vector3d T = U / mass;  // the rigid translation
+    Eigen::Vector3d turn = Eigen::Vector3d::Zero();  // sum w y0 x (u - T): the small rigid rotation's moment
     for (std::size_t k = 0; k < count; ++k) {
-      const Eigen::Vector3d y = x[k] - c;
+      const Eigen::Vector3d y = x0[k] + u[k] - c, y0 = x0[k] - c0;
       L += w[k] * y.cross(v[k]);
       Jw += w[k] * (y.squaredNorm() * Eigen::Matrix3d::Identity() - y * y.transpose());
+      J0 += w[k] * (y0.squaredNorm() * Eigen::Matrix3d::Identity() - y0 * y0.transpose());
+      turn += w[k] * y0.cross(u[k] - T);
     }
     const Eigen::Vector3d V = P / mass;
     const Eigen::Vector3d omega = Jw.ldlt().solve(L);
-    ContactBodyMotion& m = i == 0 ? r.target : r.impactor;
+    if (cn < count) {
+      const Eigen::Vector3d theta = J0.ldlt().solve(turn);
+      const Eigen::Vector3d rigid = T + theta.cross(x0[cn] - c0);
+      m.dent_m = (u[cn] - rigid).dot(inward);
+    }
     m.delta_velocity_m_s = V - v0;
     m.delta_angular_velocity_rad_s = omega - w0;
-    m.kinetic_energy_J = d.elke_J[i];
-    m.strain_energy_J = d.else_J[i];
     m.rigid_kinetic_energy_J = 0.5 * mass * V.squaredNorm() + 0.5 * omega.dot(inertia * omega);
     m.vibration_energy_J = m.kinetic_energy_J + m.strain_energy_J - m.rigid_kinetic_energy_J;
     r.initial_kinetic_energy_J += 0.5 * mass * v0.squaredNorm() + 0.5 * w0.dot(inertia * w0);
@@ -572,6 +668,18 @@ ContactRunResult run_contact(const fs::path& folder, const json& cj, const Check
     p_after += P;
     l_before += c0.cross(mass * v0) + inertia * w0;
     l_after += c.cross(P) + L;
+    // Velocity of the body's material point at the contact (the origin), before and after; the
+    // relative one is the impactor's less the target's.
+    const double sign = i == 0 ? -1.0 : 1.0;
+    v_contact_before += sign * (v0 + w0.cross(-c0));
+    v_contact_after += sign * (V + omega.cross(-c));
+    const Eigen::Vector3d expected = (i == 0 ? -1.0 : 1.0) * impulse_on_impactor;
+    free_momentum_error = std::max(free_momentum_error, (P - mass * v0 - expected).norm());
+  }
+  r.residual_indentation_m = r.target.dent_m + r.impactor.dent_m;
+  {
+    const double approach = -v_contact_before.dot(n);
+    r.restitution = approach > 0 ? v_contact_after.dot(n) / approach : 0.0;
   }
   if (const auto it = cj.find("probes"); it != cj.end() && !it->empty()) {
     for (const auto& p : *it) {
@@ -585,7 +693,7 @@ ContactRunResult run_contact(const fs::path& folder, const json& cj, const Check
     r.probe_time_s = read_node_stresses(folder / (std::string(kJobName) + ".frd"), r.probes, end - 0.5 * cj.at("time_step_s").get<double>());
   }
   const double scale = std::max(std::abs(r.impulse_Ns), 1e-300);
-  r.linear_momentum_relative_error = (p_after - p_before).norm() / scale;
+  r.linear_momentum_relative_error = (any_fixed ? free_momentum_error : (p_after - p_before).norm()) / scale;
   // Angular momentum about the contact point, per impulse times the larger body's size.
   double size = 0;
   for (int i = 0; i < 2; ++i) {

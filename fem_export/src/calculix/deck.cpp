@@ -61,6 +61,21 @@ std::string calculix_mesh_inp(const TetMesh& m, const DeckUnits& u) {
   return s.str();
 }
 
+std::string material_cards(const std::string& name, const DeckMaterial& m, double yield_Pa, double per_Pa,
+                           double per_kg_m3) {
+  std::ostringstream s;
+  s << "*MATERIAL, NAME=" << name << "\n*ELASTIC\n" << num(m.youngs_modulus_Pa * per_Pa) << ", " << num(m.poisson_ratio)
+    << "\n";
+  if (m.model == MaterialModel::plastic) {
+    s << "*PLASTIC\n";
+    for (const HardeningRow& h : hardening_table(m, yield_Pa)) {
+      s << num(h.stress_Pa * per_Pa) << ", " << num(h.plastic_strain) << "\n";
+    }
+  }
+  s << "*DENSITY\n" << num(m.density_kg_m3 * per_kg_m3) << "\n";
+  return s.str();
+}
+
 std::string calculix_inp(const DeckRequest& r, const TetMesh& m, const PatchLoad* patch) {
   const DeckOptions& o = r.options;
   const TimeSchedule ts = deck_schedule(r);
@@ -91,15 +106,7 @@ std::string calculix_inp(const DeckRequest& r, const TetMesh& m, const PatchLoad
          "** equivalent plastic strain; linear between them, constant past the last). NLGEOM on every step:\n"
          "** a dent's strains are not small. PEEQ (the .frd's PE) is written with the stresses.\n";
   }
-  s << "*MATERIAL, NAME=BODYMAT\n*ELASTIC\n" << num(r.material.youngs_modulus_Pa * o.units.per_Pa()) << ", "
-    << num(r.material.poisson_ratio) << "\n";
-  if (plastic) {
-    s << "*PLASTIC\n";
-    for (const HardeningRow& h : hardening_table(r.material, r.yield_strength_Pa.value_or(0.0))) {
-      s << num(h.stress_Pa * o.units.per_Pa()) << ", " << num(h.plastic_strain) << "\n";
-    }
-  }
-  s << "*DENSITY\n" << num(r.material.density_kg_m3 * o.units.per_kg_m3()) << "\n";
+  s << material_cards("BODYMAT", r.material, r.yield_strength_Pa.value_or(0.0), o.units.per_Pa(), o.units.per_kg_m3());
   s << "*SOLID SECTION, ELSET=BODY, MATERIAL=BODYMAT\n" << std::setprecision(15);
   if (patch) {
     for (std::size_t k = 0; k < patch->nodes.size(); ++k) {

@@ -50,7 +50,22 @@ struct ContactBody {
   /// Stress probes (own frame; the target's [outputs.fem] probes): embedded nodes PROBE1, ...
   /// whose von Mises history ccx writes (`*EL FILE, NSET=`), as the hybrid deck's.
   std::vector<Eigen::Vector3d> probes_own_m;
+  /// The yield strength of a MaterialModel::plastic material (its *PLASTIC card starts there).
+  double yield_strength_Pa = 0;
+  /// Set: the body is fixed (a floor or a fixed body: infinite mass). Its nodes at least this deep
+  /// under the contact point (along the inward normal) are held by *BOUNDARY, or, when the body is
+  /// shallower than this, those deeper than half its depth. A plane floor is given as a block
+  /// (floor_block) whose bottom face lies exactly at this depth. It starts at rest.
+  std::optional<double> support_depth_m;
 };
+
+/// The block that models a plane floor (or any fixed half-space) under a contact: a square box with
+/// its top face through `contact_point_m` normal to `outward_normal`, half-width and depth
+/// `size_m`, triangulated outward (12 triangles) in the frame of the point. Its bottom face lies at
+/// depth size_m: give the body support_depth_m = kFloorSupportDepthFraction * size_m.
+PartSurface floor_block(const Eigen::Vector3d& contact_point_m, const Eigen::Vector3d& outward_normal, double size_m);
+/// Just under 1, so that the bottom face's nodes (at depth size_m, to rounding) are held.
+inline constexpr double kFloorSupportDepthFraction = 1.0 - 1e-6;
 
 struct ContactModelOptions {
   /// The smaller Hertz contact semi-axis at F_max spans this many elements (h_c = b / this).
@@ -61,6 +76,10 @@ struct ContactModelOptions {
   /// (at least 4 h_c); the rest of the surface never touches.
   double surface_zone_factor = 4.0;
   double penalty_factor = 20;  ///< K = penalty_factor E* / h_c (see above)
+  /// A plane floor becomes a block of half-width and depth this many contact radii (the larger
+  /// semi-axis a; docs/contact-vs-hybrid.md, "A floor": its compliance misses the half-space's
+  /// by about 0.4 a / size of the approach, 1 % at 40).
+  double floor_block_factor = 40;
   /// Largest step: the analytic (elastic) contact duration 2 t_m / this (ccx may cut it back).
   int contact_increments = 40;
   double end_time_factor = 1.3;  ///< simulated time: this times 2 t_m (past the separation)
@@ -78,6 +97,8 @@ struct ContactModelRequest {
   /// The analytic Hertz impact (elastic): contact semi-axes at F_max (a >= b) and t_m.
   double semi_axis_a_m = 0, semi_axis_b_m = 0;
   double compression_time_s = 0;
+  /// The contact duration the time steps are cut from; 0: 2 t_m (elastic). A plastic law's t_c.
+  double contact_duration_s = 0;
   ContactModelOptions options;
   /// Where the request comes from (a scene's impact): its errors name it, then the deck folder.
   /// Empty: the deck folder alone.
@@ -91,6 +112,9 @@ struct ContactBodyMesh {
   Eigen::Vector3d fe_centroid_m = Eigen::Vector3d::Zero();  ///< deck frame
   Eigen::Matrix3d fe_inertia_kg_m2 = Eigen::Matrix3d::Zero();  ///< world axes, about the centroid
   std::size_t first_node = 0;  ///< 0-based: this body's nodes in the deck are [first, first + count)
+  std::size_t contact_node = 0;  ///< 0-based, body-local: the node on the contact point
+  std::size_t fixed_nodes = 0;   ///< nodes held by *BOUNDARY (a fixed body), else 0
+  bool plastic = false;          ///< *PLASTIC material
 };
 
 struct ContactDeck {
@@ -116,6 +140,11 @@ struct ContactBodyMotion {
   double kinetic_energy_J = 0, strain_energy_J = 0;  ///< ccx's ELKE and ELSE totals at the end
   double rigid_kinetic_energy_J = 0;                  ///< 1/2 P^2 / M + 1/2 L . I^-1 L at the end
   double vibration_energy_J = 0;                      ///< kinetic + strain - rigid
+  /// The permanent dent at the end: the contact node's displacement into the body (along its
+  /// inward normal) less the body's rigid displacement there (fitted to all its nodes, weighted by
+  /// their masses; 0 for a fixed body). Elastic ringing left in the body adds to it.
+  double dent_m = 0;
+  bool fixed = false;
 };
 
 struct ContactRunResult {
@@ -128,10 +157,15 @@ struct ContactRunResult {
   ContactBodyMotion target, impactor;
   double initial_kinetic_energy_J = 0;  ///< of the initial (rigid) velocity field, FE masses
   /// |P_after - P_before| / |impulse| over both bodies, and the same for the angular momentum
-  /// about the contact point (the solver's conservation check).
+  /// about the contact point (the solver's conservation check). With a fixed body: the free body's
+  /// momentum change against the contact impulse on it, and its angular momentum about the point.
   double linear_momentum_relative_error = 0, angular_momentum_relative_error = 0;
   double vibration_energy_J = 0;      ///< both bodies
   double final_total_energy_J = 0;    ///< kinetic + strain of both bodies at the end
+  /// Restitution from the bodies' rigid motions: the normal relative velocity of the contact
+  /// points after the contact over the one before, -(v_after . n) / (v_before . n).
+  double restitution = 0;
+  double residual_indentation_m = 0;  ///< both bodies' dent_m summed (the laws' d_p)
   /// The target's probes (PROBE1, ...): von Mises history at the contact force's times and peak;
   /// `point_m` in the deck frame (world, origin at the contact point); `node` the ccx node.
   std::vector<ProbeStress> probes;
