@@ -142,11 +142,15 @@ position = [5000, -3000, 2000]
 material = "steel"
 )", 1.0) + "point = [0, 0, 0]\n";
   const scene::Scene s = scene::parse_scene(text, "floor.toml");
-  const scene::CompareReport r = scene::compare_contact(s, fast(test::fresh_dir("test_compare_out", "floor")));
+  // A block of 12 contact radii (the default 40 measured +0.44 % on F_max, at 29 min under load):
+  // its missing far-field compliance stiffens the contact by O(a/L), within the tolerance.
+  scene::CompareOptions o = fast(test::fresh_dir("test_compare_out", "floor"));
+  o.contact.floor_block_factor = 12;
+  const scene::CompareReport r = scene::compare_contact(s, o);
   ASSERT_EQ(r.verdict, scene::CompareVerdict::agree) << r.explanation;
   EXPECT_FALSE(r.hybrid_deck.has_value());  // the target is the floor: no hybrid deck of it
   EXPECT_EQ(r.fixed_body, "target");
-  EXPECT_NEAR(r.floor_block_size_m, 40 * r.semi_axis_a_m, 1e-12);
+  EXPECT_NEAR(r.floor_block_size_m, 12 * r.semi_axis_a_m, 1e-12);
   // The reduced mass is the ball's: 1/2 m v^2 with m = rho 4/3 pi r^3.
   const double ball_kg = 7850 * 4.0 / 3.0 * M_PI * 1e-6;
   EXPECT_NEAR(r.impact_energy_J / (0.5 * ball_kg * 1.0), 1.0, 1e-3);  // the analytic sphere's mass
