@@ -3,6 +3,7 @@
 // edge_radius sphere or line), and the FEM deck of a sequence's worst impact (fem = "worst") or of
 // each impact (fem = "all") is the single impact's deck, loaded from the bounce as it happened.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -40,8 +41,10 @@ std::string exact(double x) {
 }
 std::string exact(const Vector3d& v) { return "[" + exact(v.x()) + ", " + exact(v.y()) + ", " + exact(v.z()) + "]"; }
 
+// `<tmp>/<name>_<pid>`, removed: ctest runs each test in its own process, in parallel, so the
+// folder names carry the process id.
 fs::path fresh_dir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / name;
+  const fs::path d = fs::temp_directory_path() / (name + "_" + std::to_string(::getpid()));
   fs::remove_all(d);
   return d;
 }
