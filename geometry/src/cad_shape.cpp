@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "cad_plugin.hpp"
+#include "sharp_vertex.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/common/plugin.hpp"
 #include "impactdeck/common/version.hpp"
@@ -388,7 +389,6 @@ std::optional<SharpFeature> CadShape::sharp_feature(const SurfacePoint& at) cons
   const auto near = I.sharp_edges_near(at.point_m, kMaxCornerEdges + 1);
   if (near.empty() || near.size() > kMaxCornerEdges) return std::nullopt;
   const Eigen::Vector3d n = at.normal.norm() > 0.0 ? Eigen::Vector3d(at.normal.normalized()) : Eigen::Vector3d::Zero();
-  const double cos_run = std::cos(kSharpRunDeg * M_PI / 180.0), sin_plane = std::sin(kSharpRunDeg * M_PI / 180.0);
 
   struct Near {
     const CadLoaded::Edge* edge;
@@ -435,33 +435,15 @@ std::optional<SharpFeature> CadShape::sharp_feature(const SurfacePoint& at) cons
   // On an edge away from its ends: that edge.
   for (const auto& x : edges)
     if (x.away.isZero()) return edge_feature(x);
-  // At a vertex: an edge lying in the contact's tangent plane is the contact (two: a face lies
-  // on the other body, a flat contact); one straight edge through it is an edge; else a corner.
-  const Near* in_plane = nullptr;
-  int in_plane_count = 0;
-  if (!n.isZero()) {
-    for (const auto& x : edges) {
-      if (std::abs(x.away.dot(n)) > sin_plane) continue;
-      if (!in_plane || x.away.dot(in_plane->away) > -cos_run) ++in_plane_count;
-      in_plane = &x;
-    }
-  }
-  if (in_plane_count > 1) return std::nullopt;
-  if (in_plane) return edge_feature(*in_plane);
-  if (edges.size() == 1 || (edges.size() == 2 && edges[0].away.dot(edges[1].away) <= -cos_run))
-    return edge_feature(edges[0]);
-  double omega = 2.0 * M_PI;
-  for (const auto& x : edges) {
-    const auto d = I.interior_dihedral_rad(*x.edge, x.point, x.away);
-    if (!d) return std::nullopt;
-    omega += *d - M_PI;
-  }
-  SharpFeature sf;
-  sf.kind = SharpFeature::Kind::corner;
-  sf.point_m = edges[0].point;
-  sf.solid_angle_sr = omega;
-  sf.apex_half_angle_rad = std::acos(std::clamp(1.0 - omega / (2.0 * M_PI), -1.0, 1.0));
-  return sf;
+  // At a vertex: the rule shared with meshes (sharp_vertex.hpp).
+  std::vector<Eigen::Vector3d> away;
+  for (const auto& x : edges) away.push_back(x.away);
+  const detail::SharpVertex sv = detail::classify_sharp_vertex(edges[0].point, away, n, [&](std::size_t i) {
+    return I.interior_dihedral_rad(*edges[i].edge, edges[i].point, edges[i].away);
+  });
+  if (sv.kind == detail::SharpVertex::Kind::edge) return edge_feature(edges[sv.edge]);
+  if (sv.kind == detail::SharpVertex::Kind::corner) return sv.feature;
+  return std::nullopt;
 }
 
 Curvature CadShape::curvature(const SurfacePoint& at) const {

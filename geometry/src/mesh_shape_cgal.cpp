@@ -24,6 +24,7 @@
 #include <CGAL/Simple_cartesian.h>
 
 #include "impactdeck/common/error.hpp"
+#include "sharp_vertex.hpp"
 #include "side_task.hpp"
 
 namespace impactdeck::geometry {
@@ -535,7 +536,7 @@ std::optional<SharpFeature> MeshShape::sharp_feature(const SurfacePoint& at) con
   const Eigen::Vector3d p = ev(hit.first);
   const auto& t = mesh_.triangles[f];
   const double tol = 1e-6 * ix.mean_edge;
-  const double cos_run = std::cos(kSharpRunDeg * M_PI / 180.0), sin_plane = std::sin(kSharpRunDeg * M_PI / 180.0);
+  const double cos_run = std::cos(kSharpRunDeg * M_PI / 180.0);
   const Eigen::Vector3d n = at.normal.norm() > 0.0 ? Eigen::Vector3d(at.normal.normalized()) : Eigen::Vector3d::Zero();
   auto other_end = [&](int e, int v) { return ix.sharp_edges[e].v0 == v ? ix.sharp_edges[e].v1 : ix.sharp_edges[e].v0; };
   auto away = [&](int e, int v) { return Eigen::Vector3d((V[other_end(e, v)] - V[v]).normalized()); };
@@ -577,31 +578,14 @@ std::optional<SharpFeature> MeshShape::sharp_feature(const SurfacePoint& at) con
     const int v = t[k];
     if (!ix.vertex_sharp[v] || (p - V[v]).norm() > tol) continue;
     const int b = ix.sharp_begin[v], c = ix.sharp_begin[v + 1];
-    int in_plane = -1, in_plane_count = 0;
-    if (!n.isZero()) {
-      for (int q = b; q < c; ++q) {
-        if (std::abs(away(ix.sharp_at[q], v).dot(n)) <= sin_plane) {
-          if (in_plane < 0 || away(ix.sharp_at[q], v).dot(away(in_plane, v)) > -cos_run) ++in_plane_count;
-          in_plane = ix.sharp_at[q];
-        }
-      }
-    }
-    if (in_plane_count > 1) return std::nullopt;  // two edges of a face on the other body: a flat contact
-    if (in_plane >= 0) return edge_feature(in_plane);
-    const bool one_edge = c - b == 1 || (c - b == 2 && away(ix.sharp_at[b], v).dot(away(ix.sharp_at[b + 1], v)) <= -cos_run);
-    if (one_edge) return edge_feature(ix.sharp_at[b]);
-    double omega = 2.0 * M_PI;
-    for (int q = b; q < c; ++q) {
-      const auto d = interior_dihedral_rad(mesh_, ix.face_normal, ix.sharp_edges[ix.sharp_at[q]]);
-      if (!d) return std::nullopt;
-      omega += *d - M_PI;
-    }
-    SharpFeature sf;
-    sf.kind = SharpFeature::Kind::corner;
-    sf.point_m = V[v];
-    sf.solid_angle_sr = omega;
-    sf.apex_half_angle_rad = std::acos(std::clamp(1.0 - omega / (2.0 * M_PI), -1.0, 1.0));
-    return sf;
+    std::vector<Eigen::Vector3d> aw;
+    for (int q = b; q < c; ++q) aw.push_back(away(ix.sharp_at[q], v));
+    const detail::SharpVertex sv = detail::classify_sharp_vertex(V[v], aw, n, [&](std::size_t i) {
+      return interior_dihedral_rad(mesh_, ix.face_normal, ix.sharp_edges[ix.sharp_at[b + static_cast<int>(i)]]);
+    });
+    if (sv.kind == detail::SharpVertex::Kind::edge) return edge_feature(ix.sharp_at[b + static_cast<int>(sv.edge)]);
+    if (sv.kind == detail::SharpVertex::Kind::corner) return sv.feature;
+    return std::nullopt;
   }
   // On a sharp edge of the face, away from its ends.
   for (int k = 0; k < 3; ++k) {
