@@ -44,8 +44,8 @@ for run, system, length, stress in (("default", "mm-t-s", "mm", "MPa"), ("SI", "
     statements = {
         "mesh.geo": lambda f: re.search(r"the mesh is saved in %s " % length, text(f)) or sys.exit(f),
         "mesh.msh": msh, "mesh_v22.msh": msh,
-        # Gmsh's input of mesh.geo, in its working unit (docs/fem.md says so for SI decks).
-        "mesh_part.stl": lambda f: text(f).startswith("solid part coordinates in mm (mesh.geo's working unit; the deck's mesh is in %s)\n" % length) or sys.exit(f),
+        # Gmsh's input of mesh.geo, in the deck's length unit like the script.
+        "mesh_part.stl": lambda f: text(f).startswith("solid part coordinates in %s (the deck's length unit)\n" % length) or sys.exit(f),
         "mesh.inp": header, "impact.inp": header, "impact.comm": header,
         "mesh.med": lambda f: (b"impactdeck target body, " + system.encode()) in open(os.path.join(d, f), "rb").read() or sys.exit(f),
         "impact.export": lambda f: True,  # file names and CPUs: no quantity with a unit
@@ -157,6 +157,42 @@ for run, length in (("default", "mm"), ("SI", "m")):
         compare(read(f), "displacement", min(frames, key=lambda x: abs(x - float(time))))
     print("%s: displacements of von_mises_peak.vtu and %d frames equal the .frd's (largest %.4g %s at the peak)"
           % (run, len(pieces), scale, length))
+PY
+
+# The part's STL and mesh.geo are in the deck's length unit: the STL's bounding box is mesh.inp's
+# (the mesh's boundary lies on the part: kOnPart of its size, the remeshed surface's chordal
+# error), and Gmsh meshes the script (a copy, outside the output folder) into a mesh of the same
+# part in that unit, within kGeoTets of mesh.msh's tetrahedron count (Gmsh's tolerances are not all
+# relative: the script in m is not the run's mesh in mm element for element; docs/fem.md).
+/usr/bin/python3 - "$tmp" <<'PY' || { echo "FAILED: the part STL and mesh.geo in the deck's unit"; fails=$((fails+1)); }
+import glob, os, re, shutil, subprocess, sys
+tmp = sys.argv[1]
+kOnPart, kGeoTets = 0.01, 0.10
+def bbox(points):
+    return [min(p[k] for p in points) for k in range(3)], [max(p[k] for p in points) for k in range(3)]
+def msh_tets_and_box(f):
+    text = open(f).read()
+    nodes = text.split("$Nodes\n")[1].split("$EndNodes")[0].split("\n")
+    pts = [[float(v) for v in l.split()[1:4]] for l in nodes[1:] if len(l.split()) == 4]
+    elems = text.split("$Elements\n")[1].split("$EndElements")[0].split("\n")
+    tets = sum(1 for l in elems[1:] if len(l.split()) > 1 and l.split()[1] == "4")
+    return tets, bbox(pts)
+for run in ("default", "SI"):
+    d = glob.glob(os.path.join(tmp, run, "fem_*"))[0]
+    stl = [[float(v) for v in l.split()[1:]] for l in open(os.path.join(d, "mesh_part.stl")) if l.strip().startswith("vertex")]
+    lo, hi = bbox(stl)
+    size = max(b - a for a, b in zip(lo, hi))
+    tets, (mlo, mhi) = msh_tets_and_box(os.path.join(d, "mesh_v22.msh"))
+    assert max(abs(a - b) for a, b in zip(lo + hi, mlo + mhi)) <= kOnPart * size, (run, lo, hi, mlo, mhi)
+    work = os.path.join(tmp, run + "_geo")
+    os.makedirs(work)
+    for f in ("mesh.geo", "mesh_part.stl"): shutil.copy(os.path.join(d, f), work)
+    r = subprocess.run(["gmsh", "-nopopup", "-3", "-format", "msh22", "-o", "geo.msh", "mesh.geo"], cwd=work, capture_output=True, text=True)
+    assert r.returncode == 0, r.stdout[-500:] + r.stderr[-500:]
+    gtets, (glo, ghi) = msh_tets_and_box(os.path.join(work, "geo.msh"))
+    assert abs(gtets - tets) <= kGeoTets * tets, (run, gtets, tets)
+    assert max(abs(a - b) for a, b in zip(glo + ghi, mlo + mhi)) <= kOnPart * size, (run, glo, ghi, mlo, mhi)
+    print("%s: mesh_part.stl spans %.6g (deck unit), mesh.geo meshes %d tets (mesh.msh %d)" % (run, size, gtets, tets))
 PY
 
 # The report's stress picture is drawn in the deck's frame: its axes are the deck's, in its length

@@ -54,8 +54,10 @@ for f in ["impact.inp", "impact.comm"]:
     assert re.search(r"Units: %s, N, s, " % re.escape(u), t), f
 assert ("mesh of the target body (%s)" % u) in open(o + "/fem_hit/mesh.inp").read()
 geo = open(o + "/fem_hit/mesh.geo").read()
+# A mesh part's script is in the deck's length unit, that of the STL it merges (docs/fem.md).
 m = re.search(r"^Mesh.ScalingFactor = ([^;]+);", geo, re.M)
-assert m and abs(float(m.group(1)) - 1e-3 / metres) <= 1e-15 * (1e-3 / metres), geo[:400]
+assert m and float(m.group(1)) == 1.0 and ("this script is in %s;" % u) in geo, geo[:400]
+assert open(o + "/fem_hit/mesh_part.stl").readline() == "solid part coordinates in %s (the deck's length unit)\n" % u
 csv = [l for l in open(o + "/sweep_hit.csv") if not l.startswith("#")]
 assert csv[0].startswith("index,x_%s,y_%s,z_%s," % (su, su, su)), csv[0]
 head = "".join(l for l in open(o + "/sweep_hit.pos") if l.startswith("//"))

@@ -629,8 +629,8 @@ DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
                  {"length_unit", to_string(r.options.units.length)},
                  {"stress_unit", r.options.units.stress_unit()},
                  {"mass_unit", r.options.units.mass_unit()},
-                 // mesh_part.stl is mesh.geo's input: Gmsh's working unit, whatever the deck's.
-                 {"mesh_part_stl_length_unit", "mm"},
+                 // mesh_part.stl, mesh.geo's input, is in the deck's length unit like the .geo.
+                 {"mesh_part_stl_length_unit", to_string(r.options.units.length)},
                  {"frame", "target"},
                  {"impulse_Ns", r.impulse_Ns},
                  {"direction", v3(r.direction)},

@@ -145,10 +145,11 @@ void add_probe_groups(const std::vector<int>& probe_tags) {
 
 // Probe points embedded in volume 1 (numbered from 1000) and their physical groups PROBEk: the
 // same in both .geo routes.
-std::string geo_probe_points(const MeshOptions& o, int first_tag = 1000) {
+// per_m: the script's length unit per metre (mm scripts: kMmPerM).
+std::string geo_probe_points(const MeshOptions& o, int first_tag = 1000, double per_m = kMmPerM) {
   std::ostringstream g;
   for (std::size_t i = 0; i < o.probes_m.size(); ++i) {
-    const Eigen::Vector3d pm = o.probes_m[i] * kMmPerM;
+    const Eigen::Vector3d pm = o.probes_m[i] * per_m;
     g << "Point(" << first_tag + i << ") = {" << fmt(pm.x()) << ", " << fmt(pm.y()) << ", " << fmt(pm.z())
       << "};\nPoint{" << first_tag + i << "} In Volume{1};\n";
   }
@@ -377,11 +378,14 @@ void read_point_mesh(const std::string& bytes, const InputContext& where, MeshRe
 constexpr double kCadMeshDeadlineS = 600;
 
 
-std::string geo_header(const std::string& what, const MeshOptions& o) {
+// The .geo's first lines: what it meshes, the unit its numbers are in (`script`: mm, Gmsh's working
+// unit, for the ellipsoid and CAD routes; the deck's own unit for the part route, whose STL is in
+// it), and Mesh.ScalingFactor so that the mesh is saved in the deck's unit like mesh.msh.
+std::string geo_header(const std::string& what, const MeshOptions& o, LengthUnit script = LengthUnit::mm) {
   std::ostringstream s;
-  s << std::setprecision(17) << msh_scaling_factor(o);
-  return "// impactdeck " + std::string(kVersion) + ": " + what +
-         "\n// Units: this script is in mm; the mesh is saved in " + to_string(o.output_unit) +
+  s << std::setprecision(17) << metres_per(script) / metres_per(o.output_unit);
+  return "// impactdeck " + std::string(kVersion) + ": " + what + "\n// Units: this script is in " + to_string(script) +
+         "; the mesh is saved in " + to_string(o.output_unit) +
          " (Mesh.ScalingFactor), like the deck's mesh.msh.\n// Reproduce the mesh with: gmsh -3 -format msh41 <this file>\n"
          "Mesh.ScalingFactor = " + s.str() + ";\n";
 }
@@ -482,18 +486,17 @@ namespace {
 constexpr int kLoadPointTag = 100000;
 constexpr int kFirstProbeTag = 100001;
 
-// The part surface as ASCII STL in mm with 17 significant digits: Gmsh reads it back exactly. It is
-// the input of mesh.geo, whose working unit is mm; the solid's name line says so and names the
-// unit of the mesh saved (`saved`, the deck's length unit).
-std::string part_stl(const PartSurface& s, LengthUnit saved) {
+// The part surface as ASCII STL in the deck's length unit `unit` with 17 significant digits: Gmsh
+// reads it back exactly. It is the input of mesh.geo, written in the same unit; the solid's name line
+// states the unit.
+std::string part_stl(const PartSurface& s, LengthUnit unit) {
   std::ostringstream o;
   o.precision(17);
-  const std::string name =
-      "part coordinates in mm (mesh.geo's working unit; the deck's mesh is in " + std::string(to_string(saved)) + ")";
+  const double per_m = 1.0 / metres_per(unit);
+  const std::string name = "part coordinates in " + std::string(to_string(unit)) + " (the deck's length unit)";
   o << "solid " << name << "\n";
   for (const auto& t : s.triangles) {
-    const Eigen::Vector3d a = s.vertices_m[t[0]] * kMmPerM, b = s.vertices_m[t[1]] * kMmPerM,
-                          c = s.vertices_m[t[2]] * kMmPerM;
+    const Eigen::Vector3d a = s.vertices_m[t[0]] * per_m, b = s.vertices_m[t[1]] * per_m, c = s.vertices_m[t[2]] * per_m;
     Eigen::Vector3d n = (b - a).cross(c - a);
     if (n.norm() > 0) n.normalize();
     o << "facet normal " << n.x() << " " << n.y() << " " << n.z() << "\n outer loop\n";
@@ -901,18 +904,25 @@ MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& l
   gmsh_step(where, "write", [&] { write_msh(folder, name, o, r); });
 
   const Try& t = tries[kept];
-  const double h = h_first * t.size_factor, h0 = std::min(h0_first, h);
+  // The .geo is in the deck's length unit, that of the STL it merges (Gmsh cannot scale a merged
+  // STL). The run meshed in mm: Gmsh's tolerances are not all relative, so in another unit the
+  // script's mesh may differ from mesh.msh by a few elements (docs/fem.md).
+  const double k = kMmPerM * metres_per(o.output_unit);  // mm per script unit
+  const double h = h_first * t.size_factor / k, h0 = std::min(h0_first, h_first * t.size_factor) / k;
+  const Eigen::Vector3d p = p_mm / k;
+  const std::string unit = to_string(o.output_unit);
   // The kept try's surface, for the .geo to merge (the run itself meshed it from memory).
   write_file_atomically(stl_copy, part_stl(surface_of(t.own_triangles), o.output_unit));
   std::ostringstream g;
-  g << geo_header("mesh part (" + part + ") from memory, written as " + stl_copy.filename().string() +
-                  " (mm)", o);
+  g << geo_header("mesh part (" + part + ") from memory, written as " + stl_copy.filename().string() + " (" + unit +
+                      ")",
+                  o, o.output_unit);
   if (attempts.size() > 1) g << "// Settings of try " << kept + 1 << " (see mesh_attempts in mesh_quality.json).\n";
   g << geo_options(h, t.own_triangles ? 6 : t.algorithm_2d, o.algorithm_3d);
   g << "Merge \"" << stl_copy.filename().string() << "\";\n";
   if (t.own_triangles) {
-    g << "// The part's own triangles are the boundary (no 2D remeshing); LOAD is its vertex at (" << fmt(p_mm.x())
-      << ", " << fmt(p_mm.y()) << ", " << fmt(p_mm.z()) << ") mm\n// (impactdeck writes it into the .msh files).\n"
+    g << "// The part's own triangles are the boundary (no 2D remeshing); LOAD is its vertex at (" << fmt(p.x())
+      << ", " << fmt(p.y()) << ", " << fmt(p.z()) << ") " << unit << "\n// (impactdeck writes it into the .msh files).\n"
       << "Surface Loop(1) = Surface{:};\nVolume(1) = {1};\n";
   } else {
     if (!split_patches) g << "// Every classified face is planar: no split into parametrizable patches.\n";
@@ -920,12 +930,12 @@ MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& l
       << fmt(kPi) << "};\n"
       << "CreateGeometry;\n"
       << "Surface Loop(1) = Surface{:};\nVolume(1) = {1};\n";
-    g << "Point(" << kLoadPointTag << ") = {" << fmt(p_mm.x()) << ", " << fmt(p_mm.y()) << ", " << fmt(p_mm.z())
+    g << "Point(" << kLoadPointTag << ") = {" << fmt(p.x()) << ", " << fmt(p.y()) << ", " << fmt(p.z())
       << "};  // the load point, a node of the surface that holds it\n"
       << "Point{" << kLoadPointTag << "} In Surface{" << load_surface << "};\n";
   }
-  g << geo_probe_points(o, kFirstProbeTag);
-  g << geo_size_field(p_mm, h0, h, o.load_zone_radius_m * kMmPerM);
+  g << geo_probe_points(o, kFirstProbeTag, kMmPerM / k);
+  g << geo_size_field(p, h0, h, o.load_zone_radius_m * kMmPerM / k);
   g << "Physical Volume(\"BODY\") = {1};\n";
   if (!t.own_triangles) g << "Physical Point(\"LOAD\") = {" << kLoadPointTag << "};\n";
   g << geo_probe_groups(o, kFirstProbeTag);
