@@ -65,7 +65,6 @@ struct QuadBody {
 // boundary edges' middle nodes on the exact surface.
 QuadBody quadratic(const TetMesh& lin, const ContactBody& b, const Eigen::Vector3d& origin_m) {
   QuadBody q;
-  const std::size_t nc = lin.nodes_m.size();
   std::vector<Eigen::Vector3d> own = lin.nodes_m;
   std::map<std::pair<int, int>, int> edge_node;
   q.elements.reserve(lin.tets.size());
@@ -108,13 +107,9 @@ QuadBody quadratic(const TetMesh& lin, const ContactBody& b, const Eigen::Vector
   }
   q.nodes.reserve(own.size());
   for (const auto& p : own) q.nodes.push_back(b.rotation * p + b.position_m - origin_m);
-  (void)nc;
-  // Contact faces: boundary faces whose centroid lies near the contact point (deck origin).
+  // Contact face candidates: every boundary face (the deck keeps those near the contact point).
   for (const auto& [k, c] : count) {
-    if (c != 1) continue;
-    const Eigen::Vector3d m = (q.nodes[k[0]] + q.nodes[k[1]] + q.nodes[k[2]]) / 3.0;
-    (void)m;
-    q.contact_faces.push_back(faces.at(k));
+    if (c == 1) q.contact_faces.push_back(faces.at(k));
   }
   // Mass properties by the 4-point rule (exact for straight edges: degree 2 in x).
   const double rho = b.material.density_kg_m3;
@@ -192,8 +187,9 @@ PartSurface floor_block(const Eigen::Vector3d& p, const Eigen::Vector3d& outward
   return s;
 }
 
-ContactDeck write_contact_deck(const ContactModelRequest& r, const fs::path& folder) {
-  const InputContext where = r.context.in_file(folder.string());
+namespace {
+
+void check_request(const ContactModelRequest& r, const InputContext& where) {
   const ContactModelOptions& o = r.options;
   if (!(r.semi_axis_b_m > 0) || !(r.semi_axis_a_m >= r.semi_axis_b_m) || !(r.compression_time_s > 0)) {
     throw where.error("contact model", "needs the Hertz contact semi-axes (a >= b > 0) and t_m > 0");
@@ -212,16 +208,242 @@ ContactDeck write_contact_deck(const ContactModelRequest& r, const fs::path& fol
       throw where.error("body '" + b->name + "'", "a fixed body's support depth must be > 0");
     }
   }
+}
+
+// The element sizes and zones of the model: h_c and where it holds.
+struct Sizing {
+  double hc = 0;            ///< element size at the contact
+  double zone = 0;          ///< radius of the h_c zone
+  double surface_zone = 0;  ///< contact faces lie within it
+};
+
+// One body as the deck needs it: its quadratic mesh in the deck frame, its held nodes, and (the
+// target) its probe nodes.
+struct DeckBodyMesh {
+  const ContactBody* body = nullptr;
+  const char* role = "";             ///< "target" or "impactor"
+  Eigen::Vector3d inward_normal;     ///< deck frame: the target's -n, the impactor's n
+  QuadBody q;
+  std::vector<int> fixed;            ///< body-local nodes held by *BOUNDARY
+  std::vector<std::pair<std::string, int>> probe_nodes;  ///< 0-based, body-local
+  ContactBodyMesh* summary = nullptr;  ///< the ContactDeck's record of it
+};
+
+// Meshes b.body into `stage`, makes it quadratic in the deck frame, picks its held nodes and its
+// contact faces, and fills b.summary.
+void mesh_deck_body(const ContactModelRequest& r, const Sizing& z, const fs::path& stage, const InputContext& where,
+                    DeckBodyMesh& b) {
+  const ContactBody& body = *b.body;
+  MeshOptions mo;
+  mo.mesh_size_m = std::max(body.far_mesh_size_m, z.hc);
+  mo.load_mesh_size_m = z.hc;
+  mo.load_zone_radius_m = z.zone;
+  mo.probes_m = body.probes_own_m;
+  MeshResult m;
+  try {
+    m = mesh_body(body, mo, stage, b.role);
+  } catch (const InputError& e) {
+    // The mesher names its file in the private stage folder: name the deck folder and the body.
+    throw where.error("body '" + body.name + "'", "meshing failed: " + e.reason());
+  }
+  b.q = quadratic(m.mesh, body, r.contact_point_m);
+  b.summary->contact_node = static_cast<std::size_t>(m.mesh.node_of("LOAD"));  // corner nodes come first
+  if (body.support_depth_m) {
+    // The held nodes: at least the support depth under the contact point, or past half the
+    // body's depth when it is shallower (a small fixed body).
+    double deepest = 0;
+    for (const auto& x : b.q.nodes) deepest = std::max(deepest, b.inward_normal.dot(x));
+    const double depth = deepest >= *body.support_depth_m ? *body.support_depth_m : 0.5 * deepest;
+    for (std::size_t n = 0; n < b.q.nodes.size(); ++n)
+      if (b.inward_normal.dot(b.q.nodes[n]) >= depth) b.fixed.push_back(static_cast<int>(n));
+    if (b.fixed.empty()) throw where.error("body '" + body.name + "'", "no node to hold the fixed body by");
+  }
+  // Probe nodes keep their numbers: the corner nodes come first in the quadratic mesh.
+  for (const auto& [group, node] : m.mesh.node_groups)
+    if (group.rfind("PROBE", 0) == 0) b.probe_nodes.emplace_back(group, node);
+  // Keep only the faces near the contact.
+  auto& cf = b.q.contact_faces;
+  cf.erase(std::remove_if(cf.begin(), cf.end(),
+                          [&](const std::pair<int, int>& f) {
+                            const auto& e = b.q.elements[f.first];
+                            Eigen::Vector3d c = Eigen::Vector3d::Zero();
+                            for (int k = 0; k < 3; ++k) c += b.q.nodes[e[kTetFaces[f.second][k]]];
+                            return (c / 3.0).norm() > z.surface_zone;
+                          }),
+           cf.end());
+  if (cf.empty()) throw where.error("body '" + body.name + "'", "no boundary face near the contact point");
+  ContactBodyMesh& bm = *b.summary;
+  bm.node_count = b.q.nodes.size();
+  bm.element_count = b.q.elements.size();
+  bm.contact_faces = cf.size();
+  bm.contact_mesh_size_m = z.hc;
+  bm.far_mesh_size_m = mo.mesh_size_m;
+  bm.fe_mass_kg = b.q.mass_kg;
+  bm.fe_centroid_m = b.q.centroid;
+  bm.fe_inertia_kg_m2 = b.q.inertia;
+  bm.fixed_nodes = b.fixed.size();
+  bm.plastic = body.material.model == MaterialModel::plastic;
+}
+
+// impact.inp: both bodies (C3D10, mm-N-s-tonne), their materials, the held nodes, the penalty
+// contact pair, the initial velocities, the dynamic step and the final printing increment.
+std::string contact_inp(const ContactModelRequest& r, const ContactDeck& out, const std::array<DeckBodyMesh, 2>& b,
+                        bool plastic) {
+  const ContactModelOptions& o = r.options;
+  const double hc = out.contact_mesh_size_m;
+  std::ostringstream d;
+  d << "** impactdeck " << kVersion << ": full-contact model of impact '" << r.impact << "' from " << r.source << "\n"
+    << "** units mm-N-s-tonne; frame: world translated so that the contact point is the origin\n"
+    << "** penalty slope K = " << o.penalty_factor << " E* / h_c, h_c = " << hc * kMm << " mm\n";
+  d << "*NODE, NSET=NALL\n";
+  const std::size_t base[2] = {0, out.target.node_count};
+  const std::size_t ebase[2] = {0, out.target.element_count};
+  for (int i = 0; i < 2; ++i) {
+    for (std::size_t n = 0; n < b[i].q.nodes.size(); ++n) {
+      const Eigen::Vector3d p = b[i].q.nodes[n] * kMm;
+      d << base[i] + n + 1 << ", " << deck_number(p.x()) << ", " << deck_number(p.y()) << ", " << deck_number(p.z()) << "\n";
+    }
+  }
+  const char* eset[2] = {"ETGT", "EIMP"};
+  for (int i = 0; i < 2; ++i) {
+    d << "*ELEMENT, TYPE=C3D10, ELSET=" << eset[i] << "\n";
+    for (std::size_t e = 0; e < b[i].q.elements.size(); ++e) {
+      d << ebase[i] + e + 1;
+      for (int k = 0; k < 10; ++k) d << ", " << base[i] + b[i].q.elements[e][k] + 1;
+      d << "\n";
+    }
+  }
+  if (!b[0].probe_nodes.empty()) {
+    d << "*NSET, NSET=NPROBES\n";
+    for (const auto& pn : b[0].probe_nodes) d << pn.second + 1 << "\n";
+  }
+  const char* sname[2] = {"STGT", "SIMP"};
+  for (int i = 0; i < 2; ++i) {
+    d << "*SURFACE, NAME=" << sname[i] << ", TYPE=ELEMENT\n";
+    for (const auto& [e, f] : b[i].q.contact_faces) d << ebase[i] + e + 1 << ", S" << f + 1 << "\n";
+  }
+  const char* mname[2] = {"MTGT", "MIMP"};
+  for (int i = 0; i < 2; ++i) {
+    // The hybrid deck's material writer: elastic, or bilinear elastic-plastic (*PLASTIC).
+    d << calculix::material_cards(mname[i], b[i].body->material, b[i].body->yield_strength_Pa, kMPa, kTonnePerMm3)
+      << "*SOLID SECTION, ELSET=" << eset[i] << ", MATERIAL=" << mname[i] << "\n";
+  }
+  // A fixed body: its deep nodes held (the floor block's bottom face).
+  for (int i = 0; i < 2; ++i) {
+    if (b[i].fixed.empty()) continue;
+    d << "*NSET, NSET=NFIX" << i << "\n";
+    for (int n : b[i].fixed) d << base[i] + n + 1 << "\n";
+    d << "*BOUNDARY\nNFIX" << i << ", 1, 3\n";
+  }
+  // Slave: the impactor's surface; master: the target's (both refined alike).
+  d << "*SURFACE INTERACTION, NAME=SI1\n*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR\n"
+    << deck_number(out.penalty_N_m3 * kMPa / kMm) << "\n"
+    << "*CONTACT PAIR, INTERACTION=SI1, TYPE=SURFACE TO SURFACE\nSIMP, STGT\n";
+  // Initial velocities: v + omega x (x - c) of each body (mm/s).
+  d << "*INITIAL CONDITIONS, TYPE=VELOCITY\n";
+  for (int i = 0; i < 2; ++i) {
+    const ContactBody& body = *b[i].body;
+    if (body.support_depth_m) continue;  // a fixed body starts at rest
+    const Eigen::Vector3d c = body.rotation * body.centroid_own_m + body.position_m - r.contact_point_m;
+    for (std::size_t n = 0; n < b[i].q.nodes.size(); ++n) {
+      const Eigen::Vector3d v = (body.velocity_m_s + body.angular_velocity_rad_s.cross(b[i].q.nodes[n] - c)) * kMm;
+      for (int k = 0; k < 3; ++k) d << base[i] + n + 1 << ", " << k + 1 << ", " << deck_number(v[k]) << "\n";
+    }
+  }
+  const std::string solver = o.iterative_solver ? ", SOLVER=ITERATIVE SCALING" : "";
+  // Automatic incrementation capped at the nominal step: ccx's contact may cut the first
+  // increment back (seen on an eccentric sphere-on-ellipsoid hit: a fixed step diverged there).
+  // The floor dt / 20 allows two cutbacks, and keeps the small steps ccx takes when the contact
+  // opens ("impact rules") from costing many increments after the separation.
+  // Plastic bodies: NLGEOM (a dent's strains are not small), as in the hybrid plastic deck.
+  const char* nlgeom = plastic ? ", NLGEOM" : "";
+  d << "*STEP" << nlgeom << ", INC=" << 20 * out.increments + 200 << "\n*DYNAMIC" << solver << "\n"
+    << deck_number(out.time_step_s) << ", " << deck_number(out.end_time_s - out.time_step_s) << ", "
+    << deck_number(0.05 * out.time_step_s) << ", " << deck_number(out.time_step_s) << "\n"
+    << "*CONTACT PRINT, FREQUENCY=1, SLAVE=SIMP, MASTER=STGT\nCF\n"
+    << (b[0].probe_nodes.empty() ? "" : "*EL FILE, FREQUENCY=1, NSET=NPROBES\nS\n") << "*END STEP\n";
+  // One more increment that prints the final state of every node and the energies.
+  d << "*STEP" << nlgeom << ", INC=100\n*DYNAMIC, DIRECT" << solver << "\n" << deck_number(out.time_step_s) << ", "
+    << deck_number(out.time_step_s) << "\n"
+    << "*CONTACT PRINT, SLAVE=SIMP, MASTER=STGT\nCF\n*NODE PRINT, NSET=NALL\nU, V\n"
+    << "*EL PRINT, ELSET=ETGT, TOTALS=ONLY\nELSE, ELKE\n*EL PRINT, ELSET=EIMP, TOTALS=ONLY\nELSE, ELKE\n*END STEP\n";
+  return d.str();
+}
+
+// contact.json: what the reader of the run needs (each body's nodes, nodal masses and mass
+// properties, the contact and fixed nodes, the probes).
+json contact_description(const ContactModelRequest& r, const ContactDeck& out, const std::array<DeckBodyMesh, 2>& b,
+                         bool plastic) {
+  const std::size_t base[2] = {0, out.target.node_count};
+  json bj = json::array();
+  for (int i = 0; i < 2; ++i) {
+    const ContactBody& body = *b[i].body;
+    const QuadBody& q = b[i].q;
+    json nodes = json::array(), w = json::array();
+    for (std::size_t n = 0; n < q.nodes.size(); ++n) {
+      nodes.push_back(json_vector(q.nodes[n]));
+      w.push_back(q.node_mass_kg[n]);
+    }
+    bj.push_back({{"name", body.name},
+                  {"role", b[i].role},
+                  {"first_node", base[i] + 1},
+                  {"node_count", q.nodes.size()},
+                  {"contact_node", base[i] + b[i].summary->contact_node + 1},
+                  {"inward_normal", json_vector(b[i].inward_normal)},
+                  {"fixed", !b[i].fixed.empty()},
+                  {"fixed_nodes", b[i].fixed.size()},
+                  {"plastic", b[i].summary->plastic},
+                  {"element_count", q.elements.size()},
+                  {"contact_faces", q.contact_faces.size()},
+                  {"fe_mass_kg", q.mass_kg},
+                  {"fe_centroid_m", json_vector(q.centroid)},
+                  {"fe_inertia_kg_m2", m3(q.inertia)},
+                  {"velocity_m_s", json_vector(body.velocity_m_s)},
+                  {"angular_velocity_rad_s", json_vector(body.angular_velocity_rad_s)},
+                  {"nodes_m", nodes},
+                  {"node_mass_kg", w}});
+  }
+  json cj = {{"impactdeck_version", kVersion},
+             {"source", r.source},
+             {"impact", r.impact},
+             {"job", kJobName},
+             {"deck_units", kDeckUnitsMmTS},
+             {"frame", "world, origin at the contact point"},
+             {"contact_point_m", json_vector(r.contact_point_m)},
+             {"normal", json_vector(r.normal)},
+             {"contact_mesh_size_m", out.contact_mesh_size_m},
+             {"penalty_N_m3", out.penalty_N_m3},
+             {"penalty_factor", r.options.penalty_factor},
+             {"time_step_s", out.time_step_s},
+             {"end_time_s", out.end_time_s},
+             {"increments", out.increments},
+             {"plastic", plastic},
+             {"bodies", bj}};
+  json probes = json::array();
+  for (const auto& [name, node] : b[0].probe_nodes) {
+    probes.push_back({{"name", name}, {"node", node + 1}, {"point_m", json_vector(b[0].q.nodes[node])}});
+  }
+  cj["probes"] = probes;
+  return cj;
+}
+
+}  // namespace
+
+ContactDeck write_contact_deck(const ContactModelRequest& r, const fs::path& folder) {
+  const InputContext where = r.context.in_file(folder.string());
+  check_request(r, where);
+  const ContactModelOptions& o = r.options;
   ContactDeck out;
-  const double hc = r.semi_axis_b_m / o.contact_elements;
-  out.contact_mesh_size_m = hc;
-  const double zone = std::max(o.refined_zone_factor * r.semi_axis_a_m, 2 * hc);
-  const double surface_zone = std::max(o.surface_zone_factor * r.semi_axis_a_m, 4 * hc);
+  Sizing z;
+  z.hc = r.semi_axis_b_m / o.contact_elements;
+  z.zone = std::max(o.refined_zone_factor * r.semi_axis_a_m, 2 * z.hc);
+  z.surface_zone = std::max(o.surface_zone_factor * r.semi_axis_a_m, 4 * z.hc);
+  out.contact_mesh_size_m = z.hc;
   const double duration = r.contact_duration_s > 0 ? r.contact_duration_s : 2.0 * r.compression_time_s;
   out.time_step_s = duration / o.contact_increments;
   out.increments = static_cast<std::size_t>(std::ceil(o.end_time_factor * o.contact_increments - 1e-9));
   out.end_time_s = out.increments * out.time_step_s;
-  out.penalty_N_m3 = o.penalty_factor * r.effective_modulus_Pa / hc;
+  out.penalty_N_m3 = o.penalty_factor * r.effective_modulus_Pa / z.hc;
 
   const fs::path parent = folder.parent_path().empty() ? fs::path(".") : folder.parent_path();
   if (!fs::is_directory(parent)) throw where.error("folder", "its parent folder does not exist");
@@ -231,200 +453,18 @@ ContactDeck write_contact_deck(const ContactModelRequest& r, const fs::path& fol
   fs::create_directories(stage);
   try {
     const auto t0 = std::chrono::steady_clock::now();
-    std::array<QuadBody, 2> q;
-    std::vector<std::pair<std::string, int>> probe_nodes;  // the target's, 0-based
-    std::array<const ContactBody*, 2> bodies = {&r.target, &r.impactor};
-    // Each body's inward normal at the contact (deck frame): the target's is -n, the impactor's n.
-    const std::array<Eigen::Vector3d, 2> inward = {-r.normal.normalized(), r.normal.normalized()};
-    std::array<std::vector<int>, 2> fixed;  // body-local nodes held by *BOUNDARY
-    std::array<ContactBodyMesh*, 2> meshes = {&out.target, &out.impactor};
-    const char* names[2] = {"target", "impactor"};
-    for (int i = 0; i < 2; ++i) {
-      MeshOptions mo;
-      mo.mesh_size_m = std::max(bodies[i]->far_mesh_size_m, hc);
-      mo.load_mesh_size_m = hc;
-      mo.load_zone_radius_m = zone;
-      mo.probes_m = bodies[i]->probes_own_m;
-      MeshResult m;
-      try {
-        m = mesh_body(*bodies[i], mo, stage, names[i]);
-      } catch (const InputError& e) {
-        // The mesher names its file in the private stage folder: name the deck folder and the body.
-        throw where.error("body '" + bodies[i]->name + "'", "meshing failed: " + e.reason());
-      }
-      q[i] = quadratic(m.mesh, *bodies[i], r.contact_point_m);
-      meshes[i]->contact_node = static_cast<std::size_t>(m.mesh.node_of("LOAD"));  // corner nodes come first
-      if (bodies[i]->support_depth_m) {
-        // The held nodes: at least the support depth under the contact point, or past half the
-        // body's depth when it is shallower (a small fixed body).
-        double deepest = 0;
-        for (const auto& x : q[i].nodes) deepest = std::max(deepest, inward[i].dot(x));
-        const double depth = deepest >= *bodies[i]->support_depth_m ? *bodies[i]->support_depth_m : 0.5 * deepest;
-        for (std::size_t n = 0; n < q[i].nodes.size(); ++n)
-          if (inward[i].dot(q[i].nodes[n]) >= depth) fixed[i].push_back(static_cast<int>(n));
-        if (fixed[i].empty()) throw where.error("body '" + bodies[i]->name + "'", "no node to hold the fixed body by");
-      }
-      // Probe nodes keep their numbers: the corner nodes come first in the quadratic mesh.
-      if (i == 0) {
-        for (const auto& [group, node] : m.mesh.node_groups)
-          if (group.rfind("PROBE", 0) == 0) probe_nodes.emplace_back(group, node);
-      }
-      // Keep only the faces near the contact.
-      auto& cf = q[i].contact_faces;
-      cf.erase(std::remove_if(cf.begin(), cf.end(),
-                              [&](const std::pair<int, int>& f) {
-                                const auto& e = q[i].elements[f.first];
-                                Eigen::Vector3d c = Eigen::Vector3d::Zero();
-                                for (int k = 0; k < 3; ++k) c += q[i].nodes[e[kTetFaces[f.second][k]]];
-                                return (c / 3.0).norm() > surface_zone;
-                              }),
-               cf.end());
-      if (cf.empty()) throw where.error("body '" + bodies[i]->name + "'", "no boundary face near the contact point");
-      ContactBodyMesh& bm = *meshes[i];
-      bm.node_count = q[i].nodes.size();
-      bm.element_count = q[i].elements.size();
-      bm.contact_faces = cf.size();
-      bm.contact_mesh_size_m = hc;
-      bm.far_mesh_size_m = mo.mesh_size_m;
-      bm.fe_mass_kg = q[i].mass_kg;
-      bm.fe_centroid_m = q[i].centroid;
-      bm.fe_inertia_kg_m2 = q[i].inertia;
-      bm.fixed_nodes = fixed[i].size();
-      bm.plastic = bodies[i]->material.model == MaterialModel::plastic;
-    }
+    std::array<DeckBodyMesh, 2> b;
+    b[0].body = &r.target, b[0].role = "target", b[0].inward_normal = -r.normal.normalized(), b[0].summary = &out.target;
+    b[1].body = &r.impactor, b[1].role = "impactor", b[1].inward_normal = r.normal.normalized(), b[1].summary = &out.impactor;
+    for (DeckBodyMesh& body : b) mesh_deck_body(r, z, stage, where, body);
+    b[1].probe_nodes.clear();  // probes are the target's
     const bool plastic = out.target.plastic || out.impactor.plastic;
     out.impactor.first_node = out.target.node_count;
     out.node_count = out.target.node_count + out.impactor.node_count;
     out.mesh_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
-    // The deck.
-    std::ostringstream d;
-    d << "** impactdeck " << kVersion << ": full-contact model of impact '" << r.impact << "' from " << r.source << "\n"
-      << "** units mm-N-s-tonne; frame: world translated so that the contact point is the origin\n"
-      << "** penalty slope K = " << o.penalty_factor << " E* / h_c, h_c = " << hc * kMm << " mm\n";
-    d << "*NODE, NSET=NALL\n";
-    std::size_t base[2] = {0, out.target.node_count};
-    std::size_t ebase[2] = {0, out.target.element_count};
-    for (int i = 0; i < 2; ++i) {
-      for (std::size_t n = 0; n < q[i].nodes.size(); ++n) {
-        const Eigen::Vector3d p = q[i].nodes[n] * kMm;
-        d << base[i] + n + 1 << ", " << deck_number(p.x()) << ", " << deck_number(p.y()) << ", " << deck_number(p.z()) << "\n";
-      }
-    }
-    const char* eset[2] = {"ETGT", "EIMP"};
-    for (int i = 0; i < 2; ++i) {
-      d << "*ELEMENT, TYPE=C3D10, ELSET=" << eset[i] << "\n";
-      for (std::size_t e = 0; e < q[i].elements.size(); ++e) {
-        d << ebase[i] + e + 1;
-        for (int k = 0; k < 10; ++k) d << ", " << base[i] + q[i].elements[e][k] + 1;
-        d << "\n";
-      }
-    }
-    if (!probe_nodes.empty()) {
-      d << "*NSET, NSET=NPROBES\n";
-      for (const auto& pn : probe_nodes) d << pn.second + 1 << "\n";
-    }
-    const char* sname[2] = {"STGT", "SIMP"};
-    for (int i = 0; i < 2; ++i) {
-      d << "*SURFACE, NAME=" << sname[i] << ", TYPE=ELEMENT\n";
-      for (const auto& [e, f] : q[i].contact_faces) d << ebase[i] + e + 1 << ", S" << f + 1 << "\n";
-    }
-    const char* mname[2] = {"MTGT", "MIMP"};
-    for (int i = 0; i < 2; ++i) {
-      // The hybrid deck's material writer: elastic, or bilinear elastic-plastic (*PLASTIC).
-      d << calculix::material_cards(mname[i], bodies[i]->material, bodies[i]->yield_strength_Pa, kMPa, kTonnePerMm3)
-        << "*SOLID SECTION, ELSET=" << eset[i] << ", MATERIAL=" << mname[i] << "\n";
-    }
-    // A fixed body: its deep nodes held (the floor block's bottom face).
-    for (int i = 0; i < 2; ++i) {
-      if (fixed[i].empty()) continue;
-      d << "*NSET, NSET=NFIX" << i << "\n";
-      for (int n : fixed[i]) d << base[i] + n + 1 << "\n";
-      d << "*BOUNDARY\nNFIX" << i << ", 1, 3\n";
-    }
-    // Slave: the impactor's surface; master: the target's (both refined alike).
-    d << "*SURFACE INTERACTION, NAME=SI1\n*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR\n"
-      << deck_number(out.penalty_N_m3 * kMPa / kMm) << "\n"
-      << "*CONTACT PAIR, INTERACTION=SI1, TYPE=SURFACE TO SURFACE\nSIMP, STGT\n";
-    // Initial velocities: v + omega x (x - c) of each body (mm/s).
-    d << "*INITIAL CONDITIONS, TYPE=VELOCITY\n";
-    for (int i = 0; i < 2; ++i) {
-      const ContactBody& b = *bodies[i];
-      if (b.support_depth_m) continue;  // a fixed body starts at rest
-      const Eigen::Vector3d c = b.rotation * b.centroid_own_m + b.position_m - r.contact_point_m;
-      for (std::size_t n = 0; n < q[i].nodes.size(); ++n) {
-        const Eigen::Vector3d v = (b.velocity_m_s + b.angular_velocity_rad_s.cross(q[i].nodes[n] - c)) * kMm;
-        for (int k = 0; k < 3; ++k) d << base[i] + n + 1 << ", " << k + 1 << ", " << deck_number(v[k]) << "\n";
-      }
-    }
-    const std::string solver = o.iterative_solver ? ", SOLVER=ITERATIVE SCALING" : "";
-    // Automatic incrementation capped at the nominal step: ccx's contact may cut the first
-    // increment back (seen on an eccentric sphere-on-ellipsoid hit: a fixed step diverged there).
-    // The floor dt / 20 allows two cutbacks, and keeps the small steps ccx takes when the contact
-    // opens ("impact rules") from costing many increments after the separation.
-    // Plastic bodies: NLGEOM (a dent's strains are not small), as in the hybrid plastic deck.
-    const char* nlgeom = plastic ? ", NLGEOM" : "";
-    d << "*STEP" << nlgeom << ", INC=" << 20 * out.increments + 200 << "\n*DYNAMIC" << solver << "\n"
-      << deck_number(out.time_step_s) << ", " << deck_number(out.end_time_s - out.time_step_s) << ", "
-      << deck_number(0.05 * out.time_step_s) << ", " << deck_number(out.time_step_s) << "\n"
-      << "*CONTACT PRINT, FREQUENCY=1, SLAVE=SIMP, MASTER=STGT\nCF\n"
-      << (probe_nodes.empty() ? "" : "*EL FILE, FREQUENCY=1, NSET=NPROBES\nS\n") << "*END STEP\n";
-    // One more increment that prints the final state of every node and the energies.
-    d << "*STEP" << nlgeom << ", INC=100\n*DYNAMIC, DIRECT" << solver << "\n" << deck_number(out.time_step_s) << ", "
-      << deck_number(out.time_step_s) << "\n"
-      << "*CONTACT PRINT, SLAVE=SIMP, MASTER=STGT\nCF\n*NODE PRINT, NSET=NALL\nU, V\n"
-      << "*EL PRINT, ELSET=ETGT, TOTALS=ONLY\nELSE, ELKE\n*EL PRINT, ELSET=EIMP, TOTALS=ONLY\nELSE, ELKE\n*END STEP\n";
-    write_file_atomically(stage / (std::string(kJobName) + ".inp"), d.str());
-
-    // What the reader needs.
-    json bj = json::array();
-    for (int i = 0; i < 2; ++i) {
-      const ContactBody& b = *bodies[i];
-      json nodes = json::array(), w = json::array();
-      for (std::size_t n = 0; n < q[i].nodes.size(); ++n) {
-        nodes.push_back(json_vector(q[i].nodes[n]));
-        w.push_back(q[i].node_mass_kg[n]);
-      }
-      bj.push_back({{"name", b.name},
-                    {"role", names[i]},
-                    {"first_node", base[i] + 1},
-                    {"node_count", q[i].nodes.size()},
-                    {"contact_node", base[i] + meshes[i]->contact_node + 1},
-                    {"inward_normal", json_vector(inward[i])},
-                    {"fixed", !fixed[i].empty()},
-                    {"fixed_nodes", fixed[i].size()},
-                    {"plastic", meshes[i]->plastic},
-                    {"element_count", q[i].elements.size()},
-                    {"contact_faces", q[i].contact_faces.size()},
-                    {"fe_mass_kg", q[i].mass_kg},
-                    {"fe_centroid_m", json_vector(q[i].centroid)},
-                    {"fe_inertia_kg_m2", m3(q[i].inertia)},
-                    {"velocity_m_s", json_vector(b.velocity_m_s)},
-                    {"angular_velocity_rad_s", json_vector(b.angular_velocity_rad_s)},
-                    {"nodes_m", nodes},
-                    {"node_mass_kg", w}});
-    }
-    json cj = {{"impactdeck_version", kVersion},
-               {"source", r.source},
-               {"impact", r.impact},
-               {"job", kJobName},
-               {"deck_units", kDeckUnitsMmTS},
-               {"frame", "world, origin at the contact point"},
-               {"contact_point_m", json_vector(r.contact_point_m)},
-               {"normal", json_vector(r.normal)},
-               {"contact_mesh_size_m", hc},
-               {"penalty_N_m3", out.penalty_N_m3},
-               {"penalty_factor", o.penalty_factor},
-               {"time_step_s", out.time_step_s},
-               {"end_time_s", out.end_time_s},
-               {"increments", out.increments},
-               {"plastic", plastic},
-               {"bodies", bj}};
-    json probes = json::array();
-    for (const auto& [name, node] : probe_nodes) {
-      probes.push_back({{"name", name}, {"node", node + 1}, {"point_m", json_vector(q[0].nodes[node])}});
-    }
-    cj["probes"] = probes;
+    write_file_atomically(stage / (std::string(kJobName) + ".inp"), contact_inp(r, out, b, plastic));
+    json cj = contact_description(r, out, b, plastic);
     write_file_atomically(stage / "contact.json", cj.dump() + "\n");
     out.description = std::move(cj);
 
