@@ -169,203 +169,182 @@ std::string toml_vec_text(const Eigen::Vector3d& v) {
 }
 }  // namespace detail
 
-Campaign read_campaign(const fs::path& file, std::size_t max_cases) {
-  FileReader fr(file);
-  std::error_code ec;
-  const std::string text = read_input_file(file, "campaign file", kMaxSceneBytes);  // regular files only
-  toml::table root;
-  try {
-    root = toml::parse(scene::toml_ascii(text, fr.name()), fr.name());
-  } catch (const toml::parse_error& e) {
-    std::ostringstream p;
-    p << "line " << e.source().begin.line << ", column " << e.source().begin.column;
-    throw InputError(fr.name(), p.str(), "TOML syntax error: " + std::string(e.description()));
-  }
-  fr.only(root, "", {"scene", "impact", "cases", "product", "points", "orientations", "drop_test", "slurm"});
+namespace {
 
-  Campaign c;
-  c.file = file;
-  const toml::node* sn = root.get("scene");
-  if (!sn) throw InputError(fr.name(), "", "missing required key 'scene' (the base scene file)");
-  if (!sn->is_string() || sn->as_string()->get().empty()) fr.fail(sn, "scene", "must be a file name (string)");
-  const fs::path base_dir = fs::absolute(file).parent_path();
-  c.scene = (base_dir / sn->as_string()->get()).lexically_normal();
-  if (!fs::is_regular_file(c.scene, ec)) fr.fail(sn, "scene", "no scene file " + c.scene.string());
-  const scene::Scene base = scene::load_scene(c.scene);  // its own errors name the scene file
-
+// What the case generators share while a campaign file is read: the base scene, the collected
+// impact, and the axes of cases each generator adds (with the place each comes from).
+struct CampaignReading {
+  const FileReader& fr;
+  const scene::Scene& base;
   std::optional<std::size_t> impact;  // none: a scene of sequences only
-  if (const toml::node* n = root.get("impact")) {
-    if (!n->is_string()) fr.fail(n, "impact", "must be an impact name (string)");
-    impact = impact_index(base, n->as_string()->get());
-    if (*impact == base.impacts.size()) fr.fail(n, "impact", "the scene has no impact named '" + n->as_string()->get() + "'");
-  } else if (!base.impacts.empty()) {
-    impact = 0;
-  }
-  if (impact) c.impact = base.impacts[*impact].name;
-  // The collected impact, for the generators that need one.
-  auto impact_spec = [&](const toml::node* n, const char* generator) -> const scene::ImpactSpec& {
-    if (!impact) fr.fail(n, generator, "the scene has no [[impacts]] entry: [" + std::string(generator) + "] varies an impact");
-    return base.impacts[*impact];
-  };
-
+  fs::path base_dir;
+  std::size_t max_cases = 0;
+  Campaign& c;
   std::vector<Axis> axes;
   std::vector<std::string> axis_places;  // where each axis comes from: its line and key
-  if (const toml::node* n = root.get("cases")) {
-    const toml::array* a = n->as_array();
-    if (!a || !a->is_array_of_tables() || a->empty()) fr.fail(n, "cases", "must be a list of tables ([[cases]])");
-    Axis axis;
-    for (std::size_t i = 0; i < a->size(); ++i) {
-      Option o;
-      const std::string table = "cases[" + std::to_string(i) + "]";
-      for (const auto& [key, v] : in_file_order(*a->get(i)->as_table())) {
-        fr.check_key(v, table, key);
-        o.overrides.push_back({key, value_text(*v)});
-      }
-      axis.push_back(std::move(o));
-    }
-    axes.push_back(std::move(axis));
-    axis_places.push_back(place(n, "cases"));
-    c.generators.push_back("cases");
-  }
-  if (const toml::node* n = root.get("product")) {
-    const toml::table* t = n->as_table();
-    if (!t || t->empty()) fr.fail(n, "product", "must be a table of \"KEY\" = [values]");
-    for (const auto& [key, v] : in_file_order(*t)) {
-      fr.check_key(v, "product", key);
-      const toml::array* a = v->as_array();
-      if (!a || a->empty()) fr.fail(v, "product.\"" + key + "\"", "must be a non-empty list of values");
-      Axis axis;
-      for (const toml::node& e : *a) axis.push_back(Option{{{key, value_text(e)}}, {}, {}, {}});
-      axes.push_back(std::move(axis));
-      axis_places.push_back(place(v, "product.\"" + key + "\""));
-    }
-    c.generators.push_back("product");
-  }
-  if (const toml::node* n = root.get("points")) {
-    const toml::table* t = n->as_table();
-    if (!t) fr.fail(n, "points", "must be a table");
-    fr.only(*t, "points", {"count", "seed", "csv"});
-    const scene::ImpactSpec& spec = impact_spec(n, "points");
-    if (spec.first_contact) {
-      fr.fail(n, "points", "impact '" + spec.name + "' uses point = \"first-contact\": [points] sets the impact point");
-    }
-    const scene::BodySpec& target = base.body(spec.target);
-    const auto shape = scene::make_shape(target, base);
-    const double unit = metres_per(base.length_unit);
-    std::vector<geometry::SurfacePoint> cloud;
-    if (const toml::node* csv = t->get("csv")) {
-      if (t->contains("count")) fr.fail(csv, "points.csv", "give either count or csv, not both");
-      if (!csv->is_string()) fr.fail(csv, "points.csv", "must be a file name (string)");
-      // The same projection limit as `run` (1 % of the target's size).
-      // A regular file of bounded size (a FIFO would block, a device never end): checked first.
-      const fs::path csv_file = base_dir / csv->as_string()->get();
-      check_input_file(csv_file, "points file", kMaxPointsCsvBytes);
-      cloud = study::csv_point_cloud(*shape, csv_file, unit, 0.01 * shape->size_m(), max_cases);
-    } else {
-      const std::size_t count = fr.count(*t, "points", "count", max_cases);
-      std::uint64_t seed = 1;
-      if (const toml::node* s = t->get("seed")) {
-        if (!s->is_integer() || s->as_integer()->get() < 0) fr.fail(s, "points.seed", "must be a whole number >= 0");
-        seed = static_cast<std::uint64_t>(s->as_integer()->get());
-      }
-      cloud = study::area_uniform_cloud(*shape, count, seed);
-    }
-    Axis axis;
-    const std::string key = "impacts[" + std::to_string(*impact) + "].point";
-    for (const auto& p : cloud) axis.push_back(Option{{{key, vec_text(p.point_m / unit)}}, p.point_m, {}, {}});
-    axes.push_back(std::move(axis));
-    axis_places.push_back(place(n, "points"));
-    c.generators.push_back("points");
-  }
-  if (const toml::node* n = root.get("orientations")) {
-    const toml::table* t = n->as_table();
-    if (!t) fr.fail(n, "orientations", "must be a table");
-    fr.only(*t, "orientations", {"count", "body"});
-    const scene::ImpactSpec& spec = impact_spec(n, "orientations");
-    if (!spec.first_contact) {
-      fr.fail(n, "orientations", "impact '" + spec.name + "' has a fixed point: orientations need point = \"first-contact\"");
-    }
-    std::string body = spec.target;
-    if (const toml::node* b = t->get("body")) {
-      if (!b->is_string()) fr.fail(b, "orientations.body", "must be a body name (string)");
-      body = b->as_string()->get();
-    }
-    const std::size_t bi = body_index(base, body);
-    if (bi == base.bodies.size()) fr.fail(t->get("body"), "orientations.body", "the scene has no body named '" + body + "'");
-    const std::size_t count = fr.count(*t, "orientations", "count", 100000);
-    const std::string prefix = "bodies[" + std::to_string(bi) + "].";
-    Axis axis;
-    for (const Eigen::Quaterniond& q : super_fibonacci_orientations(count))
-      axis.push_back(Option{orientation_overrides(prefix, q), {}, q, {}});
-    axes.push_back(std::move(axis));
-    axis_places.push_back(place(n, "orientations"));
-    c.generators.push_back("orientations");
-  }
-  if (const toml::node* n = root.get("drop_test")) {
-    const toml::table* t = n->as_table();
-    if (!t) fr.fail(n, "drop_test", "must be a table");
-    fr.only(*t, "drop_test", {"standard", "body", "height_m"});
-    if (root.contains("points") || root.contains("orientations")) {
-      fr.fail(n, "drop_test", "sets the body's orientation and placement: it does not combine with [points] or [orientations]");
-    }
-    DropTestSpec d;
-    d.table_place = place(n, "drop_test");
-    auto text = [&](const char* key, std::string& out, std::string& where) {
-      const toml::node* v = t->get(key);
-      if (!v) throw InputError(fr.name(), d.table_place, std::string("missing required key 'drop_test.") + key + "'");
-      where = place(v, std::string("drop_test.") + key);
-      if (!v->is_string() || v->as_string()->get().empty()) fr.fail(v, std::string("drop_test.") + key, "must be a name (string)");
-      out = v->as_string()->get();
-    };
-    text("standard", d.standard, d.standard_place);
-    text("body", d.body, d.body_place);
-    if (const toml::node* h = t->get("height_m")) {
-      d.height_place = place(h, "drop_test.height_m");
-      const auto v = h->value<double>();
-      if (!v || !(*v > 0) || !std::isfinite(*v)) fr.fail(h, "drop_test.height_m", "must be a number > 0 (m)");
-      d.height_m = *v;
-    }
-    const DropProgramme prog = plan_drops(base, d, impact, InputContext{fr.name(), ""});
-    c.sequence = prog.sequence;
-    if (!prog.sequence.empty()) c.impact.clear();  // the sequence's worst impact is collected
-    c.drop_test = DropTestInfo{d.standard, d.body, prog.sequence, prog.mass_kg, prog.gravity_m_s2, prog.height_m,
-                               prog.box.axes, prog.box.lengths_m()};
-    Axis axis;
-    for (const Drop& drop : prog.drops)
-      axis.push_back(Option{drop_overrides(base, prog.body_index, drop), {}, drop.orientation, drop.point.name});
-    axes.push_back(std::move(axis));
-    axis_places.push_back(d.table_place);
-    c.generators.push_back("drop_test");
-  }
-  if (!impact && c.sequence.empty()) {
-    throw InputError(fr.name(), "", "the scene has no [[impacts]] entry to collect (a scene of sequences only is "
-                                    "collected by a [drop_test] of its body)");
-  }
-  if (const toml::node* n = root.get("slurm")) {
-    const toml::table* t = n->as_table();
-    if (!t) fr.fail(n, "slurm", "must be a table");
-    c.slurm = read_slurm(*t, fr);
-  }
-  if (axes.empty()) {
-    throw InputError(fr.name(), "", "no case generator: give [product], [[cases]], [points], [orientations] or [drop_test]");
-  }
 
+  void add(Axis axis, std::string where) {
+    axes.push_back(std::move(axis));
+    axis_places.push_back(std::move(where));
+  }
+  // The collected impact, for the generators that need one.
+  const scene::ImpactSpec& impact_spec(const toml::node* n, const char* generator) const {
+    if (!impact) fr.fail(n, generator, "the scene has no [[impacts]] entry: [" + std::string(generator) + "] varies an impact");
+    return base.impacts[*impact];
+  }
+};
+
+void read_cases(const toml::node* n, CampaignReading& r) {
+  const toml::array* a = n->as_array();
+  if (!a || !a->is_array_of_tables() || a->empty()) r.fr.fail(n, "cases", "must be a list of tables ([[cases]])");
+  Axis axis;
+  for (std::size_t i = 0; i < a->size(); ++i) {
+    Option o;
+    const std::string table = "cases[" + std::to_string(i) + "]";
+    for (const auto& [key, v] : in_file_order(*a->get(i)->as_table())) {
+      r.fr.check_key(v, table, key);
+      o.overrides.push_back({key, value_text(*v)});
+    }
+    axis.push_back(std::move(o));
+  }
+  r.add(std::move(axis), place(n, "cases"));
+  r.c.generators.push_back("cases");
+}
+
+void read_product(const toml::node* n, CampaignReading& r) {
+  const toml::table* t = n->as_table();
+  if (!t || t->empty()) r.fr.fail(n, "product", "must be a table of \"KEY\" = [values]");
+  for (const auto& [key, v] : in_file_order(*t)) {
+    r.fr.check_key(v, "product", key);
+    const toml::array* a = v->as_array();
+    if (!a || a->empty()) r.fr.fail(v, "product.\"" + key + "\"", "must be a non-empty list of values");
+    Axis axis;
+    for (const toml::node& e : *a) axis.push_back(Option{{{key, value_text(e)}}, {}, {}, {}});
+    r.add(std::move(axis), place(v, "product.\"" + key + "\""));
+  }
+  r.c.generators.push_back("product");
+}
+
+void read_points(const toml::node* n, CampaignReading& r) {
+  const FileReader& fr = r.fr;
+  const toml::table* t = n->as_table();
+  if (!t) fr.fail(n, "points", "must be a table");
+  fr.only(*t, "points", {"count", "seed", "csv"});
+  const scene::ImpactSpec& spec = r.impact_spec(n, "points");
+  if (spec.first_contact) {
+    fr.fail(n, "points", "impact '" + spec.name + "' uses point = \"first-contact\": [points] sets the impact point");
+  }
+  const scene::BodySpec& target = r.base.body(spec.target);
+  const auto shape = scene::make_shape(target, r.base);
+  const double unit = metres_per(r.base.length_unit);
+  std::vector<geometry::SurfacePoint> cloud;
+  if (const toml::node* csv = t->get("csv")) {
+    if (t->contains("count")) fr.fail(csv, "points.csv", "give either count or csv, not both");
+    if (!csv->is_string()) fr.fail(csv, "points.csv", "must be a file name (string)");
+    // The same projection limit as `run` (1 % of the target's size).
+    // A regular file of bounded size (a FIFO would block, a device never end): checked first.
+    const fs::path csv_file = r.base_dir / csv->as_string()->get();
+    check_input_file(csv_file, "points file", kMaxPointsCsvBytes);
+    cloud = study::csv_point_cloud(*shape, csv_file, unit, 0.01 * shape->size_m(), r.max_cases);
+  } else {
+    const std::size_t count = fr.count(*t, "points", "count", r.max_cases);
+    std::uint64_t seed = 1;
+    if (const toml::node* s = t->get("seed")) {
+      if (!s->is_integer() || s->as_integer()->get() < 0) fr.fail(s, "points.seed", "must be a whole number >= 0");
+      seed = static_cast<std::uint64_t>(s->as_integer()->get());
+    }
+    cloud = study::area_uniform_cloud(*shape, count, seed);
+  }
+  Axis axis;
+  const std::string key = "impacts[" + std::to_string(*r.impact) + "].point";
+  for (const auto& p : cloud) axis.push_back(Option{{{key, vec_text(p.point_m / unit)}}, p.point_m, {}, {}});
+  r.add(std::move(axis), place(n, "points"));
+  r.c.generators.push_back("points");
+}
+
+void read_orientations(const toml::node* n, CampaignReading& r) {
+  const FileReader& fr = r.fr;
+  const toml::table* t = n->as_table();
+  if (!t) fr.fail(n, "orientations", "must be a table");
+  fr.only(*t, "orientations", {"count", "body"});
+  const scene::ImpactSpec& spec = r.impact_spec(n, "orientations");
+  if (!spec.first_contact) {
+    fr.fail(n, "orientations", "impact '" + spec.name + "' has a fixed point: orientations need point = \"first-contact\"");
+  }
+  std::string body = spec.target;
+  if (const toml::node* b = t->get("body")) {
+    if (!b->is_string()) fr.fail(b, "orientations.body", "must be a body name (string)");
+    body = b->as_string()->get();
+  }
+  const std::size_t bi = body_index(r.base, body);
+  if (bi == r.base.bodies.size()) fr.fail(t->get("body"), "orientations.body", "the scene has no body named '" + body + "'");
+  const std::size_t count = fr.count(*t, "orientations", "count", 100000);
+  const std::string prefix = "bodies[" + std::to_string(bi) + "].";
+  Axis axis;
+  for (const Eigen::Quaterniond& q : super_fibonacci_orientations(count))
+    axis.push_back(Option{orientation_overrides(prefix, q), {}, q, {}});
+  r.add(std::move(axis), place(n, "orientations"));
+  r.c.generators.push_back("orientations");
+}
+
+void read_drop_test(const toml::node* n, const toml::table& root, CampaignReading& r) {
+  const FileReader& fr = r.fr;
+  const toml::table* t = n->as_table();
+  if (!t) fr.fail(n, "drop_test", "must be a table");
+  fr.only(*t, "drop_test", {"standard", "body", "height_m"});
+  if (root.contains("points") || root.contains("orientations")) {
+    fr.fail(n, "drop_test", "sets the body's orientation and placement: it does not combine with [points] or [orientations]");
+  }
+  DropTestSpec d;
+  d.table_place = place(n, "drop_test");
+  auto text = [&](const char* key, std::string& out, std::string& where) {
+    const toml::node* v = t->get(key);
+    if (!v) throw InputError(fr.name(), d.table_place, std::string("missing required key 'drop_test.") + key + "'");
+    where = place(v, std::string("drop_test.") + key);
+    if (!v->is_string() || v->as_string()->get().empty()) fr.fail(v, std::string("drop_test.") + key, "must be a name (string)");
+    out = v->as_string()->get();
+  };
+  text("standard", d.standard, d.standard_place);
+  text("body", d.body, d.body_place);
+  if (const toml::node* h = t->get("height_m")) {
+    d.height_place = place(h, "drop_test.height_m");
+    const auto v = h->value<double>();
+    if (!v || !(*v > 0) || !std::isfinite(*v)) fr.fail(h, "drop_test.height_m", "must be a number > 0 (m)");
+    d.height_m = *v;
+  }
+  const DropProgramme prog = plan_drops(r.base, d, r.impact, InputContext{fr.name(), ""});
+  Campaign& c = r.c;
+  c.sequence = prog.sequence;
+  if (!prog.sequence.empty()) c.impact.clear();  // the sequence's worst impact is collected
+  c.drop_test = DropTestInfo{d.standard, d.body, prog.sequence, prog.mass_kg, prog.gravity_m_s2, prog.height_m,
+                             prog.box.axes, prog.box.lengths_m()};
+  Axis axis;
+  for (const Drop& drop : prog.drops)
+    axis.push_back(Option{drop_overrides(r.base, prog.body_index, drop), {}, drop.orientation, drop.point.name});
+  r.add(std::move(axis), d.table_place);
+  c.generators.push_back("drop_test");
+}
+
+// The cases: the product of the axes (the last varies fastest), at most max_cases, each validated
+// exactly like `run --set` and checked to keep the collected impact or sequence.
+void expand_cases(CampaignReading& r) {
+  const FileReader& fr = r.fr;
+  Campaign& c = r.c;
   std::size_t total = 1;
-  for (std::size_t i = 0; i < axes.size(); ++i) {
-    const std::size_t n = axes[i].size();
-    if (total > max_cases / n) {
-      throw InputError(fr.name(), axis_places[i],
+  for (std::size_t i = 0; i < r.axes.size(); ++i) {
+    const std::size_t n = r.axes[i].size();
+    if (total > r.max_cases / n) {
+      throw InputError(fr.name(), r.axis_places[i],
                        "its " + std::to_string(n) + " choices times the " + std::to_string(total) +
-                           " cases before it make more than " + std::to_string(max_cases) + " cases (the limit)");
+                           " cases before it make more than " + std::to_string(r.max_cases) + " cases (the limit)");
     }
     total *= n;
   }
-  // Row-major: the last axis varies fastest.
   for (std::size_t id = 0; id < total; ++id) {
     Case k;
     k.id = id;
     std::size_t rest = id, stride = total;
-    for (const Axis& a : axes) {
+    for (const Axis& a : r.axes) {
       stride /= a.size();
       const Option& o = a[rest / stride];
       rest %= stride;
@@ -400,6 +379,62 @@ Campaign read_campaign(const fs::path& file, std::size_t max_cases) {
     if (sc.outputs.fem && sc.outputs.fem->run == scene::FemOutputs::Run::calculix) c.runs_ccx = true;
     c.cases.push_back(std::move(k));
   }
+}
+
+}  // namespace
+
+Campaign read_campaign(const fs::path& file, std::size_t max_cases) {
+  FileReader fr(file);
+  std::error_code ec;
+  const std::string text = read_input_file(file, "campaign file", kMaxSceneBytes);  // regular files only
+  toml::table root;
+  try {
+    root = toml::parse(scene::toml_ascii(text, fr.name()), fr.name());
+  } catch (const toml::parse_error& e) {
+    std::ostringstream p;
+    p << "line " << e.source().begin.line << ", column " << e.source().begin.column;
+    throw InputError(fr.name(), p.str(), "TOML syntax error: " + std::string(e.description()));
+  }
+  fr.only(root, "", {"scene", "impact", "cases", "product", "points", "orientations", "drop_test", "slurm"});
+
+  Campaign c;
+  c.file = file;
+  const toml::node* sn = root.get("scene");
+  if (!sn) throw InputError(fr.name(), "", "missing required key 'scene' (the base scene file)");
+  if (!sn->is_string() || sn->as_string()->get().empty()) fr.fail(sn, "scene", "must be a file name (string)");
+  const fs::path base_dir = fs::absolute(file).parent_path();
+  c.scene = (base_dir / sn->as_string()->get()).lexically_normal();
+  if (!fs::is_regular_file(c.scene, ec)) fr.fail(sn, "scene", "no scene file " + c.scene.string());
+  const scene::Scene base = scene::load_scene(c.scene);  // its own errors name the scene file
+
+  CampaignReading r{fr, base, std::nullopt, base_dir, max_cases, c, {}, {}};
+  if (const toml::node* n = root.get("impact")) {
+    if (!n->is_string()) fr.fail(n, "impact", "must be an impact name (string)");
+    r.impact = impact_index(base, n->as_string()->get());
+    if (*r.impact == base.impacts.size()) fr.fail(n, "impact", "the scene has no impact named '" + n->as_string()->get() + "'");
+  } else if (!base.impacts.empty()) {
+    r.impact = 0;
+  }
+  if (r.impact) c.impact = base.impacts[*r.impact].name;
+
+  if (const toml::node* n = root.get("cases")) read_cases(n, r);
+  if (const toml::node* n = root.get("product")) read_product(n, r);
+  if (const toml::node* n = root.get("points")) read_points(n, r);
+  if (const toml::node* n = root.get("orientations")) read_orientations(n, r);
+  if (const toml::node* n = root.get("drop_test")) read_drop_test(n, root, r);
+  if (!r.impact && c.sequence.empty()) {
+    throw InputError(fr.name(), "", "the scene has no [[impacts]] entry to collect (a scene of sequences only is "
+                                    "collected by a [drop_test] of its body)");
+  }
+  if (const toml::node* n = root.get("slurm")) {
+    const toml::table* t = n->as_table();
+    if (!t) fr.fail(n, "slurm", "must be a table");
+    c.slurm = read_slurm(*t, fr);
+  }
+  if (r.axes.empty()) {
+    throw InputError(fr.name(), "", "no case generator: give [product], [[cases]], [points], [orientations] or [drop_test]");
+  }
+  expand_cases(r);
   if (!c.slurm.time_given) c.slurm.time = slurm_time_text(default_task_minutes(c.runs_ccx, c.slurm.cases_per_task));
   return c;
 }
