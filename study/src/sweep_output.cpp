@@ -494,30 +494,31 @@ std::string coords(const Eigen::Vector3d& p) {
 
 }  // namespace
 
-plot::Drawing force_map_drawing(const geometry::Shape& target, const Eigen::Vector3d& c,
-                                const SweepResult& r, const ForceMapOptions& o) {
-  if (r.points.empty()) throw InputError("", "force map", "no points to draw");
-  const double az = o.azimuth_deg * M_PI / 180.0, el = o.elevation_deg * M_PI / 180.0;
-  // d: unit vector from the body towards the viewer; u: screen right; w: screen up.
-  const Eigen::Vector3d d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
-  Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
-  if (std::abs(d.dot(up)) > 0.99) up = Eigen::Vector3d::UnitY();
-  const Eigen::Vector3d u = up.cross(d).normalized();
-  const Eigen::Vector3d w = d.cross(u);
+namespace {
 
-  // Half-extents of the cloud about the centroid: directions for the wireframe.
-  Eigen::Vector3d ext = Eigen::Vector3d::Zero();
-  for (const auto& p : r.points) ext = ext.cwiseMax((p.point_m - c).cwiseAbs());
-  const double big = std::max(ext.maxCoeff(), 1e-300);
-  ext = ext.cwiseMax(Eigen::Vector3d::Constant(1e-9 * big));
+// The view: d from the body towards the viewer, u screen right, w screen up; a point's screen
+// position once fitted into the plot area.
+struct MapView {
+  Eigen::Vector3d c, d, u, w;
+  double scale = 1, cx = 0, cy = 0;
+  plot::Point2 screen(const Eigen::Vector3d& p) const {
+    return plot::Point2{cx + scale * (p - c).dot(u), cy - scale * (p - c).dot(w)};
+  }
+};
 
-  struct WirePoint {
-    Eigen::Vector3d p;
-    bool front;
-  };
-  std::vector<std::vector<WirePoint>> wires;
+struct WirePoint {
+  Eigen::Vector3d p;
+  bool front;
+};
+using Wire = std::vector<WirePoint>;
+
+// The body's wireframe: meridians and parallels of the cloud's box of half-extents `ext` about c,
+// each direction cast to the surface (ray_exit), marked as facing the viewer or not.
+std::vector<Wire> body_wires(const geometry::Shape& target, const Eigen::Vector3d& c, const Eigen::Vector3d& ext,
+                             const Eigen::Vector3d& d, const ForceMapOptions& o) {
+  std::vector<Wire> wires;
   auto trace = [&](auto param, int samples) {
-    std::vector<WirePoint> line;
+    Wire line;
     for (int k = 0; k <= samples; ++k) {
       const Eigen::Vector3d dir = param(static_cast<double>(k) / samples).cwiseProduct(ext);
       if (!(dir.norm() > 0.0)) continue;
@@ -539,12 +540,127 @@ plot::Drawing force_map_drawing(const geometry::Shape& target, const Eigen::Vect
       return Eigen::Vector3d(std::cos(th), std::sin(th) * std::cos(phi), std::sin(th) * std::sin(phi));
     }, 120);
   }
+  return wires;
+}
+
+// The wires' runs on one side (front or back) as polylines.
+void draw_wires(plot::Drawing& dr, const std::vector<Wire>& wires, const MapView& v, bool front) {
+  plot::Style style;
+  style.stroke = front ? plot::Colour{0.45, 0.45, 0.45} : plot::Colour{0.80, 0.80, 0.80};
+  style.stroke_width = front ? 0.9 : 0.7;
+  for (const auto& line : wires) {
+    std::vector<plot::Point2> run;
+    for (std::size_t k = 0; k < line.size(); ++k) {
+      if (line[k].front == front) {
+        run.push_back(v.screen(line[k].p));
+      } else {
+        if (run.size() >= 2) dr.polyline(run, style);
+        run.clear();
+      }
+    }
+    if (run.size() >= 2) dr.polyline(run, style);
+  }
+}
+
+// The points of one side in `order`: a circle of radius rmax F / fmax coloured by F, or a grey
+// cross where the point has no force.
+void draw_points(plot::Drawing& dr, const SweepResult& r, const std::vector<std::size_t>& order, const MapView& v,
+                 double rmax, bool front) {
+  const double fmin = r.points[r.min_index].max_force_N, fmax = r.points[r.max_index].max_force_N;
+  auto shade = [&](double f) { return fmax > fmin ? (f - fmin) / (fmax - fmin) : 1.0; };
+  for (std::size_t i : order) {
+    const PointResult& p = r.points[i];
+    if ((p.normal.dot(v.d) >= 0.0) != front) continue;
+    if (p.flagged()) {
+      // No force there (sharp, no-fit, ...): a small grey cross instead of a circle.
+      plot::Style x;
+      x.stroke = {0.45, 0.45, 0.45};
+      x.stroke_width = 1.0;
+      x.stroke_opacity = front ? 1.0 : 0.4;
+      const plot::Point2 c0 = v.screen(p.point_m);
+      const double h = 0.35 * rmax;
+      dr.line({c0.x - h, c0.y - h}, {c0.x + h, c0.y + h}, x);
+      dr.line({c0.x - h, c0.y + h}, {c0.x + h, c0.y - h}, x);
+      continue;
+    }
+    plot::Style s;
+    s.fill = plot::viridis(shade(p.max_force_N));
+    s.fill_opacity = front ? 0.92 : 0.30;
+    s.stroke = plot::mix(s.fill, plot::kBlack, 0.45);
+    s.stroke_width = front ? 0.6 : 0.4;
+    s.stroke_opacity = front ? 1.0 : 0.4;
+    dr.circle(v.screen(p.point_m), rmax * p.max_force_N / fmax, s);
+  }
+}
+
+// The legend line: what the circles mean, and the flagged points by kind.
+std::string force_map_legend(const SweepResult& r) {
+  std::string legend = "circle radius \xE2\x88\x9D F_max, darker = lower force; faded: far side";
+  if (r.flagged_count > 0) {
+    legend += "; " + std::to_string(r.flagged_count) + " flagged points (grey x, left out: ";
+    bool any = false;
+    for (int f = 1; f < collision::kContactFlagCount; ++f) {
+      if (r.flag_counts[f] == 0) continue;
+      legend += std::string(any ? ", " : "") + std::to_string(r.flag_counts[f]) + " " +
+                collision::flag_word(static_cast<collision::ContactFlag>(f));
+      any = true;
+    }
+    legend += ")";
+  }
+  return legend;
+}
+
+// The viridis colour bar of F_max at x = bx between by0 (top) and by1, ticked in the unit fu.
+void draw_colour_bar(plot::Drawing& dr, double bx, double by0, double by1, double fmin, double fmax, const Scaled& fu) {
+  const double bwid = 20;
+  const int slices = 96;
+  for (int k = 0; k < slices; ++k) {
+    plot::Style s;
+    s.fill = plot::viridis((k + 0.5) / slices);
+    s.fill_opacity = 1.0;
+    s.stroke_width = -1;
+    const double y = by1 - (by1 - by0) * (k + 1) / slices;
+    dr.rect(bx, y, bwid, (by1 - by0) / slices + 0.6, s);
+  }
+  plot::Style frame;
+  frame.stroke_width = 0.8;
+  dr.rect(bx, by0, bwid, by1 - by0, frame);
+  const double lo = fmin * fu.factor, hi = fmax * fu.factor;
+  for (double v : plot::nice_ticks(lo, hi, 6)) {
+    const double t = hi > lo ? (v - lo) / (hi - lo) : 1.0;
+    const double y = by1 - (by1 - by0) * t;
+    dr.line({bx + bwid, y}, {bx + bwid + 5, y}, frame);
+    dr.text({bx + bwid + 8, y + 4}, plot::format_number(v, 4), 11);
+  }
+  dr.text({bx + bwid / 2, by0 - 10}, std::string("F_max [") + fu.unit + "]", 12, plot::Anchor::middle);
+}
+
+}  // namespace
+
+plot::Drawing force_map_drawing(const geometry::Shape& target, const Eigen::Vector3d& c,
+                                const SweepResult& r, const ForceMapOptions& o) {
+  if (r.points.empty()) throw InputError("", "force map", "no points to draw");
+  const double az = o.azimuth_deg * M_PI / 180.0, el = o.elevation_deg * M_PI / 180.0;
+  MapView v;
+  v.c = c;
+  v.d = Eigen::Vector3d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
+  Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+  if (std::abs(v.d.dot(up)) > 0.99) up = Eigen::Vector3d::UnitY();
+  v.u = up.cross(v.d).normalized();
+  v.w = v.d.cross(v.u);
+
+  // Half-extents of the cloud about the centroid: directions for the wireframe.
+  Eigen::Vector3d ext = Eigen::Vector3d::Zero();
+  for (const auto& p : r.points) ext = ext.cwiseMax((p.point_m - c).cwiseAbs());
+  const double big = std::max(ext.maxCoeff(), 1e-300);
+  ext = ext.cwiseMax(Eigen::Vector3d::Constant(1e-9 * big));
+  const std::vector<Wire> wires = body_wires(target, c, ext, v.d, o);
 
   // Fit the projection into the plot area.
   const double left = 30, top = 78, right = o.width_px - 150, bottom = o.height_px - 30;
   double xmin = 1e300, xmax = -1e300, ymin = 1e300, ymax = -1e300;
   auto grow = [&](const Eigen::Vector3d& p) {
-    const double x = (p - c).dot(u), y = (p - c).dot(w);
+    const double x = (p - c).dot(v.u), y = (p - c).dot(v.w);
     xmin = std::min(xmin, x); xmax = std::max(xmax, x);
     ymin = std::min(ymin, y); ymax = std::max(ymax, y);
   };
@@ -553,43 +669,17 @@ plot::Drawing force_map_drawing(const geometry::Shape& target, const Eigen::Vect
   for (const auto& p : r.points) grow(p.point_m);
   const double pad = 24;
   const double bw = std::max(xmax - xmin, 1e-12 * big), bh = std::max(ymax - ymin, 1e-12 * big);
-  const double scale = std::min((right - left - 2 * pad) / bw, (bottom - top - 2 * pad) / bh);
-  const double cx = 0.5 * (left + right) - scale * 0.5 * (xmin + xmax);
-  const double cy = 0.5 * (top + bottom) + scale * 0.5 * (ymin + ymax);
-  auto screen = [&](const Eigen::Vector3d& p) {
-    return plot::Point2{cx + scale * (p - c).dot(u), cy - scale * (p - c).dot(w)};
-  };
+  v.scale = std::min((right - left - 2 * pad) / bw, (bottom - top - 2 * pad) / bh);
+  v.cx = 0.5 * (left + right) - v.scale * 0.5 * (xmin + xmax);
+  v.cy = 0.5 * (top + bottom) + v.scale * 0.5 * (ymin + ymax);
 
   // Circle size: radius proportional to F_max, the largest about half the spacing of the points
   // seen from the front.
   const double fmin = r.points[r.min_index].max_force_N, fmax = r.points[r.max_index].max_force_N;
   const double shown = o.max_points > 0 ? std::min<double>(r.points.size(), o.max_points) : r.points.size();
   const double front_count = std::max(1.0, 0.5 * shown);
-  const double area = M_PI / 4.0 * std::max(scale * bw, 1.0) * std::max(scale * bh, 8.0);
+  const double area = M_PI / 4.0 * std::max(v.scale * bw, 1.0) * std::max(v.scale * bh, 8.0);
   const double rmax = std::clamp(0.4 * std::sqrt(area / front_count), 2.0, 20.0);
-  auto shade = [&](double f) { return fmax > fmin ? (f - fmin) / (fmax - fmin) : 1.0; };
-
-  plot::Drawing dr(o.width_px, o.height_px);
-  plot::Style back_wire;
-  back_wire.stroke = {0.80, 0.80, 0.80};
-  back_wire.stroke_width = 0.7;
-  plot::Style front_wire = back_wire;
-  front_wire.stroke = {0.45, 0.45, 0.45};
-  front_wire.stroke_width = 0.9;
-  auto draw_wires = [&](bool front) {
-    for (const auto& line : wires) {
-      std::vector<plot::Point2> run;
-      for (std::size_t k = 0; k < line.size(); ++k) {
-        if (line[k].front == front) {
-          run.push_back(screen(line[k].p));
-        } else {
-          if (run.size() >= 2) dr.polyline(run, front ? front_wire : back_wire);
-          run.clear();
-        }
-      }
-      if (run.size() >= 2) dr.polyline(run, front ? front_wire : back_wire);
-    }
-  };
 
   // Points back to front; a large cloud thinned by a fixed stride (deterministic), extremes kept.
   const std::size_t stride =
@@ -603,43 +693,19 @@ plot::Drawing force_map_drawing(const geometry::Shape& target, const Eigen::Vect
   // stable_sort, whose temporary buffer (operator new nothrow, freed with free) trips ASan's
   // alloc-dealloc check under clang with libstdc++ 12.
   std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    const double da = r.points[a].point_m.dot(d), db = r.points[b].point_m.dot(d);
+    const double da = r.points[a].point_m.dot(v.d), db = r.points[b].point_m.dot(v.d);
     return da < db || (da == db && a < b);
   });
-  auto draw_points = [&](bool front) {
-    for (std::size_t i : order) {
-      const PointResult& p = r.points[i];
-      if ((p.normal.dot(d) >= 0.0) != front) continue;
-      if (p.flagged()) {
-        // No force there (sharp, no-fit, ...): a small grey cross instead of a circle.
-        plot::Style x;
-        x.stroke = {0.45, 0.45, 0.45};
-        x.stroke_width = 1.0;
-        x.stroke_opacity = front ? 1.0 : 0.4;
-        const plot::Point2 c0 = screen(p.point_m);
-        const double h = 0.35 * rmax;
-        dr.line({c0.x - h, c0.y - h}, {c0.x + h, c0.y + h}, x);
-        dr.line({c0.x - h, c0.y + h}, {c0.x + h, c0.y - h}, x);
-        continue;
-      }
-      plot::Style s;
-      s.fill = plot::viridis(shade(p.max_force_N));
-      s.fill_opacity = front ? 0.92 : 0.30;
-      s.stroke = plot::mix(s.fill, plot::kBlack, 0.45);
-      s.stroke_width = front ? 0.6 : 0.4;
-      s.stroke_opacity = front ? 1.0 : 0.4;
-      dr.circle(screen(p.point_m), rmax * p.max_force_N / fmax, s);
-    }
-  };
-  draw_wires(false);
-  draw_points(false);
-  draw_wires(true);
-  draw_points(true);
+  plot::Drawing dr(o.width_px, o.height_px);
+  draw_wires(dr, wires, v, false);
+  draw_points(dr, r, order, v, rmax, false);
+  draw_wires(dr, wires, v, true);
+  draw_points(dr, r, order, v, rmax, true);
 
   // Extremes.
   auto mark = [&](std::size_t i, const char* label, double dy) {
     const PointResult& p = r.points[i];
-    const plot::Point2 s = screen(p.point_m);
+    const plot::Point2 s = v.screen(p.point_m);
     plot::Style ring;
     ring.stroke = {0.85, 0.1, 0.1};
     ring.stroke_width = 1.6;
@@ -663,42 +729,8 @@ plot::Drawing force_map_drawing(const geometry::Shape& target, const Eigen::Vect
       << coords(r.points[r.max_index].point_m);
   dr.text({left, 48}, sub.str(), 12);
   // The sharp-point count goes on the legend line: on the subtitle it ran past the picture's edge.
-  std::string legend = "circle radius \xE2\x88\x9D F_max, darker = lower force; faded: far side";
-  if (r.flagged_count > 0) {
-    legend += "; " + std::to_string(r.flagged_count) + " flagged points (grey x, left out: ";
-    bool any = false;
-    for (int f = 1; f < collision::kContactFlagCount; ++f) {
-      if (r.flag_counts[f] == 0) continue;
-      legend += std::string(any ? ", " : "") + std::to_string(r.flag_counts[f]) + " " +
-                collision::flag_word(static_cast<collision::ContactFlag>(f));
-      any = true;
-    }
-    legend += ")";
-  }
-  dr.text({left, 66}, legend, 11, plot::Anchor::start, {0.35, 0.35, 0.35});
-
-  // Colour bar.
-  const double bx = o.width_px - 112, by0 = top + 20, by1 = bottom - 20, bwid = 20;
-  const int slices = 96;
-  for (int k = 0; k < slices; ++k) {
-    plot::Style s;
-    s.fill = plot::viridis((k + 0.5) / slices);
-    s.fill_opacity = 1.0;
-    s.stroke_width = -1;
-    const double y = by1 - (by1 - by0) * (k + 1) / slices;
-    dr.rect(bx, y, bwid, (by1 - by0) / slices + 0.6, s);
-  }
-  plot::Style frame;
-  frame.stroke_width = 0.8;
-  dr.rect(bx, by0, bwid, by1 - by0, frame);
-  const double lo = fmin * fu.factor, hi = fmax * fu.factor;
-  for (double v : plot::nice_ticks(lo, hi, 6)) {
-    const double t = hi > lo ? (v - lo) / (hi - lo) : 1.0;
-    const double y = by1 - (by1 - by0) * t;
-    dr.line({bx + bwid, y}, {bx + bwid + 5, y}, frame);
-    dr.text({bx + bwid + 8, y + 4}, plot::format_number(v, 4), 11);
-  }
-  dr.text({bx + bwid / 2, by0 - 10}, std::string("F_max [") + fu.unit + "]", 12, plot::Anchor::middle);
+  dr.text({left, 66}, force_map_legend(r), 11, plot::Anchor::start, {0.35, 0.35, 0.35});
+  draw_colour_bar(dr, o.width_px - 112, top + 20, bottom - 20, fmin, fmax, fu);
   return dr;
 }
 
