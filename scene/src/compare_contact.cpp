@@ -281,28 +281,12 @@ CompareReport compare_contact(const Scene& scene_in, const CompareOptions& o) {
   return compare_contact(in, o);
 }
 
-CompareReport compare_contact(const CompareInput& in, const CompareOptions& o) {
-  auto output = [&](const std::string& name, bool is_folder) {
-    return o.place_output ? o.place_output(name, is_folder) : o.out_dir / name;
-  };
-  check_compare_options(o, o.context.where.empty() ? InputContext{in.source, ""} : o.context);
-  const contact::Impact& ir = *in.impact;
-  const PreparedBody& target = *in.target;
-  const PreparedBody& impactor = *in.impactor;
-  const ContactEvaluation& ev = ir.contact;
-  const collision::ForceTable& table = in.target_deck.force;
-  CompareReport rep;
-  rep.impact = in.impact_name;
-  rep.target = target.name;
-  rep.impactor = impactor.name;
-  rep.threshold = o.threshold;
-  rep.warnings = in.warnings;
-  // The decks' errors: after the caller's context, or the scene and the impact.
-  auto deck_context = [&](const std::string& what) {
-    return o.context.where.empty() ? InputContext{in.source, "impact '" + in.impact_name + "': " + what}
-                                   : o.context.at(what);
-  };
+namespace {
 
+// The analytic side of the comparison: the Hertz impact with R = 1 (elastic) or the plastic law's
+// own figures, the expected jumps of both bodies, and the analytic F(t) sampled for the overlay.
+void fill_analytic(const CompareInput& in, CompareReport& rep) {
+  const contact::Impact& ir = *in.impact;
   const collision::KernelResult& k = ir.result.kernel;
   const double R = k.restitution.coefficient;
   rep.restitution = R;
@@ -328,78 +312,36 @@ CompareReport compare_contact(const CompareInput& in, const CompareOptions& o) {
   rep.analytic_target_dw = elastic * ir.result.target_jump.delta_angular_velocity_rad_s;
   rep.analytic_impactor_dv = elastic * ir.result.impactor_jump.delta_velocity_m_s;
   rep.analytic_impactor_dw = elastic * ir.result.impactor_jump.delta_angular_velocity_rad_s;
-  {
-    collision::ForceHistory elastic = ir.result.history;  // the same pulse with R = 1
-    if (!in.plastic) {
-      elastic.restitution = 1.0;
-      elastic.law = nullptr;  // Hertz's F(t) from the summary, not the law's result with its own R
-    }
-    const int n = 200;
-    for (int i = 0; i <= n; ++i) {
-      const double t = elastic.contact_time_s() * i / n;
-      rep.analytic_time_s.push_back(t);
-      rep.analytic_force_N.push_back(elastic.force_N(t));
-    }
+  collision::ForceHistory pulse = ir.result.history;  // the same pulse with R = 1
+  if (!in.plastic) {
+    pulse.restitution = 1.0;
+    pulse.law = nullptr;  // Hertz's F(t) from the summary, not the law's result with its own R
   }
+  const int n = 200;
+  for (int i = 0; i <= n; ++i) {
+    const double t = pulse.contact_time_s() * i / n;
+    rep.analytic_time_s.push_back(t);
+    rep.analytic_force_N.push_back(pulse.force_N(t));
+  }
+}
 
-  // Time stepping shared by both models: the contact model's.
-  const fem_export::ContactModelOptions& co = o.contact;
-  const double dt = rep.analytic_duration_s / co.contact_increments;
-  const std::size_t increments = static_cast<std::size_t>(std::ceil(co.end_time_factor * co.contact_increments - 1e-9));
-  const double end_time = increments * dt;
-
-  // A plane floor: a block of half-width and depth floor_block_factor a (contact_model.hpp).
-  const double block_m = co.floor_block_factor * std::max(rep.semi_axis_a_m, rep.semi_axis_b_m);
-  if (in.target_fixed || in.impactor_fixed) {
-    const bool t = in.target_fixed;
-    rep.fixed_body = t ? target.name : impactor.name;
-    rep.fixed_kind = (t ? in.target_plane : in.impactor_plane) ? "plane as a block" : "fixed body";
-    rep.floor_block_size_m = (t ? in.target_plane : in.impactor_plane) ? block_m : 0.0;
-  }
-  double target_far = in.target_plane ? block_m / 4 : in.target_deck.options.mesh.mesh_size_m;
-  fem_export::CheckOptions check_options;
-  check_options.progress = o.progress;
-  check_options.timeout_s = o.solver_timeout_s;
-  check_options.threads = o.solver_threads;
-  const fem_export::DeckRequest& target_req = in.target_deck;
-  const bool run_hybrid = o.run_hybrid && !in.target_fixed;
-  if (o.run_hybrid && in.target_fixed) {
-    rep.warnings.push_back("the target '" + target.name + "' is fixed: no hybrid deck (it models a free target; make "
-                           "the free body the target to have one)");
-  }
-  if (run_hybrid) {
-    fem_export::DeckRequest req = target_req;
-    req.context = deck_context("hybrid deck");
-    req.options.solvers = {"calculix"};
-    req.options.end_time_s = end_time;
-    req.options.time_step_s = dt;
-    req.options.pulse_increments = static_cast<int>(std::ceil(table.time_s.back() / dt - 1e-9));
-    rep.hybrid_deck = fem_export::write_decks(req, output("hybrid", true));
-    target_far = rep.hybrid_deck->quality.mesh_size_m;  // after any adaptive refinement
-    const fem_export::TimeSchedule ts = fem_export::time_schedule(req.options, table.time_s.back());
-    rep.hybrid_increments = ts.pulse_increments + ts.main_increments;
-    for (double f : table.force_N) rep.hybrid_max_force_N = std::max(rep.hybrid_max_force_N, f);
-    if (o.progress) *o.progress << "compare-contact: running the hybrid deck (" << rep.hybrid_deck->node_count << " nodes)\n";
-    rep.hybrid_check = fem_export::run_check(*rep.hybrid_deck, check_options);
-    // The deck's frame is the target's own: rotate its jumps into the world.
-    rep.hybrid_target_dv = target.pose.rotation * rep.hybrid_check->fe_rigid_velocity_m_s;
-    rep.hybrid_target_dw = target.pose.rotation * rep.hybrid_check->angular_velocity_fe_rad_s;
-    for (const auto& f : rep.hybrid_check->failures) rep.warnings.push_back("hybrid deck check: " + f);
-  }
-
-  // The full-contact model: the impactor's own deck request gives its body and material.
-  const fem_export::DeckRequest& impactor_req = in.impactor_deck;
+// The full-contact model's request: both bodies from their deck requests; a fixed body held and at
+// rest (the free body takes the relative velocity); a plane, the block of half-width and depth
+// block_m under the contact, in the world frame.
+fem_export::ContactModelRequest contact_request(const CompareInput& in, const CompareReport& rep, double block_m,
+                                                double target_far_m, const InputContext& context) {
+  const PreparedBody& target = *in.target;
+  const PreparedBody& impactor = *in.impactor;
+  const ContactEvaluation& ev = in.impact->contact;
   fem_export::ContactModelRequest cr;
   cr.source = in.source;
   cr.impact = in.impact_name;
-  cr.context = deck_context("contact model");
-  cr.target = contact_body(target_req, target, ev.target_point, ev.input.target, Eigen::Vector3d::Zero(), target_far);
-  if (!in.target_fixed) cr.target.probes_own_m = target_req.options.mesh.probes_m;  // the hybrid deck's, target frame
-  cr.impactor = contact_body(impactor_req, impactor, ev.impactor_point, ev.input.impactor, ev.impactor_translation_m,
+  cr.context = context;
+  cr.target = contact_body(in.target_deck, target, ev.target_point, ev.input.target, Eigen::Vector3d::Zero(), target_far_m);
+  if (!in.target_fixed) cr.target.probes_own_m = in.target_deck.options.mesh.probes_m;  // the hybrid deck's, target frame
+  cr.impactor = contact_body(in.impactor_deck, impactor, ev.impactor_point, ev.input.impactor, ev.impactor_translation_m,
                              in.impactor_plane ? block_m / 4 : in.impactor_mesh_size_m);
-  // A fixed body: held and at rest, so the free body takes the relative velocity (a fixed body
-  // moves only by approach_speed_m_s, which translates it). A plane: the block under the contact,
-  // in the world frame.
+  // A fixed body moves only by approach_speed_m_s, which translates it.
   if (in.target_fixed) cr.impactor.velocity_m_s -= cr.target.velocity_m_s;
   if (in.impactor_fixed) cr.target.velocity_m_s -= cr.impactor.velocity_m_s;
   for (auto [body, fixed, plane, outward] : {std::tuple{&cr.target, in.target_fixed, in.target_plane, Eigen::Vector3d(ev.normal)},
@@ -426,8 +368,135 @@ CompareReport compare_contact(const CompareInput& in, const CompareOptions& o) {
                                                             collision::ModulusConvention::hertz);
   cr.semi_axis_a_m = rep.semi_axis_a_m;
   cr.semi_axis_b_m = rep.semi_axis_b_m;
-  cr.compression_time_s = k.compression_time_s;
+  cr.compression_time_s = in.impact->result.kernel.compression_time_s;
   cr.contact_duration_s = rep.analytic_duration_s;
+  return cr;
+}
+
+// The verdict on the finest run: agree within the threshold, or which side is in doubt (the mesh,
+// when refining moved F_max toward the analytic value; the hybrid assumptions otherwise).
+void judge(CompareReport& rep, double threshold) {
+  const ContactLevel& fine = rep.ladder.back();
+  const double d = fine.max_force_relative_difference;
+  const double vib = rep.impact_energy_J > 0 ? fine.run.vibration_energy_J / rep.impact_energy_J : 0;
+  if (std::abs(d) <= threshold) {
+    rep.verdict = CompareVerdict::agree;
+    return;
+  }
+  rep.verdict = CompareVerdict::disagree;
+  std::ostringstream m;
+  if (rep.ladder.size() >= 2) {
+    const double d0 = rep.ladder.front().max_force_relative_difference;
+    if (std::abs(d) < 0.75 * std::abs(d0)) {
+      rep.in_doubt = "contact mesh";
+      m << "refining moved F_max toward the analytic value (" << 100 * d0 << " % -> " << 100 * d
+        << " %): the contact mesh is not converged";
+    } else {
+      rep.in_doubt = "hybrid assumptions";
+      m << "refining did not move F_max toward the analytic value (" << 100 * d0 << " % -> " << 100 * d
+        << " %): the Hertz assumptions (elastic half-spaces, no vibration; here " << 100 * vib
+        << " % of the impact energy is left as vibration) are in doubt";
+    }
+  } else if (vib > 0.05) {
+    rep.in_doubt = "hybrid assumptions";
+    m << 100 * vib << " % of the impact energy is left as elastic vibration, which the rigid-body Hertz model "
+      << "ignores; run with --refine 2 to rule out the contact mesh";
+  } else {
+    rep.in_doubt = "contact mesh";
+    m << "little vibration energy (" << 100 * vib << " %): the contact mesh is the likelier cause; run with "
+      << "--refine 2 to see F_max converge";
+  }
+  rep.explanation = m.str();
+}
+
+// The F(t) overlay: analytic, each full-contact run, and the hybrid deck's applied load.
+std::string force_overlay_svg(const CompareReport& rep, const std::string& impact_name,
+                              const collision::ForceTable* hybrid_load) {
+  std::vector<plot::StressSeries> series;
+  series.push_back({"analytic Hertz (elastic)", rep.analytic_time_s, rep.analytic_force_N, 0, true});
+  for (const auto& L : rep.ladder) {
+    std::ostringstream lab;
+    lab << "full contact, " << L.contact_elements << " el./b";
+    series.push_back({lab.str(), L.run.time_s, L.run.force_N, -1, false});
+    series.back().colour = 1 + static_cast<int>(&L - &rep.ladder.front()) % 4;
+  }
+  if (hybrid_load) series.push_back({"hybrid applied load", hybrid_load->time_s, hybrid_load->force_N, plot::kVermilion, false});
+  plot::StressPlotOptions po;
+  po.title = "Contact force, impact '" + impact_name + "': full contact against the hybrid load";
+  po.quantity = "contact force";
+  po.force_N = true;
+  return plot::to_svg(plot::stress_time_drawing(series, po));
+}
+
+}  // namespace
+
+CompareReport compare_contact(const CompareInput& in, const CompareOptions& o) {
+  auto output = [&](const std::string& name, bool is_folder) {
+    return o.place_output ? o.place_output(name, is_folder) : o.out_dir / name;
+  };
+  check_compare_options(o, o.context.where.empty() ? InputContext{in.source, ""} : o.context);
+  const PreparedBody& target = *in.target;
+  const PreparedBody& impactor = *in.impactor;
+  const collision::ForceTable& table = in.target_deck.force;
+  CompareReport rep;
+  rep.impact = in.impact_name;
+  rep.target = target.name;
+  rep.impactor = impactor.name;
+  rep.threshold = o.threshold;
+  rep.warnings = in.warnings;
+  // The decks' errors: after the caller's context, or the scene and the impact.
+  auto deck_context = [&](const std::string& what) {
+    return o.context.where.empty() ? InputContext{in.source, "impact '" + in.impact_name + "': " + what}
+                                   : o.context.at(what);
+  };
+  fill_analytic(in, rep);
+
+  // Time stepping shared by both models: the contact model's.
+  const fem_export::ContactModelOptions& co = o.contact;
+  const double dt = rep.analytic_duration_s / co.contact_increments;
+  const std::size_t increments = static_cast<std::size_t>(std::ceil(co.end_time_factor * co.contact_increments - 1e-9));
+  const double end_time = increments * dt;
+
+  // A plane floor: a block of half-width and depth floor_block_factor a (contact_model.hpp).
+  const double block_m = co.floor_block_factor * std::max(rep.semi_axis_a_m, rep.semi_axis_b_m);
+  if (in.target_fixed || in.impactor_fixed) {
+    const bool t = in.target_fixed;
+    rep.fixed_body = t ? target.name : impactor.name;
+    rep.fixed_kind = (t ? in.target_plane : in.impactor_plane) ? "plane as a block" : "fixed body";
+    rep.floor_block_size_m = (t ? in.target_plane : in.impactor_plane) ? block_m : 0.0;
+  }
+  double target_far = in.target_plane ? block_m / 4 : in.target_deck.options.mesh.mesh_size_m;
+  fem_export::CheckOptions check_options;
+  check_options.progress = o.progress;
+  check_options.timeout_s = o.solver_timeout_s;
+  check_options.threads = o.solver_threads;
+  const bool run_hybrid = o.run_hybrid && !in.target_fixed;
+  if (o.run_hybrid && in.target_fixed) {
+    rep.warnings.push_back("the target '" + target.name + "' is fixed: no hybrid deck (it models a free target; make "
+                           "the free body the target to have one)");
+  }
+  if (run_hybrid) {
+    fem_export::DeckRequest req = in.target_deck;
+    req.context = deck_context("hybrid deck");
+    req.options.solvers = {"calculix"};
+    req.options.end_time_s = end_time;
+    req.options.time_step_s = dt;
+    req.options.pulse_increments = static_cast<int>(std::ceil(table.time_s.back() / dt - 1e-9));
+    rep.hybrid_deck = fem_export::write_decks(req, output("hybrid", true));
+    target_far = rep.hybrid_deck->quality.mesh_size_m;  // after any adaptive refinement
+    const fem_export::TimeSchedule ts = fem_export::time_schedule(req.options, table.time_s.back());
+    rep.hybrid_increments = ts.pulse_increments + ts.main_increments;
+    for (double f : table.force_N) rep.hybrid_max_force_N = std::max(rep.hybrid_max_force_N, f);
+    if (o.progress) *o.progress << "compare-contact: running the hybrid deck (" << rep.hybrid_deck->node_count << " nodes)\n";
+    rep.hybrid_check = fem_export::run_check(*rep.hybrid_deck, check_options);
+    // The deck's frame is the target's own: rotate its jumps into the world.
+    rep.hybrid_target_dv = target.pose.rotation * rep.hybrid_check->fe_rigid_velocity_m_s;
+    rep.hybrid_target_dw = target.pose.rotation * rep.hybrid_check->angular_velocity_fe_rad_s;
+    for (const auto& f : rep.hybrid_check->failures) rep.warnings.push_back("hybrid deck check: " + f);
+  }
+
+  // The full-contact model, refined `refine` times by sqrt(2) across the contact.
+  fem_export::ContactModelRequest cr = contact_request(in, rep, block_m, target_far, deck_context("contact model"));
   for (int level = 0; level <= o.refine; ++level) {
     cr.options = co;
     cr.options.contact_elements = co.contact_elements * std::pow(std::sqrt(2.0), level);
@@ -443,56 +512,10 @@ CompareReport compare_contact(const CompareInput& in, const CompareOptions& o) {
     L.max_force_relative_difference = rel(L.run.max_force_N, rep.analytic_max_force_N);
     rep.ladder.push_back(std::move(L));
   }
+  judge(rep, o.threshold);
 
-  // Verdict.
-  const ContactLevel& fine = rep.ladder.back();
-  const double d = fine.max_force_relative_difference;
-  const double vib = rep.impact_energy_J > 0 ? fine.run.vibration_energy_J / rep.impact_energy_J : 0;
-  if (std::abs(d) <= o.threshold) {
-    rep.verdict = CompareVerdict::agree;
-  } else {
-    rep.verdict = CompareVerdict::disagree;
-    std::ostringstream m;
-    if (rep.ladder.size() >= 2) {
-      const double d0 = rep.ladder.front().max_force_relative_difference;
-      if (std::abs(d) < 0.75 * std::abs(d0)) {
-        rep.in_doubt = "contact mesh";
-        m << "refining moved F_max toward the analytic value (" << 100 * d0 << " % -> " << 100 * d
-          << " %): the contact mesh is not converged";
-      } else {
-        rep.in_doubt = "hybrid assumptions";
-        m << "refining did not move F_max toward the analytic value (" << 100 * d0 << " % -> " << 100 * d
-          << " %): the Hertz assumptions (elastic half-spaces, no vibration; here " << 100 * vib
-          << " % of the impact energy is left as vibration) are in doubt";
-      }
-    } else if (vib > 0.05) {
-      rep.in_doubt = "hybrid assumptions";
-      m << 100 * vib << " % of the impact energy is left as elastic vibration, which the rigid-body Hertz model "
-        << "ignores; run with --refine 2 to rule out the contact mesh";
-    } else {
-      rep.in_doubt = "contact mesh";
-      m << "little vibration energy (" << 100 * vib << " %): the contact mesh is the likelier cause; run with "
-        << "--refine 2 to see F_max converge";
-    }
-    rep.explanation = m.str();
-  }
-
-  // The F(t) overlay.
-  std::vector<plot::StressSeries> series;
-  series.push_back({"analytic Hertz (elastic)", rep.analytic_time_s, rep.analytic_force_N, 0, true});
-  for (const auto& L : rep.ladder) {
-    std::ostringstream lab;
-    lab << "full contact, " << L.contact_elements << " el./b";
-    series.push_back({lab.str(), L.run.time_s, L.run.force_N, -1, false});
-    series.back().colour = 1 + static_cast<int>(&L - &rep.ladder.front()) % 4;
-  }
-  if (run_hybrid) series.push_back({"hybrid applied load", table.time_s, table.force_N, plot::kVermilion, false});
-  plot::StressPlotOptions po;
-  po.title = "Contact force, impact '" + in.impact_name + "': full contact against the hybrid load";
-  po.quantity = "contact force";
-  po.force_N = true;
   const fs::path svg = output("compare_force.svg", false);
-  write_file_atomically(svg, plot::to_svg(plot::stress_time_drawing(series, po)));
+  write_file_atomically(svg, force_overlay_svg(rep, in.impact_name, run_hybrid ? &table : nullptr));
   rep.files.push_back(svg);
   return rep;
 }
