@@ -61,6 +61,8 @@ void register_compare_contact(CLI::App& app, Context& ctx) {
           {"elastic", fem_export::MaterialModel::elastic}, {"plastic", fem_export::MaterialModel::plastic}}));
   cmd->add_flag("--no-hybrid", [args](std::int64_t) { args->options.run_hybrid = false; },
                 "Run the full-contact model only");
+  cmd->add_flag("--decks-only", [args](std::int64_t) { args->options.run_solvers = false; },
+                "Write the hybrid and full-contact decks (meshes, impact.inp) and run no solver");
   cmd->callback([args, &ctx] {
     refuse_stdout_folder(args->out, "compare-contact");
     check_stdout_writable();  // refused before any work (a later failure rolls the comparison back)

@@ -136,6 +136,52 @@ TEST_P(FemRoute, PartMeshesFromMemoryAndRunsThroughCcx) {
             << fem_export::to_string(st.verdict.kind) << ", ccx " << chk.solver_wall_time_s << " s\n";
 }
 
+// The same parts, rotated and placed a kilometre from the origin, through the other two FEM routes
+// without a solver (`compare-contact --decks-only`): the hybrid deck with the Hertz-patch load and
+// the full-contact model both mesh the part; each FE body has the part's mass within the body
+// check's tolerance, and the contact model's contact node is the contact point.
+TEST_P(FemRoute, PatchAndContactModelMeshTheSamePart) {
+  const PartCase& c = GetParam();
+  const fs::path out = fresh_dir(std::string(c.name) + "_decks");
+  std::ostringstream fem;
+  fem << "mesh_size = " << c.mesh_size << "\nload = \"hertz-patch\"\ncontact_elements = 2\n";
+  std::string text = part_scene("cm", (kData / c.file).string(), c.repair, c.point, c.ball_radius, c.speed_m_s, fem.str());
+  const std::string body = "name = \"part\"\n";
+  text.insert(text.find(body) + body.size(),
+              "position = [100000, -70000, 40000]\norientation_axis = [1, 2, 3]\norientation_angle_deg = 37\n");
+  const scene::Scene sc = scene::parse_scene(text, c.name, kData);
+  scene::CompareOptions o;
+  o.out_dir = out;
+  o.run_solvers = false;
+  o.contact.contact_elements = 1;
+  const scene::CompareReport r = scene::compare_contact(sc, o);
+  ASSERT_EQ(r.verdict, scene::CompareVerdict::decks_only);
+  ASSERT_TRUE(r.hybrid_deck.has_value());
+  const auto& hybrid = *r.hybrid_deck;
+  EXPECT_EQ(hybrid.load, fem_export::LoadKind::hertz_patch);
+  EXPECT_TRUE(hybrid.body_check.passed) << ::testing::PrintToString(hybrid.body_check.failures);
+  EXPECT_LE(hybrid.quality.load_node_distance_m, 1e-12);
+  ASSERT_EQ(r.ladder.size(), 1u);
+  const auto& deck = r.ladder[0].deck;
+  const double part_kg = hybrid.body_check.part_mass_kg;
+  EXPECT_NEAR(deck.target.fe_mass_kg / part_kg, 1.0, hybrid.body_check.tolerances.mass);
+  const double ball_kg = 7850 * 4.0 / 3.0 * M_PI * std::pow(c.ball_radius * 1e-2, 3);
+  EXPECT_NEAR(deck.impactor.fe_mass_kg / ball_kg, 1.0, hybrid.body_check.tolerances.mass);
+  // The deck frame's origin is the contact point: the target's contact node sits on it.
+  const auto& tj = deck.description.at("bodies").at(0);
+  const auto& p = tj.at("nodes_m").at(tj.at("contact_node").get<std::size_t>() - 1);
+  const double size_m = std::cbrt(hybrid.body_check.part_volume_m3);
+  EXPECT_LE(std::hypot(p.at(0).get<double>(), p.at(1).get<double>(), p.at(2).get<double>()), 1e-9 * size_m);
+  EXPECT_FALSE(fs::exists(deck.folder / "impact.frd"));  // no solver ran
+  EXPECT_TRUE(fs::is_regular_file(deck.folder / "impact.inp"));
+  const auto j = scene::to_json(r);
+  EXPECT_EQ(j.at("verdict"), "decks-only");
+  EXPECT_TRUE(j.at("contact_run").is_null());
+  std::cout << "[ " << c.name << " ] patch deck " << hybrid.node_count << " nodes (FE mass "
+            << hybrid.body_check.fe_mass_kg / part_kg - 1 << " rel.), contact model " << deck.node_count
+            << " nodes (target FE mass " << deck.target.fe_mass_kg / part_kg - 1 << " rel.)\n";
+}
+
 // Triangle counts from `impactdeck inspect` (sphere_broken.ply: 321 in the file, one duplicate
 // removed by the repair).
 INSTANTIATE_TEST_SUITE_P(

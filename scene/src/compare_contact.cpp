@@ -27,6 +27,7 @@ const char* to_string(CompareVerdict v) {
     case CompareVerdict::agree: return "agree";
     case CompareVerdict::disagree: return "disagree";
     case CompareVerdict::non_hertzian: return "non-hertzian";
+    case CompareVerdict::decks_only: return "decks-only";
   }
   return "?";
 }
@@ -487,12 +488,14 @@ CompareReport compare_contact(const CompareInput& in, const CompareOptions& o) {
     const fem_export::TimeSchedule ts = fem_export::time_schedule(req.options, table.time_s.back());
     rep.hybrid_increments = ts.pulse_increments + ts.main_increments;
     for (double f : table.force_N) rep.hybrid_max_force_N = std::max(rep.hybrid_max_force_N, f);
-    if (o.progress) *o.progress << "compare-contact: running the hybrid deck (" << rep.hybrid_deck->node_count << " nodes)\n";
-    rep.hybrid_check = fem_export::run_check(*rep.hybrid_deck, check_options);
-    // The deck's frame is the target's own: rotate its jumps into the world.
-    rep.hybrid_target_dv = target.pose.rotation * rep.hybrid_check->fe_rigid_velocity_m_s;
-    rep.hybrid_target_dw = target.pose.rotation * rep.hybrid_check->angular_velocity_fe_rad_s;
-    for (const auto& f : rep.hybrid_check->failures) rep.warnings.push_back("hybrid deck check: " + f);
+    if (o.run_solvers) {
+      if (o.progress) *o.progress << "compare-contact: running the hybrid deck (" << rep.hybrid_deck->node_count << " nodes)\n";
+      rep.hybrid_check = fem_export::run_check(*rep.hybrid_deck, check_options);
+      // The deck's frame is the target's own: rotate its jumps into the world.
+      rep.hybrid_target_dv = target.pose.rotation * rep.hybrid_check->fe_rigid_velocity_m_s;
+      rep.hybrid_target_dw = target.pose.rotation * rep.hybrid_check->angular_velocity_fe_rad_s;
+      for (const auto& f : rep.hybrid_check->failures) rep.warnings.push_back("hybrid deck check: " + f);
+    }
   }
 
   // The full-contact model, refined `refine` times by sqrt(2) across the contact.
@@ -504,6 +507,10 @@ CompareReport compare_contact(const CompareInput& in, const CompareOptions& o) {
     L.contact_elements = cr.options.contact_elements;
     const fs::path folder = output(o.refine == 0 ? std::string("contact") : "contact_L" + std::to_string(level), true);
     L.deck = fem_export::write_contact_deck(cr, folder);
+    if (!o.run_solvers) {
+      rep.ladder.push_back(std::move(L));
+      continue;
+    }
     if (o.progress) {
       *o.progress << "compare-contact: running the full-contact model, " << L.contact_elements
                   << " elements across the contact semi-axis (" << L.deck.node_count << " nodes)\n";
@@ -511,6 +518,10 @@ CompareReport compare_contact(const CompareInput& in, const CompareOptions& o) {
     L.run = fem_export::run_contact_model(L.deck, check_options);
     L.max_force_relative_difference = rel(L.run.max_force_N, rep.analytic_max_force_N);
     rep.ladder.push_back(std::move(L));
+  }
+  if (!o.run_solvers) {
+    rep.verdict = CompareVerdict::decks_only;
+    return rep;
   }
   judge(rep, o.threshold);
 
@@ -533,6 +544,32 @@ void map_paths(CompareReport& r, const std::function<fs::path(const fs::path&)>&
       for (auto& f : r.hybrid_check->stress->files) f = map(f);
   }
 }
+
+namespace {
+
+// A contact deck as written: its mesh sizes, node counts and each body's FE mass properties.
+json deck_json(const ContactLevel& L) {
+  auto body = [](const fem_export::ContactBodyMesh& b) {
+    return json{{"node_count", b.node_count},
+                {"element_count", b.element_count},
+                {"contact_faces", b.contact_faces},
+                {"far_mesh_size_m", b.far_mesh_size_m},
+                {"fe_mass_kg", b.fe_mass_kg},
+                {"fe_centroid_m", json_vector(b.fe_centroid_m)},
+                {"fixed_nodes", b.fixed_nodes}};
+  };
+  return json{{"contact_elements", L.contact_elements},
+              {"contact_mesh_size_m", L.deck.contact_mesh_size_m},
+              {"node_count", L.deck.node_count},
+              {"time_step_s", L.deck.time_step_s},
+              {"increments", L.deck.increments},
+              {"penalty_N_m3", L.deck.penalty_N_m3},
+              {"target", body(L.deck.target)},
+              {"impactor", body(L.deck.impactor)},
+              {"folder", L.deck.folder.string()}};
+}
+
+}  // namespace
 
 json to_json(const CompareReport& r) {
   json j = {{"impact", r.impact},    {"target", r.target},       {"impactor", r.impactor},
@@ -558,6 +595,21 @@ json to_json(const CompareReport& r) {
                    {"delta_velocity_m_s", {{"target", json_vector(r.analytic_target_dv)}, {"impactor", json_vector(r.analytic_impactor_dv)}}},
                    {"delta_angular_velocity_rad_s",
                     {{"target", json_vector(r.analytic_target_dw)}, {"impactor", json_vector(r.analytic_impactor_dw)}}}};
+  if (r.verdict == CompareVerdict::decks_only) {
+    // The decks as written: each contact deck's meshes, and the hybrid deck's; no solver figures.
+    json decks = json::array();
+    for (const auto& L : r.ladder) decks.push_back(deck_json(L));
+    j["contact_decks"] = decks;
+    j["hybrid_deck"] = r.hybrid_deck ? json{{"node_count", r.hybrid_deck->node_count},
+                                            {"fe_mass_kg", r.hybrid_deck->body_check.fe_mass_kg},
+                                            {"part_mass_kg", r.hybrid_deck->body_check.part_mass_kg},
+                                            {"folder", r.hybrid_deck->folder.string()}}
+                                     : json(nullptr);
+    j["contact_run"] = nullptr;
+    j["hybrid_run"] = nullptr;
+    j["warnings"] = r.warnings;
+    return j;
+  }
   auto level_json = [&](const ContactLevel& L) {
     const auto& run = L.run;
     return json{{"contact_elements", L.contact_elements},
@@ -691,6 +743,20 @@ std::string format_compare(const CompareReport& r) {
   }
   o << "  analytic (" << (r.plastic ? r.law + " law" : std::string("elastic Hertz")) << "): F_max " << r.analytic_max_force_N << " N, duration " << r.analytic_duration_s * 1e6
     << " us, impulse " << r.analytic_impulse_Ns << " N s\n";
+  if (r.verdict == CompareVerdict::decks_only) {
+    for (const auto& L : r.ladder) {
+      o << "  contact deck " << L.deck.folder.string() << ": " << L.contact_elements << " elements across b, "
+        << L.deck.node_count << " nodes (target FE mass " << L.deck.target.fe_mass_kg << " kg, impactor "
+        << L.deck.impactor.fe_mass_kg << " kg), " << L.deck.increments << " increments\n";
+    }
+    if (r.hybrid_deck) {
+      o << "  hybrid deck " << r.hybrid_deck->folder.string() << ": " << r.hybrid_deck->node_count
+        << " nodes (FE mass " << r.hybrid_deck->body_check.fe_mass_kg << " kg)\n";
+    }
+    o << "  decks only: no solver ran (run ccx on each folder's impact.inp)\n";
+    for (const auto& w : r.warnings) o << "  warning: " << w << "\n";
+    return o.str();
+  }
   o << "  refinement (elements across the contact semi-axis b, F_max, difference, nodes, wall time):\n";
   for (const auto& L : r.ladder) {
     o << "    " << L.contact_elements << "  " << L.run.max_force_N << " N  " << 100 * L.max_force_relative_difference

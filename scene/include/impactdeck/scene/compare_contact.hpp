@@ -33,6 +33,9 @@ struct CompareOptions {
   int refine = 0;                        ///< extra contact runs, each with sqrt(2) x contact_elements
   fem_export::ContactModelOptions contact;
   bool run_hybrid = true;                ///< false: the contact model only (tests)
+  /// false (`--decks-only`): write the hybrid and full-contact decks (meshes, contact.json) and run
+  /// nothing; the report's verdict is decks_only, with no force or check figures.
+  bool run_solvers = true;
   double solver_timeout_s = 0;           ///< per ccx run; 0: derived from each deck's size
   /// plastic: both bodies elastic-plastic (`--material-model plastic`); the scene's [outputs.fem]
   /// material_model = "plastic" does the same.
@@ -57,7 +60,8 @@ struct ContactLevel {
   double max_force_relative_difference = 0;  ///< F_max / analytic - 1
 };
 
-enum class CompareVerdict { agree, disagree, non_hertzian };
+/// decks_only: the decks were written and no solver ran (CompareOptions::run_solvers false).
+enum class CompareVerdict { agree, disagree, non_hertzian, decks_only };
 
 /// The laws compared with a plastic full-contact run (docs/plastic.md, "The ladder").
 inline const std::vector<std::string> kComparedLaws = {"hertz", "thornton", "jackson-green"};
