@@ -449,6 +449,8 @@ DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
     mo.context = r.context;  // the mesher names its own file after it
     mo.quality_floor_gamma = r.options.tolerances.min_gamma;
     mo.output_unit = r.options.units.length;
+    // Curved surfaces get elements along their curvature, so a coarse mesh keeps the part's volume.
+    if (mo.curvature_elements == 0) mo.curvature_elements = curvature_elements_for(r.options.tolerances.volume);
     if (r.options.load == LoadKind::hertz_patch) {
       const double h_patch = 2.0 * r.patch.b_max_m / r.options.contact_elements;
       const double h0 = mo.load_mesh_size_m > 0 ? mo.load_mesh_size_m : mo.mesh_size_m / 3.0;
@@ -584,6 +586,7 @@ DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
                     {"mesh_size_m", q.mesh_size_m},
                     {"load_mesh_size_m", q.load_mesh_size_m},
                     {"load_zone_radius_m", mo.load_zone_radius_m},
+                    {"curvature_elements_per_2pi", mo.curvature_elements},
                     {"mesh_attempts", to_json(q.attempts)},
                     {"fallback_used", q.attempts.size() > 1}};
     write_file_atomically(stage / "mesh_quality.json", quality.dump(2) + "\n");
