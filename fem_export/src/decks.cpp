@@ -540,7 +540,8 @@ DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
       out.patch.max_nodes_loaded_at_once = 1;
     }
     const ScopedTimer decks_timer([&](double sec) { out.decks_seconds += sec; });  // to the end of the writing
-    out.contact_zone_radius_m = std::max(r.options.contact_zone_factor * r.patch.a_max_m, 2.0 * q.load_mesh_size_m);
+    out.contact_zone_radius_m = std::max({r.options.contact_zone_factor * r.patch.a_max_m, 2.0 * q.load_mesh_size_m,
+                                          r.options.min_contact_zone_radius_m});
     out.plastic_zone_radius_m = std::max(kLocalPlasticZoneFactor * std::max(r.patch.a_max_m, r.dent_radius_m),
                                          2.0 * q.load_mesh_size_m);
     out.body_check = compare_body(m, r.material.density_kg_m3, r.model, r.options.tolerances,
