@@ -139,4 +139,70 @@ point = [0, 0.01, 0]
   EXPECT_EQ(m[1].str(), "Verdict: yields (smallest safety factor 0.8)");
 }
 
+// The mesh convergence decision (fem_export/convergence.hpp) on given numbers: the same verdict and
+// a governing stress within kConvergenceTolerance on both meshes holds; anything else moves.
+fem_export::MeshConvergence pair_of(VerdictKind coarse_kind, double coarse_Pa, VerdictKind fine_kind, double fine_Pa) {
+  fem_export::MeshConvergence c;
+  c.coarse.mesh_size_m = 2e-3;
+  c.fine.mesh_size_m = 1e-3;
+  c.coarse.verdict.kind = coarse_kind;
+  c.fine.verdict.kind = fine_kind;
+  c.coarse.verdict.yield_strength_Pa = c.fine.verdict.yield_strength_Pa = 2.4e8;
+  c.coarse.verdict.governing.von_mises_Pa = coarse_Pa;
+  c.fine.verdict.governing.von_mises_Pa = fine_Pa;
+  c.evaluation_radius_m = 1.36e-2;
+  fem_export::judge_convergence(c);
+  return c;
+}
+
+TEST(MeshConvergence, HoldsOrMovesWithTheMesh) {
+  using fem_export::kConvergenceTolerance;
+  ASSERT_DOUBLE_EQ(kConvergenceTolerance, 0.10);
+  // +4 %: holds.
+  auto c = pair_of(VerdictKind::survives, 1.0e8, VerdictKind::survives, 1.04e8);
+  EXPECT_NEAR(c.relative_change, 0.04, 1e-12);
+  EXPECT_TRUE(c.holds) << c.statement;
+  EXPECT_EQ(c.statement.rfind("holds", 0), 0u) << c.statement;
+  // -9.9 % and +9.9 %: within the 10 % tolerance, either way.
+  EXPECT_TRUE(pair_of(VerdictKind::survives, 1.0e8, VerdictKind::survives, 0.901e8).holds);
+  EXPECT_TRUE(pair_of(VerdictKind::survives, 1.0e8, VerdictKind::survives, 1.099e8).holds);
+  // The case: safety factor 0.73 on the first mesh, 0.54 on the refined one (+35 % stress):
+  // the same word (yields), but the stress moves.
+  c = pair_of(VerdictKind::yields, 2.4e8 / 0.73, VerdictKind::yields, 2.4e8 / 0.54);
+  EXPECT_NEAR(c.relative_change, 0.73 / 0.54 - 1, 1e-12);
+  EXPECT_FALSE(c.holds);
+  EXPECT_NE(c.statement.find("moves with the mesh: the governing stress changes by more than 10 %"), std::string::npos)
+      << c.statement;
+  // A small change that crosses the yield strength: the verdict moves though the stress hardly does.
+  c = pair_of(VerdictKind::survives, 2.35e8, VerdictKind::yields, 2.45e8);
+  EXPECT_FALSE(c.holds);
+  EXPECT_NE(c.statement.find("survives on the first mesh, yields on the refined one"), std::string::npos) << c.statement;
+  // A zero stress on the first mesh: any stress on the second is an infinite change (JSON null).
+  c = pair_of(VerdictKind::survives, 0, VerdictKind::survives, 1e6);
+  EXPECT_FALSE(c.holds);
+  EXPECT_TRUE(fem_export::to_json(c)["relative_change"].is_null());
+  EXPECT_TRUE(pair_of(VerdictKind::survives, 0, VerdictKind::survives, 0).holds);
+}
+
+TEST(MeshConvergence, TheReportVerdictStatesIt) {
+  // One mesh: the verdict says its convergence was not checked, and how to check it.
+  ImpactVerdict v = impact_verdict(judged(VerdictKind::yields, false, 0.73, 0, 0));
+  EXPECT_NE(v.convergence.find("not checked (one mesh; [outputs.fem] convergence = \"two-meshes\""), std::string::npos)
+      << v.convergence;
+  EXPECT_EQ(v.word, "yields");
+  // Two meshes whose stress moves: the word says so, the line gives both stresses and the change.
+  ImpactReport ir = judged(VerdictKind::yields, false, 0.73, 0, 0);
+  ir.fem_check->convergence = pair_of(VerdictKind::yields, 2.4e8 / 0.73, VerdictKind::yields, 2.4e8 / 0.54);
+  v = impact_verdict(ir);
+  EXPECT_EQ(v.word, "yields (moves with the mesh)");
+  for (const char* text : {"Mesh convergence: governing von Mises 328.8 MPa (mesh 2 mm", "-> 444.4 MPa (mesh 1 mm",
+                           "outside 13.6 mm of the contact point", "change +35.2 %", "moves with the mesh"})
+    EXPECT_NE(v.convergence.find(text), std::string::npos) << text << " in " << v.convergence;
+  // Two meshes that agree: the word stays.
+  ir.fem_check->convergence = pair_of(VerdictKind::yields, 3.0e8, VerdictKind::yields, 3.1e8);
+  v = impact_verdict(ir);
+  EXPECT_EQ(v.word, "yields");
+  EXPECT_NE(v.convergence.find("the verdict holds"), std::string::npos) << v.convergence;
+}
+
 }  // namespace

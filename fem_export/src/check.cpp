@@ -484,6 +484,7 @@ json to_json(const CheckResult& r) {
   j["model_delta_angular_velocity_rad_s"] = json_vector(r.model_delta_angular_velocity_rad_s);
   j["body"] = to_json(r.body);
   j["stress"] = r.stress ? to_json(*r.stress) : json(nullptr);
+  j["convergence"] = r.convergence ? to_json(*r.convergence) : json(nullptr);
   return j;
 }
 
@@ -519,6 +520,7 @@ std::string format_check(const CheckResult& r) {
   }
   s << format_body(r.body);
   if (r.stress) s << format_stress(*r.stress);
+  if (r.convergence) s << "mesh convergence: " << format_convergence(*r.convergence) << "\n";
   s << "solver wall time " << r.solver_wall_time_s << " s on " << r.solver_threads << " thread(s); " << (r.passed ? "PASSED" : "FAILED") << "\n";
   for (const auto& f : r.failures) s << "  " << f << "\n";
   return s.str();

@@ -449,6 +449,8 @@ DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
     mo.context = r.context;  // the mesher names its own file after it
     mo.quality_floor_gamma = r.options.tolerances.min_gamma;
     mo.output_unit = r.options.units.length;
+    // Curved surfaces get elements along their curvature, so a coarse mesh keeps the part's volume.
+    if (mo.curvature_elements == 0) mo.curvature_elements = curvature_elements_for(r.options.tolerances.volume);
     if (r.options.load == LoadKind::hertz_patch) {
       const double h_patch = 2.0 * r.patch.b_max_m / r.options.contact_elements;
       const double h0 = mo.load_mesh_size_m > 0 ? mo.load_mesh_size_m : mo.mesh_size_m / 3.0;
@@ -538,7 +540,8 @@ DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
       out.patch.max_nodes_loaded_at_once = 1;
     }
     const ScopedTimer decks_timer([&](double sec) { out.decks_seconds += sec; });  // to the end of the writing
-    out.contact_zone_radius_m = std::max(r.options.contact_zone_factor * r.patch.a_max_m, 2.0 * q.load_mesh_size_m);
+    out.contact_zone_radius_m = std::max({r.options.contact_zone_factor * r.patch.a_max_m, 2.0 * q.load_mesh_size_m,
+                                          r.options.min_contact_zone_radius_m});
     out.plastic_zone_radius_m = std::max(kLocalPlasticZoneFactor * std::max(r.patch.a_max_m, r.dent_radius_m),
                                          2.0 * q.load_mesh_size_m);
     out.body_check = compare_body(m, r.material.density_kg_m3, r.model, r.options.tolerances,
@@ -584,6 +587,7 @@ DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
                     {"mesh_size_m", q.mesh_size_m},
                     {"load_mesh_size_m", q.load_mesh_size_m},
                     {"load_zone_radius_m", mo.load_zone_radius_m},
+                    {"curvature_elements_per_2pi", mo.curvature_elements},
                     {"mesh_attempts", to_json(q.attempts)},
                     {"fallback_used", q.attempts.size() > 1}};
     write_file_atomically(stage / "mesh_quality.json", quality.dump(2) + "\n");

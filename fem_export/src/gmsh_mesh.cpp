@@ -92,25 +92,37 @@ std::string size_formula(const Eigen::Vector3d& p_mm, double h0_mm, double h_mm,
   return f.str();
 }
 
-void set_common_options(double h_mm, int algorithm_2d, int algorithm_3d) {
+// Curvature-adapted sizing (MeshOptions::curvature_elements): Gmsh sizes the curves and surfaces
+// for that many elements per 2 pi radians of their curvature, never below the smallest size asked
+// for anywhere else (h0) nor below h / kCurvatureMinSizeDivisor (a small fillet must not flood the
+// mesh; the element count is checked after meshing all the same).
+constexpr double kCurvatureMinSizeDivisor = 4.0;
+double curvature_min_size(const MeshOptions& o, double h_mm, double h0_mm) {
+  return o.curvature_elements > 0 ? std::min(h_mm / kCurvatureMinSizeDivisor, h0_mm) : 0.0;
+}
+
+void set_common_options(const MeshOptions& o, double h_mm, double h0_mm, int algorithm_2d) {
   gmsh::option::setNumber("Mesh.CharacteristicLengthMax", h_mm);
+  gmsh::option::setNumber("Mesh.CharacteristicLengthMin", curvature_min_size(o, h_mm, h0_mm));
   gmsh::option::setNumber("Mesh.CharacteristicLengthFromPoints", 0);
-  gmsh::option::setNumber("Mesh.CharacteristicLengthFromCurvature", 0);
+  gmsh::option::setNumber("Mesh.CharacteristicLengthFromCurvature", o.curvature_elements);
   gmsh::option::setNumber("Mesh.CharacteristicLengthExtendFromBoundary", 0);
   gmsh::option::setNumber("Mesh.Algorithm", algorithm_2d);
-  gmsh::option::setNumber("Mesh.Algorithm3D", algorithm_3d);
+  gmsh::option::setNumber("Mesh.Algorithm3D", o.algorithm_3d);
   gmsh::option::setNumber("Mesh.ElementOrder", 1);
   gmsh::option::setNumber("Mesh.Optimize", 1);
 }
 
-std::string geo_options(double h_mm, int algorithm_2d, int algorithm_3d) {
+std::string geo_options(const MeshOptions& o, double h_mm, double h0_mm, int algorithm_2d) {
   std::ostringstream g;
   g << "Mesh.CharacteristicLengthMax = " << fmt(h_mm) << ";\n"
+    << "Mesh.CharacteristicLengthMin = " << fmt(curvature_min_size(o, h_mm, h0_mm)) << ";\n"
     << "Mesh.CharacteristicLengthFromPoints = 0;\n"
-    << "Mesh.CharacteristicLengthFromCurvature = 0;\n"
+    << "Mesh.CharacteristicLengthFromCurvature = " << o.curvature_elements
+    << "; // elements per 2 Pi of curvature (0: off)\n"
     << "Mesh.CharacteristicLengthExtendFromBoundary = 0;\n"
     << "Mesh.Algorithm = " << algorithm_2d << "; // 1 MeshAdapt, 5 Delaunay, 6 Frontal-Delaunay\n"
-    << "Mesh.Algorithm3D = " << algorithm_3d << "; // 1 Delaunay, 10 HXT\n"
+    << "Mesh.Algorithm3D = " << o.algorithm_3d << "; // 1 Delaunay, 10 HXT\n"
     << "Mesh.ElementOrder = 1;\n"
     << "Mesh.Optimize = 1;\n"
     << "General.NumThreads = 1;\n";
@@ -130,7 +142,7 @@ std::string probe_name(std::size_t i) { return "PROBE" + std::to_string(i + 1); 
 void generate_tets(const InputContext& where, const MeshOptions& o, int algorithm_2d, const Eigen::Vector3d& p_mm,
                    double h0, double h) {
   gmsh_step(where, "mesh", [&] {
-    set_common_options(h, algorithm_2d, o.algorithm_3d);
+    set_common_options(o, h, h0, algorithm_2d);
     add_size_field(p_mm, h0, h, o.load_zone_radius_m * kMmPerM);
     gmsh::model::mesh::generate(3);
   });
@@ -459,7 +471,7 @@ MeshResult mesh_ellipsoid_with_gmsh(const Eigen::Vector3d& semi_axes_m, const Ei
   std::ostringstream g;
   g << geo_header("ellipsoid " + fmt(ax.x()) + " x " + fmt(ax.y()) + " x " + fmt(ax.z()) +
                   " mm (semi-axes), load point at a sphere pole", o);
-  g << "SetFactory(\"OpenCASCADE\");\n" << geo_options(h, alg2, o.algorithm_3d);
+  g << "SetFactory(\"OpenCASCADE\");\n" << geo_options(o, h, h0, alg2);
   g << "Sphere(1) = {0, 0, 0, 1};\n";
   if (angle > 1e-14) {
     g << "Rotate {{" << fmt(axis.x()) << ", " << fmt(axis.y()) << ", " << fmt(axis.z())
@@ -918,7 +930,7 @@ MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& l
                       ")",
                   o, o.output_unit);
   if (attempts.size() > 1) g << "// Settings of try " << kept + 1 << " (see mesh_attempts in mesh_quality.json).\n";
-  g << geo_options(h, t.own_triangles ? 6 : t.algorithm_2d, o.algorithm_3d);
+  g << geo_options(o, h, h0, t.own_triangles ? 6 : t.algorithm_2d);
   g << "Merge \"" << stl_copy.filename().string() << "\";\n";
   if (t.own_triangles) {
     g << "// The part's own triangles are the boundary (no 2D remeshing); LOAD is its vertex at (" << fmt(p.x())
@@ -1033,7 +1045,7 @@ MeshResult mesh_cad_once(const fs::path& cad, double cad_unit_m, const Eigen::Ve
 
   std::ostringstream g;
   g << geo_header("CAD part from " + cad.filename().string() + " (copied as " + copy.filename().string() + ")", o);
-  g << "SetFactory(\"OpenCASCADE\");\nGeometry.OCCTargetUnit = \"MM\";\n" << geo_options(h, alg2, o.algorithm_3d);
+  g << "SetFactory(\"OpenCASCADE\");\nGeometry.OCCTargetUnit = \"MM\";\n" << geo_options(o, h, h0, alg2);
   g << "Merge \"" << copy.filename().string() << "\";\n";
   if (scaled) g << "Dilate {{0, 0, 0}, {" << fmt(scale) << ", " << fmt(scale) << ", " << fmt(scale) << "}} { Volume{:}; }\n";
   const Eigen::Vector3d lp = r.mesh.nodes_m[r.mesh.node_of("LOAD")] * kMmPerM;

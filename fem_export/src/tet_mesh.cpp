@@ -17,6 +17,12 @@ std::string describe(const MeshAttempt& a) {
   return s.str();
 }
 
+int curvature_elements_for(double volume_tolerance) {
+  if (!(volume_tolerance > 0)) return kMaxCurvatureElements;
+  const double n = std::ceil(4.0 / std::sqrt(volume_tolerance));
+  return static_cast<int>(std::clamp(n, double(kMinCurvatureElements), double(kMaxCurvatureElements)));
+}
+
 int TetMesh::node_of(const std::string& group) const {
   for (const auto& [n, i] : node_groups)
     if (n == group) return i;

@@ -569,6 +569,49 @@ struct FemJob {
   fs::path folder;
 };
 
+// The deck's unit system: [outputs.fem] deck_units, else the run's output length unit's.
+fem_export::DeckUnits deck_units(const Scene& scene, const RunReport& report) {
+  const auto& deck_unit = scene.outputs.fem->deck_length_unit;
+  return deck_unit ? fem_export::DeckUnits{*deck_unit} : fem_export::default_deck_units(report.output_length_unit);
+}
+
+// `convergence = "two-meshes"` (docs/fem.md, "Mesh convergence"): the job's deck again at half its
+// element sizes (global and at the load), in its folder's `refined/`, run through the same check;
+// the refined mesh's stress is judged outside the first mesh's contact zone, so both verdicts
+// stand at the same distance from the load.
+fem_export::MeshConvergence refined_mesh_check(const Scene& scene, const RunReport& report, const FemJob& job,
+                                               const fem_export::CheckOptions& co) {
+  const fem_export::DeckResult& first = *job.ir->fem_deck;
+  fem_export::DeckRequest req = fem_request(scene, *job.ir, *job.target);
+  req.options.units = deck_units(scene, report);
+  req.options.mesh.mesh_size_m = first.quality.mesh_size_m / 2;
+  req.options.mesh.load_mesh_size_m = first.quality.load_mesh_size_m / 2;
+  req.options.adapt_mesh_size = false;  // the size is the first mesh's, halved
+  req.options.min_contact_zone_radius_m = first.contact_zone_radius_m;
+  fem_export::MeshConvergence c;
+  c.folder = "refined";
+  const fem_export::DeckResult fine = fem_export::write_deck_files(req, job.folder / c.folder);
+  const fem_export::CheckResult fine_check = fem_export::run_check(fine, co);
+  c.files = fine.files;
+  c.files.insert(c.files.end(), fine_check.solver_files.begin(), fine_check.solver_files.end());
+  if (fine_check.stress) c.files.insert(c.files.end(), fine_check.stress->files.begin(), fine_check.stress->files.end());
+  auto side = [](const fem_export::DeckResult& d, const fem_export::CheckResult& k) {
+    fem_export::ConvergenceMesh m;
+    m.mesh_size_m = d.quality.mesh_size_m;
+    m.load_mesh_size_m = d.quality.load_mesh_size_m;
+    m.node_count = d.node_count;
+    m.tet_count = d.tet_count;
+    if (k.stress) m.verdict = k.stress->verdict;
+    m.solver_wall_time_s = k.solver_wall_time_s;
+    return m;
+  };
+  c.coarse = side(first, *job.ir->fem_check);
+  c.fine = side(fine, fine_check);
+  c.evaluation_radius_m = first.contact_zone_radius_m;
+  fem_export::judge_convergence(c);
+  return c;
+}
+
 // The impacts of sequence `sr` that get an FEM deck (SequenceSpec::fem; docs/sequences.md): the
 // worst one, or every one with a force. An impact asked for without a force (the rigid impulse at
 // a sharp point) gets none: said in the report (fem_not_meshed) and as a warning.
@@ -755,9 +798,7 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
     for (const FemJob& job : fem_jobs) {
       ImpactReport& ir = *job.ir;
       fem_export::DeckRequest req = fem_request(scene, ir, *job.target);
-      const auto& deck_unit = scene.outputs.fem->deck_length_unit;
-      req.options.units = deck_unit ? fem_export::DeckUnits{*deck_unit}
-                                    : fem_export::default_deck_units(report.output_length_unit);
+      req.options.units = deck_units(scene, report);
       ir.fem_deck = fem_export::write_deck_files(req, job.folder);  // errors: req.context
       const auto& patch = ir.fem_deck->patch;
       if (ir.fem_deck->load == fem_export::LoadKind::hertz_patch &&
@@ -785,6 +826,10 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
           co.timeout_s = opt.solver_timeout_s;
           co.threads = opt.solver_threads;
           ir.fem_check = fem_export::run_check(*ir.fem_deck, co);
+          if (scene.outputs.fem->convergence == FemOutputs::Convergence::two_meshes) {
+            // The refined deck's meshing and run are timed in this stage (fem_run).
+            ir.fem_check->convergence = refined_mesh_check(scene, report, job, co);
+          }
         }
       });
     }
@@ -926,6 +971,9 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
       for (auto& f : ir.fem_check->solver_files) written(f);
       if (ir.fem_check->stress) {
         for (auto& f : ir.fem_check->stress->files) written(f);
+      }
+      if (ir.fem_check->convergence) {
+        for (auto& f : ir.fem_check->convergence->files) written(f);
       }
     }
   }

@@ -340,12 +340,27 @@ ImpactVerdict plastic_verdict(const fem_export::Verdict& fv, const fem_export::P
 
 }  // namespace
 
+// The FEM verdict's mesh convergence line (ImpactVerdict::convergence).
+void state_convergence(const fem_export::CheckResult& check, ImpactVerdict& v) {
+  if (!check.convergence) {
+    v.convergence = "Mesh convergence: not checked (one mesh; [outputs.fem] convergence = \"two-meshes\" checks it)";
+    return;
+  }
+  const fem_export::MeshConvergence& c = *check.convergence;
+  v.convergence = "Mesh convergence: " + fem_export::format_convergence(c);
+  if (!c.holds) v.word += " (moves with the mesh)";
+}
+
 ImpactVerdict impact_verdict(const ImpactReport& ir) {
   ImpactVerdict v;
   if (ir.fem_check && ir.fem_check->stress && ir.fem_check->stress->verdict.yield_strength_Pa) {
     const fem_export::StressResult& st = *ir.fem_check->stress;
     const fem_export::Verdict& fv = st.verdict;
-    if (st.plastic) return plastic_verdict(fv, *st.plastic);
+    if (st.plastic) {
+      v = plastic_verdict(fv, *st.plastic);
+      state_convergence(*ir.fem_check, v);
+      return v;
+    }
     v.kind = fv.kind == fem_export::VerdictKind::yields ? ImpactVerdict::Kind::yields : ImpactVerdict::Kind::survives;
     v.word = fem_export::to_string(fv.kind);
     v.safety_factor = fv.safety_factor;
@@ -353,6 +368,7 @@ ImpactVerdict impact_verdict(const ImpactReport& ir) {
               g(fv.governing.von_mises_Pa / 1e6, 3) + " MPa " + fv.governing_region + ", at " +
               vec3(fv.governing.point_m, 1e3, 3) + " mm (the deck's frame), t = " + g(fv.governing.time_s * 1e6, 3) +
               " \xC2\xB5s";
+    state_convergence(*ir.fem_check, v);
     return v;
   }
   const collision::ValidityReport& r = ir.validity;
@@ -400,7 +416,7 @@ std::string report_html(const Scene& scene, const RunReport& rep, const std::vec
   int overall_rank = -1;
   std::optional<double> worst;
   std::vector<std::vector<std::string>> verdict_rows;
-  std::string governing;
+  std::string governing, convergence;
   for (const ImpactReport* p : judged) {
     const ImpactReport& ir = *p;
     const ImpactVerdict v = impact_verdict(ir);
@@ -413,6 +429,7 @@ std::string report_html(const Scene& scene, const RunReport& rep, const std::vec
         overall = v.kind;
         overall_word = v.word;
         governing = "impact '" + ir.spec->name + "': " + v.basis;
+        convergence = v.convergence;
       }
       if (smaller) worst = v.safety_factor;
       word = outcome(v.kind == ImpactVerdict::Kind::survives, word);
@@ -426,6 +443,9 @@ std::string report_html(const Scene& scene, const RunReport& rep, const std::vec
             std::string(overall == ImpactVerdict::Kind::yields ? "fail" : overall == ImpactVerdict::Kind::survives ? "pass" : "") +
             "\">" + plot::html_escape(verdict) + "</p>");
   if (!governing.empty()) page.html("<p id=\"governing\" class=\"governing\">" + plot::html_escape(governing) + "</p>");
+  if (!convergence.empty()) {
+    page.html("<p id=\"convergence\" class=\"governing\">" + plot::html_escape(convergence) + "</p>");
+  }
   page.paragraph(rep.all_checks_passed() ? "Every self-check passed." : "A self-check failed (see below).",
                  rep.all_checks_passed() ? "pass" : "fail");
   page.table({"impact", "verdict", "safety factor", "basis"}, verdict_rows);

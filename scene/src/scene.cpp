@@ -454,7 +454,7 @@ FemOutputs read_fem(const toml::table& t, const Source& file, double to_m) {
            "volume_tolerance", "mass_tolerance", "inertia_tolerance", "min_gamma", "max_elements", "solver",
            "aster_cpus", "aster_mpi_processes", "compare_contact", "compare_contact_threshold", "compare_contact_refine",
            "compare_contact_elements", "compare_contact_increments", "compare_contact_penalty_factor",
-           "material_model", "deck_units"});
+           "material_model", "deck_units", "convergence"});
   FemOutputs f;
   f.place = r.self();
   if (r.has("mesh_size")) f.mesh_size_m = r.positive("mesh_size") * to_m;
@@ -494,6 +494,12 @@ FemOutputs read_fem(const toml::table& t, const Source& file, double to_m) {
   f.run = r.choice<FemOutputs::Run>("run", {{"none", FemOutputs::Run::none}, {"calculix", FemOutputs::Run::calculix}},
                                     FemOutputs::Run::none);
   if (f.run == FemOutputs::Run::calculix && !f.calculix) r.fail("run", "run = \"calculix\" needs calculix = true");
+  f.convergence = r.choice<FemOutputs::Convergence>(
+      "convergence", {{"none", FemOutputs::Convergence::none}, {"two-meshes", FemOutputs::Convergence::two_meshes}},
+      FemOutputs::Convergence::none);
+  if (f.convergence == FemOutputs::Convergence::two_meshes && f.run != FemOutputs::Run::calculix) {
+    r.fail("convergence", "convergence = \"two-meshes\" compares two ccx runs: it needs run = \"calculix\"");
+  }
   f.load = r.choice<FemOutputs::Load>("load", {{"point", FemOutputs::Load::point},
                                                {"hertz-patch", FemOutputs::Load::hertz_patch}},
                                       FemOutputs::Load::point);

@@ -32,6 +32,7 @@
 #include <Eigen/Dense>
 #include <nlohmann/json.hpp>
 
+#include "impactdeck/fem_export/convergence.hpp"
 #include "impactdeck/fem_export/decks.hpp"
 #include "impactdeck/fem_export/stress.hpp"
 
@@ -109,6 +110,9 @@ struct CheckResult {
   double model_linear_velocity_tolerance = 0, model_angular_velocity_tolerance = 0;
   BodyComparison body;                 ///< the FE body against the part
   std::optional<StressResult> stress;  ///< when the run wrote impact.frd
+  /// The verdict on a second mesh of half the size (`convergence = "two-meshes"`; the caller runs
+  /// it and fills this in: convergence.hpp).
+  std::optional<MeshConvergence> convergence;
   bool passed = false;
   std::vector<std::string> failures;   ///< one line per failed check
 };

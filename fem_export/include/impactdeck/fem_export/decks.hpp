@@ -217,6 +217,9 @@ struct DeckOptions {
   /// Radius of the contact zone (von Mises inside it is reported apart) in contact semi-axes
   /// a_max; it is never less than 2 load element sizes.
   double contact_zone_factor = 3.0;
+  /// The contact zone is never smaller than this (m): the refined mesh of a convergence check
+  /// judges its stress at the first mesh's distance (convergence.hpp).
+  double min_contact_zone_radius_m = 0;
   FemTolerances tolerances;
   /// ccx writes stresses and displacements (.frd) every increment; when nodes x increments of the
   /// free-vibration step would exceed this, every k-th increment instead (velocities too).

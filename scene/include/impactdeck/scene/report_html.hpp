@@ -37,6 +37,10 @@ struct ImpactVerdict {
   /// (a plastic deck's von Mises is capped near the yield strength: the strain is the measure).
   std::optional<double> safety_factor;
   std::string basis;  ///< what it was judged on
+  /// The FEM verdict's mesh convergence (fem_export/convergence.hpp): "holds" or "moves with the
+  /// mesh" with both meshes' governing stresses; "not checked" after a one-mesh ccx run; empty
+  /// without FEM stresses. A verdict that moves with the mesh says so in `word` too.
+  std::string convergence;
 };
 ImpactVerdict impact_verdict(const ImpactReport& ir);
 

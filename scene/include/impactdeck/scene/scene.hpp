@@ -132,6 +132,10 @@ struct FemOutputs {
   int aster_cpus = 1;           ///< Code_Aster .export `P ncpus`
   int aster_mpi_processes = 1;  ///< Code_Aster .export `P mpi_nbcpu`
   enum class Run { none, calculix } run = Run::none;  ///< "calculix": run ccx and the check
+  /// `convergence`: "none" (one mesh) or "two-meshes": the deck again at half the element size,
+  /// run and judged at the first mesh's distance from the load (fem_export/convergence.hpp);
+  /// needs run = "calculix".
+  enum class Convergence { none, two_meshes } convergence = Convergence::none;
   /// "point": F(t) on the contact node; "hertz-patch": the Hertz pressure of each instant's
   /// contact ellipse as nodal forces (docs/fem.md).
   enum class Load { point, hertz_patch } load = Load::point;
