@@ -449,8 +449,11 @@ DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
     mo.context = r.context;  // the mesher names its own file after it
     mo.quality_floor_gamma = r.options.tolerances.min_gamma;
     mo.output_unit = r.options.units.length;
-    // Curved surfaces get elements along their curvature, so a coarse mesh keeps the part's volume.
-    if (mo.curvature_elements == 0) mo.curvature_elements = curvature_elements_for(r.options.tolerances.volume);
+    // Curvature sizing (docs/fem.md), when the mesh at the asked sizes cannot be made or misses the
+    // part's volume by more than the tolerance: curved surfaces then get N elements per 2 pi of
+    // their curvature. 0: the request set its own (or none).
+    const int curvature_retry =
+        mo.curvature_elements == 0 ? curvature_elements_for(r.options.tolerances.volume) : 0;
     if (r.options.load == LoadKind::hertz_patch) {
       const double h_patch = 2.0 * r.patch.b_max_m / r.options.contact_elements;
       const double h0 = mo.load_mesh_size_m > 0 ? mo.load_mesh_size_m : mo.mesh_size_m / 3.0;
@@ -467,7 +470,38 @@ DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
       }
       return mesh_part(r.body.surface, r.load_point_m, mo, stage, "mesh", r.body.name);
     };
-    MeshResult mr = mesh_once();
+    MeshResult mr;
+    std::string first_failure;
+    try {
+      mr = mesh_once();
+    } catch (const InputError& e) {
+      if (curvature_retry == 0) throw;
+      first_failure = e.reason();
+    }
+    if (curvature_retry > 0) {
+      std::string why;
+      std::vector<MeshAttempt> flat;
+      if (!first_failure.empty()) {
+        why = "no mesh at the asked sizes (" + first_failure + ")";
+      } else if (r.model.volume_m3 > 0) {
+        const BodyComparison bc = compare_body(mr.mesh, r.material.density_kg_m3, r.model, r.options.tolerances,
+                                               r.impulse_Ns * r.direction, r.load_point_m);
+        if (bc.volume_relative_error > r.options.tolerances.volume) {
+          std::ostringstream w;
+          w << std::setprecision(3) << "FE volume " << 100 * bc.volume_relative_error << " % off the part's (tolerance "
+            << 100 * r.options.tolerances.volume << " %)";
+          why = w.str();
+          flat = mr.quality.attempts;
+        }
+      }
+      if (!why.empty()) {
+        for (auto& a : flat)
+          if (a.outcome == "ok") a.outcome = why + ": meshed again with curvature sizing";
+        mo.curvature_elements = curvature_retry;
+        mr = mesh_once();
+        mr.quality.attempts.insert(mr.quality.attempts.begin(), flat.begin(), flat.end());
+      }
+    }
     if (r.options.adapt_mesh_size && r.model.volume_m3 > 0) {
       // A default size: refine until the FE body matches the part to half the tolerances.
       const FemTolerances& tol = r.options.tolerances;
