@@ -111,6 +111,11 @@ class ThorntonLaw final : public ContactLaw {
 
 }  // namespace
 
+double yield_velocity_m_s(double m, double E, double R, double py) {
+  const double c = M_PI / (2.0 * E);
+  return c * c * std::sqrt(8.0 * M_PI * R * R * R / (15.0 * m)) * py * py * std::sqrt(py);
+}
+
 std::shared_ptr<const ContactLaw> make_thornton_law(const LawOptions& options) {
   return std::make_shared<const ThorntonLaw>(options.limiting_pressure_Pa);
 }

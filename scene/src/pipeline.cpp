@@ -292,8 +292,8 @@ void describe_law(const Scene& scene, const ImpactSpec& s, const ImpactLaw& law,
   const collision::LawResult& l = r.history.law_result;
   ir.law = law;
   if (law.limiting_pressure_Pa) {
-    ir.yield_velocity_m_s =
-        yield_velocity_m_s(r.reduced_mass_kg, r.effective_modulus_Pa, r.effective_radius_m, *law.limiting_pressure_Pa);
+    ir.yield_velocity_m_s = collision::yield_velocity_m_s(r.reduced_mass_kg, r.effective_modulus_Pa,
+                                                          r.effective_radius_m, *law.limiting_pressure_Pa);
   }
   const bool elastic = ir.yield_velocity_m_s && r.approach_velocity_m_s <= *ir.yield_velocity_m_s;
   ir.contact_law = law.automatic && law.name != "hertz" && elastic ? "hertz" : law.name;

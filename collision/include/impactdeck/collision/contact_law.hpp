@@ -99,6 +99,12 @@ class ContactLaw {
 /// yield under a circular Hertz contact, p0 = 1.60 Y for nu = 0.3 (Johnson 1985, Sect. 6.2).
 inline constexpr double kThorntonYieldFactor = 1.6;
 
+/// Johnson's yield velocity (Johnson 1985, Sect. 11.4; docs/plastic.md): the approach speed at which
+/// a Hertz impact first reaches the limiting pressure p_y, 1/2 m* V_y^2 = W_y = 2/5 F_y d_y:
+/// V_y = (pi / (2 E*))^2 (8 pi R*^3 / (15 m*))^(1/2) p_y^(5/2). Below it "thornton" is elastic.
+double yield_velocity_m_s(double reduced_mass_kg, double effective_modulus_Pa, double effective_radius_m,
+                          double limiting_pressure_Pa);
+
 /// The default indentation hardness of the laws "wedge" and "cone" over the weaker body's yield
 /// strength: a fully plastic indentation by a sharp indenter, H = 3 Y (Tabor 1951; Johnson 1985,
 /// Sect. 6.5). A sharp edge or corner is fully plastic at once.
