@@ -415,3 +415,35 @@ TEST(ThorntonLaw, YieldVelocityIsTheOnsetOfYield) {
   s.V = (1.0 + 1e-9) * Vy;
   EXPECT_GT(solve_with(*law, s).residual_indentation_m, 0.0);
 }
+
+// The dent's radius and the unloading's radius come from the law (LawResult::dent_radius_m,
+// unloading_radius_m: run's reports, the deck request and a sequence's dents read them): Thornton's
+// contact circle a* = sqrt(R* d*) and R_p = 4 E* / (3 F*) ((2 F* + F_y) / (2 pi p_y))^1.5 (his closed
+// form, F_y written here); below V_y and for Hertz no dent and R_p = R*.
+TEST(ThorntonLaw, DentAndUnloadingRadiiAreTheClosedForms) {
+  Steel s;
+  const double py = kThorntonYieldFactor * s.Y;
+  const ThorntonCurves c(s, py);
+  const double Vy = yield_velocity_m_s(s.m, s.E_star, s.R, py);
+  const auto law = make_contact_law("thornton", LawOptions{});
+  for (double ratio : {1.5, 100.0, 1e4}) {
+    s.V = ratio * Vy;
+    const LawResult t = solve_with(*law, s);
+    ASSERT_EQ(t.status, LawStatus::ok);
+    const double a = std::sqrt(s.R * t.max_indentation_m);
+    EXPECT_NEAR(t.dent_radius_m, a, test::kClosedFormRel * a) << ratio;
+    const double F = t.max_force_N;
+    const double Rp = 4.0 * s.E_star / (3.0 * F) * std::pow((2.0 * F + c.Fy) / (2.0 * M_PI * py), 1.5);
+    EXPECT_NEAR(t.unloading_radius_m, Rp, test::kClosedFormRel * Rp) << ratio;
+    EXPECT_GT(Rp, s.R);  // the dent is flatter than the part
+  }
+  s.V = 0.5 * Vy;
+  const LawResult t = solve_with(*law, s);
+  EXPECT_EQ(t.dent_radius_m, 0.0);
+  EXPECT_EQ(t.unloading_radius_m, s.R);
+  LawOptions elastic;
+  elastic.restitution = constant(0.7);
+  const LawResult h = solve_with(*make_contact_law("hertz", elastic), s);
+  EXPECT_EQ(h.dent_radius_m, 0.0);
+  EXPECT_EQ(h.unloading_radius_m, s.R);
+}

@@ -86,8 +86,7 @@ Bounce apply_bounce(const SequenceInput& in, std::size_t index, const BodyState&
     b.body_jump = r.target_jump;
     b.floor_jump = r.impactor_jump;
     b.friction = b.impact->friction;
-    const collision::LawResult& l = r.history.law_result;
-    b.dent_radius_m = l.residual_indentation_m > 0.0 ? std::sqrt(r.effective_radius_m * l.max_indentation_m) : 0.0;
+    b.dent_radius_m = r.history.law_result.dent_radius_m;  // the law's (wedge, cone: the indent's size)
   } else {
     const collision::ContactFlag f = b.contact.result.flag;
     const bool geometric = f == collision::ContactFlag::sharp || f == collision::ContactFlag::no_curvature ||

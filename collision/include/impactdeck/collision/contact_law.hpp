@@ -60,6 +60,14 @@ struct LawResult {
   double impulse_compression_Ns = 0;  ///< m_w v_w
   double impulse_total_Ns = 0;        ///< (1 + R) m_w v_w
   double residual_indentation_m = 0;  ///< the dent left behind (0 for an elastic law)
+  /// The dent's radius on the surface (0 when there is no dent): "thornton", "jackson-green" the
+  /// contact circle at d*, hertz_contact_radius_m(R*, d*) = sqrt(R* d*); "wedge" the indent's
+  /// half-width x* tan(beta) (at most L/2); "cone" the indent's radius x* tan(alpha).
+  double dent_radius_m = 0;
+  /// R_p of the Hertz unloading F = 4/3 E* sqrt(R_p) (d - d_p)^1.5 through (d*, F*): R* for an
+  /// elastic Hertz impact, Thornton's R_p, Brake's R_bar; 0 for a law whose unloading is not a
+  /// Hertz curve ("wedge", "cone", "line").
+  double unloading_radius_m = 0;
   std::array<double, 4> state{};      ///< the law's own numbers for its F(t); opaque to callers
   /// The law's own contact patch at F_max (semi-axes a >= b) and its pressure there; 0: the kernel
   /// takes the Hertz ellipse of F_max (every law but "wedge" and "cone").
