@@ -2,7 +2,10 @@
 // its self-checks, and a force table at the default tolerance.
 #include <benchmark/benchmark.h>
 
+#include <vector>
+
 #include "impactdeck/collision/compression.hpp"
+#include "impactdeck/collision/contact_law.hpp"
 #include "impactdeck/collision/force_history.hpp"
 #include "impactdeck/collision/impact.hpp"
 
@@ -70,5 +73,57 @@ static void BM_Curve1000Samples(benchmark::State& st) {
   }
 }
 BENCHMARK(BM_Curve1000Samples);
+
+// Jackson - Green integrates its plastic loading (an ODE): 2000 samples of its F(t) over [0, t_c]
+// one force_N call each (one integration from t = 0 per sample, as study::sample_curve did) against
+// each phase in one call (loading_forces / unloading_forces: one integration; sample_curve now,
+// and the force table of sample_force_table).
+static LawResult jackson_green_result(const ContactLaw& law) {
+  LawInput in;
+  in.reduced_mass_kg = 1.0;
+  in.approach_velocity_m_s = 4.43;  // a 1 m drop
+  in.effective_modulus_Pa = 210e9 / (2.0 * (1.0 - 0.09));
+  in.effective_radius_m = 5e-3;
+  in.yield_strength_Pa = 350e6;
+  LawResult r;
+  law.solve(&in, &r, 1);
+  return r;
+}
+
+constexpr int kJacksonGreenSamples = 2000;
+
+static void BM_JacksonGreen2000ForceN(benchmark::State& st) {
+  LawOptions o;
+  o.youngs_modulus_Pa = 210e9;
+  const auto law = make_contact_law("jackson-green", o);
+  const LawResult r = jackson_green_result(*law);
+  for (auto _ : st) {
+    double s = 0;
+    for (int i = 0; i < kJacksonGreenSamples; ++i) {
+      s += law->force_N(r, r.contact_time_s * i / (kJacksonGreenSamples - 1.0));
+    }
+    benchmark::DoNotOptimize(s);
+  }
+}
+BENCHMARK(BM_JacksonGreen2000ForceN)->Unit(benchmark::kMillisecond);
+
+static void BM_JacksonGreen2000Phases(benchmark::State& st) {
+  LawOptions o;
+  o.youngs_modulus_Pa = 210e9;
+  const auto law = make_contact_law("jackson-green", o);
+  const LawResult r = jackson_green_result(*law);
+  const int n = kJacksonGreenSamples / 2;
+  std::vector<double> t(n), u(n), f(2 * n);
+  for (int i = 0; i < n; ++i) {
+    t[i] = r.compression_time_s * i / (n - 1.0);
+    u[i] = (i + 1.0) / n;
+  }
+  for (auto _ : st) {
+    law->loading_forces(r, t.data(), f.data(), n);
+    law->unloading_forces(r, u.data(), f.data() + n, n);
+    benchmark::DoNotOptimize(f.data());
+  }
+}
+BENCHMARK(BM_JacksonGreen2000Phases)->Unit(benchmark::kMillisecond);
 
 BENCHMARK_MAIN();

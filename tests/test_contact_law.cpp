@@ -23,6 +23,7 @@
 #include "impactdeck/collision/impact.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impact_cases.hpp"
+#include "tolerances.hpp"
 
 using namespace impactdeck;
 using namespace impactdeck::collision;
@@ -390,4 +391,59 @@ TEST(ThorntonLaw, ClosedFormAgainstOdeIntegration) {
     EXPECT_NEAR(r.contact_time_s, tu, kThorntonOdeRel * tu);
     EXPECT_NEAR(r.restitution.coefficient, -yu[1] / s.V, kThorntonOdeRel * r.restitution.coefficient);
   }
+}
+
+// collision::yield_velocity_m_s, the one owner of V_y (scene's reports and compare_contact read it):
+// 1/2 m V_y^2 = W_y = 2/5 F_y d_y with F_y, d_y of the onset of yield written here from
+// BEYOND_HERTZ.md's a_y, d_y, F_y; Johnson's 1.56 (p_y^5 / (E*^4 rho))^(1/2) for a solid sphere
+// on a rigid flat (printed with 3 digits); and the speed where "thornton" starts to leave a dent.
+TEST(ThorntonLaw, YieldVelocityIsTheOnsetOfYield) {
+  Steel s;
+  const double py = kThorntonYieldFactor * s.Y;
+  const ThorntonCurves c(s, py);
+  const double Vy = yield_velocity_m_s(s.m, s.E_star, s.R, py);
+  const double Wy = 0.4 * c.Fy * c.dy;
+  EXPECT_NEAR(Vy, std::sqrt(2.0 * Wy / s.m), test::kClosedFormRel * Vy);
+  // A solid steel sphere of radius R on a rigid flat: m = 4/3 pi R^3 rho, R* = R.
+  const double rho = 7850.0, m_sphere = 4.0 / 3.0 * M_PI * std::pow(s.R, 3) * rho;
+  const double johnson = 1.56 * std::sqrt(std::pow(py, 5) / (std::pow(s.E_star, 4) * rho));
+  EXPECT_NEAR(yield_velocity_m_s(m_sphere, s.E_star, s.R, py), johnson, half_last_digit(1.56) / 1.56 * johnson);
+  // The law's own elastic limit is V_y.
+  const auto law = make_contact_law("thornton", LawOptions{});
+  s.V = (1.0 - 1e-9) * Vy;
+  EXPECT_EQ(solve_with(*law, s).residual_indentation_m, 0.0);
+  s.V = (1.0 + 1e-9) * Vy;
+  EXPECT_GT(solve_with(*law, s).residual_indentation_m, 0.0);
+}
+
+// The dent's radius and the unloading's radius come from the law (LawResult::dent_radius_m,
+// unloading_radius_m: run's reports, the deck request and a sequence's dents read them): Thornton's
+// contact circle a* = sqrt(R* d*) and R_p = 4 E* / (3 F*) ((2 F* + F_y) / (2 pi p_y))^1.5 (his closed
+// form, F_y written here); below V_y and for Hertz no dent and R_p = R*.
+TEST(ThorntonLaw, DentAndUnloadingRadiiAreTheClosedForms) {
+  Steel s;
+  const double py = kThorntonYieldFactor * s.Y;
+  const ThorntonCurves c(s, py);
+  const double Vy = yield_velocity_m_s(s.m, s.E_star, s.R, py);
+  const auto law = make_contact_law("thornton", LawOptions{});
+  for (double ratio : {1.5, 100.0, 1e4}) {
+    s.V = ratio * Vy;
+    const LawResult t = solve_with(*law, s);
+    ASSERT_EQ(t.status, LawStatus::ok);
+    const double a = std::sqrt(s.R * t.max_indentation_m);
+    EXPECT_NEAR(t.dent_radius_m, a, test::kClosedFormRel * a) << ratio;
+    const double F = t.max_force_N;
+    const double Rp = 4.0 * s.E_star / (3.0 * F) * std::pow((2.0 * F + c.Fy) / (2.0 * M_PI * py), 1.5);
+    EXPECT_NEAR(t.unloading_radius_m, Rp, test::kClosedFormRel * Rp) << ratio;
+    EXPECT_GT(Rp, s.R);  // the dent is flatter than the part
+  }
+  s.V = 0.5 * Vy;
+  const LawResult t = solve_with(*law, s);
+  EXPECT_EQ(t.dent_radius_m, 0.0);
+  EXPECT_EQ(t.unloading_radius_m, s.R);
+  LawOptions elastic;
+  elastic.restitution = constant(0.7);
+  const LawResult h = solve_with(*make_contact_law("hertz", elastic), s);
+  EXPECT_EQ(h.dent_radius_m, 0.0);
+  EXPECT_EQ(h.unloading_radius_m, s.R);
 }

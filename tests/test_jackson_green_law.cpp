@@ -380,3 +380,30 @@ TEST(JacksonGreenLaw, ThroughTheKernelAndCompleteImpact) {
   EXPECT_EQ(r.kernel.max_force_N, direct.max_force_N);
   EXPECT_EQ(r.kernel.contact_time_s, direct.contact_time_s);
 }
+
+// The dent's and the unloading's radii come from the law (LawResult::dent_radius_m,
+// unloading_radius_m): the contact circle sqrt(R* d_m) where Brake's d_bar > 0, and
+// R_bar = F_m^2 / ((4/3 E*)^2 (d_m - d_bar)^3); below the elastic limit no dent and R_bar = R*.
+TEST(JacksonGreenLaw, DentAndUnloadingRadiiAreBrakes) {
+  Steel s;
+  const auto law = make_contact_law("jackson-green", options_of(s));
+  for (double drop : {1.0, 0.05}) {
+    s.V = std::sqrt(2.0 * 9.81 * drop);
+    const LawResult j = solve_with(*law, s);
+    ASSERT_EQ(j.status, LawStatus::ok);
+    ASSERT_GT(j.residual_indentation_m, 0.0);
+    const double a = std::sqrt(s.R * j.max_indentation_m);
+    EXPECT_NEAR(j.dent_radius_m, a, kFormulaRel * a) << drop;
+    // d_m - d_bar from the result's fields carries d_m / (d_m - d_bar) times an ulp of d_m (18 at the
+    // 1 m drop), cubed into R_bar: the formula's tolerance times that ratio.
+    const double du = j.max_indentation_m - j.residual_indentation_m;
+    const double R_bar = std::pow(j.max_force_N / (4.0 / 3.0 * s.E_star), 2) / (du * du * du);
+    EXPECT_NEAR(j.unloading_radius_m, R_bar, j.max_indentation_m / du * kFormulaRel * R_bar) << drop;
+  }
+  s.V = 1e-3;  // Hertz throughout
+  const LawResult e = solve_with(*law, s);
+  ASSERT_EQ(e.status, LawStatus::ok);
+  EXPECT_EQ(e.residual_indentation_m, 0.0);
+  EXPECT_EQ(e.dent_radius_m, 0.0);
+  EXPECT_EQ(e.unloading_radius_m, s.R);
+}

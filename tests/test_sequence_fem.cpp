@@ -33,6 +33,8 @@ constexpr double kSameImpactRel = 1e-12;
 /// A deck's vectors (own frame) against the bounce's rotated back by its orientation: a rotation
 /// of unit vectors and of impulses, a few ulps.
 constexpr double kSameDeckRel = 1e-12;
+/// A dent's size against its closed form written here (x* tan(angle), sqrt(R* d*)): a few ulps.
+constexpr double kDentRadiusRel = 1e-12;
 
 std::string exact(double x) {
   std::ostringstream s;
@@ -172,6 +174,32 @@ TEST_P(SequenceSharp, FirstBounceIsTheSingleImpact) {
     EXPECT_NEAR(x, y, kSameImpactRel * std::max(std::abs(y), 1e-300)) << key;
   }
   EXPECT_GT(bounce["max_force_N"].get<double>(), 0.0);
+
+  // The dent the bounce records (where a later bounce lands in it) is the law's: the wedge's
+  // half-width x* tan(beta) and the cone's radius x* tan(alpha) (issue 30: both were 0), Thornton's
+  // sqrt(R* d*), none for the elastic laws; the same as the report's and the single impact's.
+  ASSERT_TRUE(b.impact.has_value());
+  const collision::ImpactResult& ir = b.impact->result;
+  const double x = ir.history.law_result.max_indentation_m;
+  const collision::ContactCurvature& t = b.contact.input.target.curvature;
+  const collision::ContactCurvature& f = t.feature != collision::SharpKind::none ? t : b.contact.input.impactor.curvature;
+  const std::string law = c.law;
+  double dent = 0.0;
+  if (law == "wedge") {
+    dent = x * std::tan(0.5 * f.feature_angle_rad);
+    EXPECT_LT(dent, 0.5 * f.feature_length_m);
+  } else if (law == "cone") {
+    dent = x * std::tan(f.feature_angle_rad);
+  } else if (law == "thornton") {
+    dent = std::sqrt(ir.effective_radius_m * x);
+  }
+  if (dent > 0.0) {
+    EXPECT_NEAR(b.dent_radius_m, dent, kDentRadiusRel * dent);
+  } else {
+    EXPECT_EQ(b.dent_radius_m, 0.0);
+  }
+  EXPECT_EQ(bounce["dent_radius_m"].get<double>(), b.dent_radius_m);
+  EXPECT_NEAR(single["dent_radius_m"].get<double>(), b.dent_radius_m, kSameImpactRel * b.dent_radius_m);
 }
 
 INSTANTIATE_TEST_SUITE_P(Laws, SequenceSharp, ::testing::ValuesIn(sharp_cases()),

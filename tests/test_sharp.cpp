@@ -39,6 +39,8 @@ constexpr double kFarBoxRel = 1e-9;
 /// A law's closed form against an rk8pd integration of m x'' = -F(x) at rtol 1e-12 and against
 /// quadrature of its F(t) at 1e-12: 1e-8 (the suite's ODE figure, tolerances.hpp kOdeCurveRel).
 constexpr double kLawOdeRel = 1e-8;
+/// The indent's size x* tan(angle): the product the law forms, written here again (a few ulps).
+constexpr double kDentRadiusRel = 1e-12;
 /// The same impact through the scene (a box corner rounded to rho) and as a sphere of radius rho
 /// with the box's reduced mass: the same formulas on the same numbers, but the reduced mass goes
 /// through the tensor form of Eq. 21 with lever arms, so a few ulps apart.
@@ -220,6 +222,11 @@ TEST(SharpLaws, WedgeAndConeAgainstEnergyBalanceIntegrationAndUnloading) {
     EXPECT_LT(r.restitution.coefficient, 0.5);  // a sharp indent in steel is nearly fully plastic
     EXPECT_DOUBLE_EQ(r.contact_semi_axis_a_m, a);
     EXPECT_DOUBLE_EQ(r.contact_semi_axis_b_m, b);
+    // The dent's size (LawResult::dent_radius_m; a sequence's dents and run's report read it): the
+    // wedge's half-width x* tan(beta) (the long edge: below L/2), the cone's radius x* tan(alpha).
+    if (edge) EXPECT_LT(half_width, 0.5 * in.sharp_length_m);
+    EXPECT_NEAR(r.dent_radius_m, half_width, kDentRadiusRel * half_width) << law->name();
+    EXPECT_EQ(r.unloading_radius_m, 0.0);  // a flat punch, not a Hertz curve
     EXPECT_NEAR(r.contact_pressure_Pa, ind.p, kLawOdeRel * ind.p);
     RecordProperty(std::string(law->name()) + "_restitution", std::to_string(r.restitution.coefficient));
     RecordProperty(std::string(law->name()) + "_dent_um", std::to_string(r.residual_indentation_m * 1e6));
@@ -265,6 +272,8 @@ TEST(SharpLaws, LineContactIsHarmonicAndElastic) {
   EXPECT_NEAR(r.compression_time_s, 0.5 * M_PI * std::sqrt(in.reduced_mass_kg / k), kLawOdeRel * r.compression_time_s);
   EXPECT_EQ(r.restitution.coefficient, 1.0);
   EXPECT_EQ(r.residual_indentation_m, 0.0);
+  EXPECT_EQ(r.dent_radius_m, 0.0);  // elastic: no dent
+  EXPECT_EQ(r.unloading_radius_m, 0.0);
   EXPECT_NEAR(impulse(*law, r, 0.0, r.contact_time_s), 2.0 * in.approach_velocity_m_s, kLawOdeRel * 2.0);
 }
 
@@ -422,6 +431,12 @@ TEST(SharpScene, BoxOnEdgeWedgeAndRoundedLineContact) {
   EXPECT_NEAR(line["effective_radius_m"].get<double>(), 5e-4, 1e-15);
   EXPECT_EQ(line["restitution"].get<double>(), 1.0);
   EXPECT_TRUE(line["checks"]["passed"].get<bool>());
+  // The dent: the wedge's half-width x* tan(beta) (the half dihedral angle as the report gives it);
+  // the line contact is elastic and leaves none (its strip is a contact patch, not a dent).
+  const double beta = 0.5 * wedge["sharp_feature"]["dihedral_angle_deg"].get<double>() * M_PI / 180.0;
+  const double half_width = wedge["max_indentation_m"].get<double>() * std::tan(beta);
+  EXPECT_NEAR(wedge["dent_radius_m"].get<double>(), half_width, kDentRadiusRel * half_width);
+  EXPECT_EQ(line["dent_radius_m"].get<double>(), 0.0);
   // Hertz alone on the sharp edge refuses.
   EXPECT_NE(error_of(box_drop(kEdge, 45, "", "contact_law = \"hertz\"")).find("edge_radius"), std::string::npos);
 }

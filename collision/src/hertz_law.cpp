@@ -41,6 +41,7 @@ HertzLaw::HertzLaw(RestitutionModel restitution, const InputContext& ctx) : rest
 void HertzLaw::solve_one(const LawInput& in, LawResult& r) const noexcept {
   r.status = hertz_compression(in, r, r.stiffness);
   if (r.status == LawStatus::ok) r.status = hertz_restitution(restitution_, in, r);
+  r.unloading_radius_m = in.effective_radius_m;  // no dent: the unloading is Hertz's own curve
 }
 
 void HertzLaw::solve(const LawInput* in, LawResult* out, std::size_t count) const noexcept {

@@ -265,7 +265,7 @@ class JacksonGreenLaw final : public ContactLaw {
     const double energy = 0.5 * m * V * V;
     if (!(energy > 0.4 * kH * d1 * d1 * std::sqrt(d1))) {  // Hertz throughout: e = 1
       const CompressionPhase hertz = compression_phase(m, V, kH);
-      detail::elastic_hertz_result(hertz, r);
+      detail::elastic_hertz_result(hertz, R, r);
     } else {
       const double T = std::sqrt(m * dc / Fc);
       Phases p;
@@ -282,7 +282,7 @@ class JacksonGreenLaw final : public ContactLaw {
       r.unloading_time_s = compression_time_factor() * du / Vr_curve;
       r.contact_time_s = r.compression_time_s + r.unloading_time_s;
       r.restitution.coefficient = std::min(1.0, Vr_curve / V);
-      r.residual_indentation_m = d_m - du;
+      detail::hertz_unloading(R, E, du, r);  // d_bar = d_m - du, its radius, R_bar
       r.state = {T, Fc, p.v_star, s};
     }
     detail::finish_plastic_result(r);

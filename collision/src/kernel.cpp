@@ -275,7 +275,8 @@ inline void step_pressure(const KernelInput& in, const RelativeCurvatures& rc, c
   } else {
     // a = (3 F R / 4 E*)^(1/3) = sqrt(R x_max) at the peak (F = 4/3 E* sqrt(R) x^(3/2)): a square
     // root instead of a cube root per point.
-    r.contact_semi_axis_a_m = r.contact_semi_axis_b_m = std::sqrt(r.effective_radius_m * r.max_indentation_m);
+    r.contact_semi_axis_a_m = r.contact_semi_axis_b_m =
+        hertz_contact_radius_m(r.effective_radius_m, r.max_indentation_m);
   }
   r.peak_pressure_Pa = hertz_peak_pressure_Pa(r.max_force_N, r.contact_semi_axis_a_m, r.contact_semi_axis_b_m);
 }

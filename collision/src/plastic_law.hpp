@@ -5,19 +5,32 @@
 
 #include "impactdeck/collision/compression.hpp"
 #include "impactdeck/collision/contact_law.hpp"
+#include "impactdeck/collision/hertz.hpp"
 
 namespace impactdeck::collision::detail {
 
 inline bool finite_positive(double x) { return x > 0.0 && x <= std::numeric_limits<double>::max(); }
 
-/// r's phases as the Hertz impact `hertz` with e = 1 and no dent: t_c = 2 t_m.
-inline void elastic_hertz_result(const CompressionPhase& hertz, LawResult& r) {
+/// r's phases as the Hertz impact `hertz` with e = 1 and no dent: t_c = 2 t_m; the unloading is
+/// the loading's Hertz curve, of radius R*.
+inline void elastic_hertz_result(const CompressionPhase& hertz, double effective_radius_m, LawResult& r) {
+  r.unloading_radius_m = effective_radius_m;
   r.max_indentation_m = hertz.max_indentation_m;
   r.max_force_N = hertz.max_force_N;
   r.compression_time_s = hertz.compression_time_s;
   r.unloading_time_s = hertz.compression_time_s;
   r.contact_time_s = 2.0 * hertz.compression_time_s;
   r.restitution.coefficient = 1.0;
+}
+
+/// What a Hertz unloading of depth du = d* - d_p from (d*, F*) (r's x_max, F_max) leaves: the dent
+/// d_p, its radius (the contact circle at d*, hertz_contact_radius_m; 0 without a dent) and the
+/// unloading's radius R_p (from du itself: d* - d_p would lose digits to cancellation).
+inline void hertz_unloading(double effective_radius_m, double effective_modulus_Pa, double du, LawResult& r) {
+  r.residual_indentation_m = r.max_indentation_m - du;
+  r.dent_radius_m =
+      r.residual_indentation_m > 0.0 ? hertz_contact_radius_m(effective_radius_m, r.max_indentation_m) : 0.0;
+  r.unloading_radius_m = hertz_radius_through_m(effective_modulus_Pa, du, r.max_force_N);
 }
 
 /// The total impulse (1 + e) m V, then r.status ok when every number that must be positive is

@@ -114,6 +114,7 @@ class WedgeLaw final : public SharpLaw {
     const double half_width = r.max_indentation_m * std::tan(beta);
     r.contact_semi_axis_a_m = std::max(0.5 * L, half_width);
     r.contact_semi_axis_b_m = std::min(0.5 * L, half_width);
+    r.dent_radius_m = r.contact_semi_axis_b_m;  // the indent's half-width x* tan(beta) (at most L/2)
     return true;
   }
 };
@@ -154,7 +155,7 @@ class ConeLaw final : public SharpLaw {
     r.max_force_N = c * r.max_indentation_m * r.max_indentation_m;
     r.compression_time_s = cone_time_factor() * r.max_indentation_m / V;
     const double a = r.max_indentation_m * ta;
-    r.contact_semi_axis_a_m = r.contact_semi_axis_b_m = a;
+    r.contact_semi_axis_a_m = r.contact_semi_axis_b_m = r.dent_radius_m = a;  // the indent's radius x* tan(alpha)
     return true;
   }
 };

@@ -70,7 +70,7 @@ class ThorntonLaw final : public ContactLaw {
     r.impulse_compression_Ns = m * V;
     if (!(energy > Wy)) {  // elastic: Hertz with e = 1
       const CompressionPhase hertz = compression_phase(m, V, kH);
-      detail::elastic_hertz_result(hertz, r);
+      detail::elastic_hertz_result(hertz, R, r);
       r.state = {hertz.compression_time_s, hertz.compression_time_s, hertz.max_force_N, 0.0};
     } else {
       const double kp = M_PI * py * R;
@@ -100,7 +100,7 @@ class ThorntonLaw final : public ContactLaw {
       r.unloading_time_s = compression_time_factor() * du / Vr;
       r.contact_time_s = r.compression_time_s + r.unloading_time_s;
       r.restitution.coefficient = Vr / V;
-      r.residual_indentation_m = d_star - du;
+      detail::hertz_unloading(R, E, du, r);  // the dent d_p = d* - du, its radius, R_p
       r.state = {t1, tH, FH, w};
     }
     detail::finish_plastic_result(r);
@@ -110,6 +110,11 @@ class ThorntonLaw final : public ContactLaw {
 };
 
 }  // namespace
+
+double yield_velocity_m_s(double m, double E, double R, double py) {
+  const double c = M_PI / (2.0 * E);
+  return c * c * std::sqrt(8.0 * M_PI * R * R * R / (15.0 * m)) * py * py * std::sqrt(py);
+}
 
 std::shared_ptr<const ContactLaw> make_thornton_law(const LawOptions& options) {
   return std::make_shared<const ThorntonLaw>(options.limiting_pressure_Pa);

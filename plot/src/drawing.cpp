@@ -352,13 +352,4 @@ std::vector<double> nice_ticks(double lo, double hi, int count) {
   return t;
 }
 
-std::string format_number(double v, int digits) {
-  if (!std::isfinite(v)) return "-";
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.*g", digits, v + 0.0);
-  std::string s(buf);
-  if (s == "-0") s = "0";
-  return s;
-}
-
 }  // namespace impactdeck::plot

@@ -1,6 +1,5 @@
 // The contact law an impact runs (scene.hpp, impact_law; docs/plastic.md).
 #include <algorithm>
-#include <cmath>
 
 #include "impactdeck/collision/contact_law.hpp"
 #include "impactdeck/scene/scene.hpp"
@@ -23,11 +22,6 @@ const Material* yielding_material(const Scene& scene, const ImpactSpec& s) {
 constexpr const char* kDefaultPlasticLaw = "thornton";
 
 }  // namespace
-
-double yield_velocity_m_s(double m, double E, double R, double py) {
-  const double c = M_PI / (2.0 * E);
-  return c * c * std::sqrt(8.0 * M_PI * R * R * R / (15.0 * m)) * py * py * std::sqrt(py);
-}
 
 ImpactLaw impact_law(const Scene& scene, const ImpactSpec& s, const InputContext& ctx) {
   ImpactLaw l;

@@ -292,23 +292,18 @@ void describe_law(const Scene& scene, const ImpactSpec& s, const ImpactLaw& law,
   const collision::LawResult& l = r.history.law_result;
   ir.law = law;
   if (law.limiting_pressure_Pa) {
-    ir.yield_velocity_m_s =
-        yield_velocity_m_s(r.reduced_mass_kg, r.effective_modulus_Pa, r.effective_radius_m, *law.limiting_pressure_Pa);
+    ir.yield_velocity_m_s = collision::yield_velocity_m_s(r.reduced_mass_kg, r.effective_modulus_Pa,
+                                                          r.effective_radius_m, *law.limiting_pressure_Pa);
   }
   const bool elastic = ir.yield_velocity_m_s && r.approach_velocity_m_s <= *ir.yield_velocity_m_s;
   ir.contact_law = law.automatic && law.name != "hertz" && elastic ? "hertz" : law.name;
-  const double unloading = l.max_indentation_m - l.residual_indentation_m;  // d* - d_p
-  const double k = 3.0 * l.max_force_N / (4.0 * r.effective_modulus_Pa * unloading * std::sqrt(unloading));
-  ir.unloading_radius_m = k * k;
-  ir.dent_radius_m = l.residual_indentation_m > 0.0 ? std::sqrt(r.effective_radius_m * l.max_indentation_m) : 0.0;
+  ir.unloading_radius_m = l.unloading_radius_m;  // the law's (0 for a flat-punch or linear unloading)
+  ir.dent_radius_m = l.dent_radius_m;
   if (law.law && (law.law->takes_sharp_points() || law.law->takes_line_contacts())) {
     // A sharp edge or corner, or a rounded edge's line contact (docs/sharp-contacts.md): no V_y; the
     // law's patch at F* (the cone's circle, the wedge's or the line's strip) under its pressure.
-    // Unloading is a flat punch or linear, not a Hertz curve: no unloading radius.
     ir.yield_velocity_m_s.reset();
     ir.contact_law = law.name;
-    ir.unloading_radius_m = 0.0;
-    ir.dent_radius_m = r.kernel.contact_semi_axis_b_m;
     collision::ValidityReport v;
     v.limits = scene.validity;
     v.contact_semi_axis_a_m = r.kernel.contact_semi_axis_a_m;
@@ -325,7 +320,7 @@ void describe_law(const Scene& scene, const ImpactSpec& s, const ImpactLaw& law,
     // The plastic contact at F*: the circle of radius a* = sqrt(R* d*) (Thornton) under the mean
     // pressure F* / (pi a*^2), not Hertz's ellipse of F*.
     collision::KernelResult plastic = r.kernel;
-    const double a = std::sqrt(r.effective_radius_m * l.max_indentation_m);
+    const double a = collision::hertz_contact_radius_m(r.effective_radius_m, l.max_indentation_m);
     plastic.contact_semi_axis_a_m = plastic.contact_semi_axis_b_m = a;
     plastic.peak_pressure_Pa = l.max_force_N / (M_PI * a * a);
     collision::ValidityReport v = collision::assess_validity(ir.contact.input, plastic, std::nullopt, std::nullopt, limits);

@@ -2,33 +2,22 @@
 
 #include <cmath>
 #include <limits>
-#include <sstream>
 
 #include "impactdeck/collision/eccentric.hpp"
 #include "impactdeck/collision/impact.hpp"
+#include "impactdeck/common/number_text.hpp"
 #include "impactdeck/geometry/plane.hpp"
 #include "impactdeck/sequence/flight.hpp"
 
 namespace impactdeck::sequence {
 namespace {
 
-std::string fmt(double x) {
-  std::ostringstream s;
-  s.precision(6);
-  s << x + 0.0;
-  return s.str();
-}
+constexpr int kMessageDigits = 6;  // significant digits of a number in a message
 
-// Why no Hertz force exists at a flagged contact, in words.
-std::string flag_reason(const contact::ContactEvaluation& e) {
-  const collision::ContactFlag f = e.result.flag;
-  std::string r;
-  if (f == collision::ContactFlag::sharp) {
-    r = "the contact point is on a sharp edge or corner, where the part has no curvature (no edge_radius): no Hertz "
-        "force exists";
-  } else {
-    r = std::string("not a Hertz contact (flag ") + collision::flag_word(f) + ")";
-  }
+// Why no force exists at a flagged contact of `body` on `floor`, in words (the kernel's explain_flag,
+// as run's impacts say it).
+std::string flag_reason(const contact::ContactEvaluation& e, const std::string& body, const std::string& floor) {
+  std::string r = collision::explain_flag(e.input, e.result, "'" + body + "'", "'" + floor + "'");
   if (!e.curvature_problem.empty()) r += " (" + e.curvature_problem + ")";
   return r;
 }
@@ -61,7 +50,8 @@ Bounce apply_bounce(const SequenceInput& in, std::size_t index, const BodyState&
                     const geometry::SurfacePoint& support) {
   const double mu = in.friction_coefficient;
   if (!(mu >= 0.0) || !std::isfinite(mu)) {
-    throw in.ctx.error("friction_coefficient", "must be a finite number >= 0, got " + fmt(mu));
+    throw in.ctx.error("friction_coefficient",
+                       "must be a finite number >= 0, got " + format_number(mu, kMessageDigits));
   }
   Bounce b;
   b.time_s = at.time_s;
@@ -86,17 +76,17 @@ Bounce apply_bounce(const SequenceInput& in, std::size_t index, const BodyState&
     b.body_jump = r.target_jump;
     b.floor_jump = r.impactor_jump;
     b.friction = b.impact->friction;
-    const collision::LawResult& l = r.history.law_result;
-    b.dent_radius_m = l.residual_indentation_m > 0.0 ? std::sqrt(r.effective_radius_m * l.max_indentation_m) : 0.0;
+    b.dent_radius_m = r.history.law_result.dent_radius_m;  // the law's (wedge, cone: the indent's size)
   } else {
     const collision::ContactFlag f = b.contact.result.flag;
     const bool geometric = f == collision::ContactFlag::sharp || f == collision::ContactFlag::no_curvature ||
                            f == collision::ContactFlag::flat || f == collision::ContactFlag::line ||
                            f == collision::ContactFlag::no_fit || f == collision::ContactFlag::saddle;
-    b.not_applicable = flag_reason(b.contact);
-    if (!geometric) throw in.ctx.error("", "at t = " + fmt(at.time_s) + " s: " + b.not_applicable);
+    b.not_applicable = flag_reason(b.contact, in.body.name, in.floor.name);
+    const std::string when = "at t = " + format_number(at.time_s, kMessageDigits) + " s";
+    if (!geometric) throw in.ctx.error("", when + ": " + b.not_applicable);
     if (!in.rigid_restitution) {
-      throw in.ctx.error("restitution", "at t = " + fmt(at.time_s) + " s " + b.not_applicable +
+      throw in.ctx.error("restitution", when + " " + b.not_applicable +
                                             "; the rigid impulse needs a constant restitution: set restitution = "
                                             "a number in [0, 1]");
     }
@@ -147,7 +137,8 @@ SequenceResult run_sequence(const SequenceInput& in) {
   }
   const double mu = in.friction_coefficient;
   if (!(mu >= 0.0) || !std::isfinite(mu)) {
-    throw ctx.error("friction_coefficient", "must be a finite number >= 0, got " + fmt(mu));
+    throw ctx.error("friction_coefficient",
+                    "must be a finite number >= 0, got " + format_number(mu, kMessageDigits));
   }
   if (in.max_impacts < 1 || in.max_impacts > kMaxImpactsLimit) {
     throw ctx.error("max_impacts", "must lie in [1, " + std::to_string(kMaxImpactsLimit) + "]");
@@ -158,7 +149,8 @@ SequenceResult run_sequence(const SequenceInput& in) {
   const Floor floor = floor_of(in.floor);
   const double gn = in.gravity_m_s2.dot(floor.normal);
   if (!in.gravity_m_s2.allFinite() || !(gn < 0.0)) {
-    throw ctx.error("gravity_m_s2", "must point towards the floor '" + in.floor.name + "': g . n = " + fmt(gn) +
+    throw ctx.error("gravity_m_s2", "must point towards the floor '" + in.floor.name +
+                                        "': g . n = " + format_number(gn, kMessageDigits) +
                                         " m/s^2, n its outward normal; it must be < 0");
   }
   const double size = in.body.shape->size_m();
@@ -166,7 +158,7 @@ SequenceResult run_sequence(const SequenceInput& in) {
   BodyState s = state_of(in.body);
   if (const double h0 = floor_gap_m(*in.body.shape, in.body.volume.centroid_m, s, floor); h0 < -tol) {
     throw ctx.error("body", "'" + in.body.name + "' is already below the floor '" + in.floor.name +
-                                "': its lowest point is " + fmt(-h0) + " m under it");
+                                "': its lowest point is " + format_number(-h0, kMessageDigits) + " m under it");
   }
   const Flight flight(in.body.inertia_kg_m2, in.gravity_m_s2, ctx);
   SequenceResult out;

@@ -5,7 +5,6 @@
 #include <cmath>
 #include <sstream>
 
-#include "impactdeck/collision/compression.hpp"
 #include "impactdeck/collision/force_history.hpp"
 #include "impactdeck/collision/hertz_law.hpp"
 #include "impactdeck/common/error.hpp"
@@ -89,19 +88,45 @@ PointResult sweep_point(const contact::ContactModel& model, double speed, const 
   return r;
 }
 
-void sample_curve(const PointResult& p, std::size_t samples, double* out) {
-  // F(t) = F_max Z(t/t_m)^n in compression, mirrored and stretched by R in restitution.
-  const double tm = p.compression_time_s, tc = p.contact_time_s, R = p.restitution;
+namespace {
+
+// F(t) of a solved impact at `samples` times uniform over [0, t_c] (the last one t_c itself, where
+// the force is back at 0): the law's own F(t), each phase in one call (loading_forces,
+// unloading_forces: one integration of a law that integrates its loading, not one per sample), in
+// place without allocating: `out` holds the times (the fractions u of the unloading) until they
+// become forces (each law's loading_forces and unloading_forces, and the defaults, read the i-th
+// time before they write the i-th force).
+void sample_law_curve(const collision::ContactLaw& law, const collision::LawResult& r, std::size_t samples,
+                      double* out) {
+  const double tm = r.compression_time_s, tc = r.contact_time_s, tu = r.unloading_time_s;
   const double last = static_cast<double>(samples - 1);
-  for (std::size_t k = 0; k < samples; ++k) {
-    const double t = tc * static_cast<double>(k) / last;
-    double tau = t / tm;
-    if (t > tm) tau = R > 0.0 ? collision::restitution_mirror_s(t, tm, R) / tm : 0.0;
-    const double z = collision::compression_shape(tau);
-    out[k] = p.max_force_N * z * std::sqrt(z);
+  for (std::size_t k = 0; k < samples; ++k) out[k] = k + 1 == samples ? tc : tc * static_cast<double>(k) / last;
+  std::size_t loading = 0;  // the samples at t <= t_m
+  while (loading < samples && out[loading] <= tm) ++loading;
+  for (std::size_t k = loading; k < samples; ++k) {  // t -> u of the unloading
+    out[k] = tu > 0.0 ? std::min(1.0, (out[k] - tm) / tu) : 1.0;
   }
-  out[0] = 0.0;
-  if (R > 0.0) out[samples - 1] = 0.0;  // end of contact
+  law.loading_forces(r, out, out, loading);
+  if (loading == samples) return;
+  if (tu > 0.0) {
+    law.unloading_forces(r, out + loading, out + loading, samples - loading);
+  } else {
+    std::fill(out + loading, out + samples, 0.0);  // no unloading phase (t_c = t_m): 0 after t_m
+  }
+  out[samples - 1] = 0.0;  // t_c: the contact has ended
+}
+
+}  // namespace
+
+void sample_curve(const PointResult& p, std::size_t samples, double* out) {
+  // The Hertz force history of the point's summary (HertzLaw::force_N: the compression curve, then
+  // its mirror stretched by R).
+  collision::ForceHistory h;
+  h.compression.max_force_N = p.max_force_N;
+  h.compression.max_indentation_m = p.max_indentation_m;
+  h.compression.compression_time_s = p.compression_time_s;
+  h.restitution = p.restitution;
+  sample_law_curve(h.curve_law(), h.result(), samples, out);
 }
 
 void sample_curve(const collision::ContactLaw& law, const PointResult& p, double speed, double effective_modulus_Pa,
@@ -114,8 +139,7 @@ void sample_curve(const collision::ContactLaw& law, const PointResult& p, double
   in.yield_strength_Pa = yield_strength_Pa;
   collision::LawResult r;
   law.solve(&in, &r, 1);
-  const double last = static_cast<double>(samples - 1);
-  for (std::size_t k = 0; k < samples; ++k) out[k] = law.force_N(r, r.contact_time_s * static_cast<double>(k) / last);
+  sample_law_curve(law, r, samples, out);
 }
 
 std::string flag_counts_text(const SweepResult& r) {

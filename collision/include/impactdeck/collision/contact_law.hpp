@@ -60,6 +60,14 @@ struct LawResult {
   double impulse_compression_Ns = 0;  ///< m_w v_w
   double impulse_total_Ns = 0;        ///< (1 + R) m_w v_w
   double residual_indentation_m = 0;  ///< the dent left behind (0 for an elastic law)
+  /// The dent's radius on the surface (0 when there is no dent): "thornton", "jackson-green" the
+  /// contact circle at d*, hertz_contact_radius_m(R*, d*) = sqrt(R* d*); "wedge" the indent's
+  /// half-width x* tan(beta) (at most L/2); "cone" the indent's radius x* tan(alpha).
+  double dent_radius_m = 0;
+  /// R_p of the Hertz unloading F = 4/3 E* sqrt(R_p) (d - d_p)^1.5 through (d*, F*): R* for an
+  /// elastic Hertz impact, Thornton's R_p, Brake's R_bar; 0 for a law whose unloading is not a
+  /// Hertz curve ("wedge", "cone", "line").
+  double unloading_radius_m = 0;
   std::array<double, 4> state{};      ///< the law's own numbers for its F(t); opaque to callers
   /// The law's own contact patch at F_max (semi-axes a >= b) and its pressure there; 0: the kernel
   /// takes the Hertz ellipse of F_max (every law but "wedge" and "cone").
@@ -98,6 +106,12 @@ class ContactLaw {
 /// Thornton's default limiting pressure p_y over the weaker body's yield strength: the onset of
 /// yield under a circular Hertz contact, p0 = 1.60 Y for nu = 0.3 (Johnson 1985, Sect. 6.2).
 inline constexpr double kThorntonYieldFactor = 1.6;
+
+/// Johnson's yield velocity (Johnson 1985, Sect. 11.4; docs/plastic.md): the approach speed at which
+/// a Hertz impact first reaches the limiting pressure p_y, 1/2 m* V_y^2 = W_y = 2/5 F_y d_y:
+/// V_y = (pi / (2 E*))^2 (8 pi R*^3 / (15 m*))^(1/2) p_y^(5/2). Below it "thornton" is elastic.
+double yield_velocity_m_s(double reduced_mass_kg, double effective_modulus_Pa, double effective_radius_m,
+                          double limiting_pressure_Pa);
 
 /// The default indentation hardness of the laws "wedge" and "cone" over the weaker body's yield
 /// strength: a fully plastic indentation by a sharp indenter, H = 3 Y (Tabor 1951; Johnson 1985,

@@ -4,6 +4,8 @@
 //   1/R* = 1/R1 + 1/R2 (a plane has curvature 0)                          (Eq. 29, Eq. 15)
 //   1/E* = (1-nu1^2)/E1 + (1-nu2^2)/E2   ("hertz" convention, default)
 //   1/E* = 1/E1 + 1/E2                   ("paper" convention, Eq. 28)
+#include <cmath>
+
 #include "impactdeck/common/error.hpp"
 
 namespace impactdeck::collision {
@@ -30,5 +32,18 @@ double effective_radius_m(double curvature_target_per_m, double curvature_impact
 
 /// Hertz constant k_H = 4/3 E* sqrt(R*) in N/m^1.5.
 double hertz_constant(double effective_modulus_Pa, double effective_radius_m);
+
+/// The radius of the circular Hertz contact at the approach d: a = sqrt(R* d) (Johnson 1985,
+/// Sect. 4.2); Thornton's contact circle at F* of a plastic law, a* = sqrt(R* d*), the dent's radius.
+inline double hertz_contact_radius_m(double effective_radius_m, double approach_m) {
+  return std::sqrt(effective_radius_m * approach_m);
+}
+
+/// R of the Hertz curve F = 4/3 E* sqrt(R) d^1.5 through (d, F): (3 F / (4 E* d^1.5))^2 (an
+/// unloading curve's radius from its depth d = d* - d_p and F*).
+inline double hertz_radius_through_m(double effective_modulus_Pa, double approach_m, double force_N) {
+  const double k = 3.0 * force_N / (4.0 * effective_modulus_Pa * approach_m * std::sqrt(approach_m));
+  return k * k;
+}
 
 }  // namespace impactdeck::collision

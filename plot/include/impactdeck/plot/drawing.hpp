@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "impactdeck/common/number_text.hpp"
+
 namespace impactdeck::plot {
 
 /// sRGB colour, each component in [0, 1].
@@ -99,7 +101,8 @@ void chart_frame(Drawing& d, double left, double top, double right, double botto
 /// About `count` "nice" tick values (1, 2, 5 x 10^k steps) covering [lo, hi].
 std::vector<double> nice_ticks(double lo, double hi, int count = 5);
 
-/// Short number for labels: up to `digits` significant digits, no trailing zeros, no "-0".
-std::string format_number(double v, int digits = 4);
+/// Short number for labels (common/number_text.hpp): up to `digits` significant digits, no
+/// trailing zeros, no "-0".
+using impactdeck::format_number;
 
 }  // namespace impactdeck::plot

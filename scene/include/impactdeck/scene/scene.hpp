@@ -250,10 +250,4 @@ std::optional<ImpactLaw> sharp_impact_law(const ImpactSpec& s, const ImpactLaw& 
 /// length reaches the edge's length (docs/sharp-contacts.md).
 ImpactLaw line_impact_law(const ImpactLaw& law, const InputContext& ctx);
 
-/// Johnson's yield velocity (BEYOND_HERTZ.md; Johnson 1985, Sect. 11.4): the approach speed at which
-/// a Hertz impact first reaches the limiting pressure p_y,
-/// V_y = (pi / (2 E*))^2 (8 pi R*^3 / (15 m*))^(1/2) p_y^(5/2).
-double yield_velocity_m_s(double reduced_mass_kg, double effective_modulus_Pa, double effective_radius_m,
-                          double limiting_pressure_Pa);
-
 }  // namespace impactdeck::scene

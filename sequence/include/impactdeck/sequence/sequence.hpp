@@ -89,7 +89,7 @@ struct Bounce {
   double energy_lost_J = 0;  ///< the body's kinetic energy before minus after (the floor is fixed)
   collision::VelocityJump body_jump, floor_jump;
   Eigen::Vector3d point_own_m = Eigen::Vector3d::Zero();  ///< the contact point, body frame
-  double dent_radius_m = 0;  ///< sqrt(R* d*) when the law left a dent, else 0
+  double dent_radius_m = 0;  ///< the law's dent radius (collision::LawResult::dent_radius_m), 0: no dent
   /// The earliest earlier impact whose dent (its radius, body frame) holds this contact point; -1: none.
   int in_dent_of = -1;
   /// Max force when it applies (NaN otherwise).
