@@ -626,8 +626,9 @@ TEST(SharpScene, BoxOnEdgeWedgeAndRoundedLineContact) {
   EXPECT_GT(wedge["residual_indentation_m"].get<double>(), 0.0);
   EXPECT_TRUE(wedge["checks"]["passed"].get<bool>());
   // With edge_radius: a cylinder along the edge on the flat floor, whose contact length is at once
-  // the whole edge: the line contact over L = 200 mm, F = (pi/4) E* L d.
-  const nlohmann::json line = impact_json(box_drop(kEdge, 45, "edge_radius = 0.5", ""));
+  // the whole edge: the line contact over L = 200 mm, F = (pi/4) E* L d; elastic under Hertz
+  // (a plastic law: "line-plastic", SharpScene.FarRotatedBoxOnARoundedEdgeYieldsAlongTheLine).
+  const nlohmann::json line = impact_json(box_drop(kEdge, 45, "edge_radius = 0.5", "contact_law = \"hertz\""));
   EXPECT_EQ(line["contact_law"], "line");
   const double m = line["reduced_mass_kg"].get<double>(), E = line["effective_modulus_Pa"].get<double>();
   const double k = 0.25 * M_PI * E * 0.2;
@@ -681,3 +682,77 @@ approach_speed_m_s = 3.0
   EXPECT_NEAR(spanning["validity"]["contact_semi_axis_a_m"].get<double>(), 0.1, 1e-12);
 }
 
+// The acceptance's edge drop with a plastic law: the box 1 km from the origin, the whole scene
+// turned by 0.7 rad about (1, 2, 3) (the floor's normal and the box's orientation), on its long edge
+// rounded to 0.5 mm, found by first contact. "auto" with a yield strength runs "line-plastic" over
+// the 200 mm edge: its numbers are the law's at the impact's reduced mass (the scene's route to the
+// law), with a dent and 0 < e < 1; Hertz keeps the elastic "line"; naming "line-plastic" gives the
+// same impact.
+TEST(SharpScene, FarRotatedBoxOnARoundedEdgeYieldsAlongTheLine) {
+  const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  const Eigen::AngleAxisd box_turn(turn * Eigen::AngleAxisd(0.25 * M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix());
+  const Eigen::Vector3d far_mm(1e6, 0.0, 0.0), up = turn.col(2);
+  auto vec = [](const Eigen::Vector3d& v) { return "[" + exact(v.x()) + ", " + exact(v.y()) + ", " + exact(v.z()) + "]"; };
+  auto scene_text = [&](const std::string& impact_keys) {
+    return R"(length_unit = "mm"
+[materials.steel]
+youngs_modulus_Pa = 2.1e11
+poisson_ratio = 0.3
+yield_strength_Pa = 2.5e8
+[[bodies]]
+name = "floor"
+shape = "plane"
+normal = )" + vec(up) + R"(
+position = )" + vec(far_mm) + R"(
+material = "steel"
+[[bodies]]
+name = "box"
+shape = "mesh"
+mesh = ")" + data("box_200x100x60mm.stl").string() + R"("
+material = "steel"
+mass_kg = 0.5
+edge_radius = 0.5
+orientation_axis = )" + vec(box_turn.axis()) + R"(
+orientation_angle_deg = )" + exact(box_turn.angle() * 180.0 / M_PI) + R"(
+position = )" + vec(far_mm + 500.0 * up) + R"(
+velocity_m_s = )" + vec(-3.0 * up) + R"(
+[[impacts]]
+name = "drop"
+target = "floor"
+impactor = "box"
+point = "first-contact"
+)" + impact_keys + "\n";
+  };
+  const nlohmann::json j = impact_json(scene_text(""));
+  EXPECT_EQ(j["contact_law"], "line-plastic");
+  EXPECT_EQ(j["validity"]["contact_law"], "line-plastic");
+  EXPECT_EQ(j["sharp_feature"]["kind"], "edge");
+  EXPECT_EQ(j["sharp_feature"]["rounded_by_edge_radius"], true);
+  EXPECT_NEAR(j["sharp_feature"]["edge_length_m"].get<double>(), 0.2, kFarBoxRel * 0.2);
+  EXPECT_NEAR(j["effective_radius_m"].get<double>(), 5e-4, kFarBoxRel * 5e-4);
+  EXPECT_GT(j["residual_indentation_m"].get<double>(), 0.0);
+  EXPECT_GT(j["restitution"].get<double>(), 0.0);
+  EXPECT_LT(j["restitution"].get<double>(), 1.0);
+  EXPECT_TRUE(j["checks"]["passed"].get<bool>());
+  // The law's own numbers at the impact's m, V and E* over the 200 mm edge.
+  collision::LawInput in = line_input(j["approach_velocity_m_s"].get<double>());
+  in.reduced_mass_kg = j["reduced_mass_kg"].get<double>();
+  in.effective_modulus_Pa = j["effective_modulus_Pa"].get<double>();
+  in.effective_radius_m = j["effective_radius_m"].get<double>();
+  in.sharp_length_m = j["sharp_feature"]["edge_length_m"].get<double>();
+  const collision::LawResult r = solve(*collision::make_contact_law("line-plastic", collision::LawOptions{}), in);
+  ASSERT_EQ(r.status, collision::LawStatus::ok);
+  for (const auto& [key, value] : {std::pair<const char*, double>{"max_force_N", r.max_force_N},
+                                   {"contact_time_s", r.contact_time_s},
+                                   {"restitution", r.restitution.coefficient},
+                                   {"residual_indentation_m", r.residual_indentation_m}}) {
+    EXPECT_NEAR(j[key].get<double>(), value, kSameImpactRel * value) << key;
+  }
+  EXPECT_NEAR(j["approach_velocity_m_s"].get<double>(), 3.0, kFarBoxRel * 3.0);
+  // Hertz: the elastic line law; "line-plastic" named: the same impact as "auto".
+  const nlohmann::json hertz = impact_json(scene_text("contact_law = \"hertz\""));
+  EXPECT_EQ(hertz["contact_law"], "line");
+  EXPECT_EQ(hertz["restitution"].get<double>(), 1.0);
+  EXPECT_GT(hertz["max_force_N"].get<double>(), j["max_force_N"].get<double>());
+  expect_same_impact(impact_json(scene_text("contact_law = \"line-plastic\"")), j);
+}
