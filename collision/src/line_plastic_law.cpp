@@ -78,7 +78,9 @@ struct PlasticPhase {
 class LinePlasticLaw final : public ContactLaw {
  public:
   explicit LinePlasticLaw(double limiting_pressure_Pa)
-      : limiting_pressure_Pa_(limiting_pressure_Pa), elastic_(make_line_law(LawOptions{})) {}
+      : limiting_pressure_Pa_(limiting_pressure_Pa), elastic_(make_line_law(LawOptions{})) {
+    gauss_legendre();  // its one allocation here, not in solve() (the kernel's hot path)
+  }
   const char* name() const noexcept override { return "line-plastic"; }
   bool takes_line_contacts() const noexcept override { return true; }
 

@@ -241,10 +241,9 @@ ImpactLaw impact_law(const Scene& scene, const ImpactSpec& s, const InputContext
 std::optional<ImpactLaw> sharp_impact_law(const ImpactSpec& s, const ImpactLaw& law, const collision::KernelInput& in,
                                           const InputContext& ctx);
 
-/// `law` with the line contact of an edge rounded by edge_radius in its place: "line" (elastic)
-/// where `law` is Hertz, "line-plastic" (at its p_y) where it is a plastic law; where the rounding
-/// lies on a surface flat along the edge, or where the elliptical contact's length reaches the
-/// edge's length (docs/sharp-contacts.md).
+/// `law` with the line contact of an edge rounded by edge_radius in its place ("line" under Hertz, else
+/// "line-plastic" at its p_y): where the rounding lies on a surface flat along the edge, or where the
+/// elliptical contact's length reaches the edge's length (docs/sharp-contacts.md).
 ImpactLaw line_impact_law(const ImpactLaw& law, const InputContext& ctx);
 
 /// Johnson's yield velocity (BEYOND_HERTZ.md; Johnson 1985, Sect. 11.4): the approach speed at which
