@@ -118,7 +118,7 @@ std::vector<SharpCase> sharp_cases() {
       {"corner_cone", corner, 35, "", "", "cone"},
       {"edge_wedge", e.axis(), e.angle() * 180.0 / M_PI, "", "", "wedge"},
       {"corner_rounded_thornton", corner, 35, "edge_radius = 0.5", "", "thornton"},
-      {"edge_rounded_line", e.axis(), e.angle() * 180.0 / M_PI, "edge_radius = 0.5", "", "line"},
+      {"edge_rounded_line", e.axis(), e.angle() * 180.0 / M_PI, "edge_radius = 0.5", "", "line-plastic"},
       {"corner_rounded_hertz", corner, 35, "edge_radius = 0.5", "restitution = 0.5", "hertz"},
       {"corner_hertz_rigid", corner, 35, "", "restitution = 0.5", ""},
   };

@@ -1,7 +1,8 @@
 // Sharp edges and corners of machined parts (issue 30 item 8, docs/sharp-contacts.md): the mesh's
-// sharp-feature query, the laws "wedge", "cone" and "line" against closed forms computed here and
-// an independent integration of m x'' = -F(x), and a box mesh dropped on a corner and on an edge,
-// with and without edge_radius.
+// sharp-feature query, the laws "wedge", "cone", "line" and "line-plastic" against closed forms
+// computed here and an independent integration of m x'' = -F(x), and a box mesh dropped on a corner
+// and on an edge, with and without edge_radius.
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -13,6 +14,7 @@
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_integration.h>
 #include <gsl/gsl_odeiv2.h>
+#include <gsl/gsl_roots.h>
 #include <gsl/gsl_sf_ellint.h>
 #include <gtest/gtest.h>
 
@@ -277,6 +279,217 @@ TEST(SharpLaws, LineContactIsHarmonicAndElastic) {
   EXPECT_NEAR(impulse(*law, r, 0.0, r.contact_time_s), 2.0 * in.approach_velocity_m_s, kLawOdeRel * 2.0);
 }
 
+// ---- "line-plastic": the rounded edge's line contact that yields (docs/sharp-contacts.md). ----
+
+namespace {
+
+// The line contact of the laws' tests: the 100 mm edge rounded to 0.5 mm, 1 kg, steel on steel.
+collision::LawInput line_input(double V) {
+  collision::LawInput in = sharp_input(collision::SharpKind::edge, V);
+  in.effective_radius_m = 5e-4;
+  return in;
+}
+
+// The line contact written here from its definitions (docs/sharp-contacts.md): the line law's
+// F = k d, k = (pi/4) E* L; plane-strain Hertz per unit length F' = F/L with the half-width
+// b = sqrt(4 F' R / (pi E*)) and peak pressure p0 = 2 F' / (pi b); first yield where p0 = p_y;
+// beyond, each increment of the width 2b carries p_y over L, with b^2 = R d (the width of the
+// elastic relation at F = k d); unloading with k from the turning point.
+struct LineContact {
+  double m, V, E, L, R, py;
+  explicit LineContact(const collision::LawInput& in)
+      : m(in.reduced_mass_kg), V(in.approach_velocity_m_s), E(in.effective_modulus_Pa), L(in.sharp_length_m),
+        R(in.effective_radius_m), py(collision::kThorntonYieldFactor * in.yield_strength_Pa) {}
+  double k() const { return 0.25 * M_PI * E * L; }
+  double half_width(double F) const { return std::sqrt(4.0 * (F / L) * R / (M_PI * E)); }
+  double peak_pressure(double F) const { return 2.0 * (F / L) / (M_PI * half_width(F)); }
+  // p0 grows as sqrt(F): p0(F_y) = p_y at F_y = F (p_y / p0(F))^2 for any F.
+  double Fy() const { return 1.0 * (py / peak_pressure(1.0)) * (py / peak_pressure(1.0)); }
+  double dy() const { return Fy() / k(); }
+  double Vy() const { return Fy() / std::sqrt(m * k()); }
+  double elastic(double x) const { return k() * x; }
+  double plastic(double x) const { return Fy() + py * L * 2.0 * (std::sqrt(R * x) - half_width(Fy())); }
+  double loading(double x) const { return x <= dy() ? elastic(x) : plastic(x); }
+};
+
+struct Branch {
+  const LineContact* c;
+  double (LineContact::*force)(double) const;
+  double x_star = 0, F_star = 0;  // the unloading branch: F* + k (x - x*)
+  double operator()(double x) const { return force ? (c->*force)(x) : F_star + c->k() * (x - x_star); }
+};
+
+int branch_rhs(double, const double y[], double dydt[], void* params) {
+  const auto* b = static_cast<const Branch*>(params);
+  dydt[0] = y[1];
+  dydt[1] = -(*b)(y[0]) / b->c->m;
+  return GSL_SUCCESS;
+}
+
+// y = (x, x') after dt from y0 under one branch (rk8pd, rtol 1e-13).
+std::array<double, 2> advance(const Branch& b, std::array<double, 2> y, double dt) {
+  if (!(dt > 0.0)) return y;
+  gsl_odeiv2_system sys{branch_rhs, nullptr, 2, const_cast<Branch*>(&b)};
+  gsl_odeiv2_driver* d = gsl_odeiv2_driver_alloc_y_new(&sys, gsl_odeiv2_step_rk8pd, 1e-6 * dt, 1e-14, 1e-13);
+  double t = 0.0;
+  EXPECT_EQ(gsl_odeiv2_driver_apply(d, &t, dt, y.data()), GSL_SUCCESS);
+  gsl_odeiv2_driver_free(d);
+  return y;
+}
+
+// Runs branch b from y0 until event(y) changes sign (steps of h, then Brent to 1e-15 relative):
+// the time taken and the state there.
+template <class Event>
+std::pair<double, std::array<double, 2>> run_until(const Branch& b, std::array<double, 2> y, double h, Event event) {
+  double t = 0.0;
+  std::array<double, 2> next = y;
+  for (int i = 0; i < 1000000 && event(next = advance(b, y, h)) > 0.0; ++i) y = next, t += h;
+  struct Ctx {
+    const Branch* b;
+    std::array<double, 2> y;
+    Event* event;
+  } ctx{&b, y, &event};
+  gsl_function f{[](double dt, void* p) {
+                   auto* c = static_cast<Ctx*>(p);
+                   return (*c->event)(advance(*c->b, c->y, dt));
+                 },
+                 &ctx};
+  gsl_root_fsolver* s = gsl_root_fsolver_alloc(gsl_root_fsolver_brent);
+  gsl_root_fsolver_set(s, &f, 0.0, h);
+  double root = h;
+  for (int i = 0; i < 200; ++i) {
+    gsl_root_fsolver_iterate(s);
+    root = gsl_root_fsolver_root(s);
+    if (gsl_root_test_interval(gsl_root_fsolver_x_lower(s), gsl_root_fsolver_x_upper(s), 1e-15 * h, 0.0) == GSL_SUCCESS) {
+      break;
+    }
+  }
+  gsl_root_fsolver_free(s);
+  return {t + root, advance(b, y, root)};
+}
+
+struct Integrated {
+  double F_max, t_m, t_c, e;
+};
+
+// m x'' = -F(x) through the three branches: elastic to d_y, plastic to x' = 0, unloading to F = 0.
+Integrated integrate_line(const LineContact& c) {
+  const double h = 0.05 * std::sqrt(c.m / c.k());  // a step well inside each branch's time scale
+  const Branch elastic{&c, &LineContact::elastic}, plastic{&c, &LineContact::plastic};
+  const auto [t1, y1] = run_until(elastic, {0.0, c.V}, h, [&](const std::array<double, 2>& y) { return c.dy() - y[0]; });
+  const auto [t2, y2] = run_until(plastic, y1, h, [](const std::array<double, 2>& y) { return y[1]; });
+  const Branch unload{&c, nullptr, y2[0], c.plastic(y2[0])};
+  const auto [t3, y3] = run_until(unload, {y2[0], 0.0}, h, [&](const std::array<double, 2>& y) { return unload(y[0]); });
+  return {unload.F_star, t1 + t2, t1 + t2 + t3, -y3[1] / c.V};
+}
+
+}  // namespace
+
+// The law against its definition: the energy balance (loading work - unloading work =
+// 1/2 m V^2 (1 - e^2)), an rk8pd integration of m x'' = -F(x) (F_max, t_m, t_c, e), and the
+// impulses of its F(t) (which inverts the plastic phase's time), from just above V_y to 1e4 V_y.
+TEST(LinePlastic, AgainstEnergyBalanceIntegrationAndImpulses) {
+  const auto law = collision::make_contact_law("line-plastic", collision::LawOptions{});
+  ASSERT_TRUE(law->takes_line_contacts());
+  const double Vy = LineContact(line_input(1.0)).Vy();
+  for (const double ratio : {1.001, 3.0, 30.0, 3.0 / Vy, 1e4}) {
+    const collision::LawInput in = line_input(ratio * Vy);
+    const LineContact c(in);
+    const collision::LawResult r = solve(*law, in);
+    ASSERT_EQ(r.status, collision::LawStatus::ok) << ratio;
+    const double m = c.m, V = c.V, energy = 0.5 * m * V * V, e = r.restitution.coefficient;
+    // Energy: the loading curve's work to d* (quadrature, split at d_y) and the unloading's.
+    gsl_integration_workspace* w = gsl_integration_workspace_alloc(1000);
+    auto work = [&](double a, double b) {
+      gsl_function f{[](double x, void* p) { return static_cast<const LineContact*>(p)->loading(x); },
+                     const_cast<LineContact*>(&c)};
+      double result = 0, err = 0;
+      gsl_integration_qags(&f, a, b, 0.0, 1e-13, 1000, w, &result, &err);
+      return result;
+    };
+    const double loading = work(0.0, c.dy()) + work(c.dy(), r.max_indentation_m);
+    gsl_integration_workspace_free(w);
+    const double unloading = 0.5 * r.max_force_N * (r.max_indentation_m - r.residual_indentation_m);
+    EXPECT_NEAR(loading, energy, kLawOdeRel * energy) << ratio;
+    EXPECT_NEAR(loading - unloading, energy * (1.0 - e * e), kLawOdeRel * energy) << ratio;
+    EXPECT_NEAR(r.max_force_N, c.loading(r.max_indentation_m), kLawOdeRel * r.max_force_N) << ratio;
+    EXPECT_NEAR(r.max_indentation_m - r.residual_indentation_m, r.max_force_N / c.k(), kLawOdeRel * r.max_indentation_m);
+    // The independent integration.
+    const Integrated ode = integrate_line(c);
+    EXPECT_NEAR(r.max_force_N, ode.F_max, kLawOdeRel * ode.F_max) << ratio;
+    EXPECT_NEAR(r.compression_time_s, ode.t_m, kLawOdeRel * ode.t_c) << ratio;
+    EXPECT_NEAR(r.contact_time_s, ode.t_c, kLawOdeRel * ode.t_c) << ratio;
+    EXPECT_NEAR(e, ode.e, kLawOdeRel) << ratio;
+    EXPECT_GT(e, 0.0);
+    EXPECT_LT(e, 1.0);
+    EXPECT_GT(r.residual_indentation_m, 0.0);
+    // F(t): the loading impulse m V (split where the elastic loading ends, at F = F_y: far above
+    // V_y that phase is a few ns of a 0.1 ms loading, which one adaptive pass steps over), the
+    // unloading's e m V.
+    const double t1 = std::asin(c.Vy() / V) * std::sqrt(m / c.k());
+    EXPECT_NEAR(law->force_N(r, t1), c.Fy(), kLawOdeRel * c.Fy()) << ratio;
+    EXPECT_NEAR(impulse(*law, r, 0.0, t1) + impulse(*law, r, t1, r.compression_time_s), m * V, kLawOdeRel * m * V)
+        << ratio;
+    EXPECT_NEAR(impulse(*law, r, r.compression_time_s, r.contact_time_s), e * m * V, kLawOdeRel * m * V) << ratio;
+    // The patch at F*: L/2 along the edge, b* = sqrt(R d*) across, under the mean pressure.
+    const double b = std::sqrt(c.R * r.max_indentation_m);
+    EXPECT_DOUBLE_EQ(r.contact_semi_axis_a_m, std::max(0.5 * c.L, b));
+    EXPECT_DOUBLE_EQ(r.contact_semi_axis_b_m, std::min(0.5 * c.L, b));
+    EXPECT_NEAR(r.contact_pressure_Pa, r.max_force_N / (2.0 * b * c.L), kLawOdeRel * r.contact_pressure_Pa);
+    RecordProperty("restitution_at_V_over_Vy_" + std::to_string(ratio), std::to_string(e));
+  }
+}
+
+// At and below V_y the law is the elastic "line" law, number for number; above it e falls from 1
+// as V grows, and an explicit limiting pressure replaces 1.6 Y.
+TEST(LinePlastic, ElasticBelowYieldAndItsLimits) {
+  const auto plastic = collision::make_contact_law("line-plastic", collision::LawOptions{});
+  const auto line = collision::make_contact_law("line", collision::LawOptions{});
+  const double Vy = LineContact(line_input(1.0)).Vy();
+  for (const double ratio : {0.01, 0.5, 1.0 - 1e-9}) {
+    const collision::LawInput in = line_input(ratio * Vy);
+    const collision::LawResult p = solve(*plastic, in), l = solve(*line, in);
+    ASSERT_EQ(p.status, collision::LawStatus::ok);
+    const double same[][2] = {{p.max_force_N, l.max_force_N},
+                              {p.max_indentation_m, l.max_indentation_m},
+                              {p.compression_time_s, l.compression_time_s},
+                              {p.contact_time_s, l.contact_time_s},
+                              {p.restitution.coefficient, l.restitution.coefficient},
+                              {p.impulse_total_Ns, l.impulse_total_Ns},
+                              {p.contact_semi_axis_b_m, l.contact_semi_axis_b_m},
+                              {p.contact_pressure_Pa, l.contact_pressure_Pa}};
+    for (const auto& [x, y] : same) EXPECT_NEAR(x, y, 1e-12 * std::abs(y)) << ratio;
+    EXPECT_EQ(p.residual_indentation_m, 0.0);
+    for (const double u : {0.1, 0.5, 0.9, 1.3, 1.9}) {
+      const double t = u * l.compression_time_s;
+      EXPECT_NEAR(plastic->force_N(p, t), line->force_N(l, t), 1e-12 * l.max_force_N) << ratio << " " << u;
+    }
+  }
+  // Above V_y: e -> 1 as V -> V_y, and e falls as V grows.
+  double previous = 1.0;
+  for (const double ratio : {1.0 + 1e-6, 1.01, 1.5, 10.0, 100.0, 1e3, 1e4}) {
+    const collision::LawResult r = solve(*plastic, line_input(ratio * Vy));
+    ASSERT_EQ(r.status, collision::LawStatus::ok) << ratio;
+    if (ratio < 1.0 + 1e-5) EXPECT_GT(r.restitution.coefficient, 1.0 - 1e-3);
+    EXPECT_LT(r.restitution.coefficient, previous) << ratio;
+    previous = r.restitution.coefficient;
+  }
+  // limiting_pressure_Pa in place of 1.6 Y: twice p_y, four times F_y, the elastic range 4 x V_y.
+  const collision::LawInput in = line_input(3.0 * Vy);
+  collision::LawOptions o;
+  o.limiting_pressure_Pa = 2.0 * collision::kThorntonYieldFactor * in.yield_strength_Pa;
+  const collision::LawResult harder = solve(*collision::make_contact_law("line-plastic", o), in);
+  EXPECT_EQ(harder.restitution.coefficient, 1.0);
+  EXPECT_LT(solve(*plastic, in).restitution.coefficient, 1.0);
+  // No limiting pressure, or no radius across the edge: no result (the scene refuses such input first).
+  collision::LawInput no_yield = in;
+  no_yield.yield_strength_Pa = 0.0;
+  EXPECT_NE(solve(*plastic, no_yield).status, collision::LawStatus::ok);
+  collision::LawInput no_radius = in;
+  no_radius.effective_radius_m = 0.0;
+  EXPECT_NE(solve(*plastic, no_radius).status, collision::LawStatus::ok);
+}
+
 // ---- The acceptance's held-out check: a box mesh dropped on a corner and on an edge. ----
 
 namespace {
@@ -422,8 +635,9 @@ TEST(SharpScene, BoxOnEdgeWedgeAndRoundedLineContact) {
   EXPECT_GT(wedge["residual_indentation_m"].get<double>(), 0.0);
   EXPECT_TRUE(wedge["checks"]["passed"].get<bool>());
   // With edge_radius: a cylinder along the edge on the flat floor, whose contact length is at once
-  // the whole edge: the line contact over L = 200 mm, F = (pi/4) E* L d.
-  const nlohmann::json line = impact_json(box_drop(kEdge, 45, "edge_radius = 0.5", ""));
+  // the whole edge: the line contact over L = 200 mm, F = (pi/4) E* L d; elastic under Hertz
+  // (a plastic law: "line-plastic", SharpScene.FarRotatedBoxOnARoundedEdgeYieldsAlongTheLine).
+  const nlohmann::json line = impact_json(box_drop(kEdge, 45, "edge_radius = 0.5", "contact_law = \"hertz\""));
   EXPECT_EQ(line["contact_law"], "line");
   const double m = line["reduced_mass_kg"].get<double>(), E = line["effective_modulus_Pa"].get<double>();
   const double k = 0.25 * M_PI * E * 0.2;
@@ -481,4 +695,79 @@ approach_speed_m_s = 3.0
   EXPECT_EQ(spanning["contact_law"], "line");
   EXPECT_NEAR(spanning["effective_radius_m"].get<double>(), 5e-4, 1e-12);  // across the edge: rho (and 1/R of the dome)
   EXPECT_NEAR(spanning["validity"]["contact_semi_axis_a_m"].get<double>(), 0.1, 1e-12);
+}
+
+// The acceptance's edge drop with a plastic law: the box 1 km from the origin, the whole scene
+// turned by 0.7 rad about (1, 2, 3) (the floor's normal and the box's orientation), on its long edge
+// rounded to 0.5 mm, found by first contact. "auto" with a yield strength runs "line-plastic" over
+// the 200 mm edge: its numbers are the law's at the impact's reduced mass (the scene's route to the
+// law), with a dent and 0 < e < 1; Hertz keeps the elastic "line"; naming "line-plastic" gives the
+// same impact.
+TEST(SharpScene, FarRotatedBoxOnARoundedEdgeYieldsAlongTheLine) {
+  const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  const Eigen::AngleAxisd box_turn(turn * Eigen::AngleAxisd(0.25 * M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix());
+  const Eigen::Vector3d far_mm(1e6, 0.0, 0.0), up = turn.col(2);
+  auto vec = [](const Eigen::Vector3d& v) { return "[" + exact(v.x()) + ", " + exact(v.y()) + ", " + exact(v.z()) + "]"; };
+  auto scene_text = [&](const std::string& impact_keys) {
+    return R"(length_unit = "mm"
+[materials.steel]
+youngs_modulus_Pa = 2.1e11
+poisson_ratio = 0.3
+yield_strength_Pa = 2.5e8
+[[bodies]]
+name = "floor"
+shape = "plane"
+normal = )" + vec(up) + R"(
+position = )" + vec(far_mm) + R"(
+material = "steel"
+[[bodies]]
+name = "box"
+shape = "mesh"
+mesh = ")" + data("box_200x100x60mm.stl").string() + R"("
+material = "steel"
+mass_kg = 0.5
+edge_radius = 0.5
+orientation_axis = )" + vec(box_turn.axis()) + R"(
+orientation_angle_deg = )" + exact(box_turn.angle() * 180.0 / M_PI) + R"(
+position = )" + vec(far_mm + 500.0 * up) + R"(
+velocity_m_s = )" + vec(-3.0 * up) + R"(
+[[impacts]]
+name = "drop"
+target = "floor"
+impactor = "box"
+point = "first-contact"
+)" + impact_keys + "\n";
+  };
+  const nlohmann::json j = impact_json(scene_text(""));
+  EXPECT_EQ(j["contact_law"], "line-plastic");
+  EXPECT_EQ(j["validity"]["contact_law"], "line-plastic");
+  EXPECT_EQ(j["sharp_feature"]["kind"], "edge");
+  EXPECT_EQ(j["sharp_feature"]["rounded_by_edge_radius"], true);
+  EXPECT_NEAR(j["sharp_feature"]["edge_length_m"].get<double>(), 0.2, kFarBoxRel * 0.2);
+  EXPECT_NEAR(j["effective_radius_m"].get<double>(), 5e-4, kFarBoxRel * 5e-4);
+  EXPECT_GT(j["residual_indentation_m"].get<double>(), 0.0);
+  EXPECT_GT(j["restitution"].get<double>(), 0.0);
+  EXPECT_LT(j["restitution"].get<double>(), 1.0);
+  EXPECT_TRUE(j["checks"]["passed"].get<bool>());
+  // The law's own numbers at the impact's m, V and E* over the 200 mm edge.
+  collision::LawInput in = line_input(j["approach_velocity_m_s"].get<double>());
+  in.reduced_mass_kg = j["reduced_mass_kg"].get<double>();
+  in.effective_modulus_Pa = j["effective_modulus_Pa"].get<double>();
+  in.effective_radius_m = j["effective_radius_m"].get<double>();
+  in.sharp_length_m = j["sharp_feature"]["edge_length_m"].get<double>();
+  const collision::LawResult r = solve(*collision::make_contact_law("line-plastic", collision::LawOptions{}), in);
+  ASSERT_EQ(r.status, collision::LawStatus::ok);
+  for (const auto& [key, value] : {std::pair<const char*, double>{"max_force_N", r.max_force_N},
+                                   {"contact_time_s", r.contact_time_s},
+                                   {"restitution", r.restitution.coefficient},
+                                   {"residual_indentation_m", r.residual_indentation_m}}) {
+    EXPECT_NEAR(j[key].get<double>(), value, kSameImpactRel * value) << key;
+  }
+  EXPECT_NEAR(j["approach_velocity_m_s"].get<double>(), 3.0, kFarBoxRel * 3.0);
+  // Hertz: the elastic line law; "line-plastic" named: the same impact as "auto".
+  const nlohmann::json hertz = impact_json(scene_text("contact_law = \"hertz\""));
+  EXPECT_EQ(hertz["contact_law"], "line");
+  EXPECT_EQ(hertz["restitution"].get<double>(), 1.0);
+  EXPECT_GT(hertz["max_force_N"].get<double>(), j["max_force_N"].get<double>());
+  expect_same_impact(impact_json(scene_text("contact_law = \"line-plastic\"")), j);
 }

@@ -41,6 +41,7 @@ std::shared_ptr<const ContactLaw> make_jackson_green_law(const LawOptions& optio
 std::shared_ptr<const ContactLaw> make_wedge_law(const LawOptions& options);
 std::shared_ptr<const ContactLaw> make_cone_law(const LawOptions& options);
 std::shared_ptr<const ContactLaw> make_line_law(const LawOptions& options);
+std::shared_ptr<const ContactLaw> make_line_plastic_law(const LawOptions& options);
 
 namespace {
 
@@ -54,6 +55,7 @@ Registry& registry() {
                         {"wedge", make_wedge_law},
                         {"cone", make_cone_law},
                         {"line", make_line_law},
+                        {"line-plastic", make_line_plastic_law},
                     }};
   return r;
 }

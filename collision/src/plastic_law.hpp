@@ -1,6 +1,7 @@
 #pragma once
-// What the plastic contact laws (thornton_law.cpp, jackson_green_law.cpp) share: the Hertz impact
-// below their elastic limit, and the last step of a result. Private to collision/.
+// What the plastic contact laws (thornton_law.cpp, jackson_green_law.cpp, line_plastic_law.cpp)
+// share: the limiting pressure, the Hertz impact below their elastic limit, and the last step of a
+// result. Private to collision/.
 #include <limits>
 
 #include "impactdeck/collision/compression.hpp"
@@ -10,6 +11,12 @@
 namespace impactdeck::collision::detail {
 
 inline bool finite_positive(double x) { return x > 0.0 && x <= std::numeric_limits<double>::max(); }
+
+/// The limiting pressure p_y of a plastic law ("thornton", "line-plastic"): `given` (the scene's
+/// limiting_pressure_Pa) when > 0, else kThorntonYieldFactor x the weaker body's yield strength.
+inline double limiting_pressure_Pa(double given, double yield_strength_Pa) {
+  return given > 0.0 ? given : kThorntonYieldFactor * yield_strength_Pa;
+}
 
 /// r's phases as the Hertz impact `hertz` with e = 1 and no dent: t_c = 2 t_m; the unloading is
 /// the loading's Hertz curve, of radius R*.

@@ -58,7 +58,7 @@ class ThorntonLaw final : public ContactLaw {
     r.status = LawStatus::degenerate;
     const double m = in.reduced_mass_kg, V = in.approach_velocity_m_s, E = in.effective_modulus_Pa,
                  R = in.effective_radius_m;
-    const double py = limiting_pressure_Pa_ > 0.0 ? limiting_pressure_Pa_ : kThorntonYieldFactor * in.yield_strength_Pa;
+    const double py = detail::limiting_pressure_Pa(limiting_pressure_Pa_, in.yield_strength_Pa);
     if (!detail::finite_positive(py)) return;  // no limiting pressure: the caller refuses such an input first
     const double kH = hertz_constant(E, R);
     r.stiffness = kH;

@@ -80,8 +80,12 @@ std::optional<ImpactLaw> sharp_impact_law(const ImpactSpec& s, const ImpactLaw& 
 
 ImpactLaw line_impact_law(const ImpactLaw& law, const InputContext& ctx) {
   ImpactLaw l = law;
-  l.name = "line";
-  l.law = collision::make_contact_law(l.name, collision::LawOptions{}, ctx);
+  // A plastic law (any but "hertz": "auto" chose Hertz without a yield strength or with a
+  // restitution) yields along the line too, at the sphere laws' p_y (impact_law).
+  l.name = law.name == "hertz" ? "line" : "line-plastic";
+  collision::LawOptions o;
+  o.limiting_pressure_Pa = l.limiting_pressure_Pa.value_or(0.0);
+  l.law = collision::make_contact_law(l.name, o, ctx);
   return l;
 }
 

@@ -395,7 +395,8 @@ namespace {
 // The contact law at a located point (docs/sharp-contacts.md, "Which law runs"): the one choice of
 // `run`'s impacts and of the sequences' bounces. At a sharp edge or corner without edge_radius, the
 // wedge or cone where the law is plastic (sharp_impact_law; Hertz keeps the flagged point); at an
-// edge rounded by edge_radius whose contact is a line, or spans the edge, the law "line". A sharp
+// edge rounded by edge_radius whose contact is a line, or spans the edge, the law "line" (Hertz) or
+// "line-plastic" (a plastic law; line_impact_law). A sharp
 // or line law named for a point it does not fit is refused (contact_law's place). When the law
 // changes, `model` is rebuilt with it and `located` solved again at the same point.
 void choose_point_law(const Scene& scene, const ImpactSpec& s, ImpactLaw& law, std::optional<ContactModel>& model,
@@ -435,7 +436,7 @@ void choose_point_law(const Scene& scene, const ImpactSpec& s, ImpactLaw& law, s
     }
   } else if (law.law->takes_line_contacts() && fitted && !rounded_edge) {
     throw InputError(where(scene), s.contact_law_place.describe(),
-                     "impact '" + s.name + "': contact_law = \"line\" is the law of an edge rounded by edge_radius, "
+                     "impact '" + s.name + "': contact_law = \"" + law.name + "\" is the law of an edge rounded by edge_radius, "
                      "but the contact point at " + text(located.point_m) + " m is not on one");
   }
 }

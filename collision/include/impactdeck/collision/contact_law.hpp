@@ -121,7 +121,7 @@ inline constexpr double kTaborHardnessFactor = 3.0;
 /// What a scene says about the law of an impact (each law reads what it needs).
 struct LawOptions {
   RestitutionModel restitution;     ///< "hertz": its restitution model
-  double limiting_pressure_Pa = 0;  ///< "thornton": p_y; 0: kThorntonYieldFactor x the yield strength
+  double limiting_pressure_Pa = 0;  ///< "thornton", "line-plastic": p_y; 0: kThorntonYieldFactor x the yield strength
   /// "jackson-green": the yielding (weaker) body's material, the one whose yield strength the law
   /// gets: its Poisson's ratio (C = 1.295 exp(0.736 nu)), its tangent modulus E_t in [0, E) (0:
   /// perfectly plastic) and its Young's modulus E (read when E_t > 0: hardening by E_t/E).

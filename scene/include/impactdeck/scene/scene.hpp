@@ -245,9 +245,9 @@ ImpactLaw impact_law(const Scene& scene, const ImpactSpec& s, const InputContext
 std::optional<ImpactLaw> sharp_impact_law(const ImpactSpec& s, const ImpactLaw& law, const collision::KernelInput& in,
                                           const InputContext& ctx);
 
-/// `law` with the line contact of an edge rounded by edge_radius ("line", elastic) in its place:
-/// where the rounding lies on a surface flat along the edge, or where the elliptical contact's
-/// length reaches the edge's length (docs/sharp-contacts.md).
+/// `law` with the line contact of an edge rounded by edge_radius in its place ("line" under Hertz, else
+/// "line-plastic" at its p_y): where the rounding lies on a surface flat along the edge, or where the
+/// elliptical contact's length reaches the edge's length (docs/sharp-contacts.md).
 ImpactLaw line_impact_law(const ImpactLaw& law, const InputContext& ctx);
 
 }  // namespace impactdeck::scene
