@@ -177,7 +177,7 @@ TEST_P(SequenceSharp, FirstBounceIsTheSingleImpact) {
 
   // The dent the bounce records (where a later bounce lands in it) is the law's: the wedge's
   // half-width x* tan(beta) and the cone's radius x* tan(alpha) (issue 30: both were 0), Thornton's
-  // sqrt(R* d*), none for the elastic laws; the same as the report's and the single impact's.
+  // sqrt(R* d*), line-plastic's strip half-width b* = sqrt(rho d*), none for the elastic laws; the same as the report's and the single impact's.
   ASSERT_TRUE(b.impact.has_value());
   const collision::ImpactResult& ir = b.impact->result;
   const double x = ir.history.law_result.max_indentation_m;
@@ -192,6 +192,8 @@ TEST_P(SequenceSharp, FirstBounceIsTheSingleImpact) {
     dent = x * std::tan(f.feature_angle_rad);
   } else if (law == "thornton") {
     dent = std::sqrt(ir.effective_radius_m * x);
+  } else if (law == "line-plastic") {
+    dent = std::min(0.5 * f.feature_length_m, std::sqrt(ir.effective_radius_m * x));  // the strip's half-width b*
   }
   if (dent > 0.0) {
     EXPECT_NEAR(b.dent_radius_m, dent, kDentRadiusRel * dent);

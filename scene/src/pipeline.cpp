@@ -583,6 +583,9 @@ fem_export::MeshConvergence refined_mesh_check(const Scene& scene, const RunRepo
   req.options.mesh.mesh_size_m = first.quality.mesh_size_m / 2;
   req.options.mesh.load_mesh_size_m = first.quality.load_mesh_size_m / 2;
   req.options.adapt_mesh_size = false;  // the size is the first mesh's, halved
+  // Curvature sizing from the start (docs/fem.md): finer than the first mesh in every respect,
+  // also where that one was a curvature-sizing retry.
+  req.options.mesh.curvature_elements = fem_export::curvature_elements_for(req.options.tolerances.volume);
   req.options.min_contact_zone_radius_m = first.contact_zone_radius_m;
   fem_export::MeshConvergence c;
   c.folder = "refined";
