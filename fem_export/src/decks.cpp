@@ -471,6 +471,15 @@ DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
       return mesh_part(r.body.surface, r.load_point_m, mo, stage, "mesh", r.body.name);
     };
     MeshResult mr;
+    // Meshes again with `mo` as changed; the tries so far stay first in mesh_attempts, the one that
+    // meshed ("ok") saying why it was left.
+    auto mesh_again = [&](const std::string& why) {
+      std::vector<MeshAttempt> before = mr.quality.attempts;
+      for (auto& a : before)
+        if (a.outcome == "ok") a.outcome = why;
+      mr = mesh_once();
+      mr.quality.attempts.insert(mr.quality.attempts.begin(), before.begin(), before.end());
+    };
     std::string first_failure;
     try {
       mr = mesh_once();
@@ -479,11 +488,8 @@ DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
       first_failure = e.reason();
     }
     if (curvature_retry > 0) {
-      std::string why;
-      std::vector<MeshAttempt> flat;
-      if (!first_failure.empty()) {
-        why = "no mesh at the asked sizes (" + first_failure + ")";
-      } else if (r.model.volume_m3 > 0) {
+      std::string why = first_failure.empty() ? "" : "no mesh at the asked sizes (" + first_failure + ")";
+      if (why.empty() && r.model.volume_m3 > 0) {
         const BodyComparison bc = compare_body(mr.mesh, r.material.density_kg_m3, r.model, r.options.tolerances,
                                                r.impulse_Ns * r.direction, r.load_point_m);
         if (bc.volume_relative_error > r.options.tolerances.volume) {
@@ -491,21 +497,16 @@ DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
           w << std::setprecision(3) << "FE volume " << 100 * bc.volume_relative_error << " % off the part's (tolerance "
             << 100 * r.options.tolerances.volume << " %)";
           why = w.str();
-          flat = mr.quality.attempts;
         }
       }
       if (!why.empty()) {
-        for (auto& a : flat)
-          if (a.outcome == "ok") a.outcome = why + ": meshed again with curvature sizing";
         mo.curvature_elements = curvature_retry;
-        mr = mesh_once();
-        mr.quality.attempts.insert(mr.quality.attempts.begin(), flat.begin(), flat.end());
+        mesh_again(why + ": meshed again with curvature sizing");
       }
     }
     if (r.options.adapt_mesh_size && r.model.volume_m3 > 0) {
       // A default size: refine until the FE body matches the part to half the tolerances.
       const FemTolerances& tol = r.options.tolerances;
-      std::vector<MeshAttempt> coarser;
       for (int k = 0; k < DeckOptions::kMaxSizeRefinements; ++k) {
         const BodyComparison bc =
             compare_body(mr.mesh, r.material.density_kg_m3, r.model, tol, r.impulse_Ns * r.direction, r.load_point_m);
@@ -520,15 +521,10 @@ DeckResult write_deck_files(const DeckRequest& r, const fs::path& folder) {
         why << std::setprecision(3) << "default size too coarse: FE volume " << 100 * bc.volume_relative_error
             << " %, inertia " << 100 * inertia << " %, predicted velocity " << 100 * lin << " % and spin "
             << 100 * ang << " % off the rigid model (more than half a tolerance): size / sqrt(2)";
-        for (auto a : mr.quality.attempts) {
-          if (a.outcome == "ok") a.outcome = why.str();
-          coarser.push_back(a);
-        }
         mo.mesh_size_m /= std::sqrt(2.0);
         if (mo.load_mesh_size_m > mo.mesh_size_m) mo.load_mesh_size_m = mo.mesh_size_m;
-        mr = mesh_once();
+        mesh_again(why.str());
       }
-      mr.quality.attempts.insert(mr.quality.attempts.begin(), coarser.begin(), coarser.end());
     }
     out.mesh_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_mesh).count();
     TetMesh& m = mr.mesh;

@@ -113,10 +113,11 @@ void set_common_options(const MeshOptions& o, double h_mm, double h0_mm, int alg
   gmsh::option::setNumber("Mesh.Optimize", 1);
 }
 
-std::string geo_options(const MeshOptions& o, double h_mm, double h0_mm, int algorithm_2d) {
+// The .geo's mesh options; h and h0 in the script's length unit (geo_header).
+std::string geo_options(const MeshOptions& o, double h, double h0, int algorithm_2d) {
   std::ostringstream g;
-  g << "Mesh.CharacteristicLengthMax = " << fmt(h_mm) << ";\n"
-    << "Mesh.CharacteristicLengthMin = " << fmt(curvature_min_size(o, h_mm, h0_mm)) << ";\n"
+  g << "Mesh.CharacteristicLengthMax = " << fmt(h) << ";\n"
+    << "Mesh.CharacteristicLengthMin = " << fmt(curvature_min_size(o, h, h0)) << ";\n"
     << "Mesh.CharacteristicLengthFromPoints = 0;\n"
     << "Mesh.CharacteristicLengthFromCurvature = " << o.curvature_elements
     << "; // elements per 2 Pi of curvature (0: off)\n"
@@ -176,8 +177,9 @@ std::string geo_probe_groups(const MeshOptions& o, int first_tag = 1000) {
   return g.str();
 }
 
-std::string geo_size_field(const Eigen::Vector3d& p_mm, double h0_mm, double h_mm, double r0_mm) {
-  return "Field[1] = MathEval;\nField[1].F = \"" + size_formula(p_mm, h0_mm, h_mm, r0_mm) +
+// The .geo's size field; p, h0, h and r0 in the script's length unit (size_formula is unit-free).
+std::string geo_size_field(const Eigen::Vector3d& p, double h0, double h, double r0) {
+  return "Field[1] = MathEval;\nField[1].F = \"" + size_formula(p, h0, h, r0) +
          "\";\nBackground Field = 1;\n";
 }
 
