@@ -139,13 +139,13 @@ void expect_same_impact(const json& a, const json& b, const std::string& what) {
 TEST(DropTest, HeightTablesAtTheirBoundaries) {
   using campaign::ista_1a_height_m;
   using campaign::mil_std_810h_height_m;
-  // MIL-STD-810H Table 516.8-VI: under 45.4 kg, 45.4 to 90.8 kg inclusive; under 91 cm, 91 cm and over.
+  // MIL-STD-810H Table 516.8-VI, the row built in: under 45.4 kg and under 91 cm. The other rows
+  // are not built in (unchecked against the standard's text): no height, the campaign asks for one.
+  EXPECT_EQ(mil_std_810h_height_m(0.0, 0.0), 1.22);
   EXPECT_EQ(mil_std_810h_height_m(45.39, 0.909), 1.22);
-  EXPECT_EQ(mil_std_810h_height_m(45.39, 0.91), 0.76);
-  EXPECT_EQ(mil_std_810h_height_m(45.4, 0.909), 0.76);
-  EXPECT_EQ(mil_std_810h_height_m(45.4, 0.91), 0.61);
-  EXPECT_EQ(mil_std_810h_height_m(90.8, 0.5), 0.76);
-  EXPECT_FALSE(mil_std_810h_height_m(90.81, 0.5).has_value());
+  EXPECT_FALSE(mil_std_810h_height_m(45.39, 0.91).has_value());
+  EXPECT_FALSE(mil_std_810h_height_m(45.4, 0.909).has_value());
+  EXPECT_FALSE(mil_std_810h_height_m(90.8, 0.5).has_value());
   // ISTA 1A: [0, 10), [10, 19), [19, 28), [28, 45), [45, 68] kg.
   EXPECT_EQ(ista_1a_height_m(0.0), 0.76);
   EXPECT_EQ(ista_1a_height_m(9.999), 0.76);
@@ -311,6 +311,25 @@ TEST(DropTest, BadProgrammesAreRefusedNamingTheKey) {
   EXPECT_NE(err("standard = \"ISTA-1A\"\nbody = \"floor\"\n").find("is fixed"), std::string::npos);
   EXPECT_NE(err("standard = \"ISTA-1A\"\nbody = \"part\"\nheight_m = -1\n").find("must be a number > 0"), std::string::npos);
   EXPECT_NE(err("standard = \"ISTA-1A\"\n").find("missing required key 'drop_test.body'"), std::string::npos);
+}
+
+TEST(DropTest, MilStdOutsideTheBuiltInRowAsksForTheHeight) {
+  // A 1.2 m long ellipsoid (11.8 kg): longer than the 0.91 m of the row built in. Its row of Table
+  // 516.8-VI is not built in (unchecked), so the campaign asks for height_m rather than guessing.
+  TempDir t("mil_large");
+  std::string scene = base_scene();
+  scene.replace(scene.find("semi_axes = ["), std::string("semi_axes = [").size() + num(kA).size(), "semi_axes = [600");
+  const fs::path file = campaign_file(t.path, scene, "standard = \"MIL-STD-810H-516.8-IV\"\nbody = \"part\"\n");
+  const std::string e = error_of([&] { campaign::read_campaign(file); });
+  EXPECT_NE(e.find("key 'drop_test': body 'part' (11.8375 kg, "), std::string::npos) << e;
+  EXPECT_NE(e.find("largest box side 1.2 m) is outside the row of MIL-STD-810H Table 516.8-VI built in (under 45.4 kg "
+                   "and 0.91 m: 1.22 m): give drop_test.height_m"),
+            std::string::npos)
+      << e;
+  const campaign::Campaign c = campaign::read_campaign(
+      campaign_file(t.path, scene, "standard = \"MIL-STD-810H-516.8-IV\"\nbody = \"part\"\nheight_m = 0.76\n"));
+  EXPECT_EQ(c.cases.size(), 26u);
+  EXPECT_EQ(c.drop_test->height_m, 0.76);
 }
 
 TEST(DropTest, ASceneOfSequencesOnlyNeedsADropTestToBeCollected) {

@@ -54,9 +54,7 @@ const std::vector<std::string>& drop_standard_names() {
 }
 
 std::optional<double> mil_std_810h_height_m(double mass_kg, double largest_dimension_m) {
-  const bool small = largest_dimension_m < 0.91;
-  if (mass_kg < 45.4) return small ? 1.22 : 0.76;
-  if (mass_kg <= 90.8) return small ? 0.76 : 0.61;
+  if (mass_kg >= 0 && mass_kg < 45.4 && largest_dimension_m < 0.91) return 1.22;
   return std::nullopt;
 }
 
@@ -241,9 +239,10 @@ DropProgramme plan_drops(const scene::Scene& sc, const DropTestSpec& spec, std::
     const double largest = p.box.lengths_m().maxCoeff();
     const auto h = mil_std_810h_height_m(p.mass_kg, largest);
     if (!spec.height_m && !h) {
-      throw ctx.error(spec.table_place, "body '" + spec.body + "' (" + mass_text +
-                                            ") is heavier than the 26-drop rows of MIL-STD-810H Table 516.8-VI "
-                                            "(up to 90.8 kg): give drop_test.height_m");
+      throw ctx.error(spec.table_place,
+                      "body '" + spec.body + "' (" + mass_text + ", largest box side " + short_number(largest) +
+                          " m) is outside the row of MIL-STD-810H Table 516.8-VI built in (under 45.4 kg and "
+                          "0.91 m: 1.22 m): give drop_test.height_m from the standard's table for this item");
     }
     p.height_m = spec.height_m.value_or(h.value_or(0));
   } else if (spec.standard == kIsta1a) {
