@@ -45,6 +45,9 @@ void register_compare_contact(CLI::App& app, Context& ctx) {
   cmd->add_option("--contact-increments", args->options.contact.contact_increments,
                   "Increments across the analytic contact duration (default 40)")
       ->check(CLI::Range(4, 100000));
+  cmd->add_option("--static-increments", args->options.contact.static_increments,
+                  "Plastic (quasi-static) runs: increments of each load and unload (default 16)")
+      ->check(CLI::Range(2, 10000));
   cmd->add_option("--penalty-factor", args->options.contact.penalty_factor,
                   "Penalty slope K = factor E* / h_c (default 20)")
       ->check(positive_number());

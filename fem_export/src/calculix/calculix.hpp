@@ -57,11 +57,11 @@ std::string material_cards(const std::string& name, const DeckMaterial& m, doubl
 std::string calculix_inp(const DeckRequest& request, const TetMesh& mesh, const PatchLoad* patch = nullptr);
 std::string calculix_mesh_inp(const TetMesh& mesh, const DeckUnits& units = {});
 
-/// Runs ccx on `dir`/impact.inp (cwd = dir, output in impact.log, progress from impact.sta up to
+/// Runs ccx on `dir`/`job`.inp (cwd = dir, output in `job`.log, progress from `job`.sta up to
 /// `end_time_s`) with options.timeout_s, or default_solver_timeout_s(nodes, solves); returns the
 /// wall time in s. Throws InputError when ccx is missing, fails or times out. The runner of the
 /// hybrid check and of the full-contact model (contact_model.hpp).
 double run_ccx_job(const std::filesystem::path& dir, const CheckOptions& options, double end_time_s,
-                   std::size_t nodes, std::size_t solves);
+                   std::size_t nodes, std::size_t solves, const std::string& job = kJobName);
 
 }  // namespace impactdeck::fem_export::calculix

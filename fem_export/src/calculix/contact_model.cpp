@@ -26,6 +26,12 @@ namespace {
 
 // SI -> mm-N-s-tonne.
 constexpr double kMm = 1000.0;
+// The quasi-static route's files: the model both runs include, and the first run's job.
+constexpr const char* kQuasiStaticModel = "model.inp";
+constexpr const char* kQuasiStaticLoadJob = "load";
+// The `impact` run's loading work at d_max may miss 1/2 m* V^2 by this fraction (the two runs'
+// samples of one path: linear chords of a curve, O(1/increments^2)); more is an error.
+constexpr double kQuasiStaticEnergyTolerance = 0.1;
 constexpr double kMPa = 1e-6;
 constexpr double kTonnePerMm3 = 1e-12;
 // ccx face numbers of a tetrahedron (corner triples, 0-based): S1 1-2-3, S2 1-4-2, S3 2-4-3, S4 3-4-1.
@@ -197,6 +203,11 @@ void check_request(const ContactModelRequest& r, const InputContext& where) {
   if (!(o.contact_elements > 0) || o.contact_increments < 4 || !(o.penalty_factor > 0) || !(o.end_time_factor >= 1)) {
     throw where.error("contact model options", "contact_elements and penalty_factor > 0, increments >= 4, end factor >= 1");
   }
+  if (o.quasi_static && (!(r.effective_mass_kg > 0) || !(r.approach_speed_m_s > 0) || !(r.probe_approach_m > 0) ||
+                         o.static_increments < 2 || (r.target.support_depth_m && r.impactor.support_depth_m))) {
+    throw where.error("contact model", "the quasi-static route needs m* > 0, V > 0, a probe approach > 0, at least 2 "
+                                       "increments and a free body");
+  }
   for (const ContactBody* b : {&r.target, &r.impactor}) {
     if (!(b->material.youngs_modulus_Pa > 0) || !(b->material.density_kg_m3 > 0) || !(b->far_mesh_size_m > 0)) {
       throw where.error("body '" + b->name + "'", "modulus, density and mesh size must be > 0");
@@ -225,8 +236,10 @@ struct DeckBodyMesh {
   Eigen::Vector3d inward_normal;     ///< deck frame: the target's -n, the impactor's n
   QuadBody q;
   std::vector<int> fixed;            ///< body-local nodes held by *BOUNDARY
+  std::vector<int> driven;           ///< quasi-static: body-local nodes pushed by the approach
   std::vector<std::pair<std::string, int>> probe_nodes;  ///< 0-based, body-local
   ContactBodyMesh* summary = nullptr;  ///< the ContactDeck's record of it
+  bool held_at_half_depth = false;     ///< quasi-static: the target of two free bodies is held
 };
 
 // Meshes b.body into `stage`, makes it quadratic in the deck frame, picks its held nodes and its
@@ -248,15 +261,21 @@ void mesh_deck_body(const ContactModelRequest& r, const Sizing& z, const fs::pat
   }
   b.q = quadratic(m.mesh, body, r.contact_point_m);
   b.summary->contact_node = static_cast<std::size_t>(m.mesh.node_of("LOAD"));  // corner nodes come first
-  if (body.support_depth_m) {
+  double deepest = 0;
+  for (const auto& x : b.q.nodes) deepest = std::max(deepest, b.inward_normal.dot(x));
+  if (body.support_depth_m || b.held_at_half_depth) {
     // The held nodes: at least the support depth under the contact point, or past half the
-    // body's depth when it is shallower (a small fixed body).
-    double deepest = 0;
-    for (const auto& x : b.q.nodes) deepest = std::max(deepest, b.inward_normal.dot(x));
-    const double depth = deepest >= *body.support_depth_m ? *body.support_depth_m : 0.5 * deepest;
+    // body's depth when it is shallower (a small fixed body, or a free body held in the
+    // quasi-static route).
+    const double depth = body.support_depth_m && deepest >= *body.support_depth_m ? *body.support_depth_m : 0.5 * deepest;
     for (std::size_t n = 0; n < b.q.nodes.size(); ++n)
       if (b.inward_normal.dot(b.q.nodes[n]) >= depth) b.fixed.push_back(static_cast<int>(n));
     if (b.fixed.empty()) throw where.error("body '" + body.name + "'", "no node to hold the fixed body by");
+  } else if (r.options.quasi_static) {
+    // The driven nodes: past half the body's depth (a sphere's far hemisphere), moved as one.
+    for (std::size_t n = 0; n < b.q.nodes.size(); ++n)
+      if (b.inward_normal.dot(b.q.nodes[n]) >= 0.5 * deepest) b.driven.push_back(static_cast<int>(n));
+    if (b.driven.empty()) throw where.error("body '" + body.name + "'", "no node to push the body by");
   }
   // Probe nodes keep their numbers: the corner nodes come first in the quadratic mesh.
   for (const auto& [group, node] : m.mesh.node_groups)
@@ -339,6 +358,18 @@ std::string contact_inp(const ContactModelRequest& r, const ContactDeck& out, co
   d << "*SURFACE INTERACTION, NAME=SI1\n*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR\n"
     << deck_number(out.penalty_N_m3 * kMPa / kMm) << "\n"
     << "*CONTACT PAIR, INTERACTION=SI1, TYPE=SURFACE TO SURFACE\nSIMP, STGT\n";
+  if (r.options.quasi_static) {
+    // The steps are the runs' own (quasi_static_steps): here the pushed nodes and the contact
+    // nodes whose displacements give the dents.
+    for (int i = 0; i < 2; ++i) {
+      if (b[i].driven.empty()) continue;
+      d << "*NSET, NSET=NDRIVEN\n";
+      for (int n : b[i].driven) d << base[i] + n + 1 << "\n";
+    }
+    d << "*NSET, NSET=NCONTACT\n"
+      << base[0] + out.target.contact_node + 1 << "\n" << base[1] + out.impactor.contact_node + 1 << "\n";
+    return d.str();
+  }
   // Initial velocities: v + omega x (x - c) of each body (mm/s).
   d << "*INITIAL CONDITIONS, TYPE=VELOCITY\n";
   for (int i = 0; i < 2; ++i) {
@@ -367,6 +398,26 @@ std::string contact_inp(const ContactModelRequest& r, const ContactDeck& out, co
     << deck_number(out.time_step_s) << "\n"
     << "*CONTACT PRINT, SLAVE=SIMP, MASTER=STGT\nCF\n*NODE PRINT, NSET=NALL\nU, V\n"
     << "*EL PRINT, ELSET=ETGT, TOTALS=ONLY\nELSE, ELKE\n*EL PRINT, ELSET=EIMP, TOTALS=ONLY\nELSE, ELKE\n*END STEP\n";
+  return d.str();
+}
+
+// A quasi-static run's deck: model.inp, then the driven nodes pushed by `approach_m` along `drive`
+// (deck frame, unit) and brought back to 0, each in `increments` increments (ccx may cut them back);
+// the driven set's reaction and the contact nodes' displacements printed at every increment.
+std::string quasi_static_inp(const std::string& impact, const std::string& source, double approach_m,
+                             const Eigen::Vector3d& drive, int increments) {
+  std::ostringstream d;
+  d << "** impactdeck " << kVersion << ": quasi-static full-contact run of impact '" << impact << "' from " << source
+    << "\n** units mm-N-s-tonne; the approach " << deck_number(approach_m * kMm) << " mm, then back to 0\n"
+    << "*INCLUDE, INPUT=" << kQuasiStaticModel << "\n";
+  const double inc = 1.0 / increments;
+  for (int step = 0; step < 2; ++step) {
+    const Eigen::Vector3d u = step == 0 ? Eigen::Vector3d(approach_m * kMm * drive) : Eigen::Vector3d::Zero();
+    d << "*STEP, NLGEOM, INC=" << 50 * increments << "\n*STATIC\n"
+      << deck_number(inc) << ", 1.0, " << deck_number(1e-4 * inc) << ", " << deck_number(inc) << "\n*BOUNDARY\n";
+    for (int k = 0; k < 3; ++k) d << "NDRIVEN, " << k + 1 << ", " << k + 1 << ", " << deck_number(u[k]) << "\n";
+    d << "*NODE PRINT, NSET=NDRIVEN, TOTALS=ONLY\nRF\n*NODE PRINT, NSET=NCONTACT\nU\n*END STEP\n";
+  }
   return d.str();
 }
 
@@ -456,6 +507,8 @@ ContactDeck write_contact_deck(const ContactModelRequest& r, const fs::path& fol
     std::array<DeckBodyMesh, 2> b;
     b[0].body = &r.target, b[0].role = "target", b[0].inward_normal = -r.normal.normalized(), b[0].summary = &out.target;
     b[1].body = &r.impactor, b[1].role = "impactor", b[1].inward_normal = r.normal.normalized(), b[1].summary = &out.impactor;
+    // Quasi-static, two free bodies: the target is held, the impactor pushed.
+    b[0].held_at_half_depth = o.quasi_static && !r.target.support_depth_m && !r.impactor.support_depth_m;
     for (DeckBodyMesh& body : b) mesh_deck_body(r, z, stage, where, body);
     b[1].probe_nodes.clear();  // probes are the target's
     const bool plastic = out.target.plastic || out.impactor.plastic;
@@ -463,8 +516,24 @@ ContactDeck write_contact_deck(const ContactModelRequest& r, const fs::path& fol
     out.node_count = out.target.node_count + out.impactor.node_count;
     out.mesh_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
-    write_file_atomically(stage / (std::string(kJobName) + ".inp"), contact_inp(r, out, b, plastic));
     json cj = contact_description(r, out, b, plastic);
+    if (o.quasi_static) {
+      // model.inp: the bodies, materials, supports and contact; load.inp: the first run's steps.
+      // impact.inp follows from load's result (run_contact_model).
+      write_file_atomically(stage / kQuasiStaticModel, contact_inp(r, out, b, plastic));
+      const Eigen::Vector3d drive = -(b[0].driven.empty() ? b[1] : b[0]).inward_normal;
+      cj["quasi_static"] = true;
+      cj["drive_direction"] = json_vector(drive);
+      cj["driven_body"] = b[0].driven.empty() ? "impactor" : "target";
+      cj["effective_mass_kg"] = r.effective_mass_kg;
+      cj["approach_speed_m_s"] = r.approach_speed_m_s;
+      cj["probe_approach_m"] = r.probe_approach_m;
+      cj["static_increments"] = o.static_increments;
+      write_file_atomically(stage / (std::string(kQuasiStaticLoadJob) + ".inp"),
+                            quasi_static_inp(r.impact, r.source, r.probe_approach_m, drive, o.static_increments));
+    } else {
+      write_file_atomically(stage / (std::string(kJobName) + ".inp"), contact_inp(r, out, b, plastic));
+    }
     write_file_atomically(stage / "contact.json", cj.dump() + "\n");
     out.description = std::move(cj);
 
@@ -558,6 +627,190 @@ namespace {
 
 ContactRunResult run_contact(const fs::path& folder, const json& cj, const CheckOptions& options);
 
+// A quasi-static run's output: the driven set's reaction along the drive at each printed time
+// (total time: step 1 in (0, 1], step 2 in (1, 2]) and the contact nodes' last displacements.
+struct StaticDat {
+  std::vector<double> time, force_N;
+  std::map<int, Eigen::Vector3d> last_u_m;
+  double last_u_time = -1;
+};
+
+StaticDat read_static_dat(const fs::path& p, const Eigen::Vector3d& drive) {
+  std::ifstream in(p);
+  if (!in) throw InputError(p.string(), "ccx output", "cannot be read");
+  StaticDat d;
+  enum { none, force, disp } state = none;
+  std::string l;
+  const std::size_t cap = 10000000;  // lines: bounded whatever the file
+  for (std::size_t lines = 0; std::getline(in, l) && lines < cap; ++lines) {
+    const bool is_force = l.find("total force (fx,fy,fz) for set NDRIVEN") != std::string::npos;
+    const bool is_disp = l.find("displacements (vx,vy,vz) for set NCONTACT") != std::string::npos;
+    if (is_force || is_disp) {
+      const auto k = l.rfind("time");
+      double t = 0;
+      std::istringstream ts(k == std::string::npos ? std::string() : l.substr(k + 4));
+      if (!(ts >> t) || !std::isfinite(t)) throw InputError(p.string(), "static run", "unreadable time in '" + l + "'");
+      if (is_force) {
+        state = force;
+        d.time.push_back(t);
+      } else {
+        state = disp;
+        d.last_u_time = t;
+      }
+      continue;
+    }
+    std::istringstream ls(l);
+    if (state == force) {
+      Eigen::Vector3d f;
+      if (ls >> f.x() >> f.y() >> f.z()) {
+        d.force_N.push_back(f.dot(drive));  // the support pushes the body along the drive
+        state = none;
+      }
+    } else if (state == disp) {
+      int n;
+      Eigen::Vector3d u;
+      if (ls >> n >> u.x() >> u.y() >> u.z()) d.last_u_m[n] = u / kMm;
+    }
+  }
+  if (d.force_N.size() != d.time.size() || d.time.empty() || d.time.back() < 2 - 1e-6) {
+    throw InputError(p.string(), "static run",
+                     "ccx printed the driven nodes' force up to time " + std::to_string(d.time.empty() ? 0.0 : d.time.back()) +
+                         " of 2 (load and unload)");
+  }
+  return d;
+}
+
+// The curves of a static run that pushed to `peak_m`: loading from (0, 0), unloading from the peak.
+struct StaticCurves {
+  std::vector<double> ld, lf, ud, uf;
+};
+StaticCurves curves_of(const StaticDat& d, double peak_m) {
+  StaticCurves c{{0.0}, {0.0}, {}, {}};
+  for (std::size_t i = 0; i < d.time.size(); ++i) {
+    const double t = d.time[i];
+    if (t <= 1 + 1e-9) {
+      if (t * peak_m > c.ld.back()) {
+        c.ld.push_back(t * peak_m);
+        c.lf.push_back(d.force_N[i]);
+      }
+    } else {
+      if (c.ud.empty()) {
+        c.ud.push_back(c.ld.back());
+        c.uf.push_back(c.lf.back());
+      }
+      const double x = (2 - t) * peak_m;
+      if (x < c.ud.back()) {
+        c.ud.push_back(x);
+        c.uf.push_back(d.force_N[i]);
+      }
+    }
+  }
+  return c;
+}
+
+double loading_work(const StaticCurves& c) {
+  double w = 0;
+  for (std::size_t i = 1; i < c.ld.size(); ++i) w += 0.5 * (c.lf[i] + c.lf[i - 1]) * (c.ld[i] - c.ld[i - 1]);
+  return w;
+}
+
+// The quasi-static route (contact_model.hpp, "Quasi-static"): run `load`, find d_max on its curve,
+// write and run `impact`, and put the mass on its curves.
+ContactRunResult run_quasi_static(const fs::path& folder, json cj, const CheckOptions& options) {
+  ContactRunResult r;
+  r.quasi_static = true;
+  r.solver_runs = 0;
+  const double mass = cj.at("effective_mass_kg"), speed = cj.at("approach_speed_m_s");
+  const double energy = 0.5 * mass * speed * speed;
+  const int increments = cj.at("static_increments");
+  const Eigen::Vector3d drive = vec3(cj.at("drive_direction"));
+  const std::string impact = cj.at("impact"), source = cj.at("source");
+  std::size_t nodes = 0;
+  for (const auto& b : cj.at("bodies")) nodes += b.at("node_count").get<std::size_t>();
+  const std::size_t solves = 8 * 2 * static_cast<std::size_t>(increments);  // cutbacks: 8 per nominal increment
+  auto dat = [&](const char* job) { return folder / (std::string(job) + ".dat"); };
+  auto where = [&](const char* job) { return (folder / (std::string(job) + ".dat")).string(); };
+
+  // Run `load`: its approach doubled (twice at most) until its loading work covers the energy.
+  double probe = cj.at("probe_approach_m");
+  double peak = cj.value("peak_approach_m", 0.0);
+  if (peak <= 0 || options.run_solver) {
+    for (int attempt = 0;; ++attempt) {
+      if (options.run_solver) {
+        if (attempt > 0) {
+          write_file_atomically(folder / (std::string(kQuasiStaticLoadJob) + ".inp"),
+                                quasi_static_inp(impact, source, probe, drive, increments));
+        }
+        r.wall_time_s += calculix::run_ccx_job(folder, options, 2.0, nodes, solves, kQuasiStaticLoadJob);
+        ++r.solver_runs;
+      }
+      const StaticDat d = read_static_dat(dat(kQuasiStaticLoadJob), drive);
+      r.increments += d.time.size();
+      const StaticCurves c = curves_of(d, probe);
+      if (loading_work(c) >= energy) {
+        peak = impact_on_curves(c.ld, c.lf, {c.ld.back(), 0.0}, {c.lf.back(), -1.0}, mass, speed).max_approach_m;
+        break;
+      }
+      if (attempt == 2 || !options.run_solver) {
+        std::ostringstream m;
+        m << "the contact took " << loading_work(c) << " J of the impact's " << energy << " J up to an approach of "
+          << probe * 1e3 << " mm (the largest tried): the bodies are softer than every contact law";
+        throw InputError(where(kQuasiStaticLoadJob), "static run", m.str());
+      }
+      probe *= 2;
+    }
+    cj["probe_approach_m"] = probe;
+    cj["peak_approach_m"] = peak;
+    write_file_atomically(folder / "contact.json", cj.dump() + "\n");
+  }
+  // Run `impact` to d_max and back.
+  if (options.run_solver) {
+    write_file_atomically(folder / (std::string(kJobName) + ".inp"), quasi_static_inp(impact, source, peak, drive, increments));
+    r.wall_time_s += calculix::run_ccx_job(folder, options, 2.0, nodes, solves, kJobName);
+    ++r.solver_runs;
+  }
+  const StaticDat d = read_static_dat(dat(kJobName), drive);
+  r.increments += d.time.size();
+  const StaticCurves c = curves_of(d, peak);
+  CurveImpact ci;
+  try {
+    // The `impact` run samples the loading path at other approaches than `load`: its work at d_max
+    // may fall a little short of 1/2 m* V^2 (energy_relative_error says how much); beyond
+    // kQuasiStaticEnergyTolerance the runs disagree and this throws.
+    ci = impact_on_curves(c.ld, c.lf, c.ud, c.uf, mass, speed, kQuasiStaticEnergyTolerance);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(where(kJobName), "static run", e.what());
+  }
+  r.peak_approach_m = peak;
+  r.energy_relative_error = std::abs(loading_work(c) / energy - 1);
+  r.curve_approach_m = c.ld;
+  r.curve_force_N = c.lf;
+  r.curve_approach_m.insert(r.curve_approach_m.end(), c.ud.begin() + 1, c.ud.end());
+  r.curve_force_N.insert(r.curve_force_N.end(), c.uf.begin() + 1, c.uf.end());
+  r.time_s = ci.time_s;
+  r.force_N = ci.force_N;
+  r.max_force_N = ci.max_force_N;
+  r.max_force_time_s = ci.max_force_time_s;
+  r.impulse_Ns = ci.impulse_Ns;
+  r.contact_duration_s = ci.contact_time_s;
+  r.restitution = ci.restitution;
+  // Each body's dent: its contact node's displacement into it at the end (both supports are back
+  // where they started).
+  for (int i = 0; i < 2; ++i) {
+    const json& b = cj.at("bodies").at(i);
+    ContactBodyMotion& m = i == 0 ? r.target : r.impactor;
+    m.fixed = b.value("fixed", false);
+    const int node = b.at("contact_node");
+    const auto it = d.last_u_m.find(node);
+    if (it == d.last_u_m.end() || d.last_u_time < 2 - 1e-6) {
+      throw InputError(where(kJobName), "static run", "no final displacement of contact node " + std::to_string(node));
+    }
+    m.dent_m = it->second.dot(vec3(b.at("inward_normal")));
+  }
+  r.residual_indentation_m = r.target.dent_m + r.impactor.dent_m;
+  return r;
+}
+
 }  // namespace
 
 ContactRunResult run_contact_model(const fs::path& folder, const CheckOptions& options) {
@@ -580,6 +833,7 @@ ContactRunResult run_contact_model(const ContactDeck& written, const CheckOption
 namespace {
 
 ContactRunResult run_contact(const fs::path& folder, const json& cj, const CheckOptions& options) {
+  if (cj.value("quasi_static", false)) return run_quasi_static(folder, cj, options);
   ContactRunResult r;
   const double end = cj.at("end_time_s");
   if (options.run_solver) {

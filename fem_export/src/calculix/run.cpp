@@ -143,8 +143,7 @@ std::string disk_full_note(const fs::path& work, const std::string& log_text) {
 
 // Runs ccx in `work` (output to impact.log; progress from impact.sta). Returns the wall time.
 double run_ccx(const fs::path& work, const CheckOptions& o, double end_time_s, double timeout_s,
-               const std::string& timeout_source) {
-  const std::string job = kJobName;
+               const std::string& timeout_source, const std::string& job = kJobName) {
   for (const char* ext : {".dat", ".sta", ".frd", ".cvg", ".12d", ".log"}) {
     std::error_code ec;
     fs::remove(work / (job + ext), ec);
@@ -217,10 +216,10 @@ constexpr const char* kOutputs[] = {".dat", ".frd", ".sta", ".cvg", ".12d", ".lo
 }  // namespace
 
 double run_ccx_job(const fs::path& dir, const CheckOptions& o, double end_time_s, std::size_t nodes,
-                   std::size_t solves) {
-  if (o.timeout_s > 0) return run_ccx(dir, o, end_time_s, o.timeout_s, "--solver-timeout-s");
+                   std::size_t solves, const std::string& job) {
+  if (o.timeout_s > 0) return run_ccx(dir, o, end_time_s, o.timeout_s, "--solver-timeout-s", job);
   return run_ccx(dir, o, end_time_s, default_solver_timeout_s(nodes, solves),
-                 "default for " + std::to_string(nodes) + " nodes and " + std::to_string(solves) + " solves");
+                 "default for " + std::to_string(nodes) + " nodes and " + std::to_string(solves) + " solves", job);
 }
 
 TetMesh CalculixSolver::read_mesh(const fs::path& dir, const DeckUnits& units) const {

@@ -86,7 +86,27 @@ struct ContactModelOptions {
   /// *DYNAMIC, SOLVER=ITERATIVE SCALING; false: SPOOLES. Measured on two spheres, 6,882 nodes, 22
   /// increments: 49 s against 225 s, the same force to 4 digits.
   bool iterative_solver = true;
+  /// The quasi-static route (the plastic comparison; see "Quasi-static" below): static steps of
+  /// prescribed approach instead of the dynamic step, each load and unload in this many increments.
+  bool quasi_static = false;
+  int static_increments = 16;
 };
+
+// Quasi-static: ccx 2.20 does not run a dynamic contact deck with *PLASTIC (it dies in incplas,
+// docs/contact-vs-hybrid.md), but it runs the static one. The contact laws are quasi-static
+// themselves (the contact time is many wave transits of the bodies), so the reference is the FE
+// contact's force-approach curve with the impact's mass on it:
+//   - each body is held or driven by its nodes beyond half its depth along the contact normal (a
+//     fixed body by its support as above); the driven one (the free body, or the impactor of two
+//     free bodies) is pushed toward the other by the approach d, then brought back to d = 0;
+//   - run `load` (load.inp) goes to probe_approach_m and back; the approach d_max where its loading
+//     work reaches 1/2 m* V^2 (m* the impact's effective mass along the normal, V the normal
+//     approach speed) is found on its curve (probe_approach_m doubled, twice at most, when the
+//     work falls short);
+//   - run `impact` (impact.inp, written after `load`) goes to d_max and back: F_max is its force at
+//     d_max, the restitution sqrt(unloading work / loading work), the residual approach where the
+//     unloading force vanishes, each body's dent from its contact node; F(t) and the contact
+//     time come from m* d'' = -F(d) on the two curves (impact_on_curves).
 
 struct ContactModelRequest {
   std::string source, impact;
@@ -100,6 +120,9 @@ struct ContactModelRequest {
   /// The contact duration the time steps are cut from; 0: 2 t_m (elastic). A plastic law's t_c.
   double contact_duration_s = 0;
   ContactModelOptions options;
+  /// Quasi-static route: m*, V and the first run's approach (a generous guess: the laws' largest
+  /// x_max times 1.5).
+  double effective_mass_kg = 0, approach_speed_m_s = 0, probe_approach_m = 0;
   /// Where the request comes from (a scene's impact): its errors name it, then the deck folder.
   /// Empty: the deck folder alone.
   InputContext context;
@@ -170,7 +193,34 @@ struct ContactRunResult {
   /// `point_m` in the deck frame (world, origin at the contact point); `node` the ccx node.
   std::vector<ProbeStress> probes;
   std::vector<double> probe_time_s;
+  /// Quasi-static route: the peak approach d_max, the `impact` run's force against approach
+  /// (loading then unloading, from d = 0), |its loading work at d_max / (1/2 m* V^2) - 1| (runs
+  /// `load` and `impact` agree), and the number of ccx runs. The momentum, vibration, velocity-jump
+  /// and probe figures above are the dynamic route's and stay empty.
+  bool quasi_static = false;
+  double peak_approach_m = 0, energy_relative_error = 0;
+  std::vector<double> curve_approach_m, curve_force_N;
+  int solver_runs = 1;
 };
+
+/// An impact on a tabulated contact: mass m (kg) meets the contact at speed V (m/s) and moves by
+/// m d'' = -F(d), F the loading curve (approach m, force N, from d = 0 with F(0) = 0, increasing d)
+/// while d grows, then the unloading curve (decreasing d, from the turning point down to where F
+/// vanishes). Both piecewise linear. The turning point is where the loading work is 1/2 m V^2.
+struct CurveImpact {
+  double max_force_N = 0, max_approach_m = 0, max_force_time_s = 0;
+  double contact_time_s = 0, restitution = 0, impulse_Ns = 0;
+  double residual_approach_m = 0;  ///< where the unloading force vanishes
+  std::vector<double> time_s, force_N;  ///< F(t), about 400 samples
+};
+/// Throws std::invalid_argument when the loading curve's work falls short of 1/2 m V^2 or a curve
+/// is not as described. RK4 in time for F(t) and the contact time (step: the loading time / 4000);
+/// the turning point, F_max and the restitution (sqrt of the work ratio) from the curves exactly.
+/// `extension` > 0: the loading curve's last segment is continued for up to that fraction of
+/// 1/2 m V^2 more work (a run that was to end at the turning point and ended a little short).
+CurveImpact impact_on_curves(const std::vector<double>& load_approach_m, const std::vector<double>& load_force_N,
+                             const std::vector<double>& unload_approach_m, const std::vector<double>& unload_force_N,
+                             double mass_kg, double speed_m_s, double extension = 0);
 
 /// Runs ccx on the deck folder (check.hpp's runner) and reads the contact force history and the
 /// final state. Throws InputError when ccx fails or its output is incomplete.

@@ -65,6 +65,10 @@ enum class CompareVerdict { agree, disagree, non_hertzian, decks_only };
 
 /// The laws compared with a plastic full-contact run (docs/plastic.md, "The ladder").
 inline const std::vector<std::string> kComparedLaws = {"hertz", "thornton", "jackson-green"};
+/// The plastic (quasi-static) comparison's first run pushes to this times the largest x_max of the
+/// compared laws: past the FE contact's own turning point unless it is softer than every law (then
+/// the run is repeated at twice the approach, contact_model.hpp).
+inline constexpr double kProbeApproachFactor = 1.5;
 
 /// One law's figures at the compared impact's point (the kernel solved again with that law; Hertz
 /// with R = 1). `problem` says why there are none (e.g. a sharp point for Hertz).
@@ -72,6 +76,7 @@ struct LawFigures {
   std::string name;
   std::optional<double> limiting_pressure_Pa;
   double max_force_N = 0, contact_time_s = 0, restitution = 0, residual_indentation_m = 0;
+  double max_indentation_m = 0;
   std::string problem;
 };
 const char* to_string(CompareVerdict v);
