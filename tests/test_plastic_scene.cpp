@@ -260,6 +260,8 @@ TEST(PlasticScene, BadLawInputIsRefusedByKey) {
                "restitution, but impacts\\[0\\]\\.restitution is set too");
   expect_error(drop("", "contact_law = \"thornton\""),
                "key 'impacts\\[0\\]\\.contact_law': .*materials 'floor_steel' and 'steel' have no yield_strength_Pa");
+  // The elastic line law needs no yield strength (it was refused as "a plastic law").
+  EXPECT_NO_THROW(parse_scene(drop("", "contact_law = \"line\""), "plastic.toml"));
   expect_error(drop(kYield, "limiting_pressure_Pa = 0"), "key 'impacts\\[0\\]\\.limiting_pressure_Pa': must be > 0, got 0");
   expect_error(drop(kYield, "limiting_pressure_Pa = -1e8"), "key 'impacts\\[0\\]\\.limiting_pressure_Pa': must be > 0");
   expect_error(drop(kYield + "\ntangent_modulus_Pa = 2.1e11", ""),

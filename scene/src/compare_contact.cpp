@@ -779,7 +779,12 @@ std::string format_compare(const CompareReport& r) {
     for (const auto& L : r.ladder) {
       o << "  contact deck " << L.deck.folder.string() << ": " << L.contact_elements << " elements across b, "
         << L.deck.node_count << " nodes (target FE mass " << L.deck.target.fe_mass_kg << " kg, impactor "
-        << L.deck.impactor.fe_mass_kg << " kg), " << L.deck.increments << " increments\n";
+        << L.deck.impactor.fe_mass_kg << " kg), ";
+      if (L.deck.description.value("quasi_static", false)) {
+        o << "quasi-static, " << L.deck.description.value("static_increments", 0) << " increments per load and unload\n";
+      } else {
+        o << L.deck.increments << " increments\n";
+      }
     }
     if (r.hybrid_deck) {
       o << "  hybrid deck " << r.hybrid_deck->folder.string() << ": " << r.hybrid_deck->node_count

@@ -689,7 +689,9 @@ SequenceSpec read_sequence(std::size_t index, const toml::table& t, const Source
 
 // A plastic law needs the yield strength of at least one of the impact's bodies (docs/plastic.md).
 void check_law_materials(const Scene& sc, const ImpactSpec& s, const Source& file) {
-  if (s.contact_law_given && s.contact_law != "auto" && s.contact_law != "hertz") {
+  // The elastic laws: "hertz" and the rounded edge's "line" (docs/sharp-contacts.md).
+  const bool elastic = s.contact_law == "auto" || s.contact_law == "hertz" || s.contact_law == "line";
+  if (s.contact_law_given && !elastic) {
     // A plastic law needs the yield strength of at least one body (docs/plastic.md).
     const Material& mt = sc.materials.at(sc.body(s.target).material);
     const Material& mi = sc.materials.at(sc.body(s.impactor).material);

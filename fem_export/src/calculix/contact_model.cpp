@@ -359,7 +359,7 @@ std::string contact_inp(const ContactModelRequest& r, const ContactDeck& out, co
     << deck_number(out.penalty_N_m3 * kMPa / kMm) << "\n"
     << "*CONTACT PAIR, INTERACTION=SI1, TYPE=SURFACE TO SURFACE\nSIMP, STGT\n";
   if (r.options.quasi_static) {
-    // The steps are the runs' own (quasi_static_steps): here the pushed nodes and the contact
+    // The steps are the runs' own (quasi_static_inp): here the pushed nodes and the contact
     // nodes whose displacements give the dents.
     for (int i = 0; i < 2; ++i) {
       if (b[i].driven.empty()) continue;
