@@ -708,7 +708,7 @@ TEST(SharpScene, FarRotatedBoxOnARoundedEdgeYieldsAlongTheLine) {
   const Eigen::AngleAxisd box_turn(turn * Eigen::AngleAxisd(0.25 * M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix());
   const Eigen::Vector3d far_mm(1e6, 0.0, 0.0), up = turn.col(2);
   auto vec = [](const Eigen::Vector3d& v) { return "[" + exact(v.x()) + ", " + exact(v.y()) + ", " + exact(v.z()) + "]"; };
-  auto scene_text = [&](const std::string& impact_keys) {
+  auto scene_text = [&](const std::string& impact_keys, double speed_m_s = 3.0) {
     return R"(length_unit = "mm"
 [materials.steel]
 youngs_modulus_Pa = 2.1e11
@@ -730,7 +730,7 @@ edge_radius = 0.5
 orientation_axis = )" + vec(box_turn.axis()) + R"(
 orientation_angle_deg = )" + exact(box_turn.angle() * 180.0 / M_PI) + R"(
 position = )" + vec(far_mm + 500.0 * up) + R"(
-velocity_m_s = )" + vec(-3.0 * up) + R"(
+velocity_m_s = )" + vec(-speed_m_s * up) + R"(
 [[impacts]]
 name = "drop"
 target = "floor"
@@ -764,6 +764,15 @@ point = "first-contact"
     EXPECT_NEAR(j[key].get<double>(), value, kSameImpactRel * value) << key;
   }
   EXPECT_NEAR(j["approach_velocity_m_s"].get<double>(), 3.0, kFarBoxRel * 3.0);
+  // V_y of the line contact: F_y = pi R* L p_y^2 / E* (p_y = 1.6 Y) over sqrt(m k), k = (pi/4) E* L.
+  const double py = 1.6 * 2.5e8, E = in.effective_modulus_Pa, R = in.effective_radius_m, L = in.sharp_length_m;
+  const double vy = M_PI * R * L * py * py / E / std::sqrt(in.reduced_mass_kg * 0.25 * M_PI * E * L);
+  ASSERT_TRUE(j["yield_velocity_m_s"].is_number());
+  EXPECT_NEAR(j["yield_velocity_m_s"].get<double>(), vy, kSameImpactRel * vy);
+  // Below V_y, "auto" runs the elastic line law and says so (as Thornton says "hertz").
+  const nlohmann::json slow = impact_json(scene_text("", 0.5 * vy));
+  EXPECT_EQ(slow["contact_law"], "line");
+  EXPECT_EQ(slow["restitution"].get<double>(), 1.0);
   // Hertz: the elastic line law; "line-plastic" named: the same impact as "auto".
   const nlohmann::json hertz = impact_json(scene_text("contact_law = \"hertz\""));
   EXPECT_EQ(hertz["contact_law"], "line");

@@ -127,7 +127,7 @@ class LinePlasticLaw final : public ContactLaw {
     r.status = LawStatus::degenerate;
     if (!detail::finite_positive(py) || !detail::finite_positive(R) || gauss_legendre() == nullptr) return;
     const double k = r.stiffness, Fe = r.max_force_N;
-    const double Fy = M_PI * R * L * py * py / E;
+    const double Fy = line_yield_force_N(E, R, k, py);
     if (!(Fe > Fy)) {  // V <= V_y: the line law's result, e = 1, no dent
       r.status = LawStatus::ok;
       return;
@@ -173,5 +173,7 @@ class LinePlasticLaw final : public ContactLaw {
 std::shared_ptr<const ContactLaw> make_line_plastic_law(const LawOptions& options) {
   return std::make_shared<const LinePlasticLaw>(options.limiting_pressure_Pa);
 }
+
+double line_yield_force_N(double E, double R, double k, double py) { return 4.0 * R * py * py * k / (E * E); }
 
 }  // namespace impactdeck::collision

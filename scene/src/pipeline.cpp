@@ -300,10 +300,18 @@ void describe_law(const Scene& scene, const ImpactSpec& s, const ImpactLaw& law,
   ir.unloading_radius_m = l.unloading_radius_m;  // the law's (0 for a flat-punch or linear unloading)
   ir.dent_radius_m = l.dent_radius_m;
   if (law.law && (law.law->takes_sharp_points() || law.law->takes_line_contacts())) {
-    // A sharp edge or corner, or a rounded edge's line contact (docs/sharp-contacts.md): no V_y; the
-    // law's patch at F* (the cone's circle, the wedge's or the line's strip) under its pressure.
+    // A sharp edge or corner, or a rounded edge's line contact (docs/sharp-contacts.md): the law's
+    // patch at F* (the cone's circle, the wedge's or the line's strip) under its pressure. A V_y
+    // only for the plastic line law (F_y over sqrt(m* k)); below it, chosen by "auto", the impact is
+    // the elastic "line" law's (as Thornton's is Hertz's).
     ir.yield_velocity_m_s.reset();
     ir.contact_law = law.name;
+    if (law.name == "line-plastic" && law.limiting_pressure_Pa && l.stiffness > 0) {
+      ir.yield_velocity_m_s = collision::line_yield_force_N(r.effective_modulus_Pa, r.effective_radius_m, l.stiffness,
+                                                            *law.limiting_pressure_Pa) /
+                              std::sqrt(r.reduced_mass_kg * l.stiffness);
+      if (law.automatic && r.approach_velocity_m_s <= *ir.yield_velocity_m_s) ir.contact_law = "line";
+    }
     collision::ValidityReport v;
     v.limits = scene.validity;
     v.contact_semi_axis_a_m = r.kernel.contact_semi_axis_a_m;

@@ -113,6 +113,14 @@ inline constexpr double kThorntonYieldFactor = 1.6;
 double yield_velocity_m_s(double reduced_mass_kg, double effective_modulus_Pa, double effective_radius_m,
                           double limiting_pressure_Pa);
 
+/// The force at which a rounded edge's line contact first yields (the law "line-plastic",
+/// docs/sharp-contacts.md): the plane-strain Hertz peak pressure reaches p_y at
+/// F_y = pi R* L p_y^2 / E* (Johnson 1985, Sect. 4.3), written with the line law's stiffness
+/// k = (pi/4) E* L (LawResult::stiffness) as 4 R* p_y^2 k / E*^2. The yield velocity is
+/// F_y / sqrt(m* k): 1/2 m* V_y^2 = 1/2 F_y^2 / k.
+double line_yield_force_N(double effective_modulus_Pa, double effective_radius_m, double line_stiffness_N_m,
+                          double limiting_pressure_Pa);
+
 /// The default indentation hardness of the laws "wedge" and "cone" over the weaker body's yield
 /// strength: a fully plastic indentation by a sharp indenter, H = 3 Y (Tabor 1951; Johnson 1985,
 /// Sect. 6.5). A sharp edge or corner is fully plastic at once.
