@@ -141,7 +141,7 @@ std::string disk_full_note(const fs::path& work, const std::string& log_text) {
   return note;
 }
 
-// Runs ccx in `work` (output to impact.log; progress from impact.sta). Returns the wall time.
+// Runs ccx on `job`.inp in `work` (output to `job`.log; progress from `job`.sta). Returns the wall time.
 double run_ccx(const fs::path& work, const CheckOptions& o, double end_time_s, double timeout_s,
                const std::string& timeout_source, const std::string& job = kJobName) {
   for (const char* ext : {".dat", ".sta", ".frd", ".cvg", ".12d", ".log"}) {
