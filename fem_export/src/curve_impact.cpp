@@ -2,6 +2,7 @@
 // full-contact route's force-approach curves with the impact's mass on them.
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -43,6 +44,25 @@ void rk4(double& d, double& v, double h, const Accel& a) {
 
 }  // namespace
 
+std::optional<double> approach_at_work(const std::vector<double>& ld, const std::vector<double>& lf, double work_J) {
+  // The work reaches work_J inside segment i (exact for the piecewise-linear force:
+  // W + f0 s + k s^2 / 2 = work_J).
+  double work = 0;
+  for (std::size_t i = 1; i < ld.size(); ++i) {
+    const double h = ld[i] - ld[i - 1], f0 = lf[i - 1], k = (lf[i] - lf[i - 1]) / h;
+    const double seg = 0.5 * (lf[i] + f0) * h;
+    if (work + seg < work_J) {
+      work += seg;
+      continue;
+    }
+    const double rest = work_J - work;
+    const double s = std::abs(k) * h < 1e-12 * std::abs(f0) ? rest / f0
+                                                            : (-f0 + std::sqrt(std::max(0.0, f0 * f0 + 2 * k * rest))) / k;
+    return ld[i - 1] + std::clamp(s, 0.0, h);
+  }
+  return std::nullopt;
+}
+
 CurveImpact impact_on_curves(const std::vector<double>& ld_in, const std::vector<double>& lf_in,
                              const std::vector<double>& ud, const std::vector<double>& uf, double mass_kg, double speed_m_s,
                              double extension) {
@@ -66,30 +86,17 @@ CurveImpact impact_on_curves(const std::vector<double>& ld_in, const std::vector
   }
   CurveImpact c;
   const double energy = 0.5 * mass_kg * speed_m_s * speed_m_s;
-  // The turning point: the loading work reaches the impact energy inside segment i (exact for the
-  // piecewise-linear force: W + f0 s + k s^2 / 2 = E).
-  double work = 0;
-  bool turned = false;
-  for (std::size_t i = 1; i < ld.size() && !turned; ++i) {
-    const double h = ld[i] - ld[i - 1], f0 = lf[i - 1], k = (lf[i] - lf[i - 1]) / h;
-    const double seg = 0.5 * (lf[i] + f0) * h;
-    if (work + seg < energy) {
-      work += seg;
-      c.max_force_N = std::max(c.max_force_N, lf[i]);
-      continue;
-    }
-    const double rest = energy - work;
-    double s = std::abs(k) * h < 1e-12 * std::abs(f0) ? rest / f0 : (-f0 + std::sqrt(std::max(0.0, f0 * f0 + 2 * k * rest))) / k;
-    s = std::clamp(s, 0.0, h);
-    c.max_approach_m = ld[i - 1] + s;
-    c.max_force_N = std::max(c.max_force_N, f0 + k * s);
-    turned = true;
-  }
-  if (!turned) {
+  const std::optional<double> turn = approach_at_work(ld, lf, energy);
+  if (!turn) {
+    double work = 0;
+    for (std::size_t i = 1; i < ld.size(); ++i) work += 0.5 * (lf[i] + lf[i - 1]) * (ld[i] - ld[i - 1]);
     throw std::invalid_argument("the loading curve's work (" + std::to_string(work) + " J up to an approach of " +
                                 std::to_string(ld.back()) + " m) falls short of the impact energy " +
                                 std::to_string(energy) + " J");
   }
+  c.max_approach_m = *turn;
+  c.max_force_N = on_curve(ld, lf, *turn);
+  for (std::size_t i = 0; i < ld.size() && ld[i] <= *turn; ++i) c.max_force_N = std::max(c.max_force_N, lf[i]);
   // The unloading curve, increasing for the look-ups, cut where its force vanishes.
   std::vector<double> ux(ud.rbegin(), ud.rend()), uy(uf.rbegin(), uf.rend());
   std::size_t last_positive = ux.size();  // from the unloading start (the end of ux)

@@ -747,8 +747,8 @@ ContactRunResult run_quasi_static(const fs::path& folder, json cj, const CheckOp
       const StaticDat d = read_static_dat(dat(kQuasiStaticLoadJob), drive);
       r.increments += d.time.size();
       const StaticCurves c = curves_of(d, probe);
-      if (loading_work(c) >= energy) {
-        peak = impact_on_curves(c.ld, c.lf, {c.ld.back(), 0.0}, {c.lf.back(), -1.0}, mass, speed).max_approach_m;
+      if (const auto turn = approach_at_work(c.ld, c.lf, energy)) {
+        peak = *turn;
         break;
       }
       if (attempt == 2 || !options.run_solver) {
