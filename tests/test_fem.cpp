@@ -523,6 +523,46 @@ TEST(FemMesh, FallbackTriesEachSettingInTurnAndKeepsTheBest) {
   EXPECT_NE(slurp(r.geo).find("Settings of try"), std::string::npos);
 }
 
+// A part dropped on a corner: the load point is a corner of the classified faces. A second point
+// there, embedded in one of the faces, lies on that face's boundary, where Gmsh meshes no node for
+// it: every remeshed try failed ("LOAD: no mesh node on its geometry point") and the part's own 12
+// triangles were kept (27 nodes, nothing refined at the corner; the contact model then found no
+// face near the contact). CGAL's cube, rotated and 40 m from the origin.
+TEST(FemMesh, LoadPointOnACornerIsRemeshedAndRefinedThere) {
+  // Coordinates of ~4e4 mm carried through Gmsh in doubles: a few ulps of 4e4, 1e-12 relative.
+  constexpr double kCoordinateRoundOffRel = 1e-12;
+  PartSurface s = part_surface(kData / "cube.off", LengthUnit::cm);
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, -2, 0.5).normalized()).toRotationMatrix();
+  const Eigen::Vector3d far(20, -30, 12);
+  for (auto& v : s.vertices_m) v = R * v + far;
+  const Eigen::Vector3d corner = s.vertices_m[3];
+  const fs::path d = fresh_dir("corner_load");
+  MeshOptions o;
+  o.mesh_size_m = 0.005;         // a 2 cm cube
+  o.load_mesh_size_m = 2e-4;     // h0
+  o.load_zone_radius_m = 1e-3;
+  const MeshResult r = mesh_part(s, corner, o, d, "mesh", "cube.off");
+  ASSERT_EQ(r.quality.attempts.size(), 1u) << r.quality.attempts.back().outcome;
+  EXPECT_EQ(r.quality.attempts[0].surface, "remeshed");
+  // The corner node is the part's corner: Gmsh's coordinates in mm round off at 40 m.
+  EXPECT_LE(r.quality.load_node_distance_m, kCoordinateRoundOffRel * far.norm());
+  // Refined there: the zone of radius 5 h0 holds many nodes (the corner's eighth of a ball, about
+  // (5 h0)^3 / h0^3 / 8 / 6 nodes; the part's own triangles gave the corner alone).
+  std::size_t near = 0;
+  for (const auto& x : r.mesh.nodes_m) near += (x - corner).norm() < 5 * o.load_mesh_size_m;
+  EXPECT_GE(near, 10u);
+  const std::string geo = slurp(r.geo);
+  EXPECT_NE(geo.find("CreateGeometry's corner point"), std::string::npos) << geo;
+  EXPECT_EQ(geo.find(" In Surface{"), std::string::npos) << geo;
+  std::cout << "[ corner    ] cube on a corner: " << r.quality.node_count << " nodes, " << near
+            << " within 5 h0 of the corner, min gamma " << r.quality.min_gamma << "\n";
+#ifdef IMPACTDECK_GMSH_EXE
+  run("cd '" + d.string() + "' && " IMPACTDECK_GMSH_EXE " mesh.geo -3 -format msh22 -o cli.msh > cli.log 2>&1");
+  const std::string cli = slurp(d / "cli.msh");
+  EXPECT_NE(cli.find("\"LOAD\""), std::string::npos) << slurp(d / "cli.log");
+#endif
+}
+
 // A CAD export's box: each 400 x 20 mm side is two triangles meeting along a diagonal. Gmsh 4.8's
 // split into parametrizable patches cuts the closed surface in two along such diagonals, and the
 // cut's nodes, 0.1-1 mm from the face's edges, leave slivers (min gamma 0.102 on this bar with the

@@ -334,7 +334,7 @@ void finish_point_mesh(const InputContext& where, const MeshOptions& o, const fs
   gmsh_step(where, "write", [&] { write_msh(folder, name, o, r); });
 }
 
-// A point mesh passed back from the child process that made it (CAD route): the tetrahedra, the
+// A point mesh passed back from the child process that made it (CAD and mesh-part routes): the tetrahedra, the
 // node groups and their distances; the parent records the quality again from them.
 std::string serialise_point_mesh(const MeshResult& r) {
   ByteWriter w;
@@ -390,6 +390,8 @@ void read_point_mesh(const std::string& bytes, const InputContext& where, MeshRe
 // meshing, where no catch reaches), crash, or run for minutes: each CAD try meshes in a child
 // process; all tries together are stopped after this many seconds.
 constexpr double kCadMeshDeadlineS = 600;
+// The same for a mesh part's tries (each in a child process too: mesh_part_with_gmsh).
+constexpr double kPartMeshDeadlineS = 600;
 
 
 // The .geo's first lines: what it meshes, the unit its numbers are in (`script`: mm, Gmsh's working
@@ -770,9 +772,10 @@ MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& l
   const double h_first = o.mesh_size_m * kMmPerM, h0_first = load_size(o) * kMmPerM;
   const std::vector<Try> tries = part_tries(o);
   std::vector<MeshAttempt> attempts;
+  const auto t0 = std::chrono::steady_clock::now();  // the tries' shared deadline
   GmshSession session(name);
   int load_surface = -1;       // remeshed: the surface the load point is embedded in
-  std::size_t load_tag = 0;    // part triangles: the Gmsh node at the load point
+  int load_point = kLoadPointTag;  // remeshed: LOAD's point entity (a classified corner when it is one)
   std::vector<int> probe_tags;
   bool split_patches = false;  // remeshed: Gmsh split the surface into parametrizable patches
 
@@ -789,6 +792,37 @@ MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& l
       }
     }
     return *split;
+  };
+
+  // The child's part of a try: the tetrahedra, LOAD and PROBEk, the .msh files.
+  auto mesh_in_child = [&](const Try& t, MeshResult& r) {
+    const double h = h_first * t.size_factor, h0 = std::min(h0_first, h);
+    generate_tets(where, o, t.own_triangles ? 6 : t.algorithm_2d, p_mm, h0, h);
+    gmsh_step(where, "mesh", [&] {
+      const std::map<std::size_t, int> index = extract(r.mesh, where);
+      int ln = -1;
+      std::size_t load_tag = 0;  // part triangles: the Gmsh node at the load point
+      if (t.own_triangles) {
+        // LOAD: the part's vertex at the load point; a discrete point entity in the .msh files.
+        std::vector<std::size_t> tags;
+        std::vector<double> xyz, par;
+        gmsh::model::mesh::getNodes(tags, xyz, par, 2, -1, true, false);
+        double best = 1e300;
+        for (std::size_t i = 0; i < tags.size(); ++i) {
+          const double d = (Eigen::Vector3d(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]) - p_mm).norm();
+          if (d < best && index.count(tags[i])) best = d, load_tag = tags[i];
+        }
+        if (!(best <= 1e-6 * size_mm)) throw where.error("gmsh mesh", "no mesh node at the load point");
+        ln = index.at(load_tag);
+        const int pt = gmsh::model::addDiscreteEntity(0);
+        gmsh::model::mesh::addElementsByType(pt, 15, {}, {load_tag});
+        gmsh::model::setPhysicalName(0, gmsh::model::addPhysicalGroup(0, {pt}), "LOAD");
+      } else {
+        ln = node_of_point_entity(load_point, index, where, "LOAD");
+      }
+      add_node_groups(r, ln, p_mm, probe_tags, index, o, where);
+    });
+    gmsh_step(where, "write", [&] { write_msh(folder, name, o, r); });
   };
 
   // Builds the geometry from the try's surface and meshes it with the try's settings.
@@ -812,7 +846,20 @@ MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& l
       for (const auto& [d, tag] : surfs) st.push_back(tag);
       gmsh::model::geo::addSurfaceLoop(st, 1);
       gmsh::model::geo::addVolume({1}, 1);
-      if (!t.own_triangles) gmsh::model::geo::addPoint(p_mm.x(), p_mm.y(), p_mm.z(), 0, kLoadPointTag);
+      if (!t.own_triangles) {
+        // A load point on a corner of the classified surfaces (a part dropped on a corner) is that
+        // corner's point: a second point there would be embedded on the surface's boundary, where
+        // Gmsh meshes no node for it.
+        load_point = kLoadPointTag;
+        gmsh::vectorpair corners;
+        gmsh::model::getEntities(corners, 0);
+        for (const auto& [d, tag] : corners) {
+          std::vector<double> xyz;
+          gmsh::model::getValue(0, tag, {}, xyz);
+          if (xyz.size() == 3 && (Eigen::Vector3d(xyz[0], xyz[1], xyz[2]) - p_mm).norm() <= 1e-6 * size_mm) load_point = tag;
+        }
+        if (load_point == kLoadPointTag) gmsh::model::geo::addPoint(p_mm.x(), p_mm.y(), p_mm.z(), 0, kLoadPointTag);
+      }
       for (std::size_t i = 0; i < o.probes_m.size(); ++i) {
         const Eigen::Vector3d pm = o.probes_m[i] * kMmPerM;
         probe_tags.push_back(gmsh::model::geo::addPoint(pm.x(), pm.y(), pm.z(), 0, kFirstProbeTag + static_cast<int>(i)));
@@ -832,37 +879,34 @@ MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& l
           m << "the load point is " << best / kMmPerM << " m from the part's surface (must lie on it)";
           throw where.error("load point", m.str());
         }
-        gmsh::model::mesh::embed(0, {kLoadPointTag}, 2, load_surface);
+        if (load_point == kLoadPointTag) gmsh::model::mesh::embed(0, {kLoadPointTag}, 2, load_surface);
       }
       if (!probe_tags.empty()) gmsh::model::mesh::embed(0, probe_tags, 3, 1);
       gmsh::model::setPhysicalName(3, gmsh::model::addPhysicalGroup(3, {1}), "BODY");
-      if (!t.own_triangles) gmsh::model::setPhysicalName(0, gmsh::model::addPhysicalGroup(0, {kLoadPointTag}), "LOAD");
+      if (!t.own_triangles) gmsh::model::setPhysicalName(0, gmsh::model::addPhysicalGroup(0, {load_point}), "LOAD");
       add_probe_groups(probe_tags);
     });
-    generate_tets(where, o, t.own_triangles ? 6 : t.algorithm_2d, p_mm, h0, h);
-    gmsh_step(where, "mesh", [&] {
-      const std::map<std::size_t, int> index = extract(r.mesh, where);
-      int ln = -1;
-      if (t.own_triangles) {
-        // LOAD: the part's vertex at the load point; a discrete point entity in the .msh files.
-        std::vector<std::size_t> tags;
-        std::vector<double> xyz, par;
-        gmsh::model::mesh::getNodes(tags, xyz, par, 2, -1, true, false);
-        double best = 1e300;
-        for (std::size_t i = 0; i < tags.size(); ++i) {
-          const double d = (Eigen::Vector3d(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]) - p_mm).norm();
-          if (d < best && index.count(tags[i])) best = d, load_tag = tags[i];
-        }
-        if (!(best <= 1e-6 * size_mm)) throw where.error("gmsh mesh", "no mesh node at the load point");
-        ln = index.at(load_tag);
-        const int pt = gmsh::model::addDiscreteEntity(0);
-        gmsh::model::mesh::addElementsByType(pt, 15, {}, {load_tag});
-        gmsh::model::setPhysicalName(0, gmsh::model::addPhysicalGroup(0, {pt}), "LOAD");
-      } else {
-        ln = node_of_point_entity(kLoadPointTag, index, where, "LOAD");
-      }
-      add_node_groups(r, ln, p_mm, probe_tags, index, o, where);
-    });
+    // In a child process, stopped at the deadline: Gmsh 4.8 throws from inside its OpenMP face
+    // meshing, where no catch reaches (std::terminate; seen with a load point embedded on a face's
+    // boundary), and may run long. The child meshes, names LOAD and PROBEk, and writes the .msh
+    // files; the last try that meshed wrote them, and the kept try is always the last one run.
+    const double left = kPartMeshDeadlineS - std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (left <= 0) {
+      std::ostringstream m;
+      m << "no try left within " << kPartMeshDeadlineS << " s";
+      throw where.error("gmsh mesh", m.str());
+    }
+    const std::string mesher =
+        "Gmsh's mesher (" + (t.own_triangles ? std::string("part triangles") : "2D algorithm " + std::to_string(t.algorithm_2d)) + ")";
+    const std::string made = run_in_child(
+        where, "gmsh mesh", mesher, left,
+        [&] {
+          MeshResult c;
+          mesh_in_child(t, c);
+          return serialise_point_mesh(c);
+        },
+        &GmshSession::last_error);
+    read_point_mesh(made, where, r);
     fill_quality(r.mesh, r.quality);
     check_mesh(r, where);
   };
@@ -915,7 +959,7 @@ MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& l
                         tries[kept].own_triangles ? "" : patches_word(split_patches)});
   }
   r.quality.attempts = attempts;
-  gmsh_step(where, "write", [&] { write_msh(folder, name, o, r); });
+  set_msh_paths(folder, name, r);  // the kept try wrote them (the last one run)
 
   const Try& t = tries[kept];
   // The .geo is in the deck's length unit, that of the STL it merges (Gmsh cannot scale a merged
@@ -944,14 +988,19 @@ MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& l
       << fmt(kPi) << "};\n"
       << "CreateGeometry;\n"
       << "Surface Loop(1) = Surface{:};\nVolume(1) = {1};\n";
-    g << "Point(" << kLoadPointTag << ") = {" << fmt(p.x()) << ", " << fmt(p.y()) << ", " << fmt(p.z())
-      << "};  // the load point, a node of the surface that holds it\n"
-      << "Point{" << kLoadPointTag << "} In Surface{" << load_surface << "};\n";
+    if (load_point == kLoadPointTag) {
+      g << "Point(" << kLoadPointTag << ") = {" << fmt(p.x()) << ", " << fmt(p.y()) << ", " << fmt(p.z())
+        << "};  // the load point, a node of the surface that holds it\n"
+        << "Point{" << kLoadPointTag << "} In Surface{" << load_surface << "};\n";
+    } else {
+      g << "// The load point (" << fmt(p.x()) << ", " << fmt(p.y()) << ", " << fmt(p.z()) << ") " << unit
+        << " is CreateGeometry's corner point " << load_point << ".\n";
+    }
   }
   g << geo_probe_points(o, kFirstProbeTag, kMmPerM / k);
   g << geo_size_field(p, h0, h, o.load_zone_radius_m * kMmPerM / k);
   g << "Physical Volume(\"BODY\") = {1};\n";
-  if (!t.own_triangles) g << "Physical Point(\"LOAD\") = {" << kLoadPointTag << "};\n";
+  if (!t.own_triangles) g << "Physical Point(\"LOAD\") = {" << load_point << "};\n";
   g << geo_probe_groups(o, kFirstProbeTag);
   r.geo = folder / (name + ".geo");
   write_file_atomically(r.geo, g.str());
