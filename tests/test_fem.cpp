@@ -563,6 +563,47 @@ TEST(FemMesh, LoadPointOnACornerIsRemeshedAndRefinedThere) {
 #endif
 }
 
+// A contact point on an edge between classified faces (a part landing on an edge, a bottle on
+// its rim): Gmsh embeds points in surfaces and volumes only, so every remeshing try failed and the
+// part's own triangles were kept. LOAD is now the edge's mesh node nearest to the point, the mesh
+// refined there, its distance reported. CGAL's cube, rotated and 40 m out, hit at 0.3 of an edge.
+TEST(FemMesh, LoadPointOnAnEdgeIsItsNearestEdgeNodeInARefinedMesh) {
+  // Gmsh interpolates along the edge in mm at 4e4 mm: a few ulps of the coordinates; 1e-10 of
+  // them leaves a margin.
+  constexpr double kOnEdgeRel = 1e-10;
+  PartSurface s = part_surface(kData / "cube.off", LengthUnit::cm);
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, -2, 0.5).normalized()).toRotationMatrix();
+  const Eigen::Vector3d far(20, -30, 12);
+  for (auto& v : s.vertices_m) v = R * v + far;
+  const Eigen::Vector3d point = s.vertices_m[0] + 0.3 * (s.vertices_m[1] - s.vertices_m[0]);  // edge 0-1
+  const fs::path d = fresh_dir("edge_load");
+  MeshOptions o;
+  o.mesh_size_m = 0.005;
+  o.load_mesh_size_m = 2e-4;
+  o.load_zone_radius_m = 1e-3;
+  const MeshResult r = mesh_part(s, point, o, d, "mesh", "cube.off");
+  ASSERT_EQ(r.quality.attempts.size(), 1u) << r.quality.attempts.back().outcome;
+  EXPECT_EQ(r.quality.attempts[0].surface, "remeshed");
+  // Gmsh spaces the edge's nodes by about h0 there: the nearest is within h0 / 2 (a node may
+  // fall on the point itself).
+  EXPECT_LE(r.quality.load_node_distance_m, 0.5 * o.load_mesh_size_m);
+  const Eigen::Vector3d load = r.mesh.nodes_m[r.mesh.node_of("LOAD")];
+  EXPECT_NEAR((load - point).norm(), r.quality.load_node_distance_m, kOnEdgeRel * far.norm());
+  // On the edge: its distance from the edge's line is round-off.
+  const Eigen::Vector3d e = (s.vertices_m[1] - s.vertices_m[0]).normalized();
+  EXPECT_LE(((load - s.vertices_m[0]) - (load - s.vertices_m[0]).dot(e) * e).norm(), kOnEdgeRel * far.norm());
+  std::size_t near = 0;
+  for (const auto& x : r.mesh.nodes_m) near += (x - point).norm() < 5 * o.load_mesh_size_m;
+  EXPECT_GE(near, 10u);
+  // The .geo says which node LOAD is (impactdeck writes it into the .msh files).
+  const std::string geo = slurp(r.geo);
+  EXPECT_NE(geo.find("LOAD is that edge's node nearest to it"), std::string::npos) << geo;
+  EXPECT_EQ(geo.find("Physical Point(\"LOAD\")"), std::string::npos) << geo;
+  std::cout << "[ edge      ] cube on an edge: " << r.quality.node_count << " nodes, " << near
+            << " within 5 h0, LOAD " << r.quality.load_node_distance_m * 1e6 << " um from the point, min gamma "
+            << r.quality.min_gamma << "\n";
+}
+
 // A CAD export's box: each 400 x 20 mm side is two triangles meeting along a diagonal. Gmsh 4.8's
 // split into parametrizable patches cuts the closed surface in two along such diagonals, and the
 // cut's nodes, 0.1-1 mm from the face's edges, leave slivers (min gamma 0.102 on this bar with the

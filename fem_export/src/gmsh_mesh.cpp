@@ -498,6 +498,35 @@ MeshResult mesh_ellipsoid_with_gmsh(const Eigen::Vector3d& semi_axes_m, const Ei
 
 namespace {
 
+// The classified edge (a discrete curve of createGeometry) that passes within `tol_mm` of p_mm, or
+// -1; from the segments the classification gave each edge (getClosestPoint does not answer on these
+// discrete curves in Gmsh 4.8).
+int edge_through(const Eigen::Vector3d& p_mm, double tol_mm) {
+  gmsh::vectorpair edges;
+  gmsh::model::getEntities(edges, 1);
+  for (const auto& [d, tag] : edges) {
+    std::vector<int> types;
+    std::vector<std::vector<std::size_t>> elements, nodes;
+    gmsh::model::mesh::getElements(types, elements, nodes, 1, tag);
+    std::vector<std::size_t> node_tags;
+    std::vector<double> xyz, par;
+    gmsh::model::mesh::getNodes(node_tags, xyz, par, 1, tag, true, false);
+    std::map<std::size_t, Eigen::Vector3d> at;
+    for (std::size_t i = 0; i < node_tags.size(); ++i) at[node_tags[i]] = {xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]};
+    for (std::size_t k = 0; k < types.size(); ++k) {
+      if (types[k] != 1) continue;  // 2-node lines
+      for (std::size_t e = 0; e + 1 < nodes[k].size(); e += 2) {
+        const auto a = at.find(nodes[k][e]), b = at.find(nodes[k][e + 1]);
+        if (a == at.end() || b == at.end()) continue;
+        const Eigen::Vector3d ab = b->second - a->second;
+        const double u = std::clamp((p_mm - a->second).dot(ab) / std::max(ab.squaredNorm(), 1e-300), 0.0, 1.0);
+        if ((a->second + u * ab - p_mm).norm() <= tol_mm) return tag;
+      }
+    }
+  }
+  return -1;
+}
+
 // Tags of the geometry points the part route adds (above any tag createGeometry hands out).
 constexpr int kLoadPointTag = 100000;
 constexpr int kFirstProbeTag = 100001;
@@ -776,6 +805,8 @@ MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& l
   GmshSession session(name);
   int load_surface = -1;       // remeshed: the surface the load point is embedded in
   int load_point = kLoadPointTag;  // remeshed: LOAD's point entity (a classified corner when it is one)
+  int load_edge = -1;  // remeshed: the classified edge the embedded load point lies on, else -1
+  bool load_on_edge_node = false;  // the kept try: LOAD is load_edge's node nearest to the point
   std::vector<int> probe_tags;
   bool split_patches = false;  // remeshed: Gmsh split the surface into parametrizable patches
 
@@ -795,30 +826,45 @@ MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& l
   };
 
   // The child's part of a try: the tetrahedra, LOAD and PROBEk, the .msh files.
-  auto mesh_in_child = [&](const Try& t, MeshResult& r) {
+  auto mesh_in_child = [&](const Try& t, MeshResult& r, bool& edge_node) {
     const double h = h_first * t.size_factor, h0 = std::min(h0_first, h);
     generate_tets(where, o, t.own_triangles ? 6 : t.algorithm_2d, p_mm, h0, h);
     gmsh_step(where, "mesh", [&] {
       const std::map<std::size_t, int> index = extract(r.mesh, where);
       int ln = -1;
-      std::size_t load_tag = 0;  // part triangles: the Gmsh node at the load point
-      if (t.own_triangles) {
-        // LOAD: the part's vertex at the load point; a discrete point entity in the .msh files.
+      std::size_t load_tag = 0;  // part triangles or an edge: the Gmsh node at (or nearest) the load point
+      std::vector<std::size_t> at_point;
+      if (!t.own_triangles) {
+        std::vector<double> xyz, par;
+        gmsh::model::mesh::getNodes(at_point, xyz, par, 0, load_point, false, false);
+      }
+      // A node of the point that no tetrahedron uses is no node of the mesh either.
+      edge_node = !t.own_triangles && (at_point.empty() || !index.count(at_point[0])) && load_edge >= 0;
+      if (t.own_triangles || edge_node) {
+        // LOAD: the part's vertex at the load point; or, where Gmsh gave the point embedded on an
+        // edge between faces no node of the mesh (it embeds points in surfaces, and one on a
+        // surface's boundary may be left out of the tetrahedra), the edge's node nearest to it,
+        // about h0/2 away at most (the size field centres h0 on the point). A discrete point
+        // entity in the .msh files.
         std::vector<std::size_t> tags;
         std::vector<double> xyz, par;
-        gmsh::model::mesh::getNodes(tags, xyz, par, 2, -1, true, false);
+        gmsh::model::mesh::getNodes(tags, xyz, par, t.own_triangles ? 2 : 1, t.own_triangles ? -1 : load_edge, true,
+                                    false);
         double best = 1e300;
         for (std::size_t i = 0; i < tags.size(); ++i) {
           const double d = (Eigen::Vector3d(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]) - p_mm).norm();
           if (d < best && index.count(tags[i])) best = d, load_tag = tags[i];
         }
-        if (!(best <= 1e-6 * size_mm)) throw where.error("gmsh mesh", "no mesh node at the load point");
+        if (!(best <= (t.own_triangles ? 1e-6 * size_mm : h0))) {
+          throw where.error("gmsh mesh", "no mesh node at the load point");
+        }
         ln = index.at(load_tag);
         const int pt = gmsh::model::addDiscreteEntity(0);
         gmsh::model::mesh::addElementsByType(pt, 15, {}, {load_tag});
         gmsh::model::setPhysicalName(0, gmsh::model::addPhysicalGroup(0, {pt}), "LOAD");
       } else {
         ln = node_of_point_entity(load_point, index, where, "LOAD");
+        gmsh::model::setPhysicalName(0, gmsh::model::addPhysicalGroup(0, {load_point}), "LOAD");
       }
       add_node_groups(r, ln, p_mm, probe_tags, index, o, where);
     });
@@ -859,6 +905,8 @@ MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& l
           if (xyz.size() == 3 && (Eigen::Vector3d(xyz[0], xyz[1], xyz[2]) - p_mm).norm() <= 1e-6 * size_mm) load_point = tag;
         }
         if (load_point == kLoadPointTag) gmsh::model::geo::addPoint(p_mm.x(), p_mm.y(), p_mm.z(), 0, kLoadPointTag);
+        // The classified edge it lies on, if any (the child's stand-in when the point gets no node).
+        load_edge = load_point == kLoadPointTag ? edge_through(p_mm, 1e-6 * size_mm) : -1;
       }
       for (std::size_t i = 0; i < o.probes_m.size(); ++i) {
         const Eigen::Vector3d pm = o.probes_m[i] * kMmPerM;
@@ -883,8 +931,7 @@ MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& l
       }
       if (!probe_tags.empty()) gmsh::model::mesh::embed(0, probe_tags, 3, 1);
       gmsh::model::setPhysicalName(3, gmsh::model::addPhysicalGroup(3, {1}), "BODY");
-      if (!t.own_triangles) gmsh::model::setPhysicalName(0, gmsh::model::addPhysicalGroup(0, {load_point}), "LOAD");
-      add_probe_groups(probe_tags);
+      add_probe_groups(probe_tags);  // LOAD: the child names it once meshed
     });
     // In a child process, stopped at the deadline: Gmsh 4.8 throws from inside its OpenMP face
     // meshing, where no catch reaches (std::terminate; seen with a load point embedded on a face's
@@ -902,11 +949,14 @@ MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& l
         where, "gmsh mesh", mesher, left,
         [&] {
           MeshResult c;
-          mesh_in_child(t, c);
-          return serialise_point_mesh(c);
+          bool edge_node = false;
+          mesh_in_child(t, c, edge_node);
+          return std::string(1, edge_node ? '1' : '0') + serialise_point_mesh(c);
         },
         &GmshSession::last_error);
-    read_point_mesh(made, where, r);
+    if (made.empty()) throw where.error("gmsh mesh", "the child process's result is truncated");
+    load_on_edge_node = made[0] == '1';
+    read_point_mesh(made.substr(1), where, r);
     fill_quality(r.mesh, r.quality);
     check_mesh(r, where);
   };
@@ -992,6 +1042,10 @@ MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& l
       g << "Point(" << kLoadPointTag << ") = {" << fmt(p.x()) << ", " << fmt(p.y()) << ", " << fmt(p.z())
         << "};  // the load point, a node of the surface that holds it\n"
         << "Point{" << kLoadPointTag << "} In Surface{" << load_surface << "};\n";
+      if (load_on_edge_node) {
+        g << "// It lies on edge " << load_edge << ", where Gmsh gives it no node: LOAD is that edge's node nearest to it\n"
+          << "// (impactdeck writes it into the .msh files).\n";
+      }
     } else {
       g << "// The load point (" << fmt(p.x()) << ", " << fmt(p.y()) << ", " << fmt(p.z()) << ") " << unit
         << " is CreateGeometry's corner point " << load_point << ".\n";
@@ -1000,7 +1054,7 @@ MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& l
   g << geo_probe_points(o, kFirstProbeTag, kMmPerM / k);
   g << geo_size_field(p, h0, h, o.load_zone_radius_m * kMmPerM / k);
   g << "Physical Volume(\"BODY\") = {1};\n";
-  if (!t.own_triangles) g << "Physical Point(\"LOAD\") = {" << load_point << "};\n";
+  if (!t.own_triangles && !load_on_edge_node) g << "Physical Point(\"LOAD\") = {" << load_point << "};\n";
   g << geo_probe_groups(o, kFirstProbeTag);
   r.geo = folder / (name + ".geo");
   write_file_atomically(r.geo, g.str());
