@@ -523,6 +523,14 @@ TEST(FemMesh, FallbackTriesEachSettingInTurnAndKeepsTheBest) {
   EXPECT_NE(slurp(r.geo).find("Settings of try"), std::string::npos);
 }
 
+// CGAL's 2 cm cube, turned by 0.7 rad about (1, -2, 0.5) and moved to `far`.
+static PartSurface far_rotated_cube(const Eigen::Vector3d& far) {
+  PartSurface s = part_surface(kData / "cube.off", LengthUnit::cm);
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, -2, 0.5).normalized()).toRotationMatrix();
+  for (auto& v : s.vertices_m) v = R * v + far;
+  return s;
+}
+
 // A part dropped on a corner: the load point is a corner of the classified faces. A second point
 // there, embedded in one of the faces, lies on that face's boundary, where Gmsh meshes no node for
 // it: every remeshed try failed ("LOAD: no mesh node on its geometry point") and the part's own 12
@@ -531,10 +539,8 @@ TEST(FemMesh, FallbackTriesEachSettingInTurnAndKeepsTheBest) {
 TEST(FemMesh, LoadPointOnACornerIsRemeshedAndRefinedThere) {
   // Coordinates of ~4e4 mm carried through Gmsh in doubles: a few ulps of 4e4, 1e-12 relative.
   constexpr double kCoordinateRoundOffRel = 1e-12;
-  PartSurface s = part_surface(kData / "cube.off", LengthUnit::cm);
-  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, -2, 0.5).normalized()).toRotationMatrix();
   const Eigen::Vector3d far(20, -30, 12);
-  for (auto& v : s.vertices_m) v = R * v + far;
+  const PartSurface s = far_rotated_cube(far);
   const Eigen::Vector3d corner = s.vertices_m[3];
   const fs::path d = fresh_dir("corner_load");
   MeshOptions o;
@@ -571,10 +577,8 @@ TEST(FemMesh, LoadPointOnAnEdgeIsItsNearestEdgeNodeInARefinedMesh) {
   // Gmsh interpolates along the edge in mm at 4e4 mm: a few ulps of the coordinates; 1e-10 of
   // them leaves a margin.
   constexpr double kOnEdgeRel = 1e-10;
-  PartSurface s = part_surface(kData / "cube.off", LengthUnit::cm);
-  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, -2, 0.5).normalized()).toRotationMatrix();
   const Eigen::Vector3d far(20, -30, 12);
-  for (auto& v : s.vertices_m) v = R * v + far;
+  const PartSurface s = far_rotated_cube(far);
   const Eigen::Vector3d point = s.vertices_m[0] + 0.3 * (s.vertices_m[1] - s.vertices_m[0]);  // edge 0-1
   const fs::path d = fresh_dir("edge_load");
   MeshOptions o;
