@@ -67,6 +67,36 @@ PY
 check "report.html's verdict box has the convergence line" \
   grep -Eq '<p id="convergence" class="governing">Mesh convergence: governing von Mises [0-9.]+ MPa \(mesh 3 mm, [0-9]+ nodes\) -&gt; [0-9.]+ MPa \(mesh 1.5 mm, [0-9]+ nodes\), outside [0-9.]+ mm of the contact point, change [-+][0-9.]+ %: the verdict (holds|moves with the mesh)' "$out/report.html"
 
+# The refined mesh's run fails (a ccx that fails in refined/ only): the first mesh's results and
+# verdict stand, the convergence is "not established" with ccx's reason, a warning says so, and
+# nothing of the refined deck is published (exit 0: the run's own checks passed).
+mkdir -p "$tmp/bin"
+cat >"$tmp/bin/ccx" <<SH
+#!/bin/sh
+case "\$PWD" in
+  */refined) echo " *ERROR in the test's ccx: refined run refused"; exit 201 ;;
+esac
+exec $(command -v ccx) "\$@"
+SH
+chmod +x "$tmp/bin/ccx"
+PATH="$tmp/bin:$PATH" "$bin" run "$tmp/conv.toml" --json --out "$tmp/nofine" >"$tmp/nofine.json" 2>"$tmp/nofine.err"
+rc=$?
+check "refined run failed: exit 0 (got $rc: $(grep error "$tmp/nofine.err" | head -c 300))" [ "$rc" = 0 ]
+check "refined run failed: no refined/ published" [ ! -e "$tmp/nofine/fem_drop/refined" ]
+check "refined run failed: the first deck's results are published" [ -s "$tmp/nofine/fem_drop/impact.frd" ]
+check "refined run failed: the JSON says not established" python3 - "$tmp/nofine.json" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+c = d["impacts"][0]["fem"]["check"]["convergence"]
+assert c["established"] is False and c["holds"] is False, c
+assert c["statement"].startswith("not established: the refined mesh (sizes halved) failed:"), c
+assert c["fine"] is None and c["folder"] is None, c
+assert c["coarse"]["governing_von_mises_Pa"] > 0, c
+assert any("mesh convergence not established" in w for w in d["warnings"]), d["warnings"]
+assert not any("/refined/" in f for f in d["files_written"]), d["files_written"]
+PY
+check "refined run failed: report.html says so" grep -q "convergence is not established: the refined mesh" "$tmp/nofine/report.html"
+
 # The key needs a ccx run: refused before anything runs (exit 3, naming the key).
 sed -i 's/^run = "calculix"/run = "none"/' "$tmp/conv.toml"
 "$bin" run "$tmp/conv.toml" --out "$tmp/none" >/dev/null 2>"$tmp/none.err"

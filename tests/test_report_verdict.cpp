@@ -203,6 +203,23 @@ TEST(MeshConvergence, TheReportVerdictStatesIt) {
   v = impact_verdict(ir);
   EXPECT_EQ(v.word, "yields");
   EXPECT_NE(v.convergence.find("the verdict holds"), std::string::npos) << v.convergence;
+  // The refined mesh failed to mesh or run: the first mesh's stress, and why nothing is compared.
+  fem_export::MeshConvergence none = pair_of(VerdictKind::yields, 3.0e8, VerdictKind::yields, 3.1e8);
+  none.fine = {};
+  none.refined_ran = false;
+  none.folder.clear();
+  fem_export::not_established(none, "the refined mesh (sizes halved) failed: ccx: exit 201");
+  ir.fem_check->convergence = none;
+  v = impact_verdict(ir);
+  EXPECT_EQ(v.word, "yields (convergence not established)");
+  EXPECT_EQ(v.convergence, "Mesh convergence: governing von Mises 300 MPa (mesh 2 mm, 0 nodes); the verdict's "
+                           "convergence is not established: the refined mesh (sizes halved) failed: ccx: exit 201");
+  const auto j = fem_export::to_json(none);
+  EXPECT_FALSE(j.at("established").get<bool>());
+  EXPECT_FALSE(j.at("holds").get<bool>());
+  EXPECT_TRUE(j.at("fine").is_null());
+  EXPECT_TRUE(j.at("folder").is_null());
+  EXPECT_TRUE(j.at("coarse").is_object());
 }
 
 }  // namespace

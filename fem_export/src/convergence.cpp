@@ -32,6 +32,12 @@ void judge_convergence(MeshConvergence& c) {
   c.statement = s.str();
 }
 
+void not_established(MeshConvergence& c, const std::string& why) {
+  c.established = false;
+  c.holds = false;
+  c.statement = "not established: " + why;
+}
+
 namespace {
 
 nlohmann::json mesh_json(const ConvergenceMesh& m) {
@@ -55,18 +61,25 @@ nlohmann::json mesh_json(const ConvergenceMesh& m) {
 nlohmann::json to_json(const MeshConvergence& c) {
   return {{"method", "two-meshes"},
           {"coarse", mesh_json(c.coarse)},
-          {"fine", mesh_json(c.fine)},
+          {"fine", c.refined_ran ? mesh_json(c.fine) : nlohmann::json()},
           {"evaluation_radius_m", c.evaluation_radius_m},
           // JSON has no infinity: a change from a zero stress is null (and does not hold).
           {"relative_change", std::isfinite(c.relative_change) ? nlohmann::json(c.relative_change) : nlohmann::json()},
           {"tolerance", c.tolerance},
           {"holds", c.holds},
+          {"established", c.established},
           {"statement", c.statement},
-          {"folder", c.folder}};
+          {"folder", c.folder.empty() ? nlohmann::json() : nlohmann::json(c.folder)}};
 }
 
 std::string format_convergence(const MeshConvergence& c) {
   std::ostringstream s;
+  if (!c.refined_ran) {
+    s << std::setprecision(4) << "governing von Mises " << c.coarse.verdict.governing.von_mises_Pa / 1e6 << " MPa (mesh "
+      << c.coarse.mesh_size_m * 1e3 << " mm, " << c.coarse.node_count << " nodes); the verdict's convergence is "
+      << c.statement;
+    return s.str();
+  }
   s << std::setprecision(4) << "governing von Mises " << c.coarse.verdict.governing.von_mises_Pa / 1e6
     << " MPa (mesh " << c.coarse.mesh_size_m * 1e3 << " mm, " << c.coarse.node_count << " nodes) -> "
     << c.fine.verdict.governing.von_mises_Pa / 1e6 << " MPa (mesh " << c.fine.mesh_size_m * 1e3 << " mm, "

@@ -595,13 +595,6 @@ fem_export::MeshConvergence refined_mesh_check(const Scene& scene, const RunRepo
   // also where that one was a curvature-sizing retry.
   req.options.mesh.curvature_elements = fem_export::curvature_elements_for(req.options.tolerances.volume);
   req.options.min_contact_zone_radius_m = first.contact_zone_radius_m;
-  fem_export::MeshConvergence c;
-  c.folder = "refined";
-  const fem_export::DeckResult fine = fem_export::write_deck_files(req, job.folder / c.folder);
-  const fem_export::CheckResult fine_check = fem_export::run_check(fine, co);
-  c.files = fine.files;
-  c.files.insert(c.files.end(), fine_check.solver_files.begin(), fine_check.solver_files.end());
-  if (fine_check.stress) c.files.insert(c.files.end(), fine_check.stress->files.begin(), fine_check.stress->files.end());
   auto side = [](const fem_export::DeckResult& d, const fem_export::CheckResult& k) {
     fem_export::ConvergenceMesh m;
     m.mesh_size_m = d.quality.mesh_size_m;
@@ -612,10 +605,39 @@ fem_export::MeshConvergence refined_mesh_check(const Scene& scene, const RunRepo
     m.solver_wall_time_s = k.solver_wall_time_s;
     return m;
   };
+  fem_export::MeshConvergence c;
+  c.folder = "refined";
+  fem_export::DeckResult fine;
+  fem_export::CheckResult fine_check;
+  try {
+    fine = fem_export::write_deck_files(req, job.folder / c.folder);
+    fine_check = fem_export::run_check(fine, co);
+  } catch (const InputError& e) {
+    // The refined mesh or its run failed (Gmsh, ccx, a bound): the first mesh's results stand and
+    // the convergence is not established; nothing of the refined deck is published.
+    std::error_code ec;
+    fs::remove_all(job.folder / c.folder, ec);
+    c.folder.clear();
+    c.refined_ran = false;
+    c.coarse = side(first, *job.ir->fem_check);
+    c.evaluation_radius_m = first.contact_zone_radius_m;
+    // Its step and reason: the file it names is in the run's staging folder, which is never published.
+    fem_export::not_established(c, "the refined mesh (sizes halved) failed: " + e.place() + ": " + e.reason());
+    return c;
+  }
+  c.files = fine.files;
+  c.files.insert(c.files.end(), fine_check.solver_files.begin(), fine_check.solver_files.end());
+  if (fine_check.stress) c.files.insert(c.files.end(), fine_check.stress->files.begin(), fine_check.stress->files.end());
   c.coarse = side(first, *job.ir->fem_check);
   c.fine = side(fine, fine_check);
   c.evaluation_radius_m = first.contact_zone_radius_m;
   fem_export::judge_convergence(c);
+  if (!fine_check.passed) {
+    // Its results are kept as the evidence (as the first mesh's are), but its stress is no check.
+    std::string failures;
+    for (const auto& f : fine_check.failures) failures += (failures.empty() ? "" : "; ") + f;
+    fem_export::not_established(c, "the refined mesh fails its checks (" + failures + ")");
+  }
   return c;
 }
 
@@ -836,6 +858,10 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
           if (scene.outputs.fem->convergence == FemOutputs::Convergence::two_meshes) {
             // The refined deck's meshing and run are timed in this stage (fem_run).
             ir.fem_check->convergence = refined_mesh_check(scene, report, job, co);
+            if (!ir.fem_check->convergence->established) {
+              report.warnings.push_back("impact '" + ir.spec->name + "': mesh convergence " +
+                                        ir.fem_check->convergence->statement);
+            }
           }
         }
       });

@@ -348,7 +348,11 @@ void state_convergence(const fem_export::CheckResult& check, ImpactVerdict& v) {
   }
   const fem_export::MeshConvergence& c = *check.convergence;
   v.convergence = "Mesh convergence: " + fem_export::format_convergence(c);
-  if (!c.holds) v.word += " (moves with the mesh)";
+  if (!c.established) {
+    v.word += " (convergence not established)";
+  } else if (!c.holds) {
+    v.word += " (moves with the mesh)";
+  }
 }
 
 ImpactVerdict impact_verdict(const ImpactReport& ir) {

@@ -37,8 +37,12 @@ struct MeshConvergence {
   double evaluation_radius_m = 0;
   double relative_change = 0;  ///< (fine - coarse) / coarse governing von Mises
   double tolerance = kConvergenceTolerance;
-  bool holds = false;          ///< same verdict kind and |relative_change| <= tolerance
-  std::string statement;       ///< "holds" or "moves with the mesh", with why
+  bool holds = false;          ///< established, the same verdict kind and |relative_change| <= tolerance
+  /// False when the refined mesh gave no verdict to compare (its deck or run failed: `fine` is
+  /// empty) or its FE checks failed: then holds is false and the statement says why.
+  bool established = true;
+  bool refined_ran = true;     ///< false: the refined mesh's deck or run failed (`fine` is empty)
+  std::string statement;       ///< "holds", "moves with the mesh" or "not established", with why
   std::string folder;          ///< the fine deck's folder, relative to the first deck's
   std::vector<std::filesystem::path> files;  ///< the fine deck's files and its solver's results
 };
@@ -47,6 +51,9 @@ struct MeshConvergence {
 /// and statement. A coarse governing stress of 0 makes any fine one a change of +inf (moves), both 0
 /// a change of 0.
 void judge_convergence(MeshConvergence& c);
+/// The refined mesh gave no verdict that can be compared: established and holds false, the
+/// statement "not established: <why>".
+void not_established(MeshConvergence& c, const std::string& why);
 
 nlohmann::json to_json(const MeshConvergence& c);
 /// One line: "governing von Mises A MPa (mesh h1 mm) -> B MPa (h2 mm), change
