@@ -218,6 +218,7 @@ TEST(MeshConvergence, TheReportVerdictStatesIt) {
   EXPECT_FALSE(j.at("established").get<bool>());
   EXPECT_FALSE(j.at("holds").get<bool>());
   EXPECT_TRUE(j.at("fine").is_null());
+  EXPECT_TRUE(j.at("relative_change").is_null());
   EXPECT_TRUE(j.at("folder").is_null());
   EXPECT_TRUE(j.at("coarse").is_object());
 }

@@ -63,8 +63,10 @@ nlohmann::json to_json(const MeshConvergence& c) {
           {"coarse", mesh_json(c.coarse)},
           {"fine", c.refined_ran ? mesh_json(c.fine) : nlohmann::json()},
           {"evaluation_radius_m", c.evaluation_radius_m},
-          // JSON has no infinity: a change from a zero stress is null (and does not hold).
-          {"relative_change", std::isfinite(c.relative_change) ? nlohmann::json(c.relative_change) : nlohmann::json()},
+          // JSON has no infinity: a change from a zero stress is null (and does not hold); so is
+          // the change when the refined mesh did not run.
+          {"relative_change", c.refined_ran && std::isfinite(c.relative_change) ? nlohmann::json(c.relative_change)
+                                                                                 : nlohmann::json()},
           {"tolerance", c.tolerance},
           {"holds", c.holds},
           {"established", c.established},
