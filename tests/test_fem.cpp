@@ -531,6 +531,21 @@ static PartSurface far_rotated_cube(const Eigen::Vector3d& far) {
   return s;
 }
 
+// Sizes for a hit on the 2 cm cube: 5 mm, h0 = 0.2 mm within 1 mm of the contact.
+static MeshOptions cube_contact_sizes() {
+  MeshOptions o;
+  o.mesh_size_m = 0.005;
+  o.load_mesh_size_m = 2e-4;
+  o.load_zone_radius_m = 1e-3;
+  return o;
+}
+
+static std::size_t nodes_within(const MeshResult& r, const Eigen::Vector3d& p, double radius_m) {
+  std::size_t n = 0;
+  for (const auto& x : r.mesh.nodes_m) n += (x - p).norm() < radius_m;
+  return n;
+}
+
 // A part dropped on a corner: the load point is a corner of the classified faces. A second point
 // there, embedded in one of the faces, lies on that face's boundary, where Gmsh meshes no node for
 // it: every remeshed try failed ("LOAD: no mesh node on its geometry point") and the part's own 12
@@ -543,10 +558,7 @@ TEST(FemMesh, LoadPointOnACornerIsRemeshedAndRefinedThere) {
   const PartSurface s = far_rotated_cube(far);
   const Eigen::Vector3d corner = s.vertices_m[3];
   const fs::path d = fresh_dir("corner_load");
-  MeshOptions o;
-  o.mesh_size_m = 0.005;         // a 2 cm cube
-  o.load_mesh_size_m = 2e-4;     // h0
-  o.load_zone_radius_m = 1e-3;
+  const MeshOptions o = cube_contact_sizes();
   const MeshResult r = mesh_part(s, corner, o, d, "mesh", "cube.off");
   ASSERT_EQ(r.quality.attempts.size(), 1u) << r.quality.attempts.back().outcome;
   EXPECT_EQ(r.quality.attempts[0].surface, "remeshed");
@@ -554,8 +566,7 @@ TEST(FemMesh, LoadPointOnACornerIsRemeshedAndRefinedThere) {
   EXPECT_LE(r.quality.load_node_distance_m, kCoordinateRoundOffRel * far.norm());
   // Refined there: the zone of radius 5 h0 holds many nodes (the corner's eighth of a ball, about
   // (5 h0)^3 / h0^3 / 8 / 6 nodes; the part's own triangles gave the corner alone).
-  std::size_t near = 0;
-  for (const auto& x : r.mesh.nodes_m) near += (x - corner).norm() < 5 * o.load_mesh_size_m;
+  const std::size_t near = nodes_within(r, corner, 5 * o.load_mesh_size_m);
   EXPECT_GE(near, 10u);
   const std::string geo = slurp(r.geo);
   EXPECT_NE(geo.find("CreateGeometry's corner point"), std::string::npos) << geo;
@@ -581,10 +592,7 @@ TEST(FemMesh, LoadPointOnAnEdgeIsItsNearestEdgeNodeInARefinedMesh) {
   const PartSurface s = far_rotated_cube(far);
   const Eigen::Vector3d point = s.vertices_m[0] + 0.3 * (s.vertices_m[1] - s.vertices_m[0]);  // edge 0-1
   const fs::path d = fresh_dir("edge_load");
-  MeshOptions o;
-  o.mesh_size_m = 0.005;
-  o.load_mesh_size_m = 2e-4;
-  o.load_zone_radius_m = 1e-3;
+  const MeshOptions o = cube_contact_sizes();
   const MeshResult r = mesh_part(s, point, o, d, "mesh", "cube.off");
   ASSERT_EQ(r.quality.attempts.size(), 1u) << r.quality.attempts.back().outcome;
   EXPECT_EQ(r.quality.attempts[0].surface, "remeshed");
@@ -596,8 +604,7 @@ TEST(FemMesh, LoadPointOnAnEdgeIsItsNearestEdgeNodeInARefinedMesh) {
   // On the edge: its distance from the edge's line is round-off.
   const Eigen::Vector3d e = (s.vertices_m[1] - s.vertices_m[0]).normalized();
   EXPECT_LE(((load - s.vertices_m[0]) - (load - s.vertices_m[0]).dot(e) * e).norm(), kOnEdgeRel * far.norm());
-  std::size_t near = 0;
-  for (const auto& x : r.mesh.nodes_m) near += (x - point).norm() < 5 * o.load_mesh_size_m;
+  const std::size_t near = nodes_within(r, point, 5 * o.load_mesh_size_m);
   EXPECT_GE(near, 10u);
   // The .geo says which node LOAD is (impactdeck writes it into the .msh files).
   const std::string geo = slurp(r.geo);

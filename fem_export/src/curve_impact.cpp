@@ -53,6 +53,12 @@ void rk4(double& d, double& v, double h, const Accel& a) {
 
 }  // namespace
 
+double curve_work_J(const std::vector<double>& x, const std::vector<double>& f) {
+  double w = 0;
+  for (std::size_t i = 1; i < x.size(); ++i) w += 0.5 * (f[i] + f[i - 1]) * (x[i] - x[i - 1]);
+  return w;
+}
+
 std::optional<double> approach_at_work(const std::vector<double>& ld, const std::vector<double>& lf, double work_J) {
   // The work reaches work_J inside segment i (exact for the piecewise-linear force:
   // W + f0 s + k s^2 / 2 = work_J).
@@ -97,10 +103,8 @@ CurveImpact impact_on_curves(const std::vector<double>& ld_in, const std::vector
   const double energy = 0.5 * mass_kg * speed_m_s * speed_m_s;
   const std::optional<double> turn = approach_at_work(ld, lf, energy);
   if (!turn) {
-    double work = 0;
-    for (std::size_t i = 1; i < ld.size(); ++i) work += 0.5 * (lf[i] + lf[i - 1]) * (ld[i] - ld[i - 1]);
-    throw std::invalid_argument("the loading curve's work (" + num(work) + " J up to an approach of " + num(ld.back()) +
-                                " m) falls short of the impact energy " + num(energy) + " J");
+    throw std::invalid_argument("the loading curve's work (" + num(curve_work_J(ld, lf)) + " J up to an approach of " +
+                                num(ld.back()) + " m) falls short of the impact energy " + num(energy) + " J");
   }
   c.max_approach_m = *turn;
   c.max_force_N = on_curve(ld, lf, *turn);
@@ -109,7 +113,7 @@ CurveImpact impact_on_curves(const std::vector<double>& ld_in, const std::vector
   // kForceFloorRel of the loading peak is zero: ccx's reaction total on separated bodies is round-off
   // of either sign (seen: +2.3e-10 N and -4.2e-11 N beside a 28 N peak).
   std::vector<double> ux(ud.rbegin(), ud.rend()), uy(uf.rbegin(), uf.rend());
-  const double floor_N = kForceFloorRel * *std::max_element(lf.begin(), lf.end());
+  const double peak_N = *std::max_element(lf.begin(), lf.end()), floor_N = kForceFloorRel * peak_N;
   for (double& f : uy) {
     if (std::abs(f) <= floor_N) f = 0;
   }
@@ -122,7 +126,7 @@ CurveImpact impact_on_curves(const std::vector<double>& ld_in, const std::vector
   if (last_positive == 0) {
     throw std::invalid_argument("the unloading force never vanishes (the bodies stay pressed): " + num(uy[0]) +
                                 " N at an approach of " + num(ux[0]) + " m, the loading peak " +
-                                num(floor_N / kForceFloorRel) + " N");
+                                num(peak_N) + " N");
   }
   {
     const std::size_t i = last_positive;  // uy[i - 1] <= 0 < uy[i]

@@ -393,6 +393,18 @@ constexpr double kCadMeshDeadlineS = 600;
 // The same for a mesh part's tries (each in a child process too: mesh_part_with_gmsh).
 constexpr double kPartMeshDeadlineS = 600;
 
+// The seconds the next try has before all tries together reach `deadline_s` (started at t0);
+// throws "no try left" when none.
+double seconds_left(std::chrono::steady_clock::time_point t0, double deadline_s, const InputContext& where) {
+  const double left = deadline_s - std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (left <= 0) {
+    std::ostringstream m;
+    m << "no try left within " << deadline_s << " s";
+    throw where.error("gmsh mesh", m.str());
+  }
+  return left;
+}
+
 
 // The .geo's first lines: what it meshes, the unit its numbers are in (`script`: mm, Gmsh's working
 // unit, for the ellipsoid and CAD routes; the deck's own unit for the part route, whose STL is in
@@ -937,12 +949,7 @@ MeshResult mesh_part_with_gmsh(const PartSurface& surf, const Eigen::Vector3d& l
     // meshing, where no catch reaches (std::terminate; seen with a load point embedded on a face's
     // boundary), and may run long. The child meshes, names LOAD and PROBEk, and writes the .msh
     // files; the last try that meshed wrote them, and the kept try is always the last one run.
-    const double left = kPartMeshDeadlineS - std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    if (left <= 0) {
-      std::ostringstream m;
-      m << "no try left within " << kPartMeshDeadlineS << " s";
-      throw where.error("gmsh mesh", m.str());
-    }
+    const double left = seconds_left(t0, kPartMeshDeadlineS, where);
     const std::string mesher =
         "Gmsh's mesher (" + (t.own_triangles ? std::string("part triangles") : "2D algorithm " + std::to_string(t.algorithm_2d)) + ")";
     const std::string made = run_in_child(
@@ -1185,12 +1192,7 @@ MeshResult mesh_cad_with_gmsh(const fs::path& cad, double cad_unit_m, const Eige
   const auto t0 = std::chrono::steady_clock::now();
   for (std::size_t k = 0;; ++k) {
     try {
-      const double left = kCadMeshDeadlineS - std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      if (left <= 0) {
-        std::ostringstream s;
-        s << "no try left within " << kCadMeshDeadlineS << " s";
-        throw file.error("gmsh mesh", s.str());
-      }
+      const double left = seconds_left(t0, kCadMeshDeadlineS, file);
       MeshResult r = mesh_cad_once(cad, cad_unit_m, load_point_m, o, folder, name, algorithms[k], left);
       r.quality.attempts.insert(r.quality.attempts.begin(), failed.begin(), failed.end());
       return r;

@@ -708,12 +708,6 @@ StaticCurves curves_of(const StaticDat& d, double peak_m) {
   return c;
 }
 
-double loading_work(const StaticCurves& c) {
-  double w = 0;
-  for (std::size_t i = 1; i < c.ld.size(); ++i) w += 0.5 * (c.lf[i] + c.lf[i - 1]) * (c.ld[i] - c.ld[i - 1]);
-  return w;
-}
-
 // The quasi-static route (contact_model.hpp, "Quasi-static"): run `load`, find d_max on its curve,
 // write and run `impact`, and put the mass on its curves.
 ContactRunResult run_quasi_static(const fs::path& folder, json cj, const CheckOptions& options) {
@@ -753,7 +747,7 @@ ContactRunResult run_quasi_static(const fs::path& folder, json cj, const CheckOp
       }
       if (attempt == 2 || !options.run_solver) {
         std::ostringstream m;
-        m << "the contact took " << loading_work(c) << " J of the impact's " << energy << " J up to an approach of "
+        m << "the contact took " << curve_work_J(c.ld, c.lf) << " J of the impact's " << energy << " J up to an approach of "
           << probe * 1e3 << " mm (the largest tried): the bodies are softer than every contact law";
         throw InputError(where(kQuasiStaticLoadJob), "static run", m.str());
       }
@@ -782,7 +776,7 @@ ContactRunResult run_quasi_static(const fs::path& folder, json cj, const CheckOp
     throw InputError(where(kJobName), "static run", e.what());
   }
   r.peak_approach_m = peak;
-  r.energy_relative_error = std::abs(loading_work(c) / energy - 1);
+  r.energy_relative_error = std::abs(curve_work_J(c.ld, c.lf) / energy - 1);
   r.curve_approach_m = c.ld;
   r.curve_force_N = c.lf;
   r.curve_approach_m.insert(r.curve_approach_m.end(), c.ud.begin() + 1, c.ud.end());

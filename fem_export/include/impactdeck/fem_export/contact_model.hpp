@@ -218,6 +218,8 @@ struct CurveImpact {
 /// the turning point, F_max and the restitution (sqrt of the work ratio) from the curves exactly.
 /// `extension` > 0: the loading curve's last segment is continued for up to that fraction of
 /// 1/2 m V^2 more work (a run that was to end at the turning point and ended a little short).
+/// The work of a piecewise-linear force over its approaches (trapezoids, exact for it), J.
+double curve_work_J(const std::vector<double>& approach_m, const std::vector<double>& force_N);
 /// The approach at which a loading curve (as impact_on_curves takes it) has done `work_J`, exact for
 /// its piecewise-linear force; nullopt when its whole work falls short.
 std::optional<double> approach_at_work(const std::vector<double>& load_approach_m, const std::vector<double>& load_force_N,
