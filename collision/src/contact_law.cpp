@@ -1,6 +1,7 @@
 #include "impactdeck/collision/contact_law.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <mutex>
 #include <sstream>
@@ -38,10 +39,13 @@ struct Registry {
 std::shared_ptr<const ContactLaw> make_hertz_law(const LawOptions& options);
 std::shared_ptr<const ContactLaw> make_thornton_law(const LawOptions& options);
 std::shared_ptr<const ContactLaw> make_jackson_green_law(const LawOptions& options);
+std::shared_ptr<const ContactLaw> make_jackson_green_sneddon_law(const LawOptions& options);
 std::shared_ptr<const ContactLaw> make_wedge_law(const LawOptions& options);
 std::shared_ptr<const ContactLaw> make_cone_law(const LawOptions& options);
 std::shared_ptr<const ContactLaw> make_line_law(const LawOptions& options);
 std::shared_ptr<const ContactLaw> make_line_plastic_law(const LawOptions& options);
+std::shared_ptr<const ContactLaw> make_rate_dependent_law(std::shared_ptr<const ContactLaw> inner, double D_per_s,
+                                                          double q);
 
 namespace {
 
@@ -52,6 +56,7 @@ Registry& registry() {
                         {"hertz", make_hertz_law},
                         {"thornton", make_thornton_law},
                         {"jackson-green", make_jackson_green_law},
+                        {"jackson-green-sneddon", make_jackson_green_sneddon_law},
                         {"wedge", make_wedge_law},
                         {"cone", make_cone_law},
                         {"line", make_line_law},
@@ -95,7 +100,21 @@ std::shared_ptr<const ContactLaw> make_contact_law(const std::string& name, cons
     s << ")";
     throw ctx.error("contact_law", s.str());
   }
-  return factory(options);
+  const double D = options.cowper_symonds_D_per_s, q = options.cowper_symonds_q;
+  if (D == 0.0 && q == 0.0) return factory(options);
+  if (!(D > 0.0 && std::isfinite(D))) {
+    throw ctx.error("cowper_symonds_D_per_s", "must be a finite number > 0 (1/s), got " + std::to_string(D));
+  }
+  if (!(q > 0.0 && std::isfinite(q))) {
+    throw ctx.error("cowper_symonds_q", "must be a finite number > 0, got " + std::to_string(q));
+  }
+  // Each impact of a rate-dependent law runs at its own flow stress: a table per material pair
+  // (LawOptions::tabulated) would be one per impact.
+  LawOptions inner = options;
+  inner.tabulated = false;
+  std::shared_ptr<const ContactLaw> law = factory(inner);
+  if (!law->uses_yield_strength()) return law;  // an elastic law: no flow stress to raise
+  return make_rate_dependent_law(std::move(law), D, q);
 }
 
 }  // namespace impactdeck::collision

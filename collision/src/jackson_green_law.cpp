@@ -13,6 +13,17 @@
 //   restitution  1/2 m V_r^2 = 2/5 F_m (d_m - d_bar) (the unloading's elastic energy), e = V_r / V
 // The fit lies up to 0.5 % above Hertz just past 1.9 d_c (it jumps there); where F_m >= F_e(d_m)
 // Brake's d_bar would be negative: it is held at 0 and V_r at V (e = 1, no dent).
+// "jackson-green-sneddon": the same loading; the unloading starts at Sneddon's stiffness of the
+// plastic contact circle a_p (Jackson - Green's own a above, not the elastic sqrt(R* d_m)) and
+// follows a power law with Etsion's exponent (Etsion, Kligerman & Kadin, IJSS 42 (2005) 3716-3729):
+//   n = 1.5 x_m^-0.0331,  dF/dd at d_m = 2 E* a_p (Sneddon 1965, any axisymmetric punch)
+//   F = F_m ((d - d_p) / delta_e)^n,  delta_e = n F_m / (2 E* a_p),  d_p = d_m - delta_e (>= 0)
+//   restitution  1/2 m V_r^2 = F_m delta_e / (n + 1), e = V_r / V;  the dent d_p, its radius a_p
+//   unloading time  t_u = C(n) delta_e / V_r, C(n) = sqrt(pi) G(1 + 1/p) / G(1/2 + 1/p), p = n + 1
+// With a_p = sqrt(R* d_m) and n = 3/2 it is exactly Hertz's unloading (delta_e = d_m, no dent).
+// Everything after the loading is a function of x_m (and Y/E*, nu), so an impact is a function of
+// v_star = V T/d_c alone for one material pair: LawOptions::tabulated reads it from a table
+// (OutcomeTable below) instead of integrating phase 2.
 // F(t), phase by phase:
 //   1. Hertz loading up to 1.9 d_c (compression.hpp's curve of the Hertz impact at V), reached at
 //      t_1 = t_H I_{z^p}(1/p, 1/2), z = 1.9 d_c / x_H, p = 5/2 (closed form);
@@ -23,11 +34,17 @@
 // Phase 2 runs in x = d/d_c and tau = t/T, T = sqrt(m d_c / F_c): x'' = -F(x)/F_c, x'(0) = V T/d_c.
 // At or below 1.9 d_c (1/2 m V^2 <= 2/5 k_H (1.9 d_c)^2.5) the impact stays Hertz: e = 1, no dent.
 #include <algorithm>
+#include <array>
+#include <atomic>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <sstream>
+#include <vector>
 
+#include <gsl/gsl_cdf.h>
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_odeiv2.h>
 #include <gsl/gsl_sf_gamma.h>
@@ -67,6 +84,9 @@ struct Curve {
                            4.0 * HG_over_Y / C * (1.0 - std::exp(-std::pow(x, 5.0 / 9.0) / 25.0)) * x;
     return plastic + (hertz - plastic) * hardening;
   }
+
+  /// Jackson - Green's contact radius over R* at x: s sqrt(x (x/1.9)^B), held at 1.
+  double radius(double x) const noexcept { return std::min(1.0, s * std::sqrt(x * std::pow(x / kElasticLimit, B))); }
 };
 
 int curve_rhs(double, const double y[], double dydt[], void* p) {
@@ -197,12 +217,231 @@ struct Phases {
   };
 };
 
+enum class Unloading : std::uint8_t {
+  brake,    // "jackson-green": Brake's Hertz curve through (d_m, F_m)
+  sneddon,  // "jackson-green-sneddon": Sneddon's stiffness at a_p, Etsion's exponent
+};
+
+/// Etsion, Kligerman & Kadin's (2005) unloading exponent n = 1.5 x_m^kEtsionExponentSlope.
+constexpr double kEtsionExponentSlope = -0.0331;
+
+/// t_m = C(n) x_max / v of the impact m x'' = -k x^n (paper Eq. 10 at z = 1, p = n + 1).
+double power_law_time_factor(double n) {
+  const double p = n + 1.0;
+  return std::sqrt(M_PI) * std::tgamma(1.0 + 1.0 / p) / std::tgamma(0.5 + 1.0 / p);
+}
+
+// A plastic impact in the units d_c, F_c, T (x = d/d_c, f = F/F_c, tau = t/T, speeds in d_c/T): a
+// function of v_star alone for one curve. Every entry is positive.
+struct Outcome {
+  double x_m = 0;    // the turning point
+  double f_m = 0;    // F_max / F_c
+  double tau_m = 0;  // t_m / T
+  double du = 0;     // (d_m - dent) / d_c, the depth the unloading recovers
+  double vr = 0;     // V_r T / d_c, the rebound speed
+  double tau_u = 0;  // t_u / T
+  double a_p = 0;    // the dent's radius over R*
+  static constexpr std::size_t kSize = 7;
+  double* begin() noexcept { return &x_m; }
+  const double* begin() const noexcept { return &x_m; }
+};
+static_assert(sizeof(Outcome) == Outcome::kSize * sizeof(double));
+
+// The unloading from (x_m, f_m) (in units with F_c T^2 / (m d_c) = 1, so 1/2 m V^2 = W reads
+// v^2 = 2 W in them).
+void unload(const Curve& c, Unloading kind, Outcome& o) noexcept {
+  if (kind == Unloading::brake) {
+    o.du = o.x_m * std::min(1.0, o.f_m / (o.x_m * std::sqrt(o.x_m)));  // d_m - d_bar
+    o.vr = std::sqrt(0.8 * o.f_m * o.du);                              // 2/5 F_m (d_m - d_bar)
+    o.tau_u = compression_time_factor() * o.du / o.vr;
+    o.a_p = c.s * std::sqrt(o.x_m);  // sqrt(R* d_m) / R*
+    return;
+  }
+  const double n = 1.5 * std::pow(o.x_m, kEtsionExponentSlope);
+  o.a_p = c.radius(o.x_m);
+  // delta_e = n F_m / (2 E* a_p); with F_c / (E* R* d_c) = 4/3 s: delta_e/d_c = 2/3 n f_m s / (a_p/R*).
+  o.du = std::min(o.x_m, 2.0 / 3.0 * n * o.f_m * c.s / o.a_p);
+  o.vr = std::sqrt(2.0 * o.f_m * o.du / (n + 1.0));
+  o.tau_u = power_law_time_factor(n) * o.du / o.vr;
+}
+
+// The outcome at v_star by integrating phase 2 (false when it fails or a number is not finite).
+bool integrate_outcome(OdeWork& w, double v_star, const Curve& shape, Unloading kind, Outcome& o) noexcept {
+  Phases p;
+  double tau2 = 0, x_m = 0;
+  if (!p.init(v_star, shape.s, shape.C, shape.hardening) || !p.to_turning_point(w, tau2, x_m)) return false;
+  o.x_m = x_m;
+  o.f_m = p.curve.fit(x_m);
+  o.tau_m = p.tau1 + tau2;
+  unload(p.curve, kind, o);
+  return std::all_of(o.begin(), o.begin() + Outcome::kSize, [](double v) { return detail::finite_positive(v); });
+}
+
+// v_star at the elastic limit: 1/2 v^2 = 2/5 1.9^2.5 (the Hertz work to x = 1.9).
+double elastic_limit_speed() { return std::sqrt(0.8 * std::pow(kElasticLimit, 2.5)); }
+
+// The loading's outcome (x_m, f_m, tau_m) as a function of u = sqrt(v_star^2 - v_0^2) (the speed
+// left at x = 1.9; each is analytic in u there, while it has a square-root branch in v_star), on the
+// grid q = asinh(u): uniform steps, linear in u near the elastic limit and logarithmic at high
+// speed. Each is interpolated in log by cubic Hermite on the nodes' values and slopes; the slopes
+// are fourth-order finite differences of the nodes (one-sided at the ends). The grid is split where
+// Jackson - Green's a/R* reaches 1 and is held there (Curve::radius): the fit's second derivative
+// jumps at that x_m, and a cubic across it errs by O(h^2) (measured: 3e-5 at 1024 nodes, 4e-7 at
+// 8192), against O(h^4) within each piece. The unloading is the closed form unload() of the
+// interpolated turning point: Brake's min(1, F_m/F_e) has a kink that no cubic follows. Why not
+// GSL's gsl_spline: its cubic spline has natural end conditions (y'' = 0 at the ends, where no
+// entry has it: O(h^2) on the first intervals), and its evaluation searches the interval by
+// bisection where this grid's index is one multiplication.
+class OutcomeTable {
+ public:
+  // Builds the table of `shape` with `nodes` nodes per piece and measures its error at the
+  // midpoints; ok() is false when an integration failed.
+  OutcomeTable(const Curve& shape, Unloading kind, OdeWork& w, std::size_t nodes) : shape_(shape), kind_(kind) {
+    v0_ = elastic_limit_speed();
+    double split = kQMax;
+    if (!clamp_q(w, split)) return;
+    for (const auto& [q0, q1] : {std::pair{kQMin, split}, std::pair{split, kQMax}}) {
+      if (!(q1 > q0)) continue;
+      Piece p;
+      p.q0 = q0;
+      p.q1 = q1;
+      p.h = (q1 - q0) / static_cast<double>(nodes - 1);
+      p.log_y.resize(nodes * kEntries);
+      for (std::size_t i = 0; i < nodes; ++i) {
+        Outcome o;
+        if (!integrate_outcome(w, speed_at(q0 + p.h * static_cast<double>(i)), shape, kind, o)) return;
+        for (std::size_t k = 0; k < kEntries; ++k) p.log_y[i * kEntries + k] = std::log(o.begin()[k]);
+      }
+      p.slopes();
+      pieces_.push_back(std::move(p));
+    }
+    // The error: at each midpoint, the largest relative error of any entry.
+    double worst = 0;
+    for (const Piece& p : pieces_) {
+      for (std::size_t i = 0; i + 1 < nodes; ++i) {
+        const double q = p.q0 + p.h * (static_cast<double>(i) + 0.5);
+        Outcome exact, table;
+        if (!integrate_outcome(w, speed_at(q), shape, kind, exact)) return;
+        p.interpolate(q, table);
+        unload(shape_, kind_, table);
+        for (std::size_t k = 0; k < Outcome::kSize; ++k) {
+          worst = std::max(worst, std::abs(table.begin()[k] / exact.begin()[k] - 1.0));
+        }
+      }
+    }
+    max_rel_error_ = worst;
+    ok_ = std::isfinite(worst);
+  }
+
+  bool ok() const noexcept { return ok_; }
+  double max_rel_error() const noexcept { return max_rel_error_; }
+
+  /// The outcome at v_star (> v_0); false beyond the table (the caller integrates).
+  bool lookup(double v_star, Outcome& o) const noexcept {
+    const double u2 = (v_star - v0_) * (v_star + v0_);
+    if (!(u2 >= 0.0)) return false;
+    const double q = std::asinh(std::sqrt(u2));
+    if (!(q >= kQMin && q <= kQMax)) return false;
+    const Piece& p = pieces_.size() > 1 && q >= pieces_[1].q0 ? pieces_[1] : pieces_[0];
+    p.interpolate(q, o);
+    unload(shape_, kind_, o);
+    return true;
+  }
+
+  /// The table's span in q = asinh(u): from just past the elastic limit (at u = 0 the Hertz phase
+  /// reaches 1.9 d_c exactly at its turning point, where phase 2 has no start) to v_star = 1e6,
+  /// V/V_c about 1.1e6. Beyond either end the law integrates.
+  static constexpr double kQMin = 1e-3, kQMax = 14.5;
+
+ private:
+  /// The tabulated entries: Outcome's first three (x_m, f_m, tau_m).
+  static constexpr std::size_t kEntries = 3;
+
+  struct Piece {
+    double q0 = 0, q1 = 0, h = 0;
+    std::vector<double> log_y, slope;  // node-major: [i * kEntries + k]
+
+    void slopes() {
+      const std::size_t n = log_y.size() / kEntries;
+      slope.assign(log_y.size(), 0.0);
+      auto y = [&](std::size_t i, std::size_t k) { return log_y[i * kEntries + k]; };
+      for (std::size_t i = 0; i < n; ++i) {
+        for (std::size_t k = 0; k < kEntries; ++k) {
+          double d;
+          if (i >= 2 && i + 2 < n) {  // central, fourth order
+            d = (y(i - 2, k) - 8.0 * y(i - 1, k) + 8.0 * y(i + 1, k) - y(i + 2, k)) / 12.0;
+          } else if (i < 2) {  // forward, fourth order
+            d = (-25.0 * y(i, k) + 48.0 * y(i + 1, k) - 36.0 * y(i + 2, k) + 16.0 * y(i + 3, k) - 3.0 * y(i + 4, k)) / 12.0;
+          } else {  // backward, fourth order
+            d = (25.0 * y(i, k) - 48.0 * y(i - 1, k) + 36.0 * y(i - 2, k) - 16.0 * y(i - 3, k) + 3.0 * y(i - 4, k)) / 12.0;
+          }
+          slope[i * kEntries + k] = d;  // per step h (the Hermite basis below is in steps)
+        }
+      }
+    }
+
+    void interpolate(double q, Outcome& o) const noexcept {
+      const std::size_t last = log_y.size() / kEntries - 1;
+      const double f = (q - q0) / h;
+      const std::size_t i = std::min(last - 1, static_cast<std::size_t>(std::max(f, 0.0)));
+      const double t = f - static_cast<double>(i), t2 = t * t, t3 = t2 * t;
+      const double h00 = 2 * t3 - 3 * t2 + 1, h10 = t3 - 2 * t2 + t, h01 = -2 * t3 + 3 * t2, h11 = t3 - t2;
+      const double* y0 = &log_y[i * kEntries];
+      const double* d0 = &slope[i * kEntries];
+      double* out = o.begin();
+      for (std::size_t k = 0; k < kEntries; ++k) {
+        out[k] = std::exp(h00 * y0[k] + h10 * d0[k] + h01 * y0[k + kEntries] + h11 * d0[k + kEntries]);
+      }
+    }
+  };
+
+  double speed_at(double q) const { return std::hypot(v0_, std::sinh(q)); }
+
+  // q at which the turning point's a/R* reaches 1 (kQMax when it does not within the table), by
+  // bisection on integrated impacts; false when an integration fails.
+  bool clamp_q(OdeWork& w, double& q) const {
+    auto clamped = [&](double at, bool& fails) {
+      Outcome o;
+      fails = !integrate_outcome(w, speed_at(at), shape_, kind_, o);
+      return shape_.s * std::sqrt(o.x_m * std::pow(o.x_m / kElasticLimit, shape_.B)) >= 1.0;
+    };
+    bool fails = false;
+    if (!clamped(kQMax, fails)) return !fails;  // q stays kQMax: one piece
+    if (fails) return false;
+    double lo = kQMin, hi = kQMax;
+    for (int it = 0; it < 60 && hi - lo > 1e-13 * hi; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      (clamped(mid, fails) ? hi : lo) = mid;
+      if (fails) return false;
+    }
+    q = hi;
+    return true;
+  }
+
+  Curve shape_;
+  Unloading kind_;
+  double v0_ = 0;
+  std::vector<Piece> pieces_;
+  double max_rel_error_ = std::numeric_limits<double>::infinity();
+  bool ok_ = false;
+};
+
+/// Nodes per piece of a table's first build. When its error exceeds kLawTableRel the table is
+/// built again with the nodes that error asks for at the interpolant's order 4 (measured: 20x less
+/// error per doubling), with a margin of kTableNodeMargin, then doubled up to kTableMaxNodes.
+constexpr std::size_t kTableFirstNodes = 128;
+constexpr std::size_t kTableMaxNodes = 8192;
+constexpr double kTableNodeMargin = 1.25;
+
 // state: [0] T (0: the elastic impact), [1] F_c, [2] v_star = V T/d_c, [3] s = pi C Y/(2E*).
 class JacksonGreenLaw final : public ContactLaw {
  public:
-  JacksonGreenLaw(double poisson_ratio, double hardening)
-      : C_(1.295 * std::exp(0.736 * poisson_ratio)), hardening_(hardening) {}
-  const char* name() const noexcept override { return "jackson-green"; }
+  JacksonGreenLaw(double poisson_ratio, double hardening, Unloading unloading, bool tabulated)
+      : C_(1.295 * std::exp(0.736 * poisson_ratio)), hardening_(hardening), unloading_(unloading), tabulated_(tabulated) {}
+  const char* name() const noexcept override {
+    return unloading_ == Unloading::brake ? "jackson-green" : "jackson-green-sneddon";
+  }
+  bool uses_yield_strength() const noexcept override { return true; }
 
   void solve(const LawInput* in, LawResult* out, std::size_t count) const noexcept override {
     OdeWork* w = ode_work();
@@ -245,8 +484,58 @@ class JacksonGreenLaw final : public ContactLaw {
   }
 
  private:
-  static double unloading(const LawResult& r, double u) noexcept {
-    return r.max_force_N * compression_force_fraction(1.0 - u);
+  // F at the fraction u of the unloading: the compression shape of its power law run backwards,
+  // F = F_m z^n with z^p = I^-1_{1-u}(1/p, 1/2) (paper Eq. 10; GSL's Qinv is the accurate side as
+  // u -> 0, where the force is largest).
+  double unloading(const LawResult& r, double u) const noexcept {
+    if (unloading_ == Unloading::brake || r.state[0] == 0.0) {
+      return r.max_force_N * compression_force_fraction(1.0 - u);
+    }
+    if (!(u < 1.0)) return 0.0;
+    const double d_c = std::cbrt(std::pow(r.state[1] / r.stiffness, 2));  // F_c = k_H d_c^1.5
+    const double n = 1.5 * std::pow(r.max_indentation_m / d_c, kEtsionExponentSlope);
+    const double p = n + 1.0;
+    return r.max_force_N * std::pow(gsl_cdf_beta_Qinv(std::max(u, 0.0), 1.0 / p, 0.5), n / p);
+  }
+
+  // The table of this law for the curve of s (built on first use; null when it cannot be built or
+  // misses kLawTableRel: the caller integrates).
+  const OutcomeTable* table_for(double s, OdeWork& w) const noexcept {
+    struct Last {
+      std::uint64_t law = 0;
+      double s = 0;
+      const OutcomeTable* table = nullptr;
+    };
+    thread_local Last last;
+    if (last.law == id_ && last.s == s) return last.table;
+    const OutcomeTable* found = nullptr;
+    try {
+      std::lock_guard<std::mutex> lock(tables_mutex_);
+      for (const auto& [key, table] : tables_) {
+        if (key == s) found = table.get();
+      }
+      if (!found && tables_.size() < kMaxTables) {
+        Curve shape;
+        shape.C = C_;
+        shape.s = s;
+        shape.B = 0.14 * std::exp(23.0 * 2.0 * s / (M_PI * C_));
+        shape.hardening = hardening_;
+        auto t = std::make_unique<OutcomeTable>(shape, unloading_, w, kTableFirstNodes);
+        if (t->ok() && t->max_rel_error() > kLawTableRel) {
+          const double ask = kTableFirstNodes * kTableNodeMargin * std::pow(t->max_rel_error() / kLawTableRel, 0.25);
+          for (auto nodes = static_cast<std::size_t>(std::ceil(ask)); nodes <= kTableMaxNodes; nodes *= 2) {
+            t = std::make_unique<OutcomeTable>(shape, unloading_, w, nodes);
+            if (!t->ok() || t->max_rel_error() <= kLawTableRel) break;
+          }
+        }
+        if (t->ok() && t->max_rel_error() <= kLawTableRel) found = t.get();
+        tables_.emplace_back(s, found ? std::move(t) : nullptr);
+      }
+    } catch (...) {  // no memory for a table: integrate
+      found = nullptr;
+    }
+    last = {id_, s, found};
+    return found;
   }
 
   void solve_one(OdeWork* w, const LawInput& in, LawResult& r) const noexcept {
@@ -266,35 +555,57 @@ class JacksonGreenLaw final : public ContactLaw {
     if (!(energy > 0.4 * kH * d1 * d1 * std::sqrt(d1))) {  // Hertz throughout: e = 1
       const CompressionPhase hertz = compression_phase(m, V, kH);
       detail::elastic_hertz_result(hertz, R, r);
-    } else {
-      const double T = std::sqrt(m * dc / Fc);
-      Phases p;
-      double tau2 = 0, x_m = 0;
-      if (!p.init(V * T / dc, s, C_, hardening_) || !p.to_turning_point(*w, tau2, x_m)) return;
-      const double d_m = x_m * dc;
-      const double F_m = Fc * p.curve.fit(x_m);
-      const double ratio = p.curve.fit(x_m) / (x_m * std::sqrt(x_m));  // F_m / F_e(d_m)
-      const double du = d_m * std::min(1.0, ratio);                     // d_m - d_bar
-      const double Vr_curve = std::sqrt(0.8 * F_m * du / m);             // the unloading's own speed
-      r.max_indentation_m = d_m;
-      r.max_force_N = F_m;
-      r.compression_time_s = T * (p.tau1 + tau2);
-      r.unloading_time_s = compression_time_factor() * du / Vr_curve;
-      r.contact_time_s = r.compression_time_s + r.unloading_time_s;
-      r.restitution.coefficient = std::min(1.0, Vr_curve / V);
-      detail::hertz_unloading(R, E, du, r);  // d_bar = d_m - du, its radius, R_bar
-      r.state = {T, Fc, p.v_star, s};
+      detail::finish_plastic_result(r);
+      return;
     }
+    const double T = std::sqrt(m * dc / Fc);
+    const double v_star = V * T / dc;
+    Outcome o;
+    const OutcomeTable* table = tabulated_ ? table_for(s, *w) : nullptr;
+    if (!(table && table->lookup(v_star, o))) {
+      Curve shape;
+      shape.C = C_;
+      shape.s = s;
+      shape.B = 0.14 * std::exp(23.0 * 2.0 * s / (M_PI * C_));
+      shape.hardening = hardening_;
+      if (!integrate_outcome(*w, v_star, shape, unloading_, o)) return;
+    }
+    r.max_indentation_m = o.x_m * dc;
+    r.max_force_N = o.f_m * Fc;
+    r.compression_time_s = o.tau_m * T;
+    r.unloading_time_s = o.tau_u * T;
+    r.contact_time_s = r.compression_time_s + r.unloading_time_s;
+    r.restitution.coefficient = std::min(1.0, o.vr / v_star);
+    const double du = o.du * dc;
+    if (unloading_ == Unloading::brake) {
+      detail::hertz_unloading(R, E, du, r);  // d_bar = d_m - du, its radius, R_bar
+    } else {
+      r.residual_indentation_m = r.max_indentation_m - du;
+      r.dent_radius_m = r.residual_indentation_m > 0.0 ? o.a_p * R : 0.0;
+      r.unloading_radius_m = 0.0;  // a power law of exponent n != 3/2, not a Hertz curve
+    }
+    r.state = {T, Fc, v_star, s};
     detail::finish_plastic_result(r);
   }
 
+  /// Tables kept per law (one per material pair a run meets; beyond, the law integrates).
+  static constexpr std::size_t kMaxTables = 16;
+
   double C_;          // 1.295 exp(0.736 nu)
   double hardening_;  // 1 - exp(-3.3 E_t/E)
+  Unloading unloading_;
+  bool tabulated_;
+  std::uint64_t id_ = next_id();  // tells this law's tables from another's in the thread's cache
+  mutable std::mutex tables_mutex_;
+  mutable std::vector<std::pair<double, std::unique_ptr<OutcomeTable>>> tables_;
+
+  static std::uint64_t next_id() {
+    static std::atomic<std::uint64_t> counter{0};
+    return ++counter;
+  }
 };
 
-}  // namespace
-
-std::shared_ptr<const ContactLaw> make_jackson_green_law(const LawOptions& options) {
+std::shared_ptr<const ContactLaw> make_law(const LawOptions& options, Unloading unloading) {
   const InputContext ctx;
   const double nu = options.poisson_ratio, Et = options.tangent_modulus_Pa, E = options.youngs_modulus_Pa;
   if (!(nu > -1.0 && nu < 0.5)) {
@@ -308,7 +619,17 @@ std::shared_ptr<const ContactLaw> make_jackson_green_law(const LawOptions& optio
     throw ctx.error("tangent_modulus_Pa", s.str());
   }
   const double hardening = Et > 0.0 ? -std::expm1(-3.3 * Et / E) : 0.0;
-  return std::make_shared<const JacksonGreenLaw>(nu, hardening);
+  return std::make_shared<const JacksonGreenLaw>(nu, hardening, unloading, options.tabulated);
+}
+
+}  // namespace
+
+std::shared_ptr<const ContactLaw> make_jackson_green_law(const LawOptions& options) {
+  return make_law(options, Unloading::brake);
+}
+
+std::shared_ptr<const ContactLaw> make_jackson_green_sneddon_law(const LawOptions& options) {
+  return make_law(options, Unloading::sneddon);
 }
 
 }  // namespace impactdeck::collision

@@ -82,6 +82,7 @@ class LinePlasticLaw final : public ContactLaw {
     gauss_legendre();  // its one allocation here, not in solve() (the kernel's hot path)
   }
   const char* name() const noexcept override { return "line-plastic"; }
+  bool uses_yield_strength() const noexcept override { return true; }
   bool takes_line_contacts() const noexcept override { return true; }
 
   void solve(const LawInput* in, LawResult* out, std::size_t count) const noexcept override {

@@ -102,6 +102,7 @@ class WedgeLaw final : public SharpLaw {
  public:
   explicit WedgeLaw(double hardness_Pa) : SharpLaw(hardness_Pa, SharpKind::edge) {}
   const char* name() const noexcept override { return "wedge"; }
+  bool uses_yield_strength() const noexcept override { return true; }
 
  protected:
   double loading_force(const LawResult& r, double t) const noexcept override {
@@ -129,6 +130,7 @@ class ConeLaw final : public SharpLaw {
  public:
   explicit ConeLaw(double hardness_Pa) : SharpLaw(hardness_Pa, SharpKind::corner) {}
   const char* name() const noexcept override { return "cone"; }
+  bool uses_yield_strength() const noexcept override { return true; }
 
  protected:
   // x(t)/x* = u solves t/t_m = I_{u^3}(1/3, 1/2) (the regularised incomplete Beta function, the

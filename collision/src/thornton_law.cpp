@@ -34,6 +34,7 @@ class ThorntonLaw final : public ContactLaw {
  public:
   explicit ThorntonLaw(double limiting_pressure_Pa) : limiting_pressure_Pa_(limiting_pressure_Pa) {}
   const char* name() const noexcept override { return "thornton"; }
+  bool uses_yield_strength() const noexcept override { return true; }
 
   void solve(const LawInput* in, LawResult* out, std::size_t count) const noexcept override {
     for (std::size_t k = 0; k < count; ++k) solve_one(in[k], out[k]);

@@ -68,6 +68,10 @@ struct LawResult {
   /// elastic Hertz impact, Thornton's R_p, Brake's R_bar; 0 for a law whose unloading is not a
   /// Hertz curve ("wedge", "cone", "line").
   double unloading_radius_m = 0;
+  /// A rate-dependent law (LawOptions::cowper_symonds_D_per_s): the contact's characteristic strain
+  /// rate (contact_strain_rate_per_s at F_max) and the flow stress the law ran at there; 0 otherwise.
+  double strain_rate_per_s = 0;
+  double flow_stress_Pa = 0;
   std::array<double, 4> state{};      ///< the law's own numbers for its F(t); opaque to callers
   /// The law's own contact patch at F_max (semi-axes a >= b) and its pressure there; 0: the kernel
   /// takes the Hertz ellipse of F_max (every law but "wedge" and "cone").
@@ -101,6 +105,9 @@ class ContactLaw {
   /// sharp) and the relative curvature along the edge is 0 (else flagged ContactFlag::line), with
   /// R* the radius across the edge.
   virtual bool takes_line_contacts() const noexcept { return false; }
+  /// True for a law that reads LawInput::yield_strength_Pa (the plastic and sharp laws): a
+  /// rate-dependent flow stress (LawOptions::cowper_symonds_D_per_s) applies to it.
+  virtual bool uses_yield_strength() const noexcept { return false; }
 };
 
 /// Thornton's default limiting pressure p_y over the weaker body's yield strength: the onset of
@@ -138,7 +145,32 @@ struct LawOptions {
   double youngs_modulus_Pa = 0;
   /// "wedge" and "cone": the indentation pressure p; 0: kTaborHardnessFactor x the yield strength.
   double hardness_Pa = 0;
+  /// "jackson-green", "jackson-green-sneddon": take F_max, the times, e and the dent from a table of
+  /// the dimensionless impact against V/V_c, built once per material pair (Y/E*, nu, E_t/E) on first
+  /// use, instead of integrating each impact. For sweeps (many impacts, one material pair); the
+  /// table's error is measured when it is built and kept below kLawTableRel, else the law integrates
+  /// (docs/plastic-laws.md, "Tabulated").
+  bool tabulated = false;
+  /// Cowper - Symonds rate dependence of the yielding body's flow stress (0: rate-independent):
+  /// Y_d = Y (1 + (rate / D)^(1/q)) at the contact's characteristic strain rate
+  /// (contact_strain_rate_per_s), solved together with the impact (docs/plastic.md, "Rate effects").
+  /// Applies to a law that uses_yield_strength(); D > 0 in 1/s, q > 0.
+  double cowper_symonds_D_per_s = 0;
+  double cowper_symonds_q = 0;
 };
+
+/// The characteristic strain rate of a plastic contact of radius a under the approach speed V:
+/// 0.2 V / a (Tabor's estimate of the mean strain rate under an indenting sphere, as Johnson 1985,
+/// Sect. 11.4, quotes it; an order of magnitude). A law evaluates it at F_max, a = sqrt(R* d*).
+double contact_strain_rate_per_s(double approach_velocity_m_s, double contact_radius_m);
+
+/// Cowper - Symonds: the flow stress at the strain rate `rate`, Y (1 + (rate / D)^(1/q)).
+double cowper_symonds_flow_stress_Pa(double yield_strength_Pa, double strain_rate_per_s, double D_per_s, double q);
+
+/// The largest relative error of a tabulated plastic law (LawOptions::tabulated) against the
+/// integrated law, on F_max, x_max, t_m, t_c, e and the dent, as measured at the midpoints between
+/// the table's nodes when it is built (a cubic Hermite interpolant's error peaks there).
+inline constexpr double kLawTableRel = 1e-6;
 
 using ContactLawFactory = std::function<std::shared_ptr<const ContactLaw>(const LawOptions&)>;
 
