@@ -19,11 +19,14 @@ const Material* yielding_material(const Scene& scene, const ImpactSpec& s) {
   return weaker;
 }
 
-constexpr const char* kDefaultPlasticLaw = "thornton";
+// The plastic law "auto" runs: Jackson - Green's FE-calibrated loading is the one whose force is
+// closest to elastic-plastic full contact (docs/plastic.md, the ladder: within 3 % on F_max where
+// Thornton's is 25-51 % low); a deck loaded by a low force errs on the unsafe side for the part.
+constexpr const char* kDefaultPlasticLaw = "jackson-green";
 
 }  // namespace
 
-ImpactLaw impact_law(const Scene& scene, const ImpactSpec& s, const InputContext& ctx) {
+ImpactLaw impact_law(const Scene& scene, const ImpactSpec& s, const InputContext& ctx, bool tabulated) {
   ImpactLaw l;
   const Material* yielding = yielding_material(scene, s);
   const std::optional<double> yield = yielding ? yielding->yield_strength_Pa : std::nullopt;
@@ -45,12 +48,18 @@ ImpactLaw impact_law(const Scene& scene, const ImpactSpec& s, const InputContext
   }
   collision::LawOptions o;
   o.restitution = s.restitution;
-  o.limiting_pressure_Pa = l.limiting_pressure_Pa.value_or(0.0);
+  // Only the scene's own p_y: else the law takes kThorntonYieldFactor x the yield strength it is
+  // given (the same number as l.limiting_pressure_Pa, or the flow stress of a rate-dependent law).
+  o.limiting_pressure_Pa = s.limiting_pressure_Pa.value_or(0.0);
+  o.tabulated = tabulated;
   if (yielding) {  // "jackson-green": the yielding body's elastic constants and hardening
     o.poisson_ratio = yielding->elastic.poisson_ratio;
     o.youngs_modulus_Pa = yielding->elastic.youngs_modulus_Pa;
     o.tangent_modulus_Pa = yielding->tangent_modulus_Pa.value_or(0.0);
+    o.cowper_symonds_D_per_s = yielding->cowper_symonds_D_per_s.value_or(0.0);
+    o.cowper_symonds_q = yielding->cowper_symonds_q.value_or(0.0);
   }
+  l.options = o;
   l.law = collision::make_contact_law(l.name, o, ctx);
   return l;
 }
@@ -65,8 +74,9 @@ std::optional<ImpactLaw> sharp_impact_law(const ImpactSpec& s, const ImpactLaw& 
   if (t.sharp == i.sharp || c.feature == collision::SharpKind::none || law.name == "hertz") return std::nullopt;
   ImpactLaw l = law;
   l.name = c.feature == collision::SharpKind::edge ? "wedge" : "cone";
-  collision::LawOptions o;
+  collision::LawOptions o = law.options;  // the rate dependence carries over
   o.hardness_Pa = s.limiting_pressure_Pa.value_or(0.0);
+  l.options = o;
   // The hardness the law runs at: limiting_pressure_Pa, else Tabor's 3 Y (l.limiting_pressure_Pa is
   // p_y = 1.6 Y here, from impact_law).
   if (s.limiting_pressure_Pa) {
@@ -83,8 +93,8 @@ ImpactLaw line_impact_law(const ImpactLaw& law, const InputContext& ctx) {
   // A plastic law (any but "hertz": "auto" chose Hertz without a yield strength or with a
   // restitution) yields along the line too, at the sphere laws' p_y (impact_law).
   l.name = law.name == "hertz" ? "line" : "line-plastic";
-  collision::LawOptions o;
-  o.limiting_pressure_Pa = l.limiting_pressure_Pa.value_or(0.0);
+  collision::LawOptions o = law.options;  // the rate dependence and the scene's p_y carry over
+  l.options = o;
   l.law = collision::make_contact_law(l.name, o, ctx);
   return l;
 }

@@ -156,6 +156,12 @@ nlohmann::json impact_json(const ImpactReport& ir) {
   i["residual_indentation_m"] = json_number(r.history.law_result.residual_indentation_m);
   i["dent_radius_m"] = json_number(ir.dent_radius_m);
   i["unloading_radius_m"] = json_number(ir.unloading_radius_m);
+  // A rate-dependent flow stress (docs/plastic.md, "Rate effects"): the contact's strain rate and the
+  // flow stress the law ran at; null for a rate-independent law.
+  const collision::LawResult& law_result = r.history.law_result;
+  const bool rate = law_result.flow_stress_Pa > 0.0;
+  i["contact_strain_rate_per_s"] = rate ? json_number(law_result.strain_rate_per_s) : nlohmann::json(nullptr);
+  i["flow_stress_Pa"] = rate ? json_number(law_result.flow_stress_Pa) : nlohmann::json(nullptr);
   const auto& k = r.checks;
   i["checks"] = {{"impulse_relative_error", json_number(k.impulse_relative_error)},
                  {"energy_relative_error", json_number(k.energy_relative_error)},
@@ -377,6 +383,10 @@ std::string format_summary(const Scene& scene, const RunReport& rep) {
     if (r.history.law_result.residual_indentation_m > 0.0) {
       o << "  dent                  " << r.history.law_result.residual_indentation_m << " m deep (both bodies), radius "
         << ir.dent_radius_m << " m; unloading radius " << ir.unloading_radius_m << " m\n";
+    }
+    if (r.history.law_result.flow_stress_Pa > 0.0) {
+      o << "  flow stress           " << r.history.law_result.flow_stress_Pa << " Pa at the contact's strain rate "
+        << r.history.law_result.strain_rate_per_s << " 1/s (Cowper - Symonds)\n";
     }
     const auto& v = ir.validity;
     o << "  validity              x_max/R* " << v.indentation_over_radius << ", contact a = "

@@ -225,7 +225,8 @@ class Reader {
 // All keys a reader may see are declared by reading them; sub-tables are read by their own reader.
 Material read_material(const std::string& name, const toml::table& t, const Source& file) {
   Reader r(t, "materials." + name, file);
-  r.allow({"youngs_modulus_Pa", "poisson_ratio", "density_kg_m3", "yield_strength_Pa", "tangent_modulus_Pa"});
+  r.allow({"youngs_modulus_Pa", "poisson_ratio", "density_kg_m3", "yield_strength_Pa", "tangent_modulus_Pa",
+           "cowper_symonds_D_per_s", "cowper_symonds_q"});
   Material m;
   m.name = name;
   m.place = r.self();
@@ -242,6 +243,18 @@ Material read_material(const std::string& name, const toml::table& t, const Sour
                                        "), got " + Reader::fmt(*et));
     }
     m.tangent_modulus_Pa = et;
+  }
+  // Rate dependence: both constants or neither, and a yield strength for them to raise.
+  const bool has_D = r.has("cowper_symonds_D_per_s"), has_q = r.has("cowper_symonds_q");
+  if (has_D) m.cowper_symonds_D_per_s = r.positive("cowper_symonds_D_per_s");
+  if (has_q) m.cowper_symonds_q = r.positive("cowper_symonds_q");
+  if (has_D != has_q) {
+    const char* missing = has_D ? "cowper_symonds_q" : "cowper_symonds_D_per_s";
+    r.fail(has_D ? "cowper_symonds_D_per_s" : "cowper_symonds_q",
+           std::string("Cowper - Symonds rate dependence needs both constants: add ") + missing);
+  }
+  if (has_D && !m.yield_strength_Pa) {
+    r.fail("cowper_symonds_D_per_s", "a rate-dependent flow stress needs the static yield_strength_Pa it raises");
   }
   r.reject_unknown();
   return m;

@@ -54,7 +54,9 @@ study::SweepCase sweep_case(const Scene& sc, const std::string& name) {
   out.setup.effective_modulus_Pa = collision::effective_modulus_Pa(
       out.setup.target.material, out.setup.impactor.material, sc.modulus_convention, ctx);
   out.setup.restitution = s.restitution;
-  out.setup.law = impact_law(sc, s, ctx).law;  // the law `run` chooses (docs/plastic.md)
+  // The law `run` chooses (docs/plastic.md), tabulated where it can be: a sweep is many impacts of
+  // one material pair.
+  out.setup.law = impact_law(sc, s, ctx, /*tabulated=*/true).law;
   out.setup.context = ctx;
   if (s.approach_speed_m_s) {
     out.setup.approach_speed_m_s = *s.approach_speed_m_s;

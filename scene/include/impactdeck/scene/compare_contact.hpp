@@ -64,7 +64,7 @@ struct ContactLevel {
 enum class CompareVerdict { agree, disagree, non_hertzian, decks_only };
 
 /// The laws compared with a plastic full-contact run (docs/plastic.md, "The ladder").
-inline const std::vector<std::string> kComparedLaws = {"hertz", "thornton", "jackson-green"};
+inline const std::vector<std::string> kComparedLaws = {"hertz", "thornton", "jackson-green", "jackson-green-sneddon"};
 /// The plastic (quasi-static) comparison's first run pushes to this times the largest x_max of the
 /// compared laws: past the FE contact's own turning point unless it is softer than every law (then
 /// the run is repeated at twice the approach, contact_model.hpp).

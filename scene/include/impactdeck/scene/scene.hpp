@@ -37,6 +37,9 @@ struct Material {
   /// Optional tangent (hardening) modulus E_t of a bilinear elastic-plastic material, in [0, E)
   /// (`tangent_modulus_Pa`; docs/plastic.md).
   std::optional<double> tangent_modulus_Pa;
+  /// Optional Cowper - Symonds rate dependence of the flow stress, Y (1 + (rate/D)^(1/q)): D in 1/s
+  /// and q, both or neither, with yield_strength_Pa (docs/plastic.md, "Rate effects").
+  std::optional<double> cowper_symonds_D_per_s, cowper_symonds_q;
   Place place;
 };
 
@@ -221,7 +224,7 @@ inline constexpr double kPlasticMaxIndentationOverRadius = 0.1;
 /// The contact law an impact runs, chosen from its keys (docs/plastic.md):
 /// `contact_law` named: that law; "auto" (the default): "hertz" when `restitution` is set, when
 /// neither body's material has a yield strength, or when [outputs.fem] compare_contact = true (its
-/// full-contact model is elastic); else "thornton" (which is Hertz with R = 1 for V <= V_y).
+/// full-contact model is elastic); else "jackson-green" (Hertz with R = 1 up to 1.9 d_c).
 struct ImpactLaw {
   std::string name;       ///< the registered law built ("hertz", "thornton", ...)
   bool automatic = false; ///< chosen by "auto"
@@ -231,11 +234,14 @@ struct ImpactLaw {
   /// The plastic law "auto" runs when a yield strength is known and no restitution is set (empty
   /// when no yield strength is known): named by the warning of a scene that sets `restitution`.
   std::string plastic_law;
+  /// The options `law` was built from (the sharp and line laws derived from it start from them).
+  collision::LawOptions options;
   std::shared_ptr<const collision::ContactLaw> law;
 };
 
-/// The law of impact `s`. Throws InputError (ctx) for a law the registry refuses.
-ImpactLaw impact_law(const Scene& scene, const ImpactSpec& s, const InputContext& ctx);
+/// The law of impact `s`. Throws InputError (ctx) for a law the registry refuses. `tabulated`:
+/// a law that can read its impacts from a table (collision::LawOptions::tabulated) does (sweeps).
+ImpactLaw impact_law(const Scene& scene, const ImpactSpec& s, const InputContext& ctx, bool tabulated = false);
 
 /// The law at a point where one body is sharp (in.target/impactor.curvature.sharp with its feature;
 /// no edge_radius rounded it): "wedge" on an edge, "cone" on a corner, at the hardness
