@@ -237,6 +237,8 @@ nlohmann::json sequence_json(const SequenceReport& sr) {
   q["body"] = sr.spec->body;
   q["floor"] = sr.spec->floor;
   q["stop_reason"] = sequence::to_string(res.stop);
+  q["stop_detail"] = res.stop_detail;
+  q["rest_height_m"] = json_number(res.rest_height_m);
   q["max_impacts"] = sr.spec->max_impacts;
   q["min_approach_speed_m_s"] = json_number(sr.spec->min_approach_speed_m_s);
   q["friction_coefficient"] = json_number(sr.spec->friction_coefficient);
