@@ -164,6 +164,7 @@ nlohmann::json impact_json(const ImpactReport& ir) {
                  {"impulse_compression_numerical_Ns", json_number(k.impulse_compression_numerical_Ns)},
                  {"carnot_loss_J", json_number(k.carnot_loss_J)},
                  {"kinetic_energy_loss_J", json_number(k.kinetic_energy_loss_J)},
+                 {"approach_kinetic_energy_J", json_number(k.approach_kinetic_energy_J)},
                  {"passed", k.passed}};
   if (ir.table) {
     i["force_table"] = {{"samples", ir.table->time_s.size()},
