@@ -171,11 +171,13 @@ void register_campaign(CLI::App& app, Context& ctx) {
   coll->add_flag("--json", a->json, "Print one JSON document on stdout (keys: docs/cli.md)");
   coll->callback([a, &ctx] {
     VerboseTimer timer(ctx, "campaign collect", "collect " + a->dir);
-    const campaign::CollectResult r = campaign::collect(a->dir);
     if (a->json) {
-      write_stdout(campaign::collect_json(r));
+      // The document goes to stdout before the commit: a stdout that fails rolls the collect back.
+      check_stdout_writable();
+      campaign::collect(a->dir, [](const campaign::CollectResult& r) { write_stdout(campaign::collect_json(r)); });
       return;
     }
+    const campaign::CollectResult r = campaign::collect(a->dir);
     ctx.report() << "collected " << r.done << " done, " << r.failed << " failed, " << r.pending << " pending: "
               << r.csv.string() << ", " << r.json.string() << "\n";
     if (r.worst_id) ctx.report() << "worst case: " << *r.worst_id << " (copied to " << r.worst_case->string() << ")\n";

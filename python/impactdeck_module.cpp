@@ -47,10 +47,38 @@ namespace {
 
 py::object to_python(const nlohmann::json& j) { return py::module_::import("json").attr("loads")(j.dump()); }
 
+// The deepest nesting of lists and dicts an override's value may have (a scene's own TOML is
+// refused beyond a few hundred levels; the value was converted recursively, so a list nested
+// 20 000 deep overflowed the C stack and killed the interpreter).
+constexpr int kMaxOverrideDepth = 64;
+
+// ascii(text): a key named in a message whatever it holds (lone surrogates, control characters).
+std::string ascii_of(const py::handle& text) {
+  return py::module_::import("builtins").attr("ascii")(text).cast<std::string>();
+}
+
+// The UTF-8 bytes of a Python str; ValueError naming `what` when it holds a lone surrogate, which
+// no UTF-8 text (and no scene) can hold.
+std::string utf8_of(const py::handle& text, const std::string& what) {
+  Py_ssize_t size = 0;
+  const char* bytes = PyUnicode_AsUTF8AndSize(text.ptr(), &size);
+  if (!bytes) {
+    PyErr_Clear();
+    throw py::value_error(what + ": holds a lone surrogate (not Unicode text): it cannot be written as UTF-8");
+  }
+  return std::string(bytes, static_cast<std::size_t>(size));
+}
+
 // A Python value as the TOML value text of an override: bool, int, float, str (a TOML string),
 // lists/tuples (arrays), dicts with str keys (inline tables), numpy arrays and scalars (as their
-// tolist()). Anything else is refused naming the override's key.
-std::string toml_value(const py::handle& v, const std::string& key) {
+// tolist()), nested at most kMaxOverrideDepth deep. Anything else is refused naming the override's
+// key: UsageError for a type, ValueError for a value no scene can hold.
+std::string toml_value(const py::handle& v, const std::string& key, int depth = 0) {
+  const std::string where = "overrides['" + key + "']";
+  if (depth > kMaxOverrideDepth) {
+    throw py::value_error(where + ": lists and dicts nested deeper than " + std::to_string(kMaxOverrideDepth) +
+                          " levels");
+  }
   if (py::isinstance<py::bool_>(v)) return v.cast<bool>() ? "true" : "false";
   if (py::isinstance<py::int_>(v)) return py::str(v).cast<std::string>();
   if (py::isinstance<py::float_>(v)) {
@@ -59,33 +87,40 @@ std::string toml_value(const py::handle& v, const std::string& key) {
     if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
     return py::repr(v).cast<std::string>();  // shortest text that reads back as x
   }
-  if (py::isinstance<py::str>(v)) return nlohmann::json(v.cast<std::string>()).dump();  // a TOML basic string
+  if (py::isinstance<py::str>(v)) return nlohmann::json(utf8_of(v, where)).dump();  // a TOML basic string
   std::string out;
   if (py::isinstance<py::list>(v) || py::isinstance<py::tuple>(v)) {
-    for (const py::handle e : v) out += (out.empty() ? "" : ", ") + toml_value(e, key);
+    for (const py::handle e : v) out += (out.empty() ? "" : ", ") + toml_value(e, key, depth + 1);
     return "[" + out + "]";
   }
   if (py::isinstance<py::dict>(v)) {
     for (const auto& [k, e] : v.cast<py::dict>()) {
-      if (!py::isinstance<py::str>(k)) throw UsageError("overrides['" + key + "']: table keys must be str");
-      out += (out.empty() ? "" : ", ") + nlohmann::json(k.cast<std::string>()).dump() + " = " + toml_value(e, key);
+      if (!py::isinstance<py::str>(k)) throw UsageError(where + ": table keys must be str");
+      out += (out.empty() ? "" : ", ") + nlohmann::json(utf8_of(k, where + ": table key " + ascii_of(k))).dump() +
+             " = " + toml_value(e, key, depth + 1);
     }
     return "{" + out + "}";
   }
-  if (py::hasattr(v, "tolist")) return toml_value(v.attr("tolist")(), key);  // numpy arrays and scalars
-  throw UsageError("overrides['" + key + "']: expected a bool, int, float, str, list, tuple or dict, not " +
+  if (py::hasattr(v, "tolist")) return toml_value(v.attr("tolist")(), key, depth);  // numpy arrays and scalars
+  throw UsageError(where + ": expected a bool, int, float, str, list, tuple or dict, not " +
                    py::str(py::type::handle_of(v).attr("__name__")).cast<std::string>());
 }
 
 // `overrides` ({KEY: value} or None) as the CLI's `--set KEY=VALUE` list: parsed by the same call
 // (scene::parse_override), so a bad key or value fails as on the command line, naming "--set KEY".
+// A key holding '=' (which KEY=VALUE would split, silently replacing the value) or a lone surrogate
+// raises ValueError naming it.
 std::vector<scene::Override> overrides_of(const py::object& overrides) {
   std::vector<scene::Override> out;
   if (overrides.is_none()) return out;
   if (!py::isinstance<py::dict>(overrides)) throw UsageError("overrides: expected a dict {KEY: value}");
   for (const auto& [k, v] : overrides.cast<py::dict>()) {
     if (!py::isinstance<py::str>(k)) throw UsageError("overrides: keys must be str, e.g. 'impacts[0].restitution'");
-    const std::string key = k.cast<std::string>();
+    const std::string key = utf8_of(k, "overrides: key " + ascii_of(k));
+    if (key.find('=') != std::string::npos) {
+      throw py::value_error("overrides: key " + ascii_of(k) +
+                            " holds '=': a key is a dotted path such as 'impacts[0].restitution', never '='");
+    }
     out.push_back(scene::parse_override(key + "=" + toml_value(v, key)));
   }
   return out;

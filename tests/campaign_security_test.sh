@@ -76,6 +76,8 @@ SH
 cat >fakebin/squeue <<'SH'
 #!/bin/bash
 printf '%s\0' "$@" >"$FAKE_SLURM_LOG/squeue.args"
+# FAKE_SQUEUE_FAIL: the controller cannot be reached (no answer on stdout, exit 1).
+if [ -n "${FAKE_SQUEUE_FAIL:-}" ]; then echo "slurm_load_jobs error: Unable to contact slurm controller" >&2; exit 1; fi
 echo "4242 RUNNING node1"
 SH
 chmod +x fakebin/sbatch fakebin/squeue
@@ -136,6 +138,22 @@ out=$(cat out.txt)
 bash -c "${out#*submit them with:$'\n'}" >/dev/null 2>dry.err || cat dry.err
 check "--dry-run's printed command submits with the right arguments, nothing injected" \
   '[ "$(cat slurmlog/sbatch.pwd)" = "$camp" ] && no_markers && [ "$(results "$camp")" = 2 ]'
+
+# A failed squeue is not an empty queue: each job's state is "unknown", with the failure.
+st=$(FAKE_SQUEUE_FAIL=1 "$bin" campaign status "$camp" --json 2>/dev/null)
+check "a failed squeue: every job 'unknown' with the reason, never []" "python3 -c '
+import json, sys
+d = json.loads(sys.argv[1])
+assert [q[\"job\"] for q in d[\"squeue\"]] == d[\"slurm_jobs\"] and d[\"slurm_jobs\"], d
+assert all(q[\"state\"] == \"unknown\" and \"exit status 1\" in q[\"reason\"] for q in d[\"squeue\"]), d
+assert \"exit status 1\" in d[\"squeue_error\"], d' \"\$st\""
+st=$(FAKE_SQUEUE_FAIL=1 "$bin" campaign status "$camp" 2>/dev/null)
+check "a failed squeue (text): the jobs' state unknown ($st)" '[[ "$st" == *": state unknown: squeue failed (exit status 1)"* ]]'
+st=$("$bin" campaign status "$camp" --json 2>/dev/null)
+check "squeue answering: its lines, no error" "python3 -c '
+import json, sys
+d = json.loads(sys.argv[1])
+assert d[\"squeue\"] == [{\"job\": \"4242\", \"state\": \"RUNNING\", \"reason\": \"node1\"}] and d[\"squeue_error\"] is None, d' \"\$st\""
 
 # Forged job ids in slurm/jobs.txt: refused before squeue runs.
 for forged in "1; touch ${mark}_10" "\$(touch ${mark}_11)" "4242 \`touch ${mark}_12\`" "-j1"; do
@@ -223,6 +241,20 @@ expect_error "a cut-short campaign.json (collect)" 3 "damaged/campaign\.json: li
 python3 -c "import json,sys; j=json.load(open('links/campaign.json')); j['cases'][1]['id']='one'; json.dump(j, open('damaged/campaign.json','w'))"
 expect_error "a campaign.json with a bad id (status)" 3 "damaged/campaign\.json: key 'cases\[1\]\.id': must be 1" "$bin" campaign status damaged
 expect_error "a campaign.json with a bad id (collect)" 3 "damaged/campaign\.json: key 'cases\[1\]\.id': must be 1" "$bin" campaign collect damaged
+# A failure.json that is not JSON, or that is another case's: refused by status and collect alike
+# (status used to print the error as the case's reason and exit 0).
+cp links/campaign.json damaged/campaign.json
+mv damaged/cases/1/result.json damaged_result1.json
+printf 'not json' >damaged/cases/1/failure.json
+expect_error "a failure.json that is not JSON (status)" 3 "damaged/cases/1/failure\.json: line 1, column [0-9]+: is not valid JSON" "$bin" campaign status damaged
+expect_error "a failure.json that is not JSON (collect)" 3 "damaged/cases/1/failure\.json: line 1, column [0-9]+: is not valid JSON" "$bin" campaign collect damaged
+printf '{"id": 0, "state": "failed", "exit_code": 3, "reason": "forged"}' >damaged/cases/1/failure.json
+expect_error "another case's failure.json" 3 "damaged/cases/1/failure\.json: key 'id': must be 1 \(the case's id\)" "$bin" campaign status damaged --json
+rm damaged/cases/1/failure.json && mv damaged_result1.json damaged/cases/1/result.json
+# A forged case folder in campaign.json: the case's folder is always cases/<id>.
+python3 -c "import json; j=json.load(open('links/campaign.json')); j['cases'][1]['folder']='../../elsewhere'; json.dump(j, open('damaged/campaign.json','w'))"
+expect_error "a forged case folder (status)" 3 "damaged/campaign\.json: key 'cases\[1\]\.folder': must be \"cases/1\"" "$bin" campaign status damaged
+expect_error "a forged case folder (collect)" 3 "damaged/campaign\.json: key 'cases\[1\]\.folder': must be \"cases/1\"" "$bin" campaign collect damaged
 check "no collect folder in the damaged campaigns" '[ ! -e deep/collect ] && [ ! -e damaged/collect ]'
 
 # ---- 4. Messages and transactions -----------------------------------------------------------

@@ -124,6 +124,13 @@ out=$(PATH="$tmp/fakebin:$PATH" "$bin" campaign run split --executor slurm --dry
 check "MaxArraySize 5 splits 6 tasks into arrays of 4 and 2 ($out)" \
   'grep -qx "#SBATCH --array=0-3" split/campaign.sbatch && grep -qx "#SBATCH --array=0-1" split/campaign.1.sbatch && [ ! -e split/campaign.2.sbatch ] && [[ "$out" == *"2 job array(s), MaxArraySize 5"* ]]'
 check "[slurm] time as minutes" 'grep -qx "#SBATCH --time=90" split/campaign.sbatch'
+# MaxArraySize 0 (job arrays disabled): refused naming the campaign file and folder.
+mkdir -p fakebin0
+printf '#!/bin/sh\nprintf "%%s\\n" "MaxArraySize            = 0"\n' >fakebin0/scontrol
+chmod +x fakebin0/scontrol
+err=$(PATH="$tmp/fakebin0:$PATH" "$bin" campaign run split --executor slurm --dry-run 2>&1 >/dev/null)
+check "MaxArraySize 0 names the campaign ($err)" \
+  '[[ "$err" == *"split/campaign.json: scontrol show config: MaxArraySize: is 0: job arrays are disabled"*"campaign '"'"'$tmp/split'"'"'"* ]]'
 # Run by hand: task 1 of the second array is campaign task 5, cases 10 and 11.
 "$bin" campaign run split --quiet >/dev/null
 SLURM_ARRAY_TASK_ID=1 sh split/campaign.1.sbatch >task.txt 2>&1

@@ -86,6 +86,36 @@ PY
   check "$cmd > a broken pipe: the output folder as before" unchanged
 done
 
+# campaign collect --json: refused before any work on /dev/full, rolled back on a broken pipe
+# (the document is written before the commit): collect/ is not published either way.
+cat >"$tmp/c.toml" <<TOML
+scene = "$scene"
+[product]
+"impacts[0].restitution" = [0.9, 0.5]
+TOML
+"$bin" campaign plan "$tmp/c.toml" --out "$tmp/camp" >/dev/null && "$bin" campaign run "$tmp/camp" --quiet >/dev/null
+"$bin" campaign collect "$tmp/camp" --json >/dev/full 2>"$tmp/err"; rc=$?
+check "campaign collect --json > /dev/full: exit 3 (got $rc)" [ "$rc" = 3 ]
+check "campaign collect --json > /dev/full: one line naming stdout" \
+  bash -c "[ \$(wc -l <'$tmp/err') = 1 ] && grep -q '^impactdeck: error: stdout: write failed: No space left on device' '$tmp/err'"
+check "campaign collect --json > /dev/full: nothing published" [ ! -e "$tmp/camp/collect" ]
+python3 - "$tmp/pipe_collect" "$bin" campaign collect "$tmp/camp" --json <<'PY'
+import os, signal, subprocess, sys
+prefix, argv = sys.argv[1], sys.argv[2:]
+r, w = os.pipe()
+os.close(r)
+with open(prefix + ".err", "wb") as err:
+    p = subprocess.run(argv, stdout=w, stderr=err, stdin=subprocess.DEVNULL,
+                       preexec_fn=lambda: signal.signal(signal.SIGPIPE, signal.SIG_IGN))
+open(prefix + ".rc", "w").write(str(p.returncode))
+PY
+check "campaign collect --json > a broken pipe: exit 3" [ "$(cat "$tmp/pipe_collect.rc")" = 3 ]
+check "campaign collect --json > a broken pipe: rolled back, says so" \
+  grep -q '^impactdeck: error: stdout: write failed: Broken pipe (before the commit: the run was rolled back, nothing was published)' "$tmp/pipe_collect.err"
+check "campaign collect --json > a broken pipe: nothing published" [ ! -e "$tmp/camp/collect" ]
+"$bin" campaign collect "$tmp/camp" --json >"$tmp/collect.json" 2>"$tmp/err"; rc=$?
+check "campaign collect --json: exit 0, published" bash -c "[ $rc = 0 ] && [ -f '$tmp/camp/collect/cases.csv' ]"
+
 # The same commands with a usable stdout publish (the checks above are not refusing everything).
 "$bin" run "$scene" --out "$out" --json >"$tmp/doc.json" 2>"$tmp/err"; rc=$?
 check "run: exit 0" [ "$rc" = 0 ]

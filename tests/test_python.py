@@ -260,6 +260,42 @@ class Overrides(unittest.TestCase):
         with self.assertRaises(impactdeck.UsageError):
             impactdeck.run(scene, overrides=["impacts[0].restitution=0.5"])
 
+    def test_overrides_are_validated_and_never_crash(self):
+        # Issue 43: a key with '=' was split (its value silently replaced), a lone surrogate raised an
+        # undocumented RuntimeError, and a list nested 20 000 deep killed the interpreter (SIGSEGV).
+        # In a child interpreter, so that a crash is a failure here, not the end of the suite.
+        code = '''
+import sys
+sys.path.insert(0, sys.argv[1])
+import impactdeck
+scene = sys.argv[2]
+deep = 0.5
+for _ in range(20000):
+    deep = [deep]
+cycle = []
+cycle.append(cycle)
+cases = [({"impacts[0].restitution=0.5": 0.9}, ValueError, "holds '='"),
+         ({"impacts[0].restitution": deep}, ValueError, "nested deeper than 64 levels"),
+         ({"impacts[0].restitution": cycle}, ValueError, "nested deeper than 64 levels"),
+         ({"impacts[0].restitution": {"a": deep}}, ValueError, "nested deeper than 64 levels"),
+         ({"impacts[0].na\\udc80me": 1}, ValueError, "lone surrogate"),
+         ({"impacts[0].name": "x\\ud800"}, ValueError, "lone surrogate"),
+         ({"impacts[0].name": {"k\\udfff": 1}}, ValueError, "lone surrogate")]
+for overrides, kind, text in cases:
+    key = next(iter(overrides))
+    try:
+        impactdeck.run(scene, overrides=overrides)
+        print("no error for", ascii(key)); sys.exit(1)
+    except kind as e:
+        if text not in str(e) or ascii(key)[1:-1].split("=")[0][:10] not in str(e):
+            print("message", ascii(str(e))); sys.exit(1)
+print("ok")
+'''
+        scene = os.path.join(SRC, "samples", "two_spheres.toml")
+        p = subprocess.run([sys.executable, "-c", code, os.path.dirname(impactdeck.__file__), scene],
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, timeout=120)
+        self.assertEqual((p.returncode, p.stdout.strip()), (0, "ok"), p.stderr[-2000:])
+
     def test_sweep_takes_overrides(self):
         scene = os.path.join(SRC, "samples", "fig4_sweep.toml")
         a = impactdeck.sweep(scene, cloud="uniform", count=50, seed=2)

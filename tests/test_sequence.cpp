@@ -3,12 +3,18 @@
 // an independent integration written here.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdio>
 #include <memory>
+#include <random>
 
 #include "impactdeck/collision/eccentric.hpp"
 #include "impactdeck/collision/hertz_law.hpp"
 #include "impactdeck/geometry/ellipsoid.hpp"
+#include "impactdeck/geometry/mass_properties.hpp"
+#include "impactdeck/geometry/mesh_shape.hpp"
 #include "impactdeck/geometry/plane.hpp"
 #include "impactdeck/scene/pipeline.hpp"
 #include "impactdeck/scene/report.hpp"
@@ -241,6 +247,119 @@ TEST(Sequence, EnergyIsConstantBetweenImpacts) {
   }
 }
 
+// --- energy: never gained, and the rest rule -------------------------------------------------
+
+// The kinetic energy of the body at `s`, J.
+double kinetic_J(const contact::PreparedBody& body, const BodyState& s) {
+  return 0.5 * body.mass_kg * s.velocity_m_s.squaredNorm() +
+         0.5 * s.angular_velocity_rad_s.dot(sequence::angular_momentum(body, s));
+}
+
+TEST(SequenceEnergy, BallWithoutMinimumApproachSpeedComesToRestNeverArrivingFasterThanItLeft) {
+  // Issue 43: e = 0.5 and min_approach_speed_m_s = 0. The flights shrink as e^2k; once one is shorter
+  // than the search resolves the body is at rest (kRestHeightRelative), instead of sinking a gap
+  // tolerance into the floor per bounce and arriving at twice its departure speed for ever.
+  const double r = 0.01, h = 0.5, e = 0.5, g = 9.81;
+  auto ball = ellipsoid_body(r, r, r, 0.1);
+  ball.pose.position_m = Vector3d(0, 0, r + h);
+  sequence::SequenceInput in = input_with(ball, e);
+  in.min_approach_speed_m_s = 0.0;
+  in.max_impacts = sequence::kMaxImpactsLimit;
+  const sequence::SequenceResult res = sequence::run_sequence(in);
+  EXPECT_EQ(res.stop, sequence::StopReason::at_rest);
+  EXPECT_NE(res.stop_detail.find("rest_height_m"), std::string::npos) << res.stop_detail;
+  const double h_rest = sequence::kRestHeightRelative * 2 * r;
+  EXPECT_DOUBLE_EQ(res.rest_height_m, h_rest);
+  // The k-th flight rises h e^(2k): the last computed impact is the last whose flight before it
+  // rose above h_rest (k <= 12 here: 0.5 m x 0.25^12 = 3e-8 m > 2e-8 m > 0.25^13 x 0.5 m).
+  const std::size_t expected = static_cast<std::size_t>(std::floor(std::log(h_rest / h) / std::log(e * e))) + 1;
+  EXPECT_EQ(res.bounces.size(), expected);
+  const double tol = sequence::kGapToleranceRelative * 2 * r;
+  for (std::size_t k = 1; k < res.bounces.size(); ++k) {
+    const double left = res.bounces[k - 1].after.velocity_m_s.z(), arrived = -res.bounces[k].before.velocity_m_s.z();
+    // A ballistic flight from the floor back to it: the same speed, up to the gap tolerance's fall.
+    EXPECT_LE(arrived * arrived, left * left + 2 * g * 2 * tol) << k;
+    EXPECT_GE(res.bounces[k].before.centroid_m.z() - r, -tol) << "impact " << k << " is inside the floor";
+  }
+}
+
+// A box [-h, h] as 12 triangles: sharp corners and edges, flat faces (the rigid impulse).
+std::shared_ptr<const geometry::Shape> box_shape(const Vector3d& h) {
+  geometry::TriangleMesh m;
+  for (int i = 0; i < 8; ++i) m.vertices_m.push_back(Vector3d(i & 1 ? h.x() : -h.x(), i & 2 ? h.y() : -h.y(), i & 4 ? h.z() : -h.z()));
+  for (const std::array<int, 3>& t : std::vector<std::array<int, 3>>{{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6},
+                                                                     {0, 1, 4}, {1, 5, 4}, {2, 6, 3}, {3, 6, 7},
+                                                                     {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}}) {
+    m.triangles.push_back(t);
+  }
+  const auto mass = geometry::compute_mass_properties(m, geometry::label_shells(m));
+  return std::make_shared<geometry::MeshShape>(m, mass);
+}
+
+TEST(SequenceEnergy, RandomBodiesNeverGainEnergyBounceAfterBounceUntilRest) {
+  // Random ellipsoids and boxes, orientations, spins, restitutions in [0, 1] and friction, each
+  // dropped with min_approach_speed_m_s = 0 until it rests (or 400 impacts at e = 1, which never
+  // rests). The body's mechanical energy (kinetic + potential) may only fall: across every impact
+  // to rounding (kImpactRounding), across every flight to the flight's stated accuracy
+  // (kFlightTolerance); and no contact lies more than the gap tolerance inside the floor.
+  constexpr double kImpactRounding = 1e-12;  // relative to the drop's energy: a few ulps of the sums
+  constexpr int kCases = 48;
+  std::mt19937_64 rng(43);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::normal_distribution<double> n(0.0, 1.0);
+  int bounces = 0, at_rest = 0;
+  double worst_gain = -std::numeric_limits<double>::infinity(), deepest = 0;
+  for (int c = 0; c < kCases; ++c) {
+    const bool box = c % 3 == 2;
+    const Vector3d axes(0.005 + 0.1 * u(rng), 0.005 + 0.1 * u(rng), 0.005 + 0.1 * u(rng));
+    const double mass = 7800 * 4.0 / 3.0 * M_PI * axes.prod();
+    auto body = box ? contact::body_of_mass("box", box_shape(axes), mass, kSteel)
+                    : ellipsoid_body(axes.x(), axes.y(), axes.z(), mass);
+    body.pose.rotation = Quaterniond(n(rng), n(rng), n(rng), n(rng)).normalized().toRotationMatrix();
+    body.pose.position_m = Vector3d(u(rng), u(rng), 2 * axes.norm() + 0.5 * u(rng));
+    body.velocity_m_s = Vector3d(n(rng), n(rng), -std::abs(n(rng)));
+    body.angular_velocity_rad_s = 10 * Vector3d(n(rng), n(rng), n(rng));
+    const double e = c == 0 ? 0.0 : c == 1 ? 1.0 : u(rng);
+    sequence::SequenceInput in = input_with(body, e);
+    in.friction_coefficient = c % 2 ? 0.0 : u(rng);
+    in.min_approach_speed_m_s = 0.0;
+    in.max_impacts = e == 1.0 ? 400 : sequence::kMaxImpactsLimit;
+    const Vector3d g = in.gravity_m_s2;
+    const double size = body.shape->size_m(), tol = sequence::kGapToleranceRelative * size;
+    const double scale = sequence::mechanical_energy_J(body, sequence::state_of(body), g) + body.mass_kg * 9.81 * size;
+    sequence::SequenceResult res;
+    try {
+      res = sequence::run_sequence(in);
+    } catch (const InputError& err) {
+      ADD_FAILURE() << "case " << c << ": " << err.what();
+      continue;
+    }
+    const std::string what = "case " + std::to_string(c) + (box ? " (box)" : " (ellipsoid)") + ", e = " +
+                             std::to_string(e) + ", mu = " + std::to_string(in.friction_coefficient);
+    if (e < 1.0) EXPECT_NE(res.stop, sequence::StopReason::max_impacts) << what;
+    at_rest += res.stop == sequence::StopReason::at_rest;
+    double E = sequence::mechanical_energy_J(body, res.trajectory.front().state, g);
+    for (std::size_t k = 1; k < res.trajectory.size(); ++k) {
+      const double Ek = sequence::mechanical_energy_J(body, res.trajectory[k].state, g);
+      const bool impact = res.trajectory[k].state.time_s == res.trajectory[k - 1].state.time_s;
+      const double gain = (Ek - E) / scale;
+      worst_gain = std::max(worst_gain, gain);
+      EXPECT_LE(gain, impact ? kImpactRounding : kFlightTolerance) << what << ", t = " << res.trajectory[k].state.time_s;
+      E = Ek;
+    }
+    for (const auto& b : res.bounces) {
+      const double gap = sequence::floor_gap_m(*body.shape, body.volume.centroid_m, b.before, sequence::Floor{});
+      deepest = std::min(deepest, gap / tol);
+      EXPECT_GE(gap, -tol) << what << ": impact at t = " << b.time_s << " inside the floor";
+      EXPECT_LE(kinetic_J(body, b.after), kinetic_J(body, b.before) * (1 + kImpactRounding) + kImpactRounding * scale) << what;
+    }
+    bounces += static_cast<int>(res.bounces.size());
+  }
+  std::printf("energy property: %d cases, %d bounces, %d at rest, worst relative energy gain %.3g, deepest contact "
+              "%.3g gap tolerances\n",
+              kCases, bounces, at_rest, worst_gain, -deepest);
+}
+
 TEST(Sequence, RefusesBadInput) {
   auto ball = ellipsoid_body(0.01, 0.01, 0.01, 0.1);
   ball.pose.position_m = Vector3d(0, 0, 0.5);
@@ -420,6 +539,8 @@ TEST(SequenceScene, SequencesOnlySceneRunsAndWritesItsFiles) {
   ASSERT_EQ(j["sequences"].size(), 1u);
   const auto& q = j["sequences"][0];
   EXPECT_EQ(q["stop_reason"], "at_rest");
+  EXPECT_NE(q["stop_detail"].get<std::string>().find("kinetic energy"), std::string::npos) << q["stop_detail"];
+  EXPECT_DOUBLE_EQ(q["rest_height_m"].get<double>(), sequence::kRestHeightRelative * 0.02);  // the 20 mm ball
   EXPECT_EQ(q["worst_impact_index"], 0);
   const auto& i0 = q["impacts"][0];
   for (const char* key : {"contact_point_m", "approach_velocity_m_s", "reduced_mass_kg", "max_force_N",

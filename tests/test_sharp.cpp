@@ -19,6 +19,7 @@
 #include <gtest/gtest.h>
 
 #include "impactdeck/collision/contact_law.hpp"
+#include "impactdeck/collision/impact.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/geometry/mass_properties.hpp"
 #include "impactdeck/geometry/mesh_io.hpp"
@@ -26,6 +27,7 @@
 #include "impactdeck/scene/pipeline.hpp"
 #include "impactdeck/scene/report.hpp"
 #include "impactdeck/scene/scene.hpp"
+#include "tolerances.hpp"
 
 using namespace impactdeck;
 namespace fs = std::filesystem;
@@ -779,4 +781,88 @@ point = "first-contact"
   EXPECT_EQ(hertz["restitution"].get<double>(), 1.0);
   EXPECT_GT(hertz["max_force_N"].get<double>(), j["max_force_N"].get<double>());
   expect_same_impact(impact_json(scene_text("contact_law = \"line-plastic\"")), j);
+}
+
+// ---- issue 43: named laws, checks near e = 1, messages ----
+
+namespace {
+
+// `text` with the drop's approach speed `v` (m/s) instead of drop_impact's 3 m/s.
+std::string at_speed(std::string text, double v) {
+  const std::string from = "approach_speed_m_s = 3.0";
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos);
+  return text.replace(at, from.size(), "approach_speed_m_s = " + exact(v));
+}
+
+}  // namespace
+
+// A named sharp law runs only where it fits: "wedge" at a corner (it ran "cone") and "cone" at an
+// edge (it ran "wedge") are refused with exit 3 naming contact_law; each runs where it fits.
+TEST(SharpScene, ANamedSharpLawThatDoesNotFitThePointIsRefusedNotSwapped) {
+  const std::string at_corner = error_of(box_drop(kCorner, 35, "", "contact_law = \"wedge\""));
+  EXPECT_TRUE(std::regex_search(at_corner, std::regex("key 'impacts\\[0\\]\\.contact_law': impact 'drop': contact_law = "
+                                                      "\"wedge\" is the law of a sharp edge, but the contact point lies "
+                                                      "on a sharp corner \\(its law is \"cone\"")))
+      << at_corner;
+  const std::string at_edge = error_of(box_drop(kEdge, 45, "", "contact_law = \"cone\""));
+  EXPECT_TRUE(std::regex_search(at_edge, std::regex("contact_law = \"cone\" is the law of a sharp corner, but the contact "
+                                                    "point lies on a sharp edge \\(its law is \"wedge\"")))
+      << at_edge;
+  EXPECT_EQ(impact_json(box_drop(kCorner, 35, "", "contact_law = \"cone\""))["contact_law"], "cone");
+  EXPECT_EQ(impact_json(box_drop(kEdge, 45, "", "contact_law = \"wedge\""))["contact_law"], "wedge");
+}
+
+// The Carnot check (Eq. 32) relative to the approach's kinetic energy: it stays defined where the
+// loss vanishes. Before, relative to the loss (1 - e^2) m v^2 / 2, Thornton and line-plastic just
+// above V_y and Hertz at e = 1 - 1e-12 failed it (exit 4) with relative errors up to 7e4.
+TEST(SharpScene, SelfChecksHoldAsRestitutionTendsToOne) {
+  const std::string line = box_drop(kEdge, 45, "edge_radius = 0.5", "");
+  const std::string ball = sphere_drop(5.0, 1.0, "");
+  for (const auto& [text, law] : {std::pair<std::string, std::string>{line, "line-plastic"}, {ball, "thornton"}}) {
+    const double vy = impact_json(text)["yield_velocity_m_s"].get<double>();
+    for (const double eps : {1e-12, 1e-6}) {
+      const nlohmann::json j = impact_json(at_speed(text, (1.0 + eps) * vy));
+      const std::string what = law + " at (1 + " + exact(eps) + ") V_y";
+      EXPECT_TRUE(j["checks"]["passed"].get<bool>()) << what << ": " << j["checks"].dump();
+      EXPECT_LT(j["checks"]["energy_relative_error"].get<double>(), test::kSelfCheckRel) << what;
+      EXPECT_LT(j["checks"]["impulse_relative_error"].get<double>(), test::kSelfCheckRel) << what;
+      EXPECT_NEAR(j["restitution"].get<double>(), 1.0, 1e-2) << what;
+      if (eps == 1e-6) EXPECT_EQ(j["contact_law"], law) << what;
+    }
+  }
+  for (const double e : {0.999999999999, 1.0}) {
+    const nlohmann::json j = impact_json(sphere_drop(5.0, 1.0, "restitution = " + exact(e)));
+    EXPECT_EQ(j["contact_law"], "hertz");
+    EXPECT_TRUE(j["checks"]["passed"].get<bool>()) << e << ": " << j["checks"].dump();
+    EXPECT_LT(j["checks"]["energy_relative_error"].get<double>(), test::kSelfCheckRel) << e;
+    const double ke = j["checks"]["approach_kinetic_energy_J"].get<double>();
+    EXPECT_NEAR(ke, 0.5 * j["reduced_mass_kg"].get<double>() * 9.0, 1e-12 * ke);
+  }
+}
+
+// A cone whose hardness pushes e above 1 names the key that sets the hardness; the advice of a
+// sharp point names only what would help there.
+TEST(SharpScene, MessagesNameTheKeyThatFixesThem) {
+  // e^2 = 3 pi p tan(alpha) / (4 E*) > 1 at p = 1e11 Pa (steel on steel, the box's corner).
+  const std::string hard = error_of(box_drop(kCorner, 35, "", "limiting_pressure_Pa = 1e11"));
+  EXPECT_NE(hard.find("limiting_pressure_Pa"), std::string::npos) << hard;
+  EXPECT_EQ(hard.find("double precision"), std::string::npos) << hard;
+  // explain_flag of a sharp point: with a yield strength known it does not ask for one; at a point
+  // whose feature is not classified it asks for neither edge_radius nor a plastic law.
+  collision::KernelInput in;
+  collision::KernelResult r;
+  r.flag = collision::ContactFlag::sharp;
+  in.target.curvature.sharp = true;
+  in.target.curvature.feature = collision::SharpKind::corner;
+  const std::string plain = collision::explain_flag(in, r, "'part'", "'floor'");
+  EXPECT_NE(plain.find("give the body edge_radius (its edge break) or a yield strength"), std::string::npos) << plain;
+  in.yield_strength_Pa = 2.5e8;
+  const std::string with_yield = collision::explain_flag(in, r, "'part'", "'floor'");
+  EXPECT_EQ(with_yield.find("or a yield strength"), std::string::npos) << with_yield;
+  EXPECT_NE(with_yield.find("let a plastic contact_law run"), std::string::npos) << with_yield;
+  in.target.curvature.feature = collision::SharpKind::none;
+  const std::string unclassified = collision::explain_flag(in, r, "'part'", "'floor'");
+  EXPECT_EQ(unclassified.find("give the body"), std::string::npos) << unclassified;
+  EXPECT_NE(unclassified.find("could not be classified"), std::string::npos) << unclassified;
 }

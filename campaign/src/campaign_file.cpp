@@ -359,6 +359,7 @@ void expand_cases(CampaignReading& r) {
     // scene and the key.
     const std::string case_place = "case " + std::to_string(id);
     const scene::Scene sc = scene::load_scene(c.scene, k.overrides, InputContext{fr.name(), case_place});
+    scene::check_output_names(sc, InputContext{fr.name(), case_place});  // names leaving the case folder
     // The collected impact must exist in every case: overrides that rename it would leave the
     // table empty.
     if (!c.sequence.empty()) {

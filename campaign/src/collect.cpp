@@ -485,7 +485,7 @@ void check_tree(const fs::path& root) {
 
 }  // namespace
 
-CollectResult collect(const fs::path& dir_in) {
+CollectResult collect(const fs::path& dir_in, const std::function<void(const CollectResult&)>& before_commit) {
   const detail::Plan plan = detail::read_plan(dir_in);
   const fs::path& dir = plan.dir;
   const std::string& impact = plan.impact;
@@ -666,6 +666,7 @@ CollectResult collect(const fs::path& dir_in) {
       fs::remove(stage / ".lock", ec);
       out.worst_case = cdir / "worst_case";
     }
+    if (before_commit) before_commit(out);  // its failure rolls the collect back
     txn.commit();
   });
   refresh_states(dir);

@@ -139,23 +139,36 @@ std::string status_report(const fs::path& dir_in, bool as_json) {
   std::vector<CaseState> states(n);
   std::map<CaseState, std::vector<std::size_t>> by;
   for (std::size_t id = 0; id < n; ++id) by[states[id] = case_state(dir, id)].push_back(id);
-  auto reason = [&](std::size_t id) {
-    try {
-      return InputError::one_line(detail::read_failure(dir, id)["reason"].get<std::string>());
-    } catch (const InputError& e) {
-      return "(" + std::string(e.what()) + ")";
-    }
-  };
+  // Each failed case's failure.json, read (and checked: a damaged one is refused, exit 3) before
+  // anything is printed.
+  std::map<std::size_t, std::string> reasons;
+  for (std::size_t id : by[CaseState::failed]) {
+    reasons[id] = InputError::one_line(detail::read_failure(dir, id)["reason"].get<std::string>());
+  }
+  auto reason = [&](std::size_t id) { return reasons.at(id); };
   const std::string list = [&] {
     std::string l;
     for (const auto& i : ids) l += (l.empty() ? "" : ",") + i;
     return l;
   }();
   // squeue from its argument vector: the ids are digits (job_ids), and no shell is involved.
+  // Missing: no answer (null). Failed (not started, stopped, killed, a non-zero exit): its answer is
+  // not an empty queue; each job's state is "unknown", with the failure as its reason.
   std::optional<detail::ProgramRun> q;
+  std::string squeue_failure;
   if (!ids.empty()) {
     q = detail::run_program({"squeue", "-h", "-o", "%i %T %R", "-j", list}, false, kSqueueTimeoutS);
-    if (q->spawn_error != 0 || q->timed_out) q.reset();
+    if (q->spawn_error == ENOENT) {
+      q.reset();
+    } else if (q->spawn_error != 0) {
+      squeue_failure = "squeue could not be started: " + std::string(std::strerror(q->spawn_error));
+    } else if (q->timed_out) {
+      squeue_failure = "squeue did not answer within " + std::to_string(static_cast<int>(kSqueueTimeoutS)) +
+                       " s and was stopped";
+    } else if (q->exit_code != 0) {
+      squeue_failure = q->exit_code < 0 ? "squeue was killed by a signal"
+                                        : "squeue failed (exit status " + std::to_string(q->exit_code) + ")";
+    }
   }
   std::ostringstream s;
   if (as_json) {
@@ -168,7 +181,10 @@ std::string status_report(const fs::path& dir_in, bool as_json) {
       cases.push_back(std::move(c));
     }
     nlohmann::json queue = nullptr;
-    if (q) {
+    if (!squeue_failure.empty()) {
+      queue = nlohmann::json::array();
+      for (const auto& job : ids) queue.push_back({{"job", job}, {"state", "unknown"}, {"reason", squeue_failure}});
+    } else if (q) {
       queue = nlohmann::json::array();
       std::istringstream lines(q->output);
       for (std::string line; std::getline(lines, line);) {
@@ -184,7 +200,9 @@ std::string status_report(const fs::path& dir_in, bool as_json) {
                                 {"counts", counts},
                                 {"cases", cases},
                                 {"slurm_jobs", ids},
-                                {"squeue", queue}};
+                                {"squeue", queue},
+                                {"squeue_error", squeue_failure.empty() ? nlohmann::json(nullptr)
+                                                                        : nlohmann::json(squeue_failure)}};
     s << doc.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
   } else {
     s << "campaign " << dir.string() << ": " << n << " cases";
@@ -199,7 +217,11 @@ std::string status_report(const fs::path& dir_in, bool as_json) {
         s << "\n";
       }
     }
-    if (q) s << "slurm jobs " << list << ": " << (q->output.empty() ? "none queued or running\n" : "\n" + q->output);
+    if (!squeue_failure.empty()) {
+      s << "slurm jobs " << list << ": state unknown: " << squeue_failure << "\n";
+    } else if (q) {
+      s << "slurm jobs " << list << ": " << (q->output.empty() ? "none queued or running\n" : "\n" + q->output);
+    }
   }
   refresh_states(dir);
   return s.str();

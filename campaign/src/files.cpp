@@ -155,6 +155,10 @@ Plan read_plan(const fs::path& dir_in) {
     const json* id = member(c, "id");
     if (!id || !id->is_number_unsigned() || id->get<std::size_t>() != i) bad(k + ".id", "must be " + std::to_string(i) + " (the case's index)");
     pc.id = i;
+    // The case's folder is always cases/<id> (the code never reads another): a forged one is refused.
+    const std::string folder = (fs::path("cases") / std::to_string(i)).string();
+    const json* fo = member(c, "folder");
+    if (!fo || *fo != folder) bad(k + ".folder", "must be \"" + folder + "\" (the case's folder)");
     const json* ov = member(c, "overrides");
     if (!ov || !ov->is_object()) bad(k + ".overrides", "must be an object of --set key -> TOML value text");
     for (const auto& [key, v] : ov->items())
@@ -206,6 +210,15 @@ nlohmann::json read_failure(const fs::path& dir, std::size_t id) {
   json r = read_json_inside(dir, rel, "failure.json", kMaxResultBytes);
   const std::string f = (dir / rel).string();
   if (!r.is_object()) throw InputError(f, "file", "is not a JSON object");
+  // Every key as run-case writes it (docs/campaign-format.md): a forged or damaged one is refused.
+  const json* fid = member(r, "id");
+  if (!fid || !fid->is_number_unsigned() || fid->get<std::size_t>() != id) {
+    throw InputError(f, "key 'id'", "must be " + std::to_string(id) + " (the case's id): not this case's failure");
+  }
+  const json* state = member(r, "state");
+  if (!state || *state != "failed") throw InputError(f, "key 'state'", "must be \"failed\"");
+  const json* code = member(r, "exit_code");
+  if (!code || !code->is_number_integer()) throw InputError(f, "key 'exit_code'", "must be a whole number");
   const json* reason = member(r, "reason");
   if (!reason || !reason->is_string()) throw InputError(f, "key 'reason'", "must be a string");
   return r;

@@ -317,7 +317,10 @@ SlurmScripts write_sbatch(const fs::path& dir_in, const SlurmOptions& o) {
   SlurmScripts out;
   out.max_array_size = o.max_array_size > 0 ? o.max_array_size : cluster_max_array_size();
   if (out.max_array_size == 0) {
-    throw InputError("scontrol show config", "MaxArraySize", "is 0: job arrays are disabled on this cluster");
+    throw InputError(plan.file.string(), "scontrol show config: MaxArraySize",
+                     "is 0: job arrays are disabled on this cluster, so the campaign '" + dir.string() +
+                         "' cannot be submitted as job arrays (run it here with 'impactdeck campaign run " +
+                         dir.string() + "', or ask the cluster's administrators for MaxArraySize > 0)");
   }
   const std::size_t cpt = plan.slurm.cases_per_task;
   out.cases_per_task = cpt;

@@ -21,12 +21,14 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <string>
 
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_sf_ellint.h>
 #include <gsl/gsl_sf_gamma.h>
 
 #include "impactdeck/collision/contact_law.hpp"
+#include "impactdeck/common/number_text.hpp"
 #include "plastic_law.hpp"
 
 namespace impactdeck::collision {
@@ -91,8 +93,28 @@ class SharpLaw : public ContactLaw {
     r.state[1] = wu;
     r.contact_pressure_Pa = p;
     detail::finish_plastic_result(r);
-    if (!(r.residual_indentation_m > 0.0)) r.status = LawStatus::degenerate;  // E* too low against p
+    if (std::isfinite(r.restitution.coefficient) && r.restitution.coefficient >= 1.0) {
+      // The punch's elastic recovery reaches the indent (E* too low against p): the hardness does
+      // not fit this feature; describe_restitution names the key that sets it.
+      r.status = LawStatus::restitution_invalid;
+      r.restitution.invalid = true;
+    } else if (!(r.residual_indentation_m > 0.0)) {
+      r.status = LawStatus::degenerate;
+    }
   }
+
+ public:
+  std::string describe_restitution(const LawResult& r, double) const override {
+    if (!r.restitution.invalid) return "";
+    const std::string feature = kind_ == SharpKind::edge ? "edge" : "corner";
+    return std::string(name()) + " law at a sharp " + feature + ": the indentation hardness p = " +
+           format_number(r.contact_pressure_Pa, 6) + " Pa is too high against the effective modulus here: the " +
+           "flat punch's elastic recovery reaches the whole indent (e = " + format_number(r.restitution.coefficient, 6) +
+           " >= 1, no dent); lower limiting_pressure_Pa (the hardness; default " +
+           "3 x the weaker body's yield strength), or give the body edge_radius";
+  }
+
+ private:
 
   double hardness_Pa_;
   SharpKind kind_;

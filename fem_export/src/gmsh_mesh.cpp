@@ -20,6 +20,7 @@
 #include "impactdeck/common/guarded_step.hpp"
 #include "impactdeck/common/version.hpp"
 #include "impactdeck/fem_export/mesh.hpp"
+#include "gmsh_home_files.hpp"
 #include "gmsh_plugin.hpp"
 
 namespace impactdeck::fem_export {
@@ -39,7 +40,7 @@ std::mutex& gmsh_mutex() {
 class GmshSession {
  public:
   explicit GmshSession(const std::string& model) : lock_(gmsh_mutex()) {
-    gmsh::initialize(0, nullptr, false);
+    initialize_gmsh_without_home_files();  // no FLTK preferences, no ~/.gmsh-tmp (gmsh_home_files.hpp)
     gmsh::option::setNumber("General.Terminal", 0);
     gmsh::option::setNumber("General.NumThreads", 1);  // deterministic meshes
     gmsh::logger::start();

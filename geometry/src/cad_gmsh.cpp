@@ -23,6 +23,7 @@
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/common/guarded_step.hpp"
 #include "impactdeck/common/version.hpp"
+#include "gmsh_home_files.hpp"
 
 namespace impactdeck::geometry {
 namespace fs = std::filesystem;
@@ -80,7 +81,7 @@ void ensure_initialized() {
     alive = false;
   }
   if (!alive) {
-    gmsh::initialize(0, nullptr, false);
+    initialize_gmsh_without_home_files();  // no FLTK preferences, no ~/.gmsh-tmp (gmsh_home_files.hpp)
     probe_error() = raw_last_gmsh_error();
   }
   gmsh::option::setNumber("General.Terminal", 0);

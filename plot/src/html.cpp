@@ -6,37 +6,11 @@
 #include <cstring>
 
 #include "impactdeck/common/version.hpp"
+#include "impactdeck/common/xml_text.hpp"
 
 namespace impactdeck::plot {
 
-std::string html_escape(std::string_view t) {
-  std::string o;
-  o.reserve(t.size());
-  for (char c : t) {
-    switch (c) {
-      case '&': o += "&amp;"; break;
-      case '<': o += "&lt;"; break;
-      case '>': o += "&gt;"; break;
-      case '"': o += "&quot;"; break;
-      case '\'': o += "&#39;"; break;
-      case '\0': o += "\xEF\xBF\xBD"; break;  // U+FFFD: HTML has no NUL character
-      case '\t':
-      case '\n':
-      case '\r': o += c; break;
-      case '\x7F': o += "\xE2\x90\xA1"; break;  // U+2421 SYMBOL FOR DELETE
-      default:
-        // Other C0 controls are not allowed in XML 1.0 and are parse errors in HTML: written as
-        // their visible symbols U+2401..U+241F (a name with \x01 stays readable and the page valid).
-        if (static_cast<unsigned char>(c) < 0x20) {
-          o += "\xE2\x90";
-          o += static_cast<char>(0x80 + static_cast<unsigned char>(c));
-        } else {
-          o += c;
-        }
-    }
-  }
-  return o;
-}
+std::string html_escape(std::string_view t) { return xml_escape(t); }
 
 std::string base64(std::string_view bytes) {
   static const char* const k = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";

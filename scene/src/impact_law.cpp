@@ -74,6 +74,16 @@ std::optional<ImpactLaw> sharp_impact_law(const ImpactSpec& s, const ImpactLaw& 
   if (t.sharp == i.sharp || c.feature == collision::SharpKind::none || law.name == "hertz") return std::nullopt;
   ImpactLaw l = law;
   l.name = c.feature == collision::SharpKind::edge ? "wedge" : "cone";
+  // A named sharp law runs only where it fits: "wedge" at an edge, "cone" at a corner; the other is
+  // refused, never swapped (docs/sharp-contacts.md, "Which law runs").
+  if ((law.name == "wedge" || law.name == "cone") && law.name != l.name) {
+    const bool edge = c.feature == collision::SharpKind::edge;
+    throw InputError(ctx.where, s.contact_law_place.describe(),
+                     "impact '" + s.name + "': contact_law = \"" + law.name + "\" is the law of a sharp " +
+                         (edge ? "corner" : "edge") + ", but the contact point lies on a sharp " +
+                         (edge ? "edge" : "corner") + " (its law is \"" + l.name + "\"; contact_law = \"auto\" " +
+                         "chooses it at each point)");
+  }
   collision::LawOptions o = law.options;  // the rate dependence carries over
   o.hardness_Pa = s.limiting_pressure_Pa.value_or(0.0);
   l.options = o;

@@ -667,7 +667,10 @@ void choose_sequence_decks(SequenceReport& sr, const Scene& scene, std::vector<s
   }
 }
 
-StagedOutputs reserve_outputs(const Scene& scene, RunTransaction& txn) {
+// Every output of the scene, each handed to `reserve(name, place, folder)` (the run's transaction
+// reserves it; check_output_names only checks its name) after the checks of the names themselves.
+using ReserveOutput = std::function<fs::path(const std::string& name, const std::string& place, bool folder)>;
+StagedOutputs reserve_outputs(const Scene& scene, const ReserveOutput& reserve) {
   StagedOutputs st;
   const std::string file = where(scene);
   const std::size_t n = scene.impacts.size();
@@ -683,9 +686,6 @@ StagedOutputs reserve_outputs(const Scene& scene, RunTransaction& txn) {
       throw InputError(file, Place{s.place.line, s.place.key + ".name"}.describe(),
                        "impact '" + s.name + "': the name is part of output file names, so it must not contain '/'");
     }
-  };
-  auto reserve = [&](const std::string& name, const std::string& place, bool folder) {
-    return reserve_output(scene, txn, name, place, folder);
   };
   for (const auto& s : scene.impacts) {
     if (scene.outputs.fem || (n > 1 && (scene.outputs.force_table_csv || scene.outputs.force_plot_svg))) {
@@ -727,6 +727,12 @@ StagedOutputs reserve_outputs(const Scene& scene, RunTransaction& txn) {
     st.report = reserve(kReportHtml, "report.html (the run's report page, written beside its other outputs)", false);
   }
   return st;
+}
+
+StagedOutputs reserve_outputs(const Scene& scene, RunTransaction& txn) {
+  return reserve_outputs(scene, [&](const std::string& name, const std::string& place, bool folder) {
+    return reserve_output(scene, txn, name, place, folder);
+  });
 }
 
 // stages_skipped: every stage not in stages_run, in pipeline order.
@@ -1050,6 +1056,17 @@ RunReport run_scene(const Scene& scene, const RunOptions& opt) {
   txn.run([&] { run_stages(scene, opt, txn, report, clock); });  // messages name the final paths
   note_skipped_stages(report);
   return report;
+}
+
+void check_output_names(const Scene& scene, const InputContext& context) {
+  try {
+    reserve_outputs(scene, [&](const std::string& name, const std::string& place, bool) {
+      return fs::path(RunTransaction::check_name(name, where(scene), place));
+    });
+  } catch (const InputError& e) {
+    if (context.where.empty()) throw;
+    throw context.in_file(e.where()).error(e.place(), e.reason());
+  }
 }
 
 }  // namespace impactdeck::scene

@@ -170,6 +170,7 @@ nlohmann::json impact_json(const ImpactReport& ir) {
                  {"impulse_compression_numerical_Ns", json_number(k.impulse_compression_numerical_Ns)},
                  {"carnot_loss_J", json_number(k.carnot_loss_J)},
                  {"kinetic_energy_loss_J", json_number(k.kinetic_energy_loss_J)},
+                 {"approach_kinetic_energy_J", json_number(k.approach_kinetic_energy_J)},
                  {"passed", k.passed}};
   if (ir.table) {
     i["force_table"] = {{"samples", ir.table->time_s.size()},
@@ -243,6 +244,8 @@ nlohmann::json sequence_json(const SequenceReport& sr) {
   q["body"] = sr.spec->body;
   q["floor"] = sr.spec->floor;
   q["stop_reason"] = sequence::to_string(res.stop);
+  q["stop_detail"] = res.stop_detail;
+  q["rest_height_m"] = json_number(res.rest_height_m);
   q["max_impacts"] = sr.spec->max_impacts;
   q["min_approach_speed_m_s"] = json_number(sr.spec->min_approach_speed_m_s);
   q["friction_coefficient"] = json_number(sr.spec->friction_coefficient);

@@ -22,6 +22,7 @@ namespace impactdeck::scene {
 namespace fs = std::filesystem;
 
 std::string Place::describe() const {
+  if (!override_place.empty()) return override_place;
   std::ostringstream s;
   if (line > 0) s << "line " << line;
   if (!key.empty()) s << (line > 0 ? ", " : "") << "key '" << key << "'";
@@ -53,6 +54,8 @@ class Source {
       : name_(name), file_(context.in_file(name)), overrides_(overrides) {}
 
   const std::string& name() const { return name_; }
+  /// The override that set the value at `key` ("--set KEY"), empty when none did.
+  std::string override_of(const std::string& key) const { return detail::override_place(overrides_, key); }
   /// The error about the value at `p`.
   InputError error(const Place& p, const std::string& reason) const { return file_.error(describe(p), reason); }
   /// The context of the value at `p`, for the library code that checks it.
@@ -79,8 +82,10 @@ class Reader {
   std::string key_path(const std::string& k) const { return prefix_.empty() ? k : prefix_ + "." + k; }
   int line_of(const toml::node* n) const { return n ? static_cast<int>(n->source().begin.line) : 0; }
   int table_line() const { return static_cast<int>(t_.source().begin.line); }
-  Place place(const std::string& k) const { return Place{line_of(t_.get(k)), key_path(k)}; }
-  Place self() const { return Place{table_line(), prefix_}; }
+  Place place(const std::string& k) const {
+    return Place{line_of(t_.get(k)), key_path(k), file_.override_of(key_path(k))};
+  }
+  Place self() const { return Place{table_line(), prefix_, file_.override_of(prefix_)}; }
 
   [[noreturn]] void fail(const std::string& k, const std::string& reason) const {
     throw file_.error(place(k), reason);

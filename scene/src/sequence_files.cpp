@@ -7,6 +7,7 @@
 #include "impactdeck/common/atomic_file.hpp"
 #include "impactdeck/common/csv_sidecar.hpp"
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/common/xml_text.hpp"
 #include "impactdeck/geometry/cad_shape.hpp"
 #include "impactdeck/geometry/ellipsoid.hpp"
 #include "impactdeck/geometry/ellipsoid_mesh.hpp"
@@ -80,8 +81,10 @@ std::size_t write_vtk_series(const fs::path& pvd, const fs::path& frames_dir, co
   if (ec) throw InputError(frames_dir.string(), "folder", "cannot create: " + ec.message());
   const double scale = 1.0 / metres_per(unit);
   std::ostringstream collection;
-  collection << "<?xml version=\"1.0\"?>\n<!-- impactdeck: sequence '" << sr.spec->name << "', body '"
-             << sr.spec->body << "'; positions in " << to_string(unit) << ", times in s -->\n"
+  collection << "<?xml version=\"1.0\"?>\n<!-- "
+             << xml_comment_text("impactdeck: sequence '" + sr.spec->name + "', body '" + sr.spec->body +
+                                 "'; positions in " + to_string(unit) + ", times in s")
+             << " -->\n"
              << "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n<Collection>\n";
   collection << std::setprecision(17);
   for (std::size_t f = 0; f < frames; ++f) {
@@ -108,7 +111,7 @@ std::size_t write_vtk_series(const fs::path& pvd, const fs::path& frames_dir, co
     std::ostringstream name;
     name << "frame_" << std::setw(4) << std::setfill('0') << f << ".vtp";
     write_file_atomically(frames_dir / name.str(), v.str());
-    collection << "<DataSet timestep=\"" << s.time_s << "\" part=\"0\" file=\"" << frames_name << "/" << name.str()
+    collection << "<DataSet timestep=\"" << s.time_s << "\" part=\"0\" file=\"" << xml_escape(frames_name + "/" + name.str())
                << "\"/>\n";
   }
   collection << "</Collection>\n</VTKFile>\n";

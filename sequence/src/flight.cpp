@@ -142,7 +142,7 @@ double max_radius_m(const geometry::Shape& shape, const Eigen::Vector3d& c) {
 }
 
 NextContact next_contact(const contact::PreparedBody& body, const Flight& flight, const BodyState& start,
-                         const Floor& floor, double tol, const InputContext& ctx) {
+                         const Floor& floor, double tol, const InputContext& ctx, double rest_height_m) {
   const geometry::Shape& shape = *body.shape;
   const Eigen::Vector3d& c_own = body.volume.centroid_m;
   const double r_max = max_radius_m(shape, c_own);
@@ -153,13 +153,36 @@ NextContact next_contact(const contact::PreparedBody& body, const Flight& flight
   const double i_min = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(body.inertia_kg_m2).eigenvalues().minCoeff();
   const double omega_max = std::max(start.angular_velocity_rad_s.norm(), std::sqrt(std::max(0.0, rotational) / i_min));
   const double g_n = std::abs(floor.normal.dot(flight.gravity()));
+  // A fall from the rest height and back: a body hovering within it longer never left the floor.
+  const double rest_time = rest_height_m > 0.0 && g_n > 0.0 ? 2.0 * std::sqrt(2.0 * rest_height_m / g_n) : 0.0;
   NextContact nc;
-  BodyState s = start;
+  BodyState s = start, prev = start;
   for (long step = 0; step < kMaxSearchSteps; ++step) {
     double rate = 0.0;
     geometry::SurfacePoint sp;
-    const double h = floor_gap_m(shape, c_own, s, floor, &sp, &rate);
+    double h = floor_gap_m(shape, c_own, s, floor, &sp, &rate);
     if (!std::isfinite(h)) throw ctx.error("", "the body's gap to the floor is not finite");
+    if (h < -tol && step > 0) {
+      // A step within the rest band (below) passed the floor: back to the crossing by bisection
+      // between the last state above it and this one, to |h| <= tol, so that a contact is always
+      // found within the gap tolerance.
+      BodyState lo = prev, hi = s;
+      for (int it = 0; it < 200 && std::abs(h) > tol; ++it) {
+        const BodyState mid = flight.advance(lo, 0.5 * (hi.time_s - lo.time_s));
+        h = floor_gap_m(shape, c_own, mid, floor, &sp, &rate);
+        (h > 0.0 ? lo : hi) = mid;
+        s = mid;
+      }
+    }
+    nc.max_gap_m = step == 0 ? h : std::max(nc.max_gap_m, h);
+    if (rest_time > 0.0 && nc.max_gap_m <= rest_height_m && s.time_s - start.time_s > rest_time) {
+      nc.state = s;
+      nc.support = sp;
+      nc.gap_m = h;
+      nc.steps = step;
+      nc.resting = true;
+      return nc;
+    }
     const double a = std::abs(floor.normal.dot(s.velocity_m_s)) + omega_max * r_max;
     if (h <= tol && rate < 0.0) {
       // Newton from s (h >= 0 up to rounding: advancement never passes the floor) on the exact rate.
@@ -186,13 +209,21 @@ NextContact next_contact(const contact::PreparedBody& body, const Flight& flight
       nc.steps = step;
       return nc;
     }
-    // The largest dt with (a + g_n dt) dt <= max(h, tol): the gap cannot close within it.
-    const double room = std::max(h, tol);
+    // The largest dt with (a + g_n dt) dt <= room: the gap cannot fall by more than room within it.
+    // room = max(h, tol): the gap cannot close. Within the rest band (every gap so far within
+    // rest_height_m of the floor, where steps of h / a would crawl: a bounce on a corner, a body
+    // rocking or spinning near the floor), room grows by rest_height_m: a step may pass the floor by
+    // at most that much, and the bisection above brings the search back to the crossing. A dip
+    // below the floor shallower than rest_height_m may be stepped over there: a bounce the rest
+    // rule does not resolve.
+    const bool in_band = rest_time > 0.0 && nc.max_gap_m <= rest_height_m;
+    const double room = std::max(h, tol) + (in_band ? rest_height_m : 0.0);
     const double disc = std::sqrt(a * a + 4.0 * g_n * room);
     const double dt = 2.0 * room / (a + disc);
     if (!(dt > 0.0) || !std::isfinite(dt)) {
       throw ctx.error("", "the body neither moves nor falls towards the floor: no next contact");
     }
+    prev = s;
     s = flight.advance(s, dt);
   }
   throw ctx.error("", "no contact with the floor found within " + std::to_string(kMaxSearchSteps) +

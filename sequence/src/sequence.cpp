@@ -164,18 +164,45 @@ SequenceResult run_sequence(const SequenceInput& in) {
   SequenceResult out;
   out.trajectory.push_back({s, floor_gap_m(*in.body.shape, in.body.volume.centroid_m, s, floor)});
   const double rest_energy = 0.5 * in.body.mass_kg * in.min_approach_speed_m_s * in.min_approach_speed_m_s;
+  // The rest rule (kRestHeightRelative): a flight whose lowest point stays within h_rest of the floor
+  // and that lands no faster than a fall from h_rest is not resolved by the search: at rest.
+  out.rest_height_m = kRestHeightRelative * size;
+  const double rest_speed = std::sqrt(2.0 * -gn * out.rest_height_m);
   for (;;) {
-    const NextContact nc = next_contact(in.body, flight, s, floor, tol, ctx);
+    const NextContact nc = next_contact(in.body, flight, s, floor, tol, ctx, out.rest_height_m);
     const double span = nc.state.time_s - s.time_s;
+    // Each sample from the one before (one integration over the flight in all, not one per sample).
+    BodyState t = s;
     for (int k = 1; k + 1 < kSamplesPerFlight; ++k) {
-      const BodyState t = flight.advance(s, span * k / (kSamplesPerFlight - 1));
+      t = flight.advance(t, s.time_s + span * k / (kSamplesPerFlight - 1) - t.time_s);
       out.trajectory.push_back({t, floor_gap_m(*in.body.shape, in.body.volume.centroid_m, t, floor)});
     }
     out.trajectory.push_back({nc.state, nc.gap_m});
     double rate = 0.0;
     floor_gap_m(*in.body.shape, in.body.volume.centroid_m, nc.state, floor, nullptr, &rate);
+    if (nc.resting) {
+      out.stop = StopReason::at_rest;
+      out.stop_detail = "the lowest point stayed within rest_height_m = " + format_number(out.rest_height_m, kMessageDigits) +
+                        " m of the floor for " + format_number(nc.state.time_s - s.time_s, kMessageDigits) +
+                        " s without approaching it (longer than a fall from that height and back): the body "
+                        "slides, rolls or spins on the floor";
+      break;
+    }
+    if (nc.max_gap_m <= out.rest_height_m && -rate <= rest_speed) {
+      out.stop = StopReason::at_rest;
+      out.stop_detail = "the lowest point rose at most " + format_number(std::max(nc.max_gap_m, 0.0), kMessageDigits) +
+                        " m above the floor before the next contact (rest_height_m = " +
+                        format_number(out.rest_height_m, kMessageDigits) + " m), which it reached at " +
+                        format_number(std::max(-rate, 0.0), kMessageDigits) +
+                        " m/s (a fall from rest_height_m: " + format_number(rest_speed, kMessageDigits) +
+                        " m/s): a bounce shorter than the contact search resolves; that contact was not computed";
+      break;
+    }
     if (-rate < in.min_approach_speed_m_s) {
       out.stop = StopReason::min_approach_speed;
+      out.stop_detail = "the next contact approaches at " + format_number(std::max(-rate, 0.0), kMessageDigits) +
+                        " m/s, below min_approach_speed_m_s = " + format_number(in.min_approach_speed_m_s, kMessageDigits) +
+                        " m/s; it was not computed";
       break;
     }
     Bounce b = apply_bounce(in, out.bounces.size(), nc.state, nc.support);
@@ -191,12 +218,16 @@ SequenceResult run_sequence(const SequenceInput& in) {
     out.bounces.push_back(std::move(b));
     if (static_cast<int>(out.bounces.size()) >= in.max_impacts) {
       out.stop = StopReason::max_impacts;
+      out.stop_detail = std::to_string(in.max_impacts) + " impacts computed (max_impacts)";
       break;
     }
     const double kinetic = 0.5 * in.body.mass_kg * s.velocity_m_s.squaredNorm() +
                            0.5 * s.angular_velocity_rad_s.dot(angular_momentum(in.body, s));
     if (kinetic <= rest_energy) {
       out.stop = StopReason::at_rest;
+      out.stop_detail = "after impact " + std::to_string(out.bounces.size() - 1) + " the kinetic energy " +
+                        format_number(kinetic, kMessageDigits) + " J is at most m v_min^2 / 2 = " +
+                        format_number(rest_energy, kMessageDigits) + " J (v_min = min_approach_speed_m_s)";
       break;
     }
   }

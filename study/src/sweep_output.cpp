@@ -11,6 +11,7 @@
 #include <mutex>
 #include <thread>
 
+#include "impactdeck/common/xml_text.hpp"
 #include "impactdeck/common/atomic_file.hpp"
 #include "impactdeck/common/csv_sidecar.hpp"
 #include "impactdeck/common/error.hpp"
@@ -322,10 +323,9 @@ void write_sweep_vtp(const std::filesystem::path& path, const SweepResult& r, co
     o << "<?xml version=\"1.0\"?>\n";
     std::ostringstream h;
     header(h, "", meta, r, options.length_unit);
-    std::string comment = h.str();
-    // "--" is not allowed inside an XML comment.
-    for (std::size_t k; (k = comment.find("--")) != std::string::npos;) comment.replace(k, 2, "- -");
-    o << "<!--\n" << comment << "-->\n";
+    // The header holds the scene's names: made comment text ("--" and control characters are not
+    // allowed inside an XML comment).
+    o << "<!--\n" << xml_comment_text(h.str()) << "-->\n";
     o << "<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"" << (little_endian() ? "LittleEndian" : "BigEndian")
       << "\" header_type=\"" << (wide ? "UInt64" : "UInt32") << "\">\n<PolyData>\n"
       << "<FieldData>\n<DataArray type=\"Float64\" Name=\"metres_per_length_unit\" NumberOfTuples=\"1\" "

@@ -1,6 +1,7 @@
 #pragma once
 // `campaign collect`: one table of every case (CSV and JSON), the worst case's files, and a map.
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -26,7 +27,10 @@ struct CollectResult {
 /// collect/worst_case; and, for point campaigns, a map over the part's surface, for drop
 /// campaigns over the orientation sphere (map.svg, map.vtp); and report.html, a self-contained
 /// page of all that (verdict over the cases, checks, map). Every file is written atomically.
-CollectResult collect(const std::filesystem::path& dir);
+/// `before_commit` (optional) runs when every file is staged, before they are published (the CLI
+/// writes its --json document there): when it throws, nothing is published.
+CollectResult collect(const std::filesystem::path& dir,
+                      const std::function<void(const CollectResult&)>& before_commit = {});
 
 /// `campaign collect --json`: one JSON document of what collect wrote (keys: docs/cli.md).
 std::string collect_json(const CollectResult& result);

@@ -52,7 +52,10 @@ struct ImpactChecks {
   double impulse_relative_error = 0;    ///< |numerical Pi_1 - m_w v_w| / (m_w v_w)   (Eq. 31)
   double carnot_loss_J = 0;             ///< (1 - R^2)/2 m_w v_w^2                    (Eq. 32)
   double kinetic_energy_loss_J = 0;     ///< from the velocities before/after, numerical Pi
-  /// |kinetic loss - Carnot loss| / Carnot loss; for R = 1 (no loss) relative to m_w v_w^2 / 2.
+  /// m_w v_w^2 / 2: the approach's kinetic energy, the check's scale (the most an impact can lose).
+  double approach_kinetic_energy_J = 0;
+  /// |kinetic loss - Carnot loss| / (m_w v_w^2 / 2): well defined as R -> 1, where the loss
+  /// vanishes; an impulse quadrature error d moves it by 2R/(1+R) d <= d (impact.cpp).
   double energy_relative_error = 0;
   CheckThresholds thresholds;
   bool passed = false;

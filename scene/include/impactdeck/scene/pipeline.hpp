@@ -117,6 +117,12 @@ contact::PreparedBody prepare_body(const BodySpec& body, const Scene& scene, Run
 /// (the outputs are the evidence); after an error (an exception) nothing is visible.
 RunReport run_scene(const Scene& scene, const RunOptions& options = {});
 
+/// The names of every output `scene` writes, checked as `run` checks them before any work
+/// (RunTransaction::check_name: relative, no '..', no control character, ...), without writing:
+/// `campaign plan` validates each case with it. Throws InputError naming the scene key (the
+/// override that set it), inside `context` (the campaign file and case) when it names a file.
+void check_output_names(const Scene& scene, const InputContext& context = {});
+
 /// Where the bodies of impact `s` touch, as `run` finds it (point mode: the projected point, else
 /// the first contact); a point where Hertz does not apply comes back flagged. Throws InputError.
 contact::ContactEvaluation locate_impact_contact(const Scene& scene, const ImpactSpec& s, const contact::ContactModel& model);

@@ -24,7 +24,10 @@ namespace impactdeck::scene {
 struct Place {
   int line = 0;          ///< 1-based; 0 when unknown
   std::string key;       ///< dotted key path, e.g. "bodies[0].radius"
-  std::string describe() const;  ///< "line 12, key 'bodies[0].radius'"
+  /// The `--set` override that gave the value ("--set KEY"), empty when the file did: named instead
+  /// of the line (an overridden value's line is the override's own text's).
+  std::string override_place;
+  std::string describe() const;  ///< "line 12, key 'bodies[0].radius'", or the override_place
 };
 
 struct Material {

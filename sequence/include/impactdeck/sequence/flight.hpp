@@ -84,6 +84,13 @@ struct NextContact {
   geometry::SurfacePoint support;   ///< own frame: the support point, normal = the support direction
   double gap_m = 0;                 ///< the gap left at the contact time (|gap| <= the tolerance)
   long steps = 0;                   ///< conservative-advancement steps taken
+  /// The largest gap the search evaluated from `start` to the contact (the start's included): how
+  /// high the lowest point rose over the flight, as far as the search saw it.
+  double max_gap_m = 0;
+  /// No contact: the lowest point stayed within the rest height of the floor, without approaching
+  /// it, for longer than a fall from that height takes there and back (next_contact's rest_height_m):
+  /// the body slides, rolls or spins on the floor. `state` is where the search stopped.
+  bool resting = false;
 };
 
 /// Most conservative-advancement steps of one search (InputError beyond).
@@ -95,8 +102,11 @@ inline constexpr long kMaxSearchSteps = 200'000;
 /// smallest principal moment), so it never steps over a contact; at a gap below
 /// `gap_tolerance_m` with dh/dt < 0, Newton steps refine the time (to |h| <= 1e-3 x the tolerance
 /// or 1e-15 s). A gap below the tolerance with dh/dt >= 0 (just bounced, or grazing) steps on by
-/// the tolerance over the bound. Throws ctx.error("", ...) beyond kMaxSearchSteps.
+/// the tolerance over the bound. With `rest_height_m` > 0, a search whose every gap stayed within
+/// it for longer than 2 sqrt(2 rest_height_m / |g.n|) (a fall from that height and back) ends
+/// `resting`. Throws ctx.error("", ...) beyond kMaxSearchSteps.
 NextContact next_contact(const contact::PreparedBody& body, const Flight& flight, const BodyState& start,
-                         const Floor& floor, double gap_tolerance_m, const InputContext& ctx = {});
+                         const Floor& floor, double gap_tolerance_m, const InputContext& ctx = {},
+                         double rest_height_m = 0);
 
 }  // namespace impactdeck::sequence

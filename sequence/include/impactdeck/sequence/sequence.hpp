@@ -27,6 +27,12 @@ inline constexpr int kDefaultMaxImpacts = 20;
 inline constexpr int kMaxImpactsLimit = 10'000;
 /// The contact search's gap tolerance, relative to the body's size.
 inline constexpr double kGapToleranceRelative = 1e-10;
+/// The rest rule's height, relative to the body's size (h_rest = kRestHeightRelative x size; 10^4
+/// gap tolerances): a flight in which the lowest point never rose more than h_rest above the floor
+/// and that lands no faster than a fall from h_rest, sqrt(2 |g.n| h_rest), is a bounce shorter than
+/// the contact search resolves (its gap tolerance could change its energy by 1e-4 of the flight's
+/// own): the body is at rest (the accumulation of ever smaller bounces; docs/sequences.md).
+inline constexpr double kRestHeightRelative = 1e-6;
 /// Trajectory samples per flight (between two impacts), bounds included.
 inline constexpr int kSamplesPerFlight = 40;
 
@@ -34,7 +40,9 @@ inline constexpr int kSamplesPerFlight = 40;
 enum class StopReason {
   max_impacts,         ///< "max_impacts": max_impacts impacts computed
   min_approach_speed,  ///< "min_approach_speed": the next contact approaches slower than the minimum
-  at_rest,             ///< "at_rest": after an impact the kinetic energy is below m v_min^2 / 2
+  /// "at_rest": after an impact the kinetic energy is below m v_min^2 / 2, or the next flight is a
+  /// bounce shorter than the search resolves (kRestHeightRelative; not computed)
+  at_rest,
 };
 const char* to_string(StopReason r);
 
@@ -108,6 +116,10 @@ struct SequenceResult {
   std::vector<TrajectorySample> trajectory;
   int worst_impact_index = -1;     ///< -1 when no impact happened
   std::string worst_impact_reason;
+  /// Why the sequence stopped, in words (the rule and its numbers; JSON `stop_detail`).
+  std::string stop_detail;
+  /// The rest rule's height h_rest = kRestHeightRelative x the body's size, m (JSON `rest_height_m`).
+  double rest_height_m = 0;
 };
 
 /// The floor of a prepared plane body (its point and outward normal, world).
