@@ -18,7 +18,7 @@
 #include "impactdeck/plot/drawing.hpp"
 #include "impactdeck/scene/scene.hpp"
 #include "impactdeck/scene/sweep_case.hpp"
-#include "impactdeck/study/progress.hpp"
+#include "impactdeck/common/progress.hpp"
 #include "impactdeck/study/sweep_command.hpp"
 #include "impactdeck/study/table1.hpp"
 #include "impactdeck/study/table1_output.hpp"
@@ -159,7 +159,7 @@ void register_study(CLI::App& app, Context& ctx) {
     txn.file("table1.csv.json", where, "--out");  // the CSV's JSON sidecar, written with it
     const fs::path svg = txn.file("table1_heatmap.svg", where, "--out");
     const fs::path png = a->no_png ? fs::path() : txn.file("table1_heatmap.png", where, "--out");
-    study::ProgressBar bar("table1", !ctx.quiet);
+    ProgressLine bar("table1", !ctx.quiet, "points");
     o.progress = [&bar](std::size_t done, std::size_t total) { bar.update(done, total); };
     const study::Table1Result r = [&] {
       VerboseTimer timer(ctx, "study table1", "table1 cells");

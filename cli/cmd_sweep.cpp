@@ -12,7 +12,7 @@
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/scene/scene.hpp"
 #include "impactdeck/scene/sweep_case.hpp"
-#include "impactdeck/study/progress.hpp"
+#include "impactdeck/common/progress.hpp"
 #include "impactdeck/study/sweep_command.hpp"
 
 namespace impactdeck::cli {
@@ -20,7 +20,7 @@ namespace impactdeck::cli {
 void register_sweep(CLI::App& app, Context& ctx) {
   struct Args {
     std::string scene, impact, cloud = "auto", out = ".", prefix, points;
-    std::string formats = "csv,vtp,pos,svg,png";
+    std::string format, formats;
     int grid_steps = 8;
     std::size_t count = 2000;
     std::uint64_t seed = 1;
@@ -50,8 +50,12 @@ void register_sweep(CLI::App& app, Context& ctx) {
   cmd->add_option("--threads", a->threads, "Worker threads (default 0: all cores)");
   cmd->add_option("-o,--out", a->out, "Output folder (created if missing; default: current folder)");
   cmd->add_option("--prefix", a->prefix, "File name prefix (default sweep_IMPACT)");
-  cmd->add_option("--formats", a->formats,
-                  "Files to write, comma-separated: csv,vtp,pos,svg,png (default: all five)");
+  CLI::Option* format = cmd->add_option(
+      "--format", a->format,
+      "Files to write, comma-separated from vtu,csv,vtp,pos,svg,png or all (default vtu,svg: the compressed "
+      "VTK file and the picture; csv,vtp,pos,svg,png: the files of earlier versions)");
+  cmd->add_option("--formats", a->formats, "The same list as --format (a bad list is a usage error, exit 2)")
+      ->excludes(format);
   cmd->add_flag("--no-png", a->no_png, "Do not render the PNG picture (png left out of --formats)");
   cmd->add_flag("--json", a->json, "Print a JSON summary on stdout");
   cmd->add_option("--max-points", a->max_points, "Most points a sweep may evaluate (default 1000000)")
@@ -61,15 +65,24 @@ void register_sweep(CLI::App& app, Context& ctx) {
       ->check(positive_number());
   add_set_option(cmd, a->set);
   add_output_length_unit_option(cmd, a->output_length_unit);
-  cmd->callback([a, &ctx] {
+  cmd->callback([a, &ctx, cmd] {
     refuse_stdout_folder(a->out, "sweep");
     check_stdout_writable();  // refused before any work (a later failure rolls the sweep back)
     check_threads(a->threads);
     study::SweepRequest q;
-    try {
-      q.formats = study::parse_sweep_formats(a->formats);
-    } catch (const std::invalid_argument& e) {
-      throw UsageError("--formats '" + a->formats + "': " + e.what());
+    // --format: bad input (exit 3, one line naming the flag and the formats known), before any work.
+    if (cmd->count("--format") > 0) {
+      try {
+        q.formats = study::parse_sweep_formats(a->format);
+      } catch (const std::invalid_argument& e) {
+        throw InputError("", "--format '" + a->format + "'", e.what());
+      }
+    } else if (cmd->count("--formats") > 0) {
+      try {
+        q.formats = study::parse_sweep_formats(a->formats);
+      } catch (const std::invalid_argument& e) {
+        throw UsageError("--formats '" + a->formats + "': " + e.what());
+      }
     }
     if (a->no_png) q.formats.png = false;
     const scene::Scene sc = scene::load_scene(a->scene, overrides_from(a->set));
@@ -87,9 +100,9 @@ void register_sweep(CLI::App& app, Context& ctx) {
     q.sweep.curve_samples = a->curve_samples;
     q.out_dir = a->out;
     q.prefix = a->prefix;
-    // Two bars, computing then writing; they end their line when unwinding (~ProgressBar), before
+    // Two bars, computing then writing; they end their line when unwinding (~ProgressLine), before
     // an error is printed.
-    study::ProgressBar sweep_bar("sweep", !ctx.quiet), write_bar("write", !ctx.quiet);
+    ProgressLine sweep_bar("sweep", !ctx.quiet, "points"), write_bar("write", !ctx.quiet, "values");
     q.progress = [&](Stage stage, std::size_t done, std::size_t total) {
       if (stage == Stage::sweep) {
         sweep_bar.update(done, total);

@@ -24,7 +24,8 @@ void Context::warn(const std::string& text) const {
   if (!quiet) std::cerr << "impactdeck: warning: " << InputError::one_line(text) << "\n";
 }
 
-std::ostream* Context::progress() const { return quiet ? nullptr : &std::cerr; }
+// Progress (lines, bars) goes to a terminal only: a log file or a pipe gets none.
+std::ostream* Context::progress() const { return quiet || ::isatty(STDERR_FILENO) != 1 ? nullptr : &std::cerr; }
 
 void Context::note(const std::string& command, const std::string& text) const {
   if (verbose) std::cerr << "impactdeck: " << command << ": " << InputError::one_line(text) << "\n";

@@ -41,6 +41,9 @@ find_package(PkgConfig QUIET)
 impactdeck_require(PKG_CONFIG_FOUND "pkg-config" pkgconf)
 pkg_check_modules(Cairo QUIET IMPORTED_TARGET cairo)
 impactdeck_require(Cairo_FOUND "cairo" libcairo2-dev)
+# zlib: the compressed blocks of the sweeps' VTK files (study/src/vtk_xml.cpp).
+find_package(ZLIB QUIET)
+impactdeck_require(ZLIB_FOUND "zlib" zlib1g-dev)
 # nettle: the SHA-256 of the input files on the report page.
 pkg_check_modules(Nettle QUIET IMPORTED_TARGET nettle)
 impactdeck_require(Nettle_FOUND "nettle" nettle-dev)

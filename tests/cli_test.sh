@@ -94,12 +94,28 @@ check "failed check publishes the evidence" test -s "$tmp/out4/force_table2.csv"
 check "failed check: the report says FAILED first" grep -q "^FAILED: " <(sed -n 2p "$tmp/strict.out")
 
 # 6. Sweep: files, JSON summary, quiet progress, errors.
-"$bin" sweep "$src/samples/fig4_sweep.toml" --out "$tmp/sw" --json --quiet --no-png >"$tmp/sw.json" 2>"$tmp/sw.err"
+# The files of earlier versions, one flag away (--format csv,vtp,pos,svg,png).
+"$bin" sweep "$src/samples/fig4_sweep.toml" --out "$tmp/sw" --json --quiet --format csv,vtp,pos,svg,png --no-png >"$tmp/sw.json" 2>"$tmp/sw.err"
 check "sweep exit 0" test $? -eq 0
 for f in sweep_fig4.csv sweep_fig4.pos sweep_fig4.vtp sweep_fig4.svg; do
   check "sweep wrote $f" test -s "$tmp/sw/$f"
 done
 check "sweep --no-png writes no PNG" test ! -e "$tmp/sw/sweep_fig4.png"
+# By default: the compressed VTK file and the picture's SVG, nothing else.
+"$bin" sweep "$src/samples/fig4_sweep.toml" --out "$tmp/swd" --quiet >/dev/null 2>&1
+check "sweep default exit 0" test $? -eq 0
+check "sweep writes the .vtu and the .svg by default" test "$(ls "$tmp/swd" | tr '\n' ' ')" = "sweep_fig4.svg sweep_fig4.vtu "
+check "sweep's default .vtu is zlib-compressed" grep -q 'compressor="vtkZLibDataCompressor"' "$tmp/swd/sweep_fig4.vtu"
+# --format: an unknown name, an empty list or an empty name exit 3 with one line naming the flag and
+# the formats known, and nothing written (not even the folder).
+for bad in "csv,stl" "" "vtu,,csv"; do
+  "$bin" sweep "$src/samples/fig4_sweep.toml" --out "$tmp/swbad" --quiet --format "$bad" >/dev/null 2>"$tmp/swbad.err"
+  rc=$?
+  check "sweep --format '$bad' exit 3 (got $rc)" test $rc -eq 3
+  check "sweep --format '$bad': one line naming the flag and the formats" \
+    test "$(wc -l <"$tmp/swbad.err")" -eq 1 -a -n "$(grep -- "--format" "$tmp/swbad.err" | grep "csv, vtp, pos, svg, png, vtu or all")"
+  check "sweep --format '$bad': nothing written" test ! -e "$tmp/swbad"
+done
 "$bin" sweep "$src/samples/fig4_sweep.toml" --out "$tmp/swf" --quiet --formats png,csv >/dev/null 2>&1
 check "sweep --formats png,csv exit 0" test $? -eq 0
 check "sweep --formats writes what it lists" test "$(ls "$tmp/swf" | tr '\n' ' ')" = "sweep_fig4.csv sweep_fig4.csv.json sweep_fig4.png "
@@ -125,7 +141,7 @@ PY
 # samples/drop_test.toml hit by the floor at 300 points; maps of F_max, restitution and the dent,
 # and the law's F(t) curves.
 "$bin" sweep "$src/samples/drop_test.toml" --set 'impacts[0].contact_law="thornton"' --cloud uniform --count 300 \
-  --curves --curve-samples 21 --no-png --quiet --json --out "$tmp/swt" >"$tmp/swt.json" 2>"$tmp/swt.err"
+  --curves --curve-samples 21 --format csv,pos --quiet --json --out "$tmp/swt" >"$tmp/swt.json" 2>"$tmp/swt.err"
 rc=$?
 check "thornton sweep on a real part exit 0 (got $rc: $(tail -1 "$tmp/swt.err"))" test $rc -eq 0
 python3 - "$tmp/swt.json" "$tmp/swt" <<'PY' || { echo "FAILED: thornton sweep"; fails=$((fails+1)); }
@@ -191,7 +207,7 @@ PY
 passes=$((passes+1))
 
 # 9. Sweep over a cube's vertices and faces: corners flagged, counted, left out.
-"$bin" sweep "$src/tests/data/bad/scenes/mesh_sharp_edge.toml" --cloud uniform --count 100 --json --quiet --no-png \
+"$bin" sweep "$src/tests/data/bad/scenes/mesh_sharp_edge.toml" --cloud uniform --count 100 --json --quiet --format csv,vtu \
   --out "$tmp/sh" >"$tmp/sh.json"
 check "sweep on a cube exit 0" test $? -eq 0
 python3 - "$tmp/sh.json" "$tmp/sh/sweep_impact1.csv" <<'PY' || { echo "FAILED: sweep on a cube"; fails=$((fails+1)); }

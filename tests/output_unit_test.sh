@@ -31,7 +31,7 @@ for unit in default m in; do
   o="$tmp/$unit"
   "$bin" run "$scene" --json --out "$o" "${flag[@]}" >"$o.run.json" 2>"$o.err"
   check "$unit: run exit 0" test $? -eq 0
-  "$bin" sweep "$scene" --cloud uniform --count 300 --quiet --json --no-png --out "$o" "${flag[@]}" \
+  "$bin" sweep "$scene" --cloud uniform --count 300 --quiet --json --format csv,vtp,pos,svg --out "$o" "${flag[@]}" \
     >"$o.sweep.json" 2>>"$o.err"
   check "$unit: sweep (uniform) exit 0" test $? -eq 0
   "$bin" sweep "$scene" --cloud vertices --prefix corners --quiet --formats csv,vtp,pos --out "$o" "${flag[@]}" \

@@ -1,6 +1,7 @@
 // Writes the sweep files that tests/vtk_reader_test.py reads with VTK's own XML reader (Debian's
-// python3-vtk9, what ParaView uses): for two sweeps, the CSV and the binary VTP with UInt32 and
-// with UInt64 block sizes.
+// python3-vtk9, what ParaView uses) and tests/meshio_reader_test.py with meshio: for two sweeps,
+// the CSV, the raw VTP with UInt32 and with UInt64 block sizes, the compressed VTP and the
+// compressed VTU (the file a sweep writes by default).
 //   1. samples/fig4_sweep.toml: the paper's grid and 500 area-uniform points on the ellipsoid;
 //   2. the 100 mm cube of tests/data/bad (mesh): its 8 corners (flagged sharp_feature = 1) and
 //      200 area-uniform points.
@@ -20,10 +21,14 @@ using namespace impactdeck;
 namespace {
 void write(const fs::path& out, const std::string& name, const study::SweepResult& r) {
   study::write_sweep_csv(out / (name + ".csv"), r, {});
-  study::write_sweep_vtp(out / (name + "_u32.vtp"), r, {});
-  study::SweepWriteOptions wide;
+  study::SweepWriteOptions raw;
+  raw.vtk_compress = false;
+  study::write_sweep_vtp(out / (name + "_u32.vtp"), r, {}, raw);
+  study::SweepWriteOptions wide = raw;
   wide.vtp_uint64_headers = true;
   study::write_sweep_vtp(out / (name + "_u64.vtp"), r, {}, wide);
+  study::write_sweep_vtp(out / (name + "_zlib.vtp"), r, {});  // compressed: the default
+  study::write_sweep_vtu(out / (name + ".vtu"), r, {});
 }
 }  // namespace
 

@@ -723,14 +723,20 @@ TEST(Cloud, PaperGridCounts) {
 }
 
 TEST(Progress, RenderAndSilence) {
-  const std::string line = ProgressBar::render("sweep", 50, 200, 2.0, 20);
+  const std::string line = ProgressLine::render("sweep", 50, 200, 2.0, "points", "", 20);
   EXPECT_NE(line.find("25%"), std::string::npos) << line;
-  EXPECT_NE(line.find("50/200"), std::string::npos) << line;
+  EXPECT_NE(line.find("50/200 points"), std::string::npos) << line;
   EXPECT_NE(line.find("#####     "), std::string::npos) << line;
+  EXPECT_NE(line.find("25 points/s"), std::string::npos) << line;  // the rate
+  EXPECT_NE(line.find("6 s left"), std::string::npos) << line;     // 150 more at 25 per second
+  // An unknown total: the count, the rate and the time elapsed.
+  const std::string open = ProgressLine::render("mesh", 3, 0, 12.0, "tries", "HXT");
+  EXPECT_EQ(open, "mesh 3 tries, 0.25 tries/s, 12 s elapsed (HXT)");
+  EXPECT_NE(ProgressLine::render("sweep", 2.5e6, 5e6, 1.0, "points").find("2.5 M/5 M points"), std::string::npos);
   ProgressBar quiet("sweep", false);
   quiet.update(1, 2);
   EXPECT_FALSE(quiet.shown());
-  ProgressBar young("sweep", true);  // shown only after a second, whatever the terminal
+  ProgressBar young("sweep", true);  // shown only after a few seconds, whatever the terminal
   young.update(1, 2);
   EXPECT_FALSE(young.shown());
 }

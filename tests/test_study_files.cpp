@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 #include <tinyxml2.h>
+#include <zlib.h>
 
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/geometry/ellipsoid.hpp"
@@ -204,13 +205,17 @@ TEST_F(SweepFiles, GmshPosViews) {
   EXPECT_EQ(std::count(pos.begin(), pos.end(), '{'), std::count(pos.begin(), pos.end(), '}'));
 }
 
-// A binary VTP split into its XML part (well-formed once the appended block is cut out) and its
-// arrays decoded from the appended raw data, by their offsets and the header_type's block sizes.
+// A binary VTK file (.vtp, .vtu) split into its XML part (well-formed once the appended block is
+// cut out) and its arrays decoded from the appended raw data, by their offsets and the header_type's
+// block sizes: raw (a byte count, then the values) or, with compressor="vtkZLibDataCompressor",
+// VTK's compressed layout (blocks, block size, last block size, each block's size, then the
+// blocks, each inflated by zlib).
 struct Vtp {
   tinyxml2::XMLDocument doc;
-  std::map<std::string, std::vector<double>> arrays;  // Float64 and Int64 values as doubles
+  std::map<std::string, std::vector<double>> arrays;  // every type's values as doubles
   std::map<std::string, double> field_data;            // <FieldData> (ASCII, one value each)
   std::string header_type;
+  bool compressed = false;
 };
 void read_vtp(const fs::path& p, Vtp& v) {
   const std::string text = slurp(p);
@@ -226,8 +231,19 @@ void read_vtp(const fs::path& p, Vtp& v) {
   ASSERT_STREQ(root->Attribute("byte_order"), "LittleEndian");
   v.header_type = root->Attribute("header_type");
   ASSERT_TRUE(v.header_type == "UInt32" || v.header_type == "UInt64") << v.header_type;
+  v.compressed = root->Attribute("compressor") != nullptr;
+  if (v.compressed) {
+    ASSERT_STREQ(root->Attribute("compressor"), "vtkZLibDataCompressor");
+    ASSERT_EQ(v.header_type, "UInt64");
+  }
   const std::size_t size_bytes = v.header_type == "UInt64" ? 8 : 4;
   const char* data = text.data() + underscore + 1;
+  const std::size_t data_size = text.size() - underscore - 1;
+  auto word = [&](std::size_t at) {
+    std::uint64_t x = 0;
+    std::memcpy(&x, data + at, size_bytes);
+    return x;
+  };
   std::size_t expected_offset = 0;
   for (const auto* a : all(root, "DataArray")) {
     if (std::string(a->Parent()->ToElement()->Name()) == "FieldData") {
@@ -238,48 +254,77 @@ void read_vtp(const fs::path& p, Vtp& v) {
     ASSERT_STREQ(a->Attribute("format"), "appended");
     const std::size_t offset = std::stoull(a->Attribute("offset"));
     EXPECT_EQ(offset, expected_offset) << a->Attribute("Name");  // blocks follow each other
-    std::uint64_t bytes = 0;
-    std::memcpy(&bytes, data + offset, size_bytes);
-    ASSERT_LE(underscore + 1 + offset + size_bytes + bytes, text.size());
-    ASSERT_EQ(bytes % 8, 0u);
-    std::vector<double>& out = v.arrays[a->Attribute("Name")];
-    for (std::size_t k = 0; k < bytes / 8; ++k) {
-      const char* at8 = data + offset + size_bytes + 8 * k;
-      if (std::string(a->Attribute("type")) == "Int64") {
-        std::int64_t x;
-        std::memcpy(&x, at8, 8);
-        out.push_back(static_cast<double>(x));
-      } else {
-        ASSERT_STREQ(a->Attribute("type"), "Float64");
-        double x;
-        std::memcpy(&x, at8, 8);
-        out.push_back(x);
+    std::string values;
+    if (!v.compressed) {
+      const std::uint64_t bytes = word(offset);
+      ASSERT_LE(offset + size_bytes + bytes, data_size);
+      values.assign(data + offset + size_bytes, bytes);
+      expected_offset = offset + size_bytes + bytes;
+    } else {
+      const std::uint64_t blocks = word(offset), block = word(offset + 8), last = word(offset + 16);
+      std::size_t at_block = offset + 8 * (3 + blocks);
+      for (std::uint64_t b = 0; b < blocks; ++b) {
+        const std::uint64_t packed = word(offset + 8 * (3 + b));
+        ASSERT_LE(at_block + packed, data_size);
+        uLongf size = static_cast<uLongf>(b + 1 == blocks ? last : block);
+        std::string out(size, '\0');
+        ASSERT_EQ(uncompress(reinterpret_cast<Bytef*>(out.data()), &size,
+                             reinterpret_cast<const Bytef*>(data + at_block), static_cast<uLong>(packed)), Z_OK);
+        ASSERT_EQ(size, b + 1 == blocks ? last : block);
+        values += out;
+        at_block += packed;
       }
+      expected_offset = at_block;
     }
-    expected_offset = offset + size_bytes + bytes;
+    const std::string type = a->Attribute("type");
+    std::vector<double>& out = v.arrays[a->Attribute("Name")];
+    auto decode = [&](auto x) {
+      ASSERT_EQ(values.size() % sizeof(x), 0u);
+      for (std::size_t k = 0; k < values.size(); k += sizeof(x)) {
+        std::memcpy(&x, values.data() + k, sizeof(x));
+        out.push_back(static_cast<double>(x));
+      }
+    };
+    if (type == "Float64") decode(0.0);
+    else if (type == "Int64") decode(std::int64_t{0});
+    else if (type == "Int32") decode(std::int32_t{0});
+    else if (type == "UInt8") decode(std::uint8_t{0});
+    else FAIL() << "type " << type;
   }
   // After the last block: the closing tags only.
   EXPECT_EQ(text.substr(underscore + 1 + expected_offset), "\n</AppendedData>\n</VTKFile>\n");
 }
 
 TEST_F(SweepFiles, VtpIsBinaryPolyDataWithTheResultsArrays) {
-  for (bool wide : {false, true}) {
-    SCOPED_TRACE(wide ? "UInt64 block sizes" : "UInt32 block sizes");
+  // Compressed (the default), and raw with UInt32 and UInt64 block sizes; as PolyData and as an
+  // UnstructuredGrid of vertex cells.
+  struct Case {
+    bool compress, wide, grid;
+  };
+  for (const Case c : {Case{true, false, false}, Case{false, false, false}, Case{false, true, false}, Case{true, false, true},
+                       Case{false, false, true}}) {
+    SCOPED_TRACE(std::string(c.grid ? "vtu, " : "vtp, ") +
+                 (c.compress ? "compressed" : c.wide ? "UInt64 block sizes" : "UInt32 block sizes"));
     SweepWriteOptions o;
-    o.vtp_uint64_headers = wide;
-    write_sweep_vtp(*dir / "w.vtp", *result, {}, o);
+    o.vtk_compress = c.compress;
+    o.vtp_uint64_headers = c.wide;
+    const fs::path f = *dir / (c.grid ? "w.vtu" : "w.vtp");
+    if (c.grid) write_sweep_vtu(f, *result, {}, o);
+    else write_sweep_vtp(f, *result, {}, o);
     Vtp v;
-    read_vtp(*dir / "w.vtp", v);
-    EXPECT_EQ(v.header_type, wide ? "UInt64" : "UInt32");
+    read_vtp(f, v);
+    EXPECT_EQ(v.header_type, c.wide || c.compress ? "UInt64" : "UInt32");
+    EXPECT_EQ(v.compressed, c.compress);
     const auto* root = v.doc.RootElement();
     EXPECT_STREQ(root->Name(), "VTKFile");
-    EXPECT_STREQ(root->Attribute("type"), "PolyData");
+    EXPECT_STREQ(root->Attribute("type"), c.grid ? "UnstructuredGrid" : "PolyData");
     const auto pieces = all(root, "Piece");
     ASSERT_EQ(pieces.size(), 1u);
     const std::size_t n = result->points.size();
     EXPECT_EQ(pieces[0]->UnsignedAttribute("NumberOfPoints"), n);
-    EXPECT_EQ(pieces[0]->UnsignedAttribute("NumberOfVerts"), n);
-    EXPECT_EQ(v.arrays.size(), 14u);  // 10 scalars (flag included) + normals + points + connectivity + offsets
+    EXPECT_EQ(pieces[0]->UnsignedAttribute(c.grid ? "NumberOfCells" : "NumberOfVerts"), n);
+    // 10 scalars (flag included) + normals + points + connectivity + offsets (+ cell types)
+    EXPECT_EQ(v.arrays.size(), c.grid ? 15u : 14u);
     const double fmax = result->points[result->max_index].max_force_N;
     for (std::size_t i = 0; i < n; ++i) {
       const PointResult& p = result->points[i];
@@ -300,8 +345,40 @@ TEST_F(SweepFiles, VtpIsBinaryPolyDataWithTheResultsArrays) {
       }
       ASSERT_EQ(v.arrays["connectivity"].at(i), static_cast<double>(i));
       ASSERT_EQ(v.arrays["offsets"].at(i), static_cast<double>(i + 1));
+      if (c.grid) ASSERT_EQ(v.arrays["types"].at(i), 1.0);  // VTK_VERTEX
     }
   }
+}
+
+// A compressed file of many blocks (a 200 000-point result: 5 blocks per Float64 array) decodes to
+// the same values on 1 and 3 threads, byte for byte the same file, and is smaller than the raw one.
+TEST_F(SweepFiles, CompressedVtkOfManyBlocks) {
+  SweepResult big = *result;
+  big.points.resize(200000);
+  for (std::size_t i = result->points.size(); i < big.points.size(); ++i) {
+    big.points[i] = result->points[i % result->points.size()];
+    big.points[i].point_m *= 1.0 + 1e-7 * static_cast<double>(i);
+  }
+  std::string first;
+  for (unsigned threads : {1u, 3u}) {
+    SweepWriteOptions o;
+    o.threads = threads;
+    const fs::path f = *dir / ("big" + std::to_string(threads) + ".vtu");
+    write_sweep_vtu(f, big, {}, o);
+    if (first.empty()) first = slurp(f);
+    else EXPECT_TRUE(slurp(f) == first);
+  }
+  Vtp v;
+  read_vtp(*dir / "big1.vtu", v);
+  ASSERT_EQ(v.arrays["Points"].size(), 3 * big.points.size());
+  for (std::size_t i = 0; i < big.points.size(); ++i) {
+    ASSERT_EQ(v.arrays["max_force_N"][i], big.points[i].max_force_N);
+    for (int k = 0; k < 3; ++k) ASSERT_EQ(v.arrays["Points"][3 * i + k], big.points[i].point_m[k]);
+  }
+  SweepWriteOptions raw;
+  raw.vtk_compress = false;
+  write_sweep_vtu(*dir / "big_raw.vtu", big, {}, raw);
+  EXPECT_LT(fs::file_size(*dir / "big1.vtu"), fs::file_size(*dir / "big_raw.vtu"));
 }
 
 // The coordinates in the output length unit (issue 18): the .vtp's points, the CSV's columns and
@@ -455,10 +532,15 @@ TEST_F(SweepFiles, NonFiniteValueIsAnInternalErrorAndNoFile) {
 }
 
 TEST(SweepFormats, ParsesTheListAndRefusesUnknownOrRepeatedNames) {
-  const SweepFormats all = parse_sweep_formats("csv,vtp,pos,svg,png");
-  EXPECT_TRUE(all.csv && all.vtp && all.pos && all.svg && all.png && !all.curves);
+  const SweepFormats old = parse_sweep_formats("csv,vtp,pos,svg,png");
+  EXPECT_TRUE(old.csv && old.vtp && old.pos && old.svg && old.png && !old.vtu && !old.curves);
   const SweepFormats two = parse_sweep_formats("png,csv");
-  EXPECT_TRUE(two.csv && two.png && !two.vtp && !two.pos && !two.svg);
+  EXPECT_TRUE(two.csv && two.png && !two.vtp && !two.pos && !two.svg && !two.vtu);
+  const SweepFormats every = parse_sweep_formats("all");
+  EXPECT_TRUE(every.csv && every.vtp && every.pos && every.svg && every.png && every.vtu);
+  const SweepFormats defaults;  // the compressed .vtu and the picture's SVG
+  EXPECT_TRUE(defaults.vtu && defaults.svg && !defaults.csv && !defaults.vtp && !defaults.pos && !defaults.png);
+  EXPECT_THROW(parse_sweep_formats("csv,,pos"), std::invalid_argument);
   EXPECT_THROW(parse_sweep_formats("csv,xyz"), std::invalid_argument);
   EXPECT_THROW(parse_sweep_formats("csv,csv"), std::invalid_argument);
   EXPECT_THROW(parse_sweep_formats(""), std::invalid_argument);

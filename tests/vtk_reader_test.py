@@ -1,13 +1,14 @@
-"""The binary VTP files of a sweep, read by VTK's own XML reader (vtkXMLPolyDataReader, what
-ParaView uses; Debian python3-vtk9), hold exactly the CSV's numbers: every point-data array, the
-points and the vertex cells, for UInt32 and UInt64 block sizes.
+"""The binary VTK files of a sweep, read by VTK's own XML readers (vtkXMLPolyDataReader and
+vtkXMLUnstructuredGridReader, what ParaView and pyvista use; Debian python3-vtk9), hold exactly the
+CSV's numbers: every point-data array, the points and the vertex cells, in the raw .vtp with UInt32
+and UInt64 block sizes, the zlib-compressed .vtp and the compressed .vtu (a sweep's default file).
 usage: vtk_reader_test.py DIR (written by sweep_files_fixture)"""
 import csv
 import os
 import sys
 
 try:
-    from vtkmodules.vtkIOXML import vtkXMLPolyDataReader
+    from vtkmodules.vtkIOXML import vtkXMLPolyDataReader, vtkXMLUnstructuredGridReader
     from vtkmodules.vtkCommonCore import vtkLogger
 except ImportError as e:
     sys.exit(f"FAILED: VTK's Python modules are missing ({e}): install the Debian package python3-vtk9")
@@ -35,9 +36,9 @@ for name in ["ellipsoid", "cube"]:
         "contact_ellipse_axis_ratio": ["contact_ellipse_axis_ratio"], "sharp_feature": ["sharp_feature"],
         "normal": ["nx", "ny", "nz"],
     }
-    for header in ["u32", "u64"]:
-        path = os.path.join(folder, f"{name}_{header}.vtp")
-        reader = vtkXMLPolyDataReader()
+    for header in ["_u32.vtp", "_u64.vtp", "_zlib.vtp", ".vtu"]:
+        path = os.path.join(folder, name + header)
+        reader = vtkXMLUnstructuredGridReader() if header == ".vtu" else vtkXMLPolyDataReader()
         reader.SetFileName(path)
         reader.Update()
         pd = reader.GetOutput()
@@ -45,8 +46,9 @@ for name in ["ellipsoid", "cube"]:
         if reader.GetErrorCode() != 0:
             problems.append(f"reader error code {reader.GetErrorCode()}")
         n = len(body)
-        if pd.GetNumberOfPoints() != n or pd.GetNumberOfVerts() != n:
-            problems.append(f"{pd.GetNumberOfPoints()} points, {pd.GetNumberOfVerts()} verts, CSV has {n} rows")
+        cells = pd.GetNumberOfCells() if header == ".vtu" else pd.GetNumberOfVerts()
+        if pd.GetNumberOfPoints() != n or cells != n:
+            problems.append(f"{pd.GetNumberOfPoints()} points, {cells} cells, CSV has {n} rows")
         data = pd.GetPointData()
         names = sorted(data.GetArrayName(i) for i in range(data.GetNumberOfArrays()))
         if names != sorted(list(expected) + ["flag"]):
@@ -74,11 +76,13 @@ for name in ["ellipsoid", "cube"]:
                if points is None or list(points.GetPoint(i)) != [float(body[i][col[c]]) for c in ["x_m", "y_m", "z_m"]]]
         if bad:
             problems.append(f"points: {len(bad)} differ from the CSV")
-        verts = pd.GetVerts()
+        verts = pd.GetCells() if header == ".vtu" else pd.GetVerts()
         cells = [verts.GetOffsetsArray().GetValue(i) for i in range(n + 1)] if verts else []
         ids = [verts.GetConnectivityArray().GetValue(i) for i in range(n)] if verts else []
         if cells != list(range(n + 1)) or ids != list(range(n)):
             problems.append("vertex cells are not one per point")
+        if header == ".vtu" and any(pd.GetCellType(i) != 1 for i in range(n)):  # VTK_VERTEX
+            problems.append("cells that are not vertices")
         sharp = sum(float(r[col["sharp_feature"]]) for r in body)
         if (name == "cube") != (sharp > 0):
             problems.append(f"{sharp} sharp points")

@@ -20,7 +20,7 @@
 #include "impactdeck/common/atomic_file.hpp"
 #include "impactdeck/common/error.hpp"
 #include "impactdeck/common/input_file.hpp"
-#include "impactdeck/study/progress.hpp"
+#include "impactdeck/common/progress.hpp"
 #include "detail.hpp"
 
 extern char** environ;
@@ -91,7 +91,7 @@ RunSummary run_local(const fs::path& dir_in, const LocalOptions& o) {
       todo.push_back(id);
     }
   }
-  study::ProgressBar bar("campaign", o.progress_bar);
+  ProgressLine bar("campaign", o.progress_bar, "cases");
   std::map<pid_t, std::size_t> running;
   std::size_t next = 0, finished = 0;
   const std::size_t jobs = std::max<std::size_t>(1, o.jobs);

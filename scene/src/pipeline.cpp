@@ -15,6 +15,8 @@
 #include "impactdeck/common/csv_sidecar.hpp"
 #include "impactdeck/common/run_transaction.hpp"
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/common/number_text.hpp"
+#include "impactdeck/common/progress.hpp"
 #include "impactdeck/common/stage.hpp"
 #include "impactdeck/fem_export/force_table.hpp"
 #include "impactdeck/plot/force_plot.hpp"
@@ -453,7 +455,7 @@ void choose_point_law(const Scene& scene, const ImpactSpec& s, ImpactLaw& law, s
 // every Hertzian impact (solve_located_impact: the same checks, law figures and warnings as a
 // single impact), and the rigid impulse's report where no Hertz force exists.
 SequenceReport run_sequence(const Scene& scene, const SequenceSpec& q, const std::map<std::string, PreparedBody>& bodies,
-                            std::vector<std::string>& warnings) {
+                            std::vector<std::string>& warnings, bool progress) {
   SequenceReport sr;
   sr.spec = std::make_shared<const SequenceSpec>(q);
   const InputContext ctx{where(scene), InputContext::joined(q.place.describe(), "sequence '" + q.name + "'")};
@@ -493,7 +495,13 @@ SequenceReport run_sequence(const Scene& scene, const SequenceSpec& q, const std
     solved.emplace(index, std::move(ir));
     return impact;
   };
+  // A long sequence (many impacts of a large mesh) shows its progress on a terminal.
+  ProgressLine line("sequence '" + q.name + "'", progress, "impacts");
+  in.progress = [&line](std::size_t impacts, int max_impacts, double time_s) {
+    line.update(static_cast<double>(impacts), max_impacts, "t = " + format_number(time_s, 4) + " s");
+  };
   sr.result = sequence::run_sequence(in);
+  line.finish();
   for (std::size_t i = 0; i < sr.result.bounces.size(); ++i) {
     const sequence::Bounce& b = sr.result.bounces[i];
     if (auto it = solved.find(i); it != solved.end()) {
@@ -784,7 +792,7 @@ void run_stages(const Scene& scene, const RunOptions& opt, RunTransaction& txn, 
   }
   for (const auto& q : scene.sequences) {
     ScopedTimer timer([&report](double sec) { add_stage(report, kSequenceStage, sec); });
-    report.sequences.push_back(run_sequence(scene, q, bodies, report.warnings));
+    report.sequences.push_back(run_sequence(scene, q, bodies, report.warnings, opt.progress != nullptr));
   }
 
   // A failed check does not stop the run: every output is still written and published, as the

@@ -216,6 +216,7 @@ SequenceResult run_sequence(const SequenceInput& in) {
     s = b.after;
     out.trajectory.push_back({s, nc.gap_m});
     out.bounces.push_back(std::move(b));
+    if (in.progress) in.progress(out.bounces.size(), in.max_impacts, s.time_s);
     if (static_cast<int>(out.bounces.size()) >= in.max_impacts) {
       out.stop = StopReason::max_impacts;
       out.stop_detail = std::to_string(in.max_impacts) + " impacts computed (max_impacts)";

@@ -84,7 +84,7 @@ void sweep_stages(const SweepCase& ss, const SweepRequest& q, RunTransaction* tx
     const std::string prefix_place = q.prefix.empty() ? "--prefix (default sweep_<impact name>)" : "--prefix";
     for (const auto& [wanted, suffix] : {std::pair{formats.csv, ".csv"}, std::pair{formats.curves, "_curves.csv"},
                                          std::pair{formats.pos, ".pos"}, std::pair{formats.vtp, ".vtp"},
-                                         std::pair{formats.svg, ".svg"}, std::pair{formats.png, ".png"}}) {
+                                         std::pair{formats.vtu, ".vtu"}, std::pair{formats.svg, ".svg"}, std::pair{formats.png, ".png"}}) {
       if (!wanted) continue;
       const fs::path staged = txn->file(prefix + suffix, txn->out_dir().string(), prefix_place);
       rep.files_written.push_back(txn->public_path(staged));

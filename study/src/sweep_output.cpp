@@ -11,7 +11,6 @@
 #include <mutex>
 #include <thread>
 
-#include "impactdeck/common/xml_text.hpp"
 #include "impactdeck/common/atomic_file.hpp"
 #include "impactdeck/common/csv_sidecar.hpp"
 #include "impactdeck/common/error.hpp"
@@ -20,6 +19,7 @@
 #include "number_text.hpp"
 #include "parallel.hpp"
 #include "table_text.hpp"
+#include "vtk_xml.hpp"
 
 namespace impactdeck::study {
 namespace {
@@ -230,22 +230,13 @@ void write_sweep_pos(const std::filesystem::path& path, const SweepResult& r, co
 
 namespace {
 
-// One array of a binary VTP file: its XML attributes and its raw values (host byte order).
-struct VtpArray {
-  std::string type;  // Float64, Int64
-  std::string name;
-  int components = 1;
-  std::function<void(std::size_t begin, std::size_t end, char* out)> fill;  // values of points [begin, end)
-  std::size_t value_bytes() const { return 8 * static_cast<std::size_t>(components); }
-};
-
 double finite(double v) {
   if (!std::isfinite(v)) throw Error(ExitCode::internal_error, std::string(kWhat) + ": non-finite value");
   return v + 0.0;
 }
 
 template <class Get>
-VtpArray scalar_array(const char* name, const std::vector<PointResult>& P, Get get) {
+detail::VtkArray scalar_array(const char* name, const std::vector<PointResult>& P, Get get) {
   return {"Float64", name, 1, [&P, get](std::size_t begin, std::size_t end, char* out) {
             for (std::size_t i = begin; i < end; ++i) {
               const double v = finite(get(P[i]));
@@ -254,8 +245,16 @@ VtpArray scalar_array(const char* name, const std::vector<PointResult>& P, Get g
           }};
 }
 
+// A small count (0/1, a flag's number) as one byte.
 template <class Get>
-VtpArray vector_array(const char* name, const std::vector<PointResult>& P, Get get) {
+detail::VtkArray byte_array(const char* name, const std::vector<PointResult>& P, Get get) {
+  return {"UInt8", name, 1, [&P, get](std::size_t begin, std::size_t end, char* out) {
+            for (std::size_t i = begin; i < end; ++i) out[i - begin] = static_cast<char>(get(P[i]));
+          }};
+}
+
+template <class Get>
+detail::VtkArray vector_array(const char* name, const std::vector<PointResult>& P, Get get) {
   return {"Float64", name, 3, [&P, get](std::size_t begin, std::size_t end, char* out) {
             for (std::size_t i = begin; i < end; ++i) {
               const Eigen::Vector3d x = get(P[i]);
@@ -267,30 +266,13 @@ VtpArray vector_array(const char* name, const std::vector<PointResult>& P, Get g
           }};
 }
 
-VtpArray count_array(const char* name, std::int64_t first) {
-  return {"Int64", name, 1, [first](std::size_t begin, std::size_t end, char* out) {
-            for (std::size_t i = begin; i < end; ++i) {
-              const std::int64_t v = first + static_cast<std::int64_t>(i);
-              std::memcpy(out + 8 * (i - begin), &v, 8);
-            }
-          }};
-}
-
-bool little_endian() {
-  const std::uint16_t one = 1;
-  unsigned char b;
-  std::memcpy(&b, &one, 1);
-  return b == 1;
-}
-
-}  // namespace
-
-void write_sweep_vtp(const std::filesystem::path& path, const SweepResult& r, const SweepMeta& meta,
-                     const SweepWriteOptions& options) {
-  const std::size_t n = r.points.size();
+// The .vtp and the .vtu: the same points, point data and header, as PolyData or UnstructuredGrid.
+void write_sweep_vtk(const std::filesystem::path& path, const SweepResult& r, const SweepMeta& meta,
+                     const SweepWriteOptions& options, detail::VtkDataset dataset) {
+  static_assert(collision::kContactFlagCount <= 256, "the flag array is one byte");
   const double fmax = max_force(r);
   const auto& P = r.points;
-  const std::vector<VtpArray> point_data = {
+  const std::vector<detail::VtkArray> point_data = {
       scalar_array("max_force_N", P, [](const PointResult& p) { return p.max_force_N; }),
       scalar_array("force_ratio", P, [fmax](const PointResult& p) { return p.max_force_N / fmax; }),
       scalar_array("restitution", P, [](const PointResult& p) { return p.restitution; }),
@@ -299,93 +281,60 @@ void write_sweep_vtp(const std::filesystem::path& path, const SweepResult& r, co
       scalar_array("effective_radius_m", P, [](const PointResult& p) { return p.effective_radius_m; }),
       scalar_array("target_radius_m", P, [](const PointResult& p) { return radius_out(p.target_radius_m); }),
       scalar_array("contact_ellipse_axis_ratio", P, [](const PointResult& p) { return p.contact_ellipse_axis_ratio; }),
-      scalar_array("sharp_feature", P, [](const PointResult& p) { return p.sharp_feature ? 1.0 : 0.0; }),
+      byte_array("sharp_feature", P, [](const PointResult& p) { return p.sharp_feature ? 1 : 0; }),
       // collision::ContactFlag's number (0: valid)
-      scalar_array("flag", P, [](const PointResult& p) { return static_cast<double>(p.flag); }),
+      byte_array("flag", P, [](const PointResult& p) { return static_cast<int>(p.flag); }),
       vector_array("normal", P, [](const PointResult& p) -> const Eigen::Vector3d& { return p.normal; })};
   const double per_m = 1.0 / metres_per(options.length_unit);
-  const VtpArray points = vector_array("Points", P, [per_m](const PointResult& p) -> Eigen::Vector3d { return p.point_m * per_m; });
-  const VtpArray connectivity = count_array("connectivity", 0), offsets = count_array("offsets", 1);
+  const detail::VtkArray points =
+      vector_array("Points", P, [per_m](const PointResult& p) -> Eigen::Vector3d { return p.point_m * per_m; });
+  std::ostringstream h;
+  header(h, "", meta, r, options.length_unit);
+  detail::VtkWriteOptions w;
+  w.dataset = dataset;
+  w.compress = options.vtk_compress;
+  w.uint64_headers = options.vtp_uint64_headers;
+  w.threads = options.threads;
+  w.progress = options.progress;
+  detail::write_vtk_points(path, P.size(), point_data, points, "max_force_N", "normal", h.str(),
+                           num(metres_per(options.length_unit)), w);
+}
 
-  // Appended raw data: per array a block size (UInt32, or UInt64 when a block needs it or when
-  // asked), then the values; each array's offset counts from the byte after the '_'.
-  const std::size_t largest = n * 24;
-  const bool wide = options.vtp_uint64_headers || largest > 0xffffffffull;
-  const std::size_t size_bytes = wide ? 8 : 4;
-  write_file_atomically(path, [&](std::ostream& o) {
-    std::size_t offset = 0;
-    auto declare = [&](const VtpArray& a) {
-      o << "<DataArray type=\"" << a.type << "\" Name=\"" << a.name << "\"";
-      if (a.components != 1) o << " NumberOfComponents=\"" << a.components << "\"";
-      o << " format=\"appended\" offset=\"" << offset << "\"/>\n";
-      offset += size_bytes + n * a.value_bytes();
-    };
-    o << "<?xml version=\"1.0\"?>\n";
-    std::ostringstream h;
-    header(h, "", meta, r, options.length_unit);
-    // The header holds the scene's names: made comment text ("--" and control characters are not
-    // allowed inside an XML comment).
-    o << "<!--\n" << xml_comment_text(h.str()) << "-->\n";
-    o << "<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"" << (little_endian() ? "LittleEndian" : "BigEndian")
-      << "\" header_type=\"" << (wide ? "UInt64" : "UInt32") << "\">\n<PolyData>\n"
-      << "<FieldData>\n<DataArray type=\"Float64\" Name=\"metres_per_length_unit\" NumberOfTuples=\"1\" "
-         "format=\"ascii\">" << num(metres_per(options.length_unit)) << "</DataArray>\n</FieldData>\n"
-      << "<Piece NumberOfPoints=\"" << n << "\" NumberOfVerts=\"" << n
-      << "\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n"
-      << "<PointData Scalars=\"max_force_N\" Normals=\"normal\">\n";
-    for (const VtpArray& a : point_data) declare(a);
-    o << "</PointData>\n<Points>\n";
-    declare(points);
-    o << "</Points>\n<Verts>\n";
-    declare(connectivity);
-    declare(offsets);
-    o << "</Verts>\n</Piece>\n</PolyData>\n<AppendedData encoding=\"raw\">\n_";
-    std::vector<const VtpArray*> all;
-    for (const VtpArray& a : point_data) all.push_back(&a);
-    for (const VtpArray* a : {&points, &connectivity, &offsets}) all.push_back(a);
-    // Progress over all arrays' values.
-    std::size_t done = 0;
-    for (const VtpArray* a : all) {
-      const std::uint64_t bytes = n * a->value_bytes();
-      char size[8];
-      if (wide) {
-        std::memcpy(size, &bytes, 8);
-      } else {
-        const std::uint32_t b32 = static_cast<std::uint32_t>(bytes);
-        std::memcpy(size, &b32, 4);
-      }
-      o.write(size, static_cast<std::streamsize>(size_bytes));
-      detail::RowWriteOptions w = row_options(options);
-      w.chunk_rows = 65536;
-      if (options.progress)
-        w.progress = [&](std::size_t d, std::size_t) { options.progress(done + d, n * all.size()); };
-      detail::write_rows(o, n, [a](std::size_t begin, std::size_t end, std::string& out) {
-        out.resize((end - begin) * a->value_bytes());
-        a->fill(begin, end, out.data());
-      }, w);
-      done += n;
-    }
-    o << "\n</AppendedData>\n</VTKFile>\n";
-  });
+}  // namespace
+
+void write_sweep_vtp(const std::filesystem::path& path, const SweepResult& r, const SweepMeta& meta,
+                     const SweepWriteOptions& options) {
+  write_sweep_vtk(path, r, meta, options, detail::VtkDataset::poly_data);
+}
+
+void write_sweep_vtu(const std::filesystem::path& path, const SweepResult& r, const SweepMeta& meta,
+                     const SweepWriteOptions& options) {
+  write_sweep_vtk(path, r, meta, options, detail::VtkDataset::unstructured_grid);
 }
 
 SweepFormats parse_sweep_formats(const std::string& list) {
+  static const char* const known = "csv, vtp, pos, svg, png, vtu or all";
+  if (list.empty()) throw std::invalid_argument(std::string("the list is empty; name one or more of ") + known);
   SweepFormats f;
-  f.csv = f.vtp = f.pos = f.svg = f.png = false;
+  f.csv = f.vtp = f.pos = f.svg = f.png = f.vtu = false;
+  bool all = false;
   std::size_t start = 0;
   for (;;) {
     const std::size_t comma = list.find(',', start);
     const std::string name = list.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
     bool* flag = name == "csv" ? &f.csv : name == "vtp" ? &f.vtp : name == "pos" ? &f.pos
-               : name == "svg" ? &f.svg : name == "png" ? &f.png : nullptr;
+               : name == "svg" ? &f.svg : name == "png" ? &f.png : name == "vtu" ? &f.vtu
+               : name == "all" ? &all : nullptr;
+    if (name.empty()) throw std::invalid_argument(std::string("an empty name in the list; known: ") + known);
     if (!flag)
-      throw std::invalid_argument("'" + name + "' is not one of csv, vtp, pos, svg, png" +
-                                  did_you_mean(name, {"csv", "vtp", "pos", "svg", "png"}));
+      throw std::invalid_argument("'" + name + "' is not one of " + known +
+                                  did_you_mean(name, {"csv", "vtp", "pos", "svg", "png", "vtu", "all"}));
     if (*flag) throw std::invalid_argument("'" + name + "' is listed twice");
     *flag = true;
     if (comma == std::string::npos) break;
     start = comma + 1;
   }
+  if (all) f.csv = f.vtp = f.pos = f.svg = f.png = f.vtu = true;
   return f;
 }
 
@@ -416,7 +365,9 @@ std::vector<std::filesystem::path> write_sweep_files(const std::filesystem::path
     jobs.push_back({with("_curves.csv"), n, [&](const SweepWriteOptions& o) { write_sweep_curves_csv(with("_curves.csv"), r, meta, o); }});
   if (formats.pos)
     jobs.push_back({with(".pos"), n * (3 + (r.sharp_count > 0 ? 1 : 0) + (r.flagged_count > r.sharp_count ? 1 : 0)), [&](const SweepWriteOptions& o) { write_sweep_pos(with(".pos"), r, meta, o); }});
-  if (formats.vtp) jobs.push_back({with(".vtp"), 12 * n, [&](const SweepWriteOptions& o) { write_sweep_vtp(with(".vtp"), r, meta, o); }});
+  // .vtp: 11 point-data arrays, the points, 2 cell arrays; .vtu one more (the cell types).
+  if (formats.vtp) jobs.push_back({with(".vtp"), 14 * n, [&](const SweepWriteOptions& o) { write_sweep_vtp(with(".vtp"), r, meta, o); }});
+  if (formats.vtu) jobs.push_back({with(".vtu"), 15 * n, [&](const SweepWriteOptions& o) { write_sweep_vtu(with(".vtu"), r, meta, o); }});
   if (formats.svg || formats.png) {
     jobs.push_back({formats.svg ? with(".svg") : with(".png"), 0, [&](const SweepWriteOptions&) {
                       const plot::Drawing drawing = force_map_drawing(*picture.target, picture.centroid_m, r, picture.options);

@@ -14,6 +14,7 @@
 #include "../deck_text.hpp"
 #include "../solver_process.hpp"
 #include "impactdeck/common/error.hpp"
+#include "impactdeck/common/progress.hpp"
 
 namespace impactdeck::fem_export::calculix {
 namespace fs = std::filesystem;
@@ -148,22 +149,16 @@ double run_ccx(const fs::path& work, const CheckOptions& o, double end_time_s, d
     std::error_code ec;
     fs::remove(work / (job + ext), ec);
   }
-  const auto t0 = std::chrono::steady_clock::now();
-  std::string last;
-  auto last_print = t0;
-  bool final_line = false;  // after the run: the last state once more, however short the run was
+  // Progress (common/progress.hpp): ccx's simulated time against the step's end, from its .sta
+  // file, read at most every half second; on a terminal only, once the run has lasted a while.
+  ProgressLine line("ccx", o.progress != nullptr, "s simulated");
+  auto last_read = std::chrono::steady_clock::now();
   auto poll = [&] {
-    if (!o.progress || (!final_line && std::chrono::steady_clock::now() - last_print < std::chrono::seconds(2))) return;
-    last_print = std::chrono::steady_clock::now();
-    const auto s = last_sta_line(work / (job + ".sta"));
-    if (s && s->text != last) {
-      const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      *o.progress << "ccx: step " << s->step << ", increment " << s->increment << ", time " << s->time_s << " s of "
-                  << end_time_s << " s (" << static_cast<int>(100.0 * std::min(1.0, s->time_s / end_time_s)) << " %), "
-                  << static_cast<int>(el) << " s elapsed\n";
-      o.progress->flush();
-      last = s->text;
-    }
+    if (!line.enabled() || std::chrono::steady_clock::now() - last_read < std::chrono::milliseconds(500)) return;
+    last_read = std::chrono::steady_clock::now();
+    if (const auto s = last_sta_line(work / (job + ".sta")))
+      line.update(std::min(s->time_s, end_time_s), end_time_s,
+                  "step " + std::to_string(s->step) + ", increment " + std::to_string(s->increment));
   };
   const std::string threads = std::to_string(solver_threads(o));
   const fs::path log = work / (job + ".log");
@@ -176,9 +171,7 @@ double run_ccx(const fs::path& work, const CheckOptions& o, double end_time_s, d
     throw e.context().error(e.place(), e.reason() + " (install the Debian package calculix-ccx, or name the "
                                                     "solver with --ccx)");
   }
-  // A run shorter than the 2 s between progress lines still shows where ccx ended.
-  final_line = true;
-  poll();
+  line.finish();
   const std::string where = log.string();
   std::string first_error, last_line;
   scan_log(log, first_error, last_line);

@@ -73,6 +73,8 @@ struct SequenceInput {
   std::function<std::optional<contact::Impact>(std::size_t index, const contact::ContactModel&,
                                                contact::ContactEvaluation& e)>
       complete;
+  /// Called after each impact with (impacts so far, max_impacts, time reached in s); optional.
+  std::function<void(std::size_t impacts, int max_impacts, double time_s)> progress;
 };
 
 /// One impact of a sequence.

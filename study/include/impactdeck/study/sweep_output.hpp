@@ -1,10 +1,10 @@
 #pragma once
-// Files of a sweep: per-point CSV (and the force curves), a Gmsh post-processing view (.pos), a
-// VTK PolyData file (.vtp, ParaView), and the Fig. 4-like picture: wireframe of the body with a
+// Files of a sweep: per-point CSV (and the force curves), a Gmsh post-processing view (.pos), VTK
+// XML files (.vtu, .vtp: ParaView, pyvista, meshio), and the Fig. 4-like picture: wireframe of the body with a
 // circle per point, radius proportional to F_max, darker for lower force, colour bar in force
 // units. Coordinates in every file are in SweepWriteOptions::length_unit (default m; the CLI's
 // --output-length-unit, default the scene's unit) in the target's frame, and each file says so
-// (CSV columns x_<unit>, the .pos and .vtp header comments, the .vtp's FieldData
+// (CSV columns x_<unit>, the .pos and VTK files' header comments, the VTK files' FieldData
 // metres_per_length_unit); every other quantity is SI with its unit in its name. Every file is written
 // atomically; no NaN or Inf is ever written (a non-finite value is an internal error).
 #include <filesystem>
@@ -35,7 +35,9 @@ struct SweepWriteOptions {
   unsigned threads = 0;  ///< formatting threads; 0: all cores
   /// (rows written, rows in total) of the file being written, from the calling thread.
   ProgressFn progress;
-  /// VTP block sizes as UInt64 even when every block fits UInt32 (they must above 4 GiB).
+  /// VTK files (.vtp, .vtu) with zlib-compressed blocks; false: raw values.
+  bool vtk_compress = true;
+  /// Raw VTK files: block sizes as UInt64 even when every block fits UInt32 (they must above 4 GiB).
   bool vtp_uint64_headers = false;
   /// Unit of the point coordinates in every file (the FEM decks' unit, so that both overlay).
   LengthUnit length_unit = LengthUnit::m;
@@ -65,14 +67,22 @@ void write_sweep_curves_csv(const std::filesystem::path& path, const SweepResult
 void write_sweep_pos(const std::filesystem::path& path, const SweepResult& r, const SweepMeta& meta,
                      const SweepWriteOptions& options = {});
 
-/// VTK XML PolyData, binary: the XML part declares every array `format="appended"` with its
-/// offset, and `<AppendedData encoding="raw">_` holds per array its byte count (UInt32, or UInt64,
-/// as the `header_type` attribute says) and the raw values in the host's byte order (the
-/// `byte_order` attribute): what ParaView's reader (vtkXMLPolyDataReader) expects. One vertex per
-/// point; point data max_force_N, force_ratio, reduced_mass_kg, effective_radius_m,
-/// target_radius_m, contact_ellipse_axis_ratio, sharp_feature (0/1; the computed arrays are 0
-/// there) and normals, all Float64 (the same doubles as the CSV); connectivity and offsets Int64.
+/// VTK XML PolyData (.vtp, ParaView, VTK, pyvista): one vertex per point; point data
+/// max_force_N, force_ratio, restitution, residual_indentation_m, reduced_mass_kg,
+/// effective_radius_m, target_radius_m, contact_ellipse_axis_ratio (Float64: the CSV's doubles),
+/// sharp_feature (0/1) and flag (collision::ContactFlag's number, 0 where the model applies) as
+/// UInt8, normals (Float64 x 3); connectivity and offsets Int32 (Int64 from 2^31 points). Every
+/// array `format="appended"` in `<AppendedData encoding="raw">`: by default zlib-compressed blocks
+/// (`compressor="vtkZLibDataCompressor"`, header_type UInt64), else (options.vtk_compress false) the
+/// raw values after their byte count (UInt32, or UInt64 as header_type says); host byte order
+/// (the `byte_order` attribute). Written in blocks as they are compressed, within bounded memory.
 void write_sweep_vtp(const std::filesystem::path& path, const SweepResult& r, const SweepMeta& meta,
+                     const SweepWriteOptions& options = {});
+
+/// The same points and arrays as an UnstructuredGrid (.vtu) of VTK_VERTEX cells (cell types
+/// UInt8): the compact file a sweep writes by default, read by ParaView, VTK, pyvista and meshio
+/// (which reads no PolyData).
+void write_sweep_vtu(const std::filesystem::path& path, const SweepResult& r, const SweepMeta& meta,
                      const SweepWriteOptions& options = {});
 
 struct ForceMapOptions {
@@ -93,18 +103,19 @@ struct ForceMapOptions {
 plot::Drawing force_map_drawing(const geometry::Shape& target, const Eigen::Vector3d& centroid_m,
                                 const SweepResult& r, const ForceMapOptions& options = {});
 
-/// Which files a sweep writes (`impactdeck sweep --formats csv,vtp,pos,svg,png`; the curves CSV
-/// with --curves).
+/// Which files a sweep writes (`impactdeck sweep --format vtu,csv,vtp,pos,svg,png`; the curves CSV
+/// with --curves). Default: the compressed .vtu and the picture's SVG.
 struct SweepFormats {
-  bool csv = true, vtp = true, pos = true, svg = true, png = true;
+  bool csv = false, vtp = false, pos = false, svg = true, png = false, vtu = true;
   bool curves = false;  ///< PREFIX_curves.csv (needs a sweep run with curves)
 };
-/// Parses a comma-separated list of csv, vtp, pos, svg and png (each at most once); the reason of
-/// a refusal is thrown as std::invalid_argument (the CLI makes it a usage error).
+/// Parses a comma-separated list of csv, vtp, pos, svg, png, vtu (each at most once) and all (every
+/// one); the reason of a refusal (an unknown or repeated name, an empty list or name) is thrown as
+/// std::invalid_argument, naming the formats known.
 SweepFormats parse_sweep_formats(const std::string& list);
 
 /// Everything a sweep writes, as `impactdeck sweep` does: BASE.csv, BASE_curves.csv, BASE.pos,
-/// BASE.vtp, BASE.svg, BASE.png (those asked for, in that order; BASE is a path prefix). The
+/// BASE.vtp, BASE.vtu, BASE.svg, BASE.png (those asked for, in that order; BASE is a path prefix). The
 /// picture is drawn and rendered on a thread of its own while the data files are written;
 /// `options.progress` gets (done, total) over all the data files' rows. Returns the files written.
 struct SweepPicture {
