@@ -787,7 +787,7 @@ point = "first-contact"
     ASSERT_EQ(mesh.impacts.size(), 1u);
     const auto& c = cad.impacts[0];
     const auto& m = mesh.impacts[0];
-    EXPECT_EQ(c.contact_law, extra.empty() ? "cone" : "jackson-green") << extra;
+    EXPECT_EQ(c.contact_law, extra.empty() ? "cone" : "jackson-green-sneddon") << extra;
     EXPECT_EQ(c.contact_law, m.contact_law);
     EXPECT_GT(c.result.kernel.max_force_N, 0.0);
     EXPECT_LE(relative_difference(c.result.kernel.max_force_N, m.result.kernel.max_force_N), test::kCadExactRel)

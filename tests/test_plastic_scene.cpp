@@ -138,11 +138,11 @@ TEST(PlasticScene, AutoRule) {
   EXPECT_EQ(none.impacts[0].contact_law, "hertz");
   EXPECT_FALSE(none.impacts[0].law.limiting_pressure_Pa);
   EXPECT_FALSE(none.impacts[0].yield_velocity_m_s);
-  // A yield strength and V > V_y: Jackson - Green (the law closest to full contact on F_max;
-  // docs/plastic.md), with p_y = 1.6 Y of the weaker body for V_y.
+  // A yield strength and V > V_y: Jackson - Green's loading with Sneddon's unloading (the law
+  // closest to converged full contact; docs/plastic.md), with p_y = 1.6 Y of the weaker body for V_y.
   const RunReport yields = run(drop(kYield, ""));
   const ImpactReport& y = yields.impacts[0];
-  EXPECT_EQ(y.contact_law, "jackson-green");
+  EXPECT_EQ(y.contact_law, "jackson-green-sneddon");
   EXPECT_TRUE(y.law.automatic);
   EXPECT_EQ(*y.law.limiting_pressure_Pa, collision::kThorntonYieldFactor * 3.5e8);
   EXPECT_GT(y.result.history.law_result.residual_indentation_m, 0.0);
@@ -245,7 +245,7 @@ TEST(PlasticScene, ExplicitRestitutionKeepsHertzAndNamesThePlasticLaw) {
   EXPECT_EQ(ir.contact_law, "hertz");
   EXPECT_EQ(ir.result.restitution.coefficient, 0.8);
   bool named = false;
-  for (const auto& w : ir.validity.warnings) named = named || w.find("\"jackson-green\" applies") != std::string::npos;
+  for (const auto& w : ir.validity.warnings) named = named || w.find("\"jackson-green-sneddon\" applies") != std::string::npos;
   EXPECT_TRUE(named);
   EXPECT_FALSE(ir.validity.ok);
   // Without a yield strength there is nothing to warn about.

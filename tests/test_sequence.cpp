@@ -566,14 +566,14 @@ TEST(SequenceScene, SequencesOnlySceneRunsAndWritesItsFiles) {
 
 TEST(SequenceScene, PlasticLawRecordsTheDentOfAnEarlierImpact) {
   // The vertical bounces of a sphere land on the same spot: from the second impact on, inside the
-  // first one's dent (the law "jackson-green", chosen by "auto" from the yield strength).
+  // first one's dent (the law "jackson-green-sneddon", chosen by "auto" from the yield strength).
   const scene::Scene sc = scene::parse_scene(
       scene_text("name = \"part\"\nshape = \"sphere\"\nradius = 10\nposition = [0, 0, 500]", "max_impacts = 3\n"),
       "seq.toml");
   const scene::RunReport r = scene::run_scene(sc, scene::RunOptions{fresh_dir("impactdeck_test_sequence_dent")});
   const auto& b = r.sequences[0].result.bounces;
   ASSERT_EQ(b.size(), 3u);
-  EXPECT_EQ(r.sequences[0].impacts[0].contact_law, "jackson-green");
+  EXPECT_EQ(r.sequences[0].impacts[0].contact_law, "jackson-green-sneddon");
   EXPECT_GT(b[0].dent_radius_m, 0.0);
   EXPECT_EQ(b[0].in_dent_of, -1);
   EXPECT_EQ(b[1].in_dent_of, 0);

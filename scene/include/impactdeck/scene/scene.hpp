@@ -227,7 +227,7 @@ inline constexpr double kPlasticMaxIndentationOverRadius = 0.1;
 /// The contact law an impact runs, chosen from its keys (docs/plastic.md):
 /// `contact_law` named: that law; "auto" (the default): "hertz" when `restitution` is set, when
 /// neither body's material has a yield strength, or when [outputs.fem] compare_contact = true (its
-/// full-contact model is elastic); else "jackson-green" (Hertz with R = 1 up to 1.9 d_c).
+/// full-contact model is elastic); else "jackson-green-sneddon" (Hertz with R = 1 up to 1.9 d_c).
 struct ImpactLaw {
   std::string name;       ///< the registered law built ("hertz", "thornton", ...)
   bool automatic = false; ///< chosen by "auto"
