@@ -202,10 +202,10 @@ material = "steel"
   o.material_model = fem_export::MaterialModel::plastic;
   const scene::CompareReport r = scene::compare_contact(s, o);
   ASSERT_TRUE(r.plastic);
-  EXPECT_EQ(r.law, "thornton");
+  EXPECT_EQ(r.law, "jackson-green-sneddon");  // "auto"'s plastic law (docs/plastic.md)
   const auto& L = *r.finest();
   std::cout << "[ plastic ] V/V_y " << r.approach_velocity_m_s / r.yield_velocity_m_s.value_or(1) << ", FE F_max "
-            << L.run.max_force_N << " N (thornton " << r.analytic_max_force_N << "), t_c " << L.run.contact_duration_s * 1e6
+            << L.run.max_force_N << " N (" << r.law << " " << r.analytic_max_force_N << "), t_c " << L.run.contact_duration_s * 1e6
             << " us (" << r.analytic_duration_s * 1e6 << "), e " << L.run.restitution << " (" << r.restitution
             << "), dent " << L.run.residual_indentation_m * 1e6 << " um (" << r.analytic_residual_indentation_m * 1e6
             << "), " << L.deck.node_count << " nodes, " << L.run.wall_time_s << " s\n";

@@ -119,7 +119,7 @@ TEST(ContactLaw, RegistryNamesBuildsAndRefuses) {
     ADD_FAILURE() << "an unknown law was built";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("unknown contact law \"no-such-law\" (known: \"cone\" \"hertz\" "
-                                         "\"jackson-green\" \"line\" \"line-plastic\" \"linear-spring\" "
+                                         "\"jackson-green\" \"jackson-green-sneddon\" \"line\" \"line-plastic\" \"linear-spring\" "
                                          "\"thornton\" \"wedge\")"),
               std::string::npos)
         << e.what();

@@ -30,6 +30,9 @@ using Eigen::Vector3d;
 /// the same numbers, except the state handed over as 17-digit text and the placement moved by a
 /// lift (the lever arm is a difference of coordinates ~0.3 m apart): a few ulps.
 constexpr double kSameImpactRel = 1e-12;
+/// The same for a law that integrates its loading ("jackson-green", "jackson-green-sneddon"): its
+/// stated error (docs/plastic-laws.md, 1e-9 relative) on inputs that agree to kSameImpactRel.
+constexpr double kSameIntegratedImpactRel = 1e-9;
 /// A deck's vectors (own frame) against the bounce's rotated back by its orientation: a rotation
 /// of unit vectors and of impulses, a few ulps.
 constexpr double kSameDeckRel = 1e-12;
@@ -117,7 +120,8 @@ std::vector<SharpCase> sharp_cases() {
   return {
       {"corner_cone", corner, 35, "", "", "cone"},
       {"edge_wedge", e.axis(), e.angle() * 180.0 / M_PI, "", "", "wedge"},
-      {"corner_rounded_thornton", corner, 35, "edge_radius = 0.5", "", "thornton"},
+      {"corner_rounded_default", corner, 35, "edge_radius = 0.5", "", "jackson-green-sneddon"},
+      {"corner_rounded_thornton", corner, 35, "edge_radius = 0.5", "contact_law = \"thornton\"", "thornton"},
       {"edge_rounded_line", e.axis(), e.angle() * 180.0 / M_PI, "edge_radius = 0.5", "", "line-plastic"},
       {"corner_rounded_hertz", corner, 35, "edge_radius = 0.5", "restitution = 0.5", "hertz"},
       {"corner_hertz_rigid", corner, 35, "", "restitution = 0.5", ""},
@@ -167,11 +171,13 @@ TEST_P(SequenceSharp, FirstBounceIsTheSingleImpact) {
   EXPECT_EQ(bounce["contact_law"], c.law);
   EXPECT_EQ(single["contact_law"], c.law);
   EXPECT_EQ(bounce["sharp_feature"], single["sharp_feature"]);
+  const bool integrated = std::string(c.law).rfind("jackson-green", 0) == 0;
   for (const char* key : {"max_force_N", "reduced_mass_kg", "approach_velocity_m_s", "contact_time_s", "restitution",
                           "residual_indentation_m"}) {
     ASSERT_TRUE(bounce[key].is_number()) << key;
     const double x = bounce[key].get<double>(), y = single[key].get<double>();
-    EXPECT_NEAR(x, y, kSameImpactRel * std::max(std::abs(y), 1e-300)) << key;
+    const double rel = integrated ? kSameIntegratedImpactRel : kSameImpactRel;
+    EXPECT_NEAR(x, y, rel * std::max(std::abs(y), 1e-300)) << key;
   }
   EXPECT_GT(bounce["max_force_N"].get<double>(), 0.0);
 
@@ -195,13 +201,20 @@ TEST_P(SequenceSharp, FirstBounceIsTheSingleImpact) {
   } else if (law == "line-plastic") {
     dent = std::min(0.5 * f.feature_length_m, std::sqrt(ir.effective_radius_m * x));  // the strip's half-width b*
   }
-  if (dent > 0.0) {
+  if (law == "jackson-green-sneddon") {
+    // Jackson - Green's plastic radius a_p = R* (pi C Y/(2E*)) sqrt(x (x/1.9)^B), x = d*/d_c >= 1.9:
+    // wider than the elastic sqrt(R* d*) by (x/1.9)^(B/2), and held at R* (docs/plastic-laws.md).
+    const double R = ir.effective_radius_m;
+    EXPECT_GE(b.dent_radius_m, (1.0 - kSameImpactRel) * std::min(R, std::sqrt(R * x)));
+    EXPECT_LE(b.dent_radius_m, (1.0 + kSameImpactRel) * R);
+  } else if (dent > 0.0) {
     EXPECT_NEAR(b.dent_radius_m, dent, kDentRadiusRel * dent);
   } else {
     EXPECT_EQ(b.dent_radius_m, 0.0);
   }
   EXPECT_EQ(bounce["dent_radius_m"].get<double>(), b.dent_radius_m);
-  EXPECT_NEAR(single["dent_radius_m"].get<double>(), b.dent_radius_m, kSameImpactRel * b.dent_radius_m);
+  EXPECT_NEAR(single["dent_radius_m"].get<double>(), b.dent_radius_m,
+              (integrated ? kSameIntegratedImpactRel : kSameImpactRel) * b.dent_radius_m);
 }
 
 INSTANTIATE_TEST_SUITE_P(Laws, SequenceSharp, ::testing::ValuesIn(sharp_cases()),
