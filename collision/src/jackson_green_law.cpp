@@ -76,6 +76,16 @@ struct Curve {
   double B = 0;          // 0.14 exp(23 Y/E*)
   double hardening = 0;  // 1 - exp(-3.3 E_t/E)
 
+  /// The curve of C, s and the hardening blend; B from Y/E* = 2 s / (pi C).
+  static Curve of(double C, double s, double hardening) noexcept {
+    Curve c;
+    c.C = C;
+    c.s = s;
+    c.B = 0.14 * std::exp(23.0 * 2.0 * s / (M_PI * C));
+    c.hardening = hardening;
+    return c;
+  }
+
   double fit(double x) const noexcept {
     const double hertz = x * std::sqrt(x);
     const double a_over_R = std::min(1.0, s * std::sqrt(x * std::pow(x / kElasticLimit, B)));
@@ -128,10 +138,7 @@ struct Phases {
   // From state = {T, F_c, v_star, s} and the law's constants; false when a number is not finite.
   bool init(double v, double s_, double C, double hardening) noexcept {
     v_star = v;
-    curve.C = C;
-    curve.s = s_;
-    curve.B = 0.14 * std::exp(23.0 * 2.0 * s_ / (M_PI * C));  // Y/E* = 2 s / (pi C)
-    curve.hardening = hardening;
+    curve = Curve::of(C, s_, hardening);
     const CompressionPhase h = compression_phase(1.0, v, 1.0);  // x'' = -x^1.5
     fH = h.max_force_N;
     tH = h.compression_time_s;
@@ -515,11 +522,7 @@ class JacksonGreenLaw final : public ContactLaw {
         if (key == s) found = table.get();
       }
       if (!found && tables_.size() < kMaxTables) {
-        Curve shape;
-        shape.C = C_;
-        shape.s = s;
-        shape.B = 0.14 * std::exp(23.0 * 2.0 * s / (M_PI * C_));
-        shape.hardening = hardening_;
+        const Curve shape = Curve::of(C_, s, hardening_);
         auto t = std::make_unique<OutcomeTable>(shape, unloading_, w, kTableFirstNodes);
         if (t->ok() && t->max_rel_error() > kLawTableRel) {
           const double ask = kTableFirstNodes * kTableNodeMargin * std::pow(t->max_rel_error() / kLawTableRel, 0.25);
@@ -563,12 +566,7 @@ class JacksonGreenLaw final : public ContactLaw {
     Outcome o;
     const OutcomeTable* table = tabulated_ ? table_for(s, *w) : nullptr;
     if (!(table && table->lookup(v_star, o))) {
-      Curve shape;
-      shape.C = C_;
-      shape.s = s;
-      shape.B = 0.14 * std::exp(23.0 * 2.0 * s / (M_PI * C_));
-      shape.hardening = hardening_;
-      if (!integrate_outcome(*w, v_star, shape, unloading_, o)) return;
+      if (!integrate_outcome(*w, v_star, Curve::of(C_, s, hardening_), unloading_, o)) return;
     }
     r.max_indentation_m = o.x_m * dc;
     r.max_force_N = o.f_m * Fc;
